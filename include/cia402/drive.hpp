@@ -1,0 +1,119 @@
+// The drive-side state machine: control word and plant feedback in, state, status word and power
+// stage / brake / ramp commands out. One call per cycle; no heap, no exceptions, no locks, no I/O,
+// bounded work (at most max_rows row checks).
+#pragma once
+
+#include <cstdint>
+
+#include "cia402/profile.hpp"
+#include "cia402/sdo_abort.hpp"
+#include "cia402/state.hpp"
+
+namespace cia402 {
+
+/// Everything the drive reads in one cycle. The defaults are an ideal plant: DC link on, no STO, at
+/// standstill with no holding brake to wait for, remote control.
+struct drive_inputs {
+  std::uint16_t control_word = 0;   ///< 0x6040
+  std::uint16_t fault_code = 0;     ///< error code of the present fault cause (0x603F); 0 = none
+  std::uint8_t fault_class = 2;     ///< error class 0..4, read by profiles with error classes
+  bool dc_link = true;              ///< DC-link (main) voltage present (S13)
+  bool sto = false;                 ///< safe torque off active (S14)
+  bool standstill = true;           ///< the motion side is at standstill / its ramp has finished
+  bool brake_engaged = true;        ///< the holding brake has engaged (true if none is fitted)
+  bool remote = true;               ///< the control word is to be processed (status bit 9)
+  bool connection_lost = false;     ///< fieldbus connection lost: 0x6007 decides (S10)
+  bool warning = false;             ///< a warning from elsewhere (status bit 7)
+  bool target_reached = false;      ///< the operation mode's target reached (status bit 10)
+  bool internal_limit = false;      ///< an internal limit is active (status bit 11)
+  bool local_enable = false;        ///< local request to enable the power stage (seed 001)
+  bool local_disable = false;       ///< local request to disable the power stage (seed 001)
+  std::int32_t actual_speed_rpm = 0;    ///< read by profiles with a speed limit (seed 001 T2/T7)
+  std::uint16_t mode_status_bits = 0;   ///< status bits 8 and 12..15, passed through
+};
+
+/// Which stop the motion side must run this cycle.
+enum class stop_ramp : std::uint8_t {
+  none = 0,           ///< no stop: follow the set-points (or hold, when torque is on but idle)
+  slow_down = 1,      ///< the mode's deceleration (0x6084)
+  quick_stop = 2,     ///< the quick-stop deceleration (0x6085)
+  current_limit = 3,  ///< stop at the current limit
+  voltage_limit = 4,  ///< stop at the voltage limit
+  coast = 5,          ///< torque off at once; the motor turns freely
+};
+
+/// "none", "slow_down", ...; never null.
+const char* stop_ramp_name(stop_ramp r) noexcept;
+
+/// Everything the drive decides in one cycle.
+struct drive_outputs {
+  state current = state::start;
+  std::uint16_t status_word = 0;            ///< 0x6041
+  std::uint8_t transition = no_transition;  ///< the transition taken this cycle (0..17)
+  stop_ramp ramp = stop_ramp::none;
+  bool torque = false;                      ///< power stage on, drive function enabled
+  bool brake_released = false;              ///< holding brake released
+  bool clear_setpoints = false;             ///< the motion side must drop its set-points now
+  std::uint16_t error_code = 0;             ///< 0x603F
+  std::uint8_t error_register = 0;          ///< 0x1001
+};
+
+/// One axis's state between cycles: 12 bytes. The profile is passed to each call, so many axes
+/// share one profile.
+struct axis {
+  state current = state::start;
+  std::uint8_t pending_row = 0xFF;      ///< row whose stop is running (S7), 0xFF = none
+  std::uint8_t last_transition = no_transition;  ///< the last transition taken, ever
+  std::uint8_t flags = 0;               ///< detail::axis_flag bits
+  std::uint16_t error_code = 0;         ///< 0x603F
+  std::int8_t options[option_count] = {};  ///< option-code values, index by `option`
+};
+
+/// The error register 0x1001 that goes with an error code (CiA 301): bit 0 for any error, bit 1
+/// current (0x2xxx), 2 voltage (0x3xxx), 3 temperature (0x4xxx), 4 communication (0x81xx, 0x82xx),
+/// 5 device profile (0x83xx..0x8Fxx, e.g. 0x8611 following error), 7 manufacturer (0xFFxx).
+std::uint8_t error_register_of(std::uint16_t error_code) noexcept;
+
+/// Error codes the drive raises itself.
+namespace error_code {
+inline constexpr std::uint16_t generic = 0x1000;        ///< replay's `fault` without a code
+inline constexpr std::uint16_t dc_link_undervoltage = 0x3220;  ///< S13
+inline constexpr std::uint16_t safe_torque_off = 0xFF01;  ///< S14: STO while torque was on (no
+                                                          ///< standard code: manufacturer range)
+inline constexpr std::uint16_t heartbeat = 0x8130;             ///< S10: 0x6007 = 1
+}  // namespace error_code
+
+/// An axis at power-on with the profile's default option codes. Its first steps take T0 and T1.
+axis make_axis(const profile& p) noexcept;
+
+/// Runs one cycle.
+drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noexcept;
+
+/// Writes an option code (0x605A..0x605E, 0x6007). A value the profile does not support is refused
+/// with its SDO abort code (0x06090030) and changes nothing; an object the profile lacks gives
+/// 0x06020000.
+sdo_abort write_option(const profile& p, axis& a, std::uint16_t index, std::int32_t value) noexcept;
+/// Reads an option code; the abort code tells if the object does not exist.
+sdo_abort read_option(const profile& p, const axis& a, std::uint16_t index, std::int32_t& value) noexcept;
+
+/// A drive: an axis bound to its profile, for code that runs one axis.
+class drive {
+ public:
+  explicit drive(const profile& p) noexcept : profile_(&p), axis_(make_axis(p)) {}
+  drive_outputs step(const drive_inputs& in) noexcept { return cia402::step(*profile_, axis_, in); }
+  sdo_abort write(std::uint16_t index, std::int32_t value) noexcept {
+    return write_option(*profile_, axis_, index, value);
+  }
+  sdo_abort read(std::uint16_t index, std::int32_t& value) const noexcept {
+    return read_option(*profile_, axis_, index, value);
+  }
+  state current() const noexcept { return axis_.current; }
+  const axis& state_of_axis() const noexcept { return axis_; }
+  const profile& table() const noexcept { return *profile_; }
+
+ private:
+  const profile* profile_;
+  axis axis_;
+};
+
+}  // namespace cia402

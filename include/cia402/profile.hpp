@@ -1,0 +1,291 @@
+// A profile is one drive's variant of the state machine, as data: the control-word decoder, the
+// transition table (one row per transition the seed prints, T0..T17), what each state does, and
+// which option-code values the drive supports. The drive-side machine (drive.hpp), the master side
+// and every tool read these tables; nothing else restates them.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "cia402/state.hpp"
+#include "cia402/words.hpp"
+
+namespace cia402 {
+
+/// A fact is something true in this step: a decoded command, an input, a guard condition.
+/// A row fires when at least one of its `any` facts holds, all of its `all` facts hold and
+/// none of its `none` facts hold.
+enum class fact : std::uint32_t {
+  disable_voltage = 1u << 0,   ///< command decoded from the control word (words.hpp `command`)
+  quick_stop = 1u << 1,
+  shutdown = 1u << 2,
+  switch_on = 1u << 3,
+  enable_operation = 1u << 4,
+  stop_and_inhibit = 1u << 5,
+  fault_reset = 1u << 6,       ///< 0->1 edge of control-word bit 7 (S2)
+  automatic = 1u << 7,         ///< always holds: the trigger of automatic transitions
+  fault = 1u << 8,             ///< a fault cause calls for the fault reaction (T13)
+  fault_quick_stop = 1u << 9,  ///< an error of class 1 (seed 001): quick stop, not T13
+  fault_present = 1u << 10,    ///< any fault cause is present (T15 needs it absent)
+  fault_immediate = 1u << 11,  ///< the fault reaction is to coast (class 3/4, STO, undervoltage)
+  dc_link = 1u << 12,          ///< DC-link (main) voltage present (S13)
+  sto = 1u << 13,              ///< safe torque off active (S14)
+  overspeed = 1u << 14,        ///< |actual speed| above the profile's `speed_limit_rpm`
+  stop_complete = 1u << 15,    ///< the running stop has ended: standstill and brake engaged, or coast
+  quick_stop_ends = 1u << 16,  ///< 0x605A is 1..4: QUICK STOP ACTIVE ends by itself (T12)
+  quick_stop_stays = 1u << 17, ///< 0x605A is 5..8: QUICK STOP ACTIVE holds; T16 allowed
+  entered_by_fault = 1u << 18, ///< the present state was entered through a fault fact (seed 001 T16)
+  local_enable = 1u << 19,     ///< local request to enable the power stage (seed 001 T3/T4)
+  local_disable = 1u << 20,    ///< local request to disable the power stage (seed 001 T9/T10/T12)
+  fault_latched = 1u << 21,    ///< a class-4 error was seen: only a power cycle clears it
+  undervoltage = 1u << 22,     ///< DC-link voltage absent: the trigger form of !dc_link (seed 001 T7)
+  halt = 1u << 23,             ///< control-word bit 8 with 0x605D supported (S8)
+};
+
+inline constexpr int fact_count = 24;
+
+/// A set of facts.
+class fact_set {
+ public:
+  constexpr fact_set() noexcept = default;
+  constexpr fact_set(fact f) noexcept : bits_(static_cast<std::uint32_t>(f)) {}
+  constexpr explicit fact_set(std::uint32_t bits) noexcept : bits_(bits) {}
+  constexpr std::uint32_t bits() const noexcept { return bits_; }
+  constexpr bool has(fact f) const noexcept { return (bits_ & static_cast<std::uint32_t>(f)) != 0; }
+  constexpr bool empty() const noexcept { return bits_ == 0; }
+  constexpr fact_set operator|(fact_set o) const noexcept { return fact_set(bits_ | o.bits_); }
+  constexpr fact_set operator&(fact_set o) const noexcept { return fact_set(bits_ & o.bits_); }
+  constexpr fact_set& operator|=(fact_set o) noexcept { bits_ |= o.bits_; return *this; }
+  constexpr bool operator==(fact_set o) const noexcept { return bits_ == o.bits_; }
+  constexpr bool operator!=(fact_set o) const noexcept { return bits_ != o.bits_; }
+
+ private:
+  std::uint32_t bits_ = 0;
+};
+
+constexpr fact_set operator|(fact a, fact b) noexcept { return fact_set(a) | fact_set(b); }
+
+/// "fault_reset", "dc_link", ... as written in profile files; never null.
+const char* fact_name(fact f) noexcept;
+bool parse_fact(std::string_view name, fact& out) noexcept;
+/// The fact a decoded command raises.
+constexpr fact command_fact(command c) noexcept {
+  return static_cast<fact>(1u << static_cast<unsigned>(c));
+}
+
+/// What the drive does before a row's state change takes effect (S7). `immediate`: the state changes
+/// in the step the row fires and the new state's outputs apply at once (a coast where torque was on).
+enum class row_stop : std::uint8_t {
+  immediate = 0,
+  shutdown_option = 1,           ///< 0x605B decides: 0 immediate, 1 slow-down ramp first (T8)
+  disable_operation_option = 2,  ///< 0x605C decides: 0 immediate, 1 slow-down ramp first (T5)
+  slow_down_ramp = 3,            ///< always ramp on the slow-down ramp first
+  quick_stop_ramp = 4,           ///< always ramp on the quick-stop ramp first (seed 004 T17)
+};
+
+namespace row_flag {
+/// The row may fire while another row's stop is still running (S7: T9, T11, T13 take over).
+inline constexpr std::uint8_t interrupts_stop = 1u << 0;
+/// Taking the row clears all internal set-points (T4 in 002, T11 in 003/004).
+inline constexpr std::uint8_t clears_setpoints = 1u << 1;
+}  // namespace row_flag
+
+/// One transition row, as a seed prints it.
+struct transition_row {
+  std::uint8_t number = 0;      ///< the seed's transition number, 0..17
+  state to = state::start;
+  std::uint16_t from = 0;       ///< set of source states (state_bit)
+  fact_set any;                 ///< triggers: at least one must hold
+  fact_set all;                 ///< guard: all must hold
+  fact_set none;                ///< guard: none may hold
+  row_stop stop = row_stop::immediate;
+  std::uint8_t flags = 0;       ///< row_flag bits
+};
+
+/// One rule of a control-word decoder: if (control_word & mask) == value, the command is `result`.
+/// Rules are tried in order and the first match wins (S1). Masks may use bits 0..4 only.
+struct decoder_rule {
+  std::uint8_t mask = 0;
+  std::uint8_t value = 0;
+  command result = command::enable_operation;
+};
+
+/// What a state asks of the power stage and the motion side.
+enum class state_activity : std::uint8_t {
+  idle = 0,           ///< no torque, brake closed
+  hold = 1,           ///< torque on, brake released, no motion (seed 003/004 SWITCHED ON)
+  run = 2,            ///< torque on, motion enabled; halt (bit 8) ramps by 0x605D
+  quick_stop = 3,     ///< stop by 0x605A
+  fault_reaction = 4, ///< stop by 0x605E, then T14
+};
+
+/// What a state shows in the status word and what it does.
+struct state_info {
+  std::uint8_t status_pattern = 0;  ///< values of status bits 0..3, 5, 6 (mask 0x6F)
+  state_activity activity = state_activity::idle;
+};
+
+/// The option-code objects of the drive-side machine.
+enum class option : std::uint8_t {
+  quick_stop = 0,         ///< 0x605A
+  shutdown = 1,           ///< 0x605B
+  disable_operation = 2,  ///< 0x605C
+  halt = 3,               ///< 0x605D
+  fault_reaction = 4,     ///< 0x605E
+  abort_connection = 5,   ///< 0x6007
+};
+
+inline constexpr int option_count = 6;
+
+constexpr std::uint16_t option_index(option o) noexcept {
+  constexpr std::uint16_t indices[option_count] = {0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007};
+  return indices[static_cast<int>(o)];
+}
+/// Maps 0x605A..0x605E and 0x6007 to their option; false for any other index.
+bool option_of_index(std::uint16_t index, option& out) noexcept;
+
+/// Which values of one option-code object a profile supports. Bit v of `supported` stands for value
+/// v (0..15). An object whose `supported` is 0 does not exist in the profile (reads and writes are
+/// refused), and the drive behaves as if it held `default_value`.
+struct option_spec {
+  std::uint16_t supported = 0;
+  std::int8_t default_value = 0;
+  constexpr bool exists() const noexcept { return supported != 0; }
+  constexpr bool allows(std::int32_t v) const noexcept {
+    return v >= 0 && v < 16 && ((supported >> v) & 1u) != 0;
+  }
+};
+
+inline constexpr std::size_t max_rows = 32;
+inline constexpr std::size_t max_decoder_rules = 8;
+
+/// A profile: a view of its tables (which live in static storage, or in a `custom_profile`) plus
+/// lookup tables derived from them by finalize(). Copying a profile copies the view, not the rows.
+struct profile {
+  const char* name = "";
+  const char* seed = "";   ///< the seed file the table comes from, or "" for a user profile
+  const char* title = "";  ///< one line for `cia402 profiles`
+
+  const decoder_rule* decoder = nullptr;
+  std::uint8_t decoder_size = 0;
+  const transition_row* rows = nullptr;
+  std::uint8_t row_count = 0;
+  std::array<state_info, state_count> states{};
+  std::array<option_spec, option_count> options{};
+  /// T2/T7 of seed 001 test |actual speed| against this (rpm); 0 = no such condition.
+  std::int32_t speed_limit_rpm = 0;
+  /// Error classes 0..4 of seed 001 are honoured; without them every fault cause calls for T13.
+  bool error_classes = false;
+
+  // Derived by finalize(): the decoder as a table over control-word bits 0..4, and per state the
+  // rows that leave it (bit i = rows[i]) and the union of their triggers, so a step that can fire
+  // nothing costs one AND.
+  std::array<std::uint8_t, 32> command_of_bits{};
+  std::array<std::uint32_t, state_count> rows_from{};
+  std::array<std::uint32_t, state_count> triggers_from{};
+
+  /// Recomputes the derived tables from the data above. Call after any change to it.
+  constexpr void finalize() noexcept {
+    for (unsigned bits = 0; bits < 32; ++bits) {
+      std::uint8_t result = static_cast<std::uint8_t>(command::enable_operation);
+      for (std::size_t r = 0; r < decoder_size; ++r) {
+        if ((bits & decoder[r].mask) == decoder[r].value) {
+          result = static_cast<std::uint8_t>(decoder[r].result);
+          break;
+        }
+      }
+      command_of_bits[bits] = result;
+    }
+    for (int s = 0; s < state_count; ++s) {
+      rows_from[s] = 0;
+      triggers_from[s] = 0;
+      for (std::size_t r = 0; r < row_count && r < max_rows; ++r) {
+        if ((rows[r].from >> s) & 1u) {
+          rows_from[s] |= 1u << r;
+          triggers_from[s] |= rows[r].any.bits();
+        }
+      }
+    }
+  }
+
+  /// The command that bits 0..4 of a control word decode to.
+  constexpr command decode(std::uint16_t control_word) const noexcept {
+    return static_cast<command>(command_of_bits[control_word & 0x1Fu]);
+  }
+  constexpr const state_info& info(state s) const noexcept {
+    return states[static_cast<int>(s)];
+  }
+  constexpr const option_spec& spec(option o) const noexcept {
+    return options[static_cast<int>(o)];
+  }
+  /// True if torque may be on in state s (its activity is not idle): the safety invariant.
+  constexpr bool torque_allowed(state s) const noexcept {
+    return info(s).activity != state_activity::idle;
+  }
+  /// The status-word bits showing state s (bits 0..3, 5, 6).
+  constexpr std::uint16_t status_pattern(state s) const noexcept { return info(s).status_pattern; }
+};
+
+/// A profile that owns its tables: what a profile file loads into. No heap; copies re-point.
+class custom_profile {
+ public:
+  custom_profile() noexcept { repoint(); }
+  custom_profile(const custom_profile& o) noexcept { *this = o; }
+  custom_profile& operator=(const custom_profile& o) noexcept {
+    name_ = o.name_; seed_ = o.seed_; title_ = o.title_;
+    decoder_ = o.decoder_; rows_ = o.rows_; view_ = o.view_;
+    repoint();
+    return *this;
+  }
+  /// Starts from a copy of another profile (built-in or not), tables included.
+  explicit custom_profile(const profile& base) noexcept;
+
+  const profile& get() const noexcept { return view_; }
+  operator const profile&() const noexcept { return view_; }  // NOLINT: a custom profile is a profile
+
+  bool set_name(std::string_view s) noexcept { return assign(name_, s); }
+  bool set_seed(std::string_view s) noexcept { return assign(seed_, s); }
+  bool set_title(std::string_view s) noexcept { return assign(title_, s); }
+  /// Replace the tables; false (and no change) if they exceed the capacities.
+  bool set_decoder(const decoder_rule* rules, std::size_t n) noexcept;
+  bool set_rows(const transition_row* rows, std::size_t n) noexcept;
+  /// The rest of the profile (states, options, flags); tables and names are kept.
+  profile& settings() noexcept { return view_; }
+  /// Recompute the derived tables; call after any change.
+  void finalize() noexcept { repoint(); view_.finalize(); }
+
+ private:
+  template <std::size_t N>
+  static bool assign(std::array<char, N>& to, std::string_view s) noexcept {
+    if (s.size() >= N) return false;
+    for (std::size_t i = 0; i < N; ++i) to[i] = i < s.size() ? s[i] : '\0';
+    return true;
+  }
+  void repoint() noexcept {
+    view_.name = name_.data(); view_.seed = seed_.data(); view_.title = title_.data();
+    view_.decoder = decoder_.data(); view_.rows = rows_.data();
+  }
+  std::array<char, 40> name_{};
+  std::array<char, 64> seed_{};
+  std::array<char, 128> title_{};
+  std::array<decoder_rule, max_decoder_rules> decoder_{};
+  std::array<transition_row, max_rows> rows_{};
+  profile view_{};
+};
+
+/// The built-in profiles: cia402, no-quick-stop, lexium32, s300-profibus, ax2000-profibus.
+std::size_t builtin_profile_count() noexcept;
+const profile& builtin_profile(std::size_t i) noexcept;
+/// The built-in profile of that name, or nullptr.
+const profile* find_builtin_profile(std::string_view name) noexcept;
+/// The standard profile, `cia402` (seed 002 and semantics.md).
+const profile& standard_profile() noexcept;
+
+/// Checks a profile for mistakes a table can hold: rows from no state, a destination out of range,
+/// decoder masks outside bits 0..4, a row or option default the profile cannot honour.
+/// Returns nullptr when the profile is sound, else a reason; `row` gets the offending row index or -1.
+const char* check_profile(const profile& p, int& row) noexcept;
+
+}  // namespace cia402

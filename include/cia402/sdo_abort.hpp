@@ -1,0 +1,37 @@
+// One error enum for object access; its values are the CiA 301 SDO abort codes, so the CANopen layer
+// sends them unchanged.
+#pragma once
+
+#include <cstdint>
+
+namespace cia402 {
+
+enum class sdo_abort : std::uint32_t {
+  none = 0,
+  toggle_bit_not_alternated = 0x05030000,
+  sdo_protocol_timed_out = 0x05040000,
+  command_specifier_invalid = 0x05040001,
+  out_of_memory = 0x05040005,
+  unsupported_access = 0x06010000,
+  write_only_object = 0x06010001,
+  read_only_object = 0x06010002,
+  object_does_not_exist = 0x06020000,
+  cannot_map_to_pdo = 0x06040041,
+  pdo_length_exceeded = 0x06040042,
+  general_parameter_incompatibility = 0x06040043,
+  hardware_error = 0x06060000,
+  data_type_length_mismatch = 0x06070010,
+  data_type_length_too_high = 0x06070012,
+  data_type_length_too_low = 0x06070013,
+  sub_index_does_not_exist = 0x06090011,
+  invalid_value = 0x06090030,
+  value_too_high = 0x06090031,
+  value_too_low = 0x06090032,
+  general_error = 0x08000000,
+  cannot_store_in_present_state = 0x08000022,
+};
+
+/// A short English reason, e.g. "value range of parameter exceeded"; never null.
+const char* sdo_abort_text(sdo_abort code) noexcept;
+
+}  // namespace cia402

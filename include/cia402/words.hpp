@@ -1,0 +1,51 @@
+// Bits of the control word 0x6040 and the status word 0x6041 (cia402-reference.md §1.2, §2.1).
+#pragma once
+
+#include <cstdint>
+
+namespace cia402 {
+
+namespace control_bit {
+inline constexpr std::uint16_t switch_on = 1u << 0;
+inline constexpr std::uint16_t enable_voltage = 1u << 1;
+inline constexpr std::uint16_t quick_stop = 1u << 2;  ///< active low
+inline constexpr std::uint16_t enable_operation = 1u << 3;
+inline constexpr std::uint16_t fault_reset = 1u << 7;  ///< acts on its 0->1 edge (S2)
+inline constexpr std::uint16_t halt = 1u << 8;         ///< 0x605D (S8)
+}  // namespace control_bit
+
+namespace status_bit {
+inline constexpr std::uint16_t ready_to_switch_on = 1u << 0;
+inline constexpr std::uint16_t switched_on = 1u << 1;
+inline constexpr std::uint16_t operation_enabled = 1u << 2;
+inline constexpr std::uint16_t fault = 1u << 3;
+inline constexpr std::uint16_t voltage_enabled = 1u << 4;  ///< DC-link voltage present (S11)
+inline constexpr std::uint16_t quick_stop = 1u << 5;       ///< active low
+inline constexpr std::uint16_t switch_on_disabled = 1u << 6;
+inline constexpr std::uint16_t warning = 1u << 7;
+inline constexpr std::uint16_t remote = 1u << 9;
+inline constexpr std::uint16_t target_reached = 1u << 10;
+inline constexpr std::uint16_t internal_limit_active = 1u << 11;
+/// The bits the FSA state is shown in: 0..3, 5 and 6.
+inline constexpr std::uint16_t state_bits = 0x006F;
+/// Bits the drive passes through from the motion side unchanged: 8 and 12..15.
+inline constexpr std::uint16_t mode_specific = 0xF100;
+}  // namespace status_bit
+
+/// Commands of the control word, as a profile's decoder yields them (cia402-reference.md §2.2).
+/// `stop_and_inhibit` is the DRIVECOM "fast stop, switch-on inhibited" of seed 004's bit 2 (T17).
+enum class command : std::uint8_t {
+  disable_voltage = 0,
+  quick_stop = 1,
+  shutdown = 2,
+  switch_on = 3,  ///< also "Disable operation": same bits, the state tells them apart
+  enable_operation = 4,
+  stop_and_inhibit = 5,
+};
+
+inline constexpr int command_count = 6;
+
+/// "DISABLE_VOLTAGE", "QUICK_STOP", ...; never null.
+const char* command_name(command c) noexcept;
+
+}  // namespace cia402

@@ -1,0 +1,296 @@
+#include "cia402/drive.hpp"
+
+#include "cia402/words.hpp"
+
+namespace cia402 {
+namespace {
+
+namespace axis_flag {
+constexpr std::uint8_t fault_reset_bit = 1u << 0;   // bit 7 of the previous control word (S2)
+constexpr std::uint8_t torque_on = 1u << 1;         // torque was on in the previous cycle
+constexpr std::uint8_t entered_by_fault = 1u << 2;  // the present state came from a fault fact
+constexpr std::uint8_t coast_reaction = 1u << 3;    // the fault reaction is a coast
+constexpr std::uint8_t fault_latched = 1u << 4;     // a class-4 error: only a power cycle clears
+}  // namespace axis_flag
+
+constexpr std::uint8_t no_row = 0xFF;
+
+constexpr std::uint32_t bits(fact f) noexcept { return static_cast<std::uint32_t>(f); }
+
+constexpr std::uint32_t command_facts = bits(fact::disable_voltage) | bits(fact::quick_stop) |
+                                        bits(fact::shutdown) | bits(fact::switch_on) |
+                                        bits(fact::enable_operation) |
+                                        bits(fact::stop_and_inhibit) | bits(fact::fault_reset);
+constexpr std::uint32_t fault_facts = bits(fact::fault) | bits(fact::fault_quick_stop);
+
+std::int8_t option_value(const axis& a, option o) noexcept {
+  return a.options[static_cast<int>(o)];
+}
+
+// 1/5 slow-down, 2/6 quick-stop, 3/7 current limit, 4/8 voltage limit, 0 coast (0x605A, 0x605E).
+stop_ramp ramp_of_code(int code) noexcept {
+  if (code <= 0) return stop_ramp::coast;
+  return static_cast<stop_ramp>(((code - 1) & 3) + 1);
+}
+
+// The ramp a row's stop runs before its state change; none means the change is immediate.
+stop_ramp ramp_of_row(const axis& a, row_stop stop) noexcept {
+  switch (stop) {
+    case row_stop::shutdown_option:
+      return option_value(a, option::shutdown) == 1 ? stop_ramp::slow_down : stop_ramp::none;
+    case row_stop::disable_operation_option:
+      return option_value(a, option::disable_operation) == 1 ? stop_ramp::slow_down
+                                                             : stop_ramp::none;
+    case row_stop::slow_down_ramp: return stop_ramp::slow_down;
+    case row_stop::quick_stop_ramp: return stop_ramp::quick_stop;
+    case row_stop::immediate: break;
+  }
+  return stop_ramp::none;
+}
+
+// What the present state (or the pending row's stop) asks of the motion side, and whether that stop
+// ends with torque off (so the brake closes at standstill first, S12).
+struct activity_now {
+  stop_ramp ramp = stop_ramp::none;
+  bool torque_wanted = false;
+  bool stop_ends_torque = false;
+};
+
+activity_now activity_of(const profile& p, const axis& a, bool halt) noexcept {
+  activity_now now;
+  if (a.pending_row != no_row) {
+    now.ramp = ramp_of_row(a, p.rows[a.pending_row].stop);
+    now.torque_wanted = true;
+    now.stop_ends_torque = true;
+    return now;
+  }
+  switch (p.info(a.current).activity) {
+    case state_activity::idle: break;
+    case state_activity::hold: now.torque_wanted = true; break;
+    case state_activity::run:
+      now.torque_wanted = true;
+      if (halt) now.ramp = ramp_of_code(option_value(a, option::halt));
+      break;
+    case state_activity::quick_stop: {
+      const int code = option_value(a, option::quick_stop);
+      now.ramp = ramp_of_code(code);
+      now.torque_wanted = now.ramp != stop_ramp::coast;
+      now.stop_ends_torque = code >= 1 && code <= 4;
+      break;
+    }
+    case state_activity::fault_reaction:
+      now.ramp = (a.flags & axis_flag::coast_reaction)
+                     ? stop_ramp::coast
+                     : ramp_of_code(option_value(a, option::fault_reaction));
+      now.torque_wanted = now.ramp != stop_ramp::coast;
+      now.stop_ends_torque = true;
+      break;
+  }
+  return now;
+}
+
+// The fault the drive acts on this cycle: a cause from outside, a lost connection with 0x6007 = 1,
+// or an event of its own (STO or undervoltage while torque was on, S13/S14).
+struct fault_now {
+  std::uint16_t code = 0;
+  std::uint8_t error_class = 0;
+  bool internal = false;
+};
+
+fault_now fault_of(const profile& p, const axis& a, const drive_inputs& in) noexcept {
+  fault_now f;
+  const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
+  if (torque_was_on && in.sto) {
+    f = {error_code::safe_torque_off, 3, true};
+  } else if (torque_was_on && !in.dc_link) {
+    f = {error_code::dc_link_undervoltage, 3, true};
+  } else if (in.fault_code != 0) {
+    f = {in.fault_code, p.error_classes ? in.fault_class : std::uint8_t{2}, false};
+  } else if (in.connection_lost && option_value(a, option::abort_connection) == 1) {
+    f = {error_code::heartbeat, 2, false};
+  }
+  return f;
+}
+
+bool fault_latched(const axis& a) noexcept { return (a.flags & axis_flag::fault_latched) != 0; }
+
+void set_flag(axis& a, std::uint8_t flag, bool on) noexcept {
+  a.flags = static_cast<std::uint8_t>(on ? (a.flags | flag) : (a.flags & ~flag));
+}
+
+}  // namespace
+
+std::uint8_t error_register_of(std::uint16_t code) noexcept {
+  if (code == 0) return 0;
+  std::uint8_t reg = 0x01;
+  const unsigned group = code >> 12;
+  const unsigned high = code >> 8;
+  if (group == 0x2) reg |= 0x02;
+  if (group == 0x3) reg |= 0x04;
+  if (group == 0x4) reg |= 0x08;
+  if (high == 0x81 || high == 0x82) reg |= 0x10;
+  if (group == 0x8 && high >= 0x83) reg |= 0x20;
+  if (high == 0xFF) reg |= 0x80;
+  return reg;
+}
+
+axis make_axis(const profile& p) noexcept {
+  axis a;
+  for (int i = 0; i < option_count; ++i) a.options[i] = p.options[i].default_value;
+  return a;
+}
+
+drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noexcept {
+  // Facts of this cycle.
+  std::uint32_t f = bits(fact::automatic);
+  const std::uint16_t cw = in.control_word;
+  const bool reset_bit = (cw & control_bit::fault_reset) != 0;
+  const bool reset_edge = reset_bit && !(a.flags & axis_flag::fault_reset_bit);
+  set_flag(a, axis_flag::fault_reset_bit, reset_bit);  // S2: whatever the state
+
+  const int abort_code = option_value(a, option::abort_connection);
+  if (in.connection_lost && abort_code == 2) {
+    f |= bits(fact::disable_voltage);  // S10
+  } else if (in.connection_lost && abort_code == 3) {
+    f |= bits(fact::quick_stop);
+  } else if (in.remote) {
+    f |= bits(command_fact(p.decode(cw)));
+    if (reset_edge) f |= bits(fact::fault_reset);
+  }
+  const bool halt = in.remote && (cw & control_bit::halt) && p.spec(option::halt).exists();
+  if (halt) f |= bits(fact::halt);
+
+  const fault_now fault = fault_of(p, a, in);
+  if (fault.code != 0) {
+    if (!p.error_classes || fault.error_class >= 2) f |= bits(fact::fault);
+    if (p.error_classes && fault.error_class == 1) f |= bits(fact::fault_quick_stop);
+    if (!p.error_classes || fault.error_class >= 1) f |= bits(fact::fault_present);
+    if (fault.error_class >= 3) f |= bits(fact::fault_immediate);
+    if (p.error_classes && fault.error_class == 4) set_flag(a, axis_flag::fault_latched, true);
+  }
+  if (fault_latched(a)) f |= bits(fact::fault_latched);
+  f |= in.dc_link ? bits(fact::dc_link) : bits(fact::undervoltage);
+  if (in.sto) f |= bits(fact::sto);
+  if (p.speed_limit_rpm > 0 &&
+      (in.actual_speed_rpm > p.speed_limit_rpm || in.actual_speed_rpm < -p.speed_limit_rpm)) {
+    f |= bits(fact::overspeed);
+  }
+  if (in.local_enable) f |= bits(fact::local_enable);
+  if (in.local_disable) f |= bits(fact::local_disable);
+  const int qs_code = option_value(a, option::quick_stop);
+  if (qs_code >= 1 && qs_code <= 4) f |= bits(fact::quick_stop_ends);
+  if (qs_code >= 5 && qs_code <= 8) f |= bits(fact::quick_stop_stays);
+  if (a.flags & axis_flag::entered_by_fault) f |= bits(fact::entered_by_fault);
+
+  const activity_now before = activity_of(p, a, halt);
+  const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
+  if (before.ramp == stop_ramp::coast || in.sto || (in.standstill && in.brake_engaged)) {
+    f |= bits(fact::stop_complete);
+  }
+
+  // The first row leaving the present state whose facts hold.
+  const int from = static_cast<int>(a.current);
+  std::uint8_t match = no_row;
+  if (p.triggers_from[from] & f) {
+    for (std::uint32_t rows = p.rows_from[from]; rows != 0; rows &= rows - 1) {
+      const std::uint8_t i = static_cast<std::uint8_t>(__builtin_ctz(rows));
+      const transition_row& r = p.rows[i];
+      if ((r.any.bits() & f) && (r.all.bits() & f) == r.all.bits() && !(r.none.bits() & f)) {
+        match = i;
+        break;
+      }
+    }
+  }
+
+  // S7: while a row's stop runs, only rows that interrupt stops may take over; otherwise the
+  // pending row completes when its stop does.
+  std::uint8_t commit = no_row;
+  if (a.pending_row != no_row) {
+    if (match != no_row && match != a.pending_row &&
+        (p.rows[match].flags & row_flag::interrupts_stop)) {
+      commit = match;
+    } else if (f & bits(fact::stop_complete)) {
+      commit = a.pending_row;
+    }
+  } else if (match != no_row) {
+    const bool ramp_first = torque_was_on && !in.sto &&
+                            ramp_of_row(a, p.rows[match].stop) != stop_ramp::none;
+    if (ramp_first) {
+      a.pending_row = match;
+    } else {
+      commit = match;
+    }
+  }
+
+  drive_outputs out;
+  if (commit != no_row) {
+    const transition_row& r = p.rows[commit];
+    const std::uint32_t why = r.any.bits() & f;
+    a.current = r.to;
+    a.pending_row = no_row;
+    a.last_transition = r.number;
+    out.transition = r.number;
+    out.clear_setpoints = (r.flags & row_flag::clears_setpoints) != 0;
+    set_flag(a, axis_flag::entered_by_fault, (why & fault_facts) && !(why & command_facts));
+    if (why & fault_facts) a.error_code = fault.code;
+    if (why & bits(fact::fault)) {
+      // A fault reaction has nothing to ramp when torque is already off, or cannot (S14).
+      set_flag(a, axis_flag::coast_reaction, fault.internal || fault.error_class >= 3 ||
+                                                 !torque_was_on || in.sto);
+    }
+    if (why & bits(fact::fault_reset)) {
+      a.error_code = 0;
+      set_flag(a, axis_flag::coast_reaction, false);
+    }
+  } else if ((f & bits(fact::fault)) && (a.current == state::fault_reaction_active ||
+                                         a.current == state::fault)) {
+    a.error_code = fault.code;  // S4: a new fault there is recorded, no transition
+  }
+
+  // Outputs of the state the drive is in now.
+  const activity_now now = activity_of(p, a, halt);
+  const state s = a.current;
+  out.current = s;
+  out.ramp = in.sto && now.torque_wanted ? stop_ramp::coast : now.ramp;
+  out.torque = now.torque_wanted && !in.sto && p.torque_allowed(s) && now.ramp != stop_ramp::coast;
+  out.brake_released = out.torque && !(now.stop_ends_torque && in.standstill);
+  set_flag(a, axis_flag::torque_on, out.torque);
+
+  std::uint16_t sw = p.status_pattern(s);
+  if (in.dc_link) sw |= status_bit::voltage_enabled;
+  const bool class_warning = p.error_classes && in.fault_code != 0 && in.fault_class <= 1;
+  if (in.warning || in.sto || class_warning) sw |= status_bit::warning;
+  if (in.remote) sw |= status_bit::remote;
+  const state_activity act = p.info(s).activity;
+  const bool holding_stop =
+      (act == state_activity::run && halt) ||
+      (act == state_activity::quick_stop && qs_code >= 5 && qs_code <= 8);
+  const bool target = a.pending_row == no_row &&
+                      (holding_stop ? in.standstill
+                                    : act == state_activity::run && in.target_reached);
+  if (target) sw |= status_bit::target_reached;
+  if (in.internal_limit) sw |= status_bit::internal_limit_active;
+  sw |= in.mode_status_bits & status_bit::mode_specific;
+  out.status_word = sw;
+  out.error_code = a.error_code;
+  out.error_register = error_register_of(a.error_code);
+  return out;
+}
+
+sdo_abort write_option(const profile& p, axis& a, std::uint16_t index, std::int32_t value) noexcept {
+  option o;
+  if (!option_of_index(index, o) || !p.spec(o).exists()) return sdo_abort::object_does_not_exist;
+  if (!p.spec(o).allows(value)) return sdo_abort::invalid_value;
+  a.options[static_cast<int>(o)] = static_cast<std::int8_t>(value);
+  return sdo_abort::none;
+}
+
+sdo_abort read_option(const profile& p, const axis& a, std::uint16_t index,
+                      std::int32_t& value) noexcept {
+  option o;
+  if (!option_of_index(index, o) || !p.spec(o).exists()) return sdo_abort::object_does_not_exist;
+  value = a.options[static_cast<int>(o)];
+  return sdo_abort::none;
+}
+
+}  // namespace cia402

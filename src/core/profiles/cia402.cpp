@@ -1,0 +1,60 @@
+// Profile `cia402`: the standard, as seed 002_522d2c0bb8f5a5f8.txt (CoE table 7.8) prints it, with
+// the points it leaves open fixed by semantics.md (S1..S14). docs/profiles/cia402.md cites each row.
+#include "profiles/builtin.hpp"
+#include "profiles/rows.hpp"
+
+namespace cia402::detail {
+namespace {
+
+// Rows are tried in this order and the first match wins: T13 comes first because faults win over
+// any command (S12); the others follow the seed's numbering.
+constexpr transition_row rows[] = {
+    row(13, every_state_but_fault, S::fault_reaction_active, facts(F::fault), {}, {},
+        row_stop::immediate, interrupts),
+    row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic)),
+    row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
+    row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown)),
+    // S3: Enable operation here runs T3, then T4 in the next step. S13/S14: voltage, no STO.
+    row(3, from(S::ready_to_switch_on), S::switched_on, facts(F::switch_on, F::enable_operation),
+        facts(F::dc_link), facts(F::sto)),
+    row(4, from(S::switched_on), S::operation_enabled, facts(F::enable_operation),
+        facts(F::dc_link), facts(F::sto), row_stop::immediate, clears),
+    row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
+        row_stop::disable_operation_option),
+    row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown)),
+    row(7, from(S::ready_to_switch_on), S::switch_on_disabled,
+        facts(F::disable_voltage, F::quick_stop)),
+    row(8, from(S::operation_enabled), S::ready_to_switch_on, facts(F::shutdown), {}, {},
+        row_stop::shutdown_option),
+    row(9, from(S::operation_enabled), S::switch_on_disabled, facts(F::disable_voltage), {}, {},
+        row_stop::immediate, interrupts),
+    row(10, from(S::switched_on), S::switch_on_disabled,
+        facts(F::disable_voltage, F::quick_stop)),
+    row(11, from(S::operation_enabled), S::quick_stop_active, facts(F::quick_stop), {}, {},
+        row_stop::immediate, interrupts),
+    row(12, from(S::quick_stop_active), S::switch_on_disabled, facts(F::disable_voltage)),
+    row(12, from(S::quick_stop_active), S::switch_on_disabled, facts(F::automatic),
+        facts(F::quick_stop_ends, F::stop_complete)),
+    row(14, from(S::fault_reaction_active), S::fault, facts(F::automatic), facts(F::stop_complete)),
+    row(15, from(S::fault), S::switch_on_disabled, facts(F::fault_reset), {}, facts(F::fault_present)),
+    row(16, from(S::quick_stop_active), S::operation_enabled, facts(F::enable_operation),
+        facts(F::quick_stop_stays)),
+};
+
+constexpr std::array<option_spec, option_count> options = {{
+    {value_range(0, 8), 2},  // 0x605A quick stop (S5)
+    {value_range(0, 1), 1},  // 0x605B shutdown (S7)
+    {value_range(0, 1), 1},  // 0x605C disable operation (S7)
+    {value_range(1, 4), 1},  // 0x605D halt (S8)
+    {value_range(0, 4), 2},  // 0x605E fault reaction (S9)
+    {value_range(0, 3), 1},  // 0x6007 abort connection (S10)
+}};
+
+}  // namespace
+
+const profile cia402_profile = make_profile(
+    "cia402", "002_522d2c0bb8f5a5f8.txt",
+    "CiA 402 standard (CoE table 7.8) with semantics.md S1..S14", standard_decoder, rows,
+    standard_states(state_activity::idle), options);
+
+}  // namespace cia402::detail

@@ -1,0 +1,56 @@
+// Profile `no-quick-stop`: the CANopen drive of seed 000_44b471b7401b86be.txt, which does not
+// support Quick Stop (its footnote on T7, T10, T11, T12). docs/profiles/no-quick-stop.md cites each row.
+#include "profiles/builtin.hpp"
+#include "profiles/rows.hpp"
+
+namespace cia402::detail {
+namespace {
+
+// First match wins; T13 first because faults win over any command. There is no T11, T12 or T16:
+// QUICK STOP ACTIVE cannot be reached. A Quick stop command acts as Disable voltage wherever it acts:
+// T7 and T10 as the seed says, and T9 by our choice, so the stop a master asks for is never ignored.
+constexpr transition_row rows[] = {
+    row(13, every_state_but_fault, S::fault_reaction_active, facts(F::fault), {}, {},
+        row_stop::immediate, interrupts),
+    row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic)),
+    row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
+    row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown)),
+    // "System checks if power supply is switched on" (seed line 49).
+    row(3, from(S::ready_to_switch_on), S::switched_on, facts(F::switch_on, F::enable_operation),
+        facts(F::dc_link), facts(F::sto)),
+    row(4, from(S::switched_on), S::operation_enabled, facts(F::enable_operation),
+        facts(F::dc_link), facts(F::sto), row_stop::immediate, clears),
+    // T5, T8: ramp on 0x221E, close the brake at standstill, then power off (seed lines 69, 99).
+    row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
+        row_stop::slow_down_ramp),
+    row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown)),
+    row(7, from(S::ready_to_switch_on), S::switch_on_disabled,
+        facts(F::disable_voltage, F::quick_stop)),
+    row(8, from(S::operation_enabled), S::ready_to_switch_on, facts(F::shutdown), {}, {},
+        row_stop::slow_down_ramp),
+    // T9 coasts and closes the brake at once (seed line 109).
+    row(9, from(S::operation_enabled), S::switch_on_disabled,
+        facts(F::disable_voltage, F::quick_stop), {}, {}, row_stop::immediate, interrupts),
+    row(10, from(S::switched_on), S::switch_on_disabled,
+        facts(F::disable_voltage, F::quick_stop)),
+    row(14, from(S::fault_reaction_active), S::fault, facts(F::automatic), facts(F::stop_complete)),
+    row(15, from(S::fault), S::switch_on_disabled, facts(F::fault_reset), {}, facts(F::fault_present)),
+};
+
+constexpr std::array<option_spec, option_count> options = {{
+    {0, 0},                  // 0x605A: no quick stop
+    {0, 1},                  // 0x605B: fixed ramp (0x221E), not an object here
+    {0, 1},                  // 0x605C: likewise
+    {value_range(1, 4), 1},  // 0x605D halt: the standard's, the seed is silent
+    {value_range(0, 4), 2},  // 0x605E: the standard's, the seed is silent
+    {value_range(0, 3), 1},  // 0x6007: the standard's
+}};
+
+}  // namespace
+
+const profile no_quick_stop_profile = make_profile(
+    "no-quick-stop", "000_44b471b7401b86be.txt",
+    "CANopen drive without quick stop; ramped T5/T8 on 0x221E, coasting T9", standard_decoder, rows,
+    standard_states(state_activity::idle), options);
+
+}  // namespace cia402::detail

@@ -1,0 +1,102 @@
+// Shorthand for writing transition tables, so a built-in profile reads like its seed's table.
+#pragma once
+
+#include "cia402/profile.hpp"
+
+namespace cia402::detail {
+
+using S = state;
+using F = fact;
+
+constexpr std::uint16_t from(S a) noexcept { return state_bit(a); }
+constexpr std::uint16_t from(S a, S b) noexcept { return state_bit(a) | state_bit(b); }
+
+/// T13 leaves every state but FAULT REACTION ACTIVE and FAULT (S4); START is left by T0 alone.
+inline constexpr std::uint16_t every_state_but_fault =
+    state_bit(S::not_ready_to_switch_on) | state_bit(S::switch_on_disabled) |
+    state_bit(S::ready_to_switch_on) | state_bit(S::switched_on) |
+    state_bit(S::operation_enabled) | state_bit(S::quick_stop_active);
+
+constexpr fact_set facts() noexcept { return fact_set(); }
+template <typename... More>
+constexpr fact_set facts(F first, More... more) noexcept {
+  return fact_set(first) | facts(more...);
+}
+
+constexpr transition_row row(std::uint8_t number, std::uint16_t from_states, S to, fact_set any,
+                             fact_set all = {}, fact_set none = {},
+                             row_stop stop = row_stop::immediate, std::uint8_t flags = 0) noexcept {
+  transition_row r;
+  r.number = number;
+  r.from = from_states;
+  r.to = to;
+  r.any = any;
+  r.all = all;
+  r.none = none;
+  r.stop = stop;
+  r.flags = flags;
+  return r;
+}
+
+inline constexpr std::uint8_t interrupts = row_flag::interrupts_stop;
+inline constexpr std::uint8_t clears = row_flag::clears_setpoints;
+
+/// The standard's decoding of bits 0..3, first match wins (S1).
+inline constexpr decoder_rule standard_decoder[] = {
+    {0x02, 0x00, command::disable_voltage},
+    {0x04, 0x00, command::quick_stop},
+    {0x01, 0x00, command::shutdown},
+    {0x08, 0x00, command::switch_on},
+};
+
+/// Status bits 0..3, 5, 6 of each state (cia402-reference.md §1.1; S11 sets bit 5 in RTSO, SO, OE).
+constexpr std::array<state_info, state_count> standard_states(state_activity switched_on) noexcept {
+  std::array<state_info, state_count> s{};
+  s[static_cast<int>(S::start)] = {0x00, state_activity::idle};
+  s[static_cast<int>(S::not_ready_to_switch_on)] = {0x00, state_activity::idle};
+  s[static_cast<int>(S::switch_on_disabled)] = {0x40, state_activity::idle};
+  s[static_cast<int>(S::ready_to_switch_on)] = {0x21, state_activity::idle};
+  s[static_cast<int>(S::switched_on)] = {0x23, switched_on};
+  s[static_cast<int>(S::operation_enabled)] = {0x27, state_activity::run};
+  s[static_cast<int>(S::quick_stop_active)] = {0x07, state_activity::quick_stop};
+  s[static_cast<int>(S::fault_reaction_active)] = {0x0F, state_activity::fault_reaction};
+  s[static_cast<int>(S::fault)] = {0x08, state_activity::idle};
+  return s;
+}
+
+/// Bits v0, v1, ... set: the supported values of an option code.
+constexpr std::uint16_t values() noexcept { return 0; }
+template <typename... More>
+constexpr std::uint16_t values(int first, More... more) noexcept {
+  return static_cast<std::uint16_t>((1u << first) | values(more...));
+}
+constexpr std::uint16_t value_range(int lo, int hi) noexcept {
+  std::uint16_t m = 0;
+  for (int v = lo; v <= hi; ++v) m = static_cast<std::uint16_t>(m | (1u << v));
+  return m;
+}
+
+/// Puts the pieces together and derives the lookup tables.
+template <std::size_t NDecoder, std::size_t NRows>
+constexpr profile make_profile(const char* name, const char* seed, const char* title,
+                               const decoder_rule (&decoder)[NDecoder],
+                               const transition_row (&rows)[NRows],
+                               std::array<state_info, state_count> states,
+                               std::array<option_spec, option_count> options) noexcept {
+  static_assert(NDecoder <= max_decoder_rules, "too many decoder rules");
+  static_assert(NRows <= max_rows, "too many rows");
+  profile p;
+  p.name = name;
+  p.seed = seed;
+  p.title = title;
+  p.decoder = decoder;
+  p.decoder_size = static_cast<std::uint8_t>(NDecoder);
+  p.rows = rows;
+  p.row_count = static_cast<std::uint8_t>(NRows);
+  p.states = states;
+  p.options = options;
+  p.finalize();
+  return p;
+}
+
+}  // namespace cia402::detail
