@@ -58,13 +58,22 @@ struct drive_outputs {
   std::uint8_t error_register = 0;          ///< 0x1001
 };
 
+/// Bits of `axis::flags`: what the drive remembers from the previous cycle.
+namespace axis_flag {
+inline constexpr std::uint8_t fault_reset_bit = 1u << 0;   ///< bit 7 of the previous control word (S2)
+inline constexpr std::uint8_t torque_on = 1u << 1;         ///< torque was on in the previous cycle
+inline constexpr std::uint8_t entered_by_fault = 1u << 2;  ///< the state came from a fault fact
+inline constexpr std::uint8_t coast_reaction = 1u << 3;    ///< the running fault reaction coasts
+inline constexpr std::uint8_t fault_latched = 1u << 4;     ///< class-4 error: only power-off clears
+}  // namespace axis_flag
+
 /// One axis's state between cycles: 12 bytes. The profile is passed to each call, so many axes
 /// share one profile.
 struct axis {
   state current = state::start;
   std::uint8_t pending_row = 0xFF;      ///< row whose stop is running (S7), 0xFF = none
   std::uint8_t last_transition = no_transition;  ///< the last transition taken, ever
-  std::uint8_t flags = 0;               ///< detail::axis_flag bits
+  std::uint8_t flags = 0;               ///< axis_flag bits
   std::uint16_t error_code = 0;         ///< 0x603F
   std::int8_t options[option_count] = {};  ///< option-code values, index by `option`
 };

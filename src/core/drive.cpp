@@ -5,14 +5,6 @@
 namespace cia402 {
 namespace {
 
-namespace axis_flag {
-constexpr std::uint8_t fault_reset_bit = 1u << 0;   // bit 7 of the previous control word (S2)
-constexpr std::uint8_t torque_on = 1u << 1;         // torque was on in the previous cycle
-constexpr std::uint8_t entered_by_fault = 1u << 2;  // the present state came from a fault fact
-constexpr std::uint8_t coast_reaction = 1u << 3;    // the fault reaction is a coast
-constexpr std::uint8_t fault_latched = 1u << 4;     // a class-4 error: only a power cycle clears
-}  // namespace axis_flag
-
 constexpr std::uint8_t no_row = 0xFF;
 
 constexpr std::uint32_t bits(fact f) noexcept { return static_cast<std::uint32_t>(f); }
