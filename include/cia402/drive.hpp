@@ -14,22 +14,24 @@ namespace cia402 {
 /// Everything the drive reads in one cycle. The defaults are an ideal plant: DC link on, no STO, at
 /// standstill with no holding brake to wait for, remote control.
 struct drive_inputs {
-  std::uint16_t control_word = 0;   ///< 0x6040
+  // The first eight bytes hold what a quiet cycle must find as it is by default (no fault, voltage,
+  // no STO, remote, connection, no local request), so the step checks them with one comparison.
   std::uint16_t fault_code = 0;     ///< error code of the present fault cause (0x603F); 0 = none
-  std::uint8_t fault_class = 2;     ///< error class 0..4, read by profiles with error classes
   bool dc_link = true;              ///< DC-link (main) voltage present (S13)
   bool sto = false;                 ///< safe torque off active (S14)
-  bool standstill = true;           ///< the motion side is at standstill / its ramp has finished
-  bool brake_engaged = true;        ///< the holding brake has engaged (true if none is fitted)
   bool remote = true;               ///< the control word is to be processed (status bit 9)
   bool connection_lost = false;     ///< fieldbus connection lost: 0x6007 decides (S10)
+  bool local_enable = false;        ///< local request to enable the power stage (seed 001)
+  bool local_disable = false;       ///< local request to disable the power stage (seed 001)
+  std::uint16_t control_word = 0;   ///< 0x6040
+  std::uint8_t fault_class = 2;     ///< error class 0..4, read by profiles with error classes
+  bool standstill = true;           ///< the motion side is at standstill / its ramp has finished
+  bool brake_engaged = true;        ///< the holding brake has engaged (true if none is fitted)
   bool warning = false;             ///< a warning from elsewhere (status bit 7)
   bool target_reached = false;      ///< the operation mode's target reached (status bit 10)
   bool internal_limit = false;      ///< an internal limit is active (status bit 11)
-  bool local_enable = false;        ///< local request to enable the power stage (seed 001)
-  bool local_disable = false;       ///< local request to disable the power stage (seed 001)
-  std::int32_t actual_speed_rpm = 0;    ///< read by profiles with a speed limit (seed 001 T2/T7)
   std::uint16_t mode_status_bits = 0;   ///< status bits 8 and 12..15, passed through
+  std::int32_t actual_speed_rpm = 0;    ///< read by profiles with a speed limit (seed 001 T2/T7)
 };
 
 /// Which stop the motion side must run this cycle.
@@ -95,8 +97,17 @@ inline constexpr std::uint16_t heartbeat = 0x8130;             ///< S10: 0x6007 
 /// An axis at power-on with the profile's default option codes. Its first steps take T0 and T1.
 axis make_axis(const profile& p) noexcept;
 
+namespace detail {
+inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_outputs& out) noexcept;
+drive_outputs full_step(const profile& p, axis& a, const drive_inputs& in) noexcept;
+}  // namespace detail
+
 /// Runs one cycle.
-drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noexcept;
+inline drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noexcept {
+  drive_outputs out;
+  if (detail::quiet_step(p, a, in, out)) return out;
+  return detail::full_step(p, a, in);
+}
 
 /// Writes an option code (0x605A..0x605E, 0x6007). A value the profile does not support is refused
 /// with its SDO abort code (0x06090030) and changes nothing; an object the profile lacks gives
@@ -126,3 +137,5 @@ class drive {
 };
 
 }  // namespace cia402
+
+#include "cia402/detail/quiet_step.hpp"

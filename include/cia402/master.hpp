@@ -108,9 +108,17 @@ class master {
   void clear_target() noexcept;
 
   /// One cycle: the status word the drive last reported (and 0x603F when known) in, the control
-  /// word to send out. Never blocks, never allocates.
+  /// word to send out. Never blocks, never allocates. A status word like the last one, with nothing
+  /// latched and no deadline passed, gets the same command at once.
   std::uint16_t step(std::uint16_t status_word, std::uint64_t now,
-                     std::uint16_t error_code = 0) noexcept;
+                     std::uint16_t error_code = 0) noexcept {
+    if (status_word == last_status_word_ && repeatable_ &&
+        (timeout_ == 0 || outcome_ == master_outcome::reached || now - since_ < timeout_)) {
+      control_word_ = static_cast<std::uint16_t>(command_bits_ | (application_bits & ~owned_));
+      return control_word_;
+    }
+    return decide(status_word, now, error_code);
+  }
 
   master_outcome outcome() const noexcept { return outcome_; }
   state observed() const noexcept { return observed_; }
@@ -122,6 +130,8 @@ class master {
   std::uint16_t last_control_word() const noexcept { return control_word_; }
 
  private:
+  std::uint16_t decide(std::uint16_t status_word, std::uint64_t now, std::uint16_t error_code) noexcept;
+
   const master_policy* policy_ = nullptr;
   std::uint64_t since_ = 0;    // when the observed state last changed
   std::uint64_t timeout_ = 0;
@@ -132,6 +142,12 @@ class master {
   std::uint8_t transition_ = no_transition;
   std::uint8_t cycles_left_ = 0;
   bool started_in_fault_ = false;
+  // The quiet cycle: the same status word again gets the same owned bits, unless the decision
+  // depended on something that changes by itself (bit 7 just sent, a latched outcome).
+  bool repeatable_ = false;
+  std::uint16_t last_status_word_ = 0;
+  std::uint16_t command_bits_ = 0;  // owned bits of the last word
+  std::uint16_t owned_ = 0;
 };
 
 }  // namespace cia402

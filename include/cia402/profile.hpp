@@ -185,6 +185,9 @@ struct profile {
   std::array<std::uint8_t, 32> command_of_bits{};
   std::array<std::uint32_t, state_count> rows_from{};
   std::array<std::uint32_t, state_count> triggers_from{};
+  /// triggers_from, or every fact for states that stop by an option code (QUICK STOP ACTIVE,
+  /// FAULT REACTION ACTIVE): a cycle with none of these facts changes nothing (drive.hpp quiet step).
+  std::array<std::uint32_t, state_count> busy_from{};
 
   /// Recomputes the derived tables from the data above. Call after any change to it.
   constexpr void finalize() noexcept {
@@ -207,6 +210,10 @@ struct profile {
           triggers_from[s] |= rows[r].any.bits();
         }
       }
+      const state_activity act = states[s].activity;
+      const bool stopping =
+          act == state_activity::quick_stop || act == state_activity::fault_reaction;
+      busy_from[s] = stopping ? 0xFFFFFFFFu : triggers_from[s];
     }
   }
 

@@ -15,6 +15,14 @@ constexpr std::uint32_t command_facts = bits(fact::disable_voltage) | bits(fact:
                                         bits(fact::stop_and_inhibit) | bits(fact::fault_reset);
 constexpr std::uint32_t fault_facts = bits(fact::fault) | bits(fact::fault_quick_stop);
 
+// The facts 0x605A's value raises, by value (S5): 1..4 end by themselves, 5..8 stay.
+constexpr std::uint32_t quick_stop_facts[16] = {
+    0,
+    bits(fact::quick_stop_ends), bits(fact::quick_stop_ends), bits(fact::quick_stop_ends),
+    bits(fact::quick_stop_ends), bits(fact::quick_stop_stays), bits(fact::quick_stop_stays),
+    bits(fact::quick_stop_stays), bits(fact::quick_stop_stays), 0, 0, 0, 0, 0, 0, 0,
+};
+
 std::int8_t option_value(const axis& a, option o) noexcept {
   return a.options[static_cast<int>(o)];
 }
@@ -104,8 +112,6 @@ fault_now fault_of(const profile& p, const axis& a, const drive_inputs& in) noex
   return f;
 }
 
-bool fault_latched(const axis& a) noexcept { return (a.flags & axis_flag::fault_latched) != 0; }
-
 void set_flag(axis& a, std::uint8_t flag, bool on) noexcept {
   a.flags = static_cast<std::uint8_t>(on ? (a.flags | flag) : (a.flags & ~flag));
 }
@@ -132,50 +138,63 @@ axis make_axis(const profile& p) noexcept {
   return a;
 }
 
-drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noexcept {
-  // Facts of this cycle.
-  std::uint32_t f = bits(fact::automatic);
+namespace {
+
+// Everything but the quiet cycle (detail/quiet_step.hpp): facts, the first matching row, pending
+// stops (S7), outputs.
+}  // namespace
+
+drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& in) noexcept {
+  drive_outputs out;
+  // Facts of this cycle. The common cycle (remote, no fault, voltage, no STO, no stop pending)
+  // takes no branch here but the one on the fault code.
   const std::uint16_t cw = in.control_word;
-  const bool reset_bit = (cw & control_bit::fault_reset) != 0;
-  const bool reset_edge = reset_bit && !(a.flags & axis_flag::fault_reset_bit);
-  set_flag(a, axis_flag::fault_reset_bit, reset_bit);  // S2: whatever the state
+  const std::uint32_t reset_bit = (cw >> 7) & 1u;
+  const std::uint32_t reset_edge = reset_bit & ~static_cast<std::uint32_t>(a.flags);
+  a.flags = static_cast<std::uint8_t>((a.flags & ~axis_flag::fault_reset_bit) | reset_bit);  // S2
+
+  std::uint32_t f = bits(fact::automatic) |
+                    (in.dc_link ? bits(fact::dc_link) : bits(fact::undervoltage)) |
+                    (static_cast<std::uint32_t>(in.sto) << 13) |
+                    (static_cast<std::uint32_t>(in.local_enable) << 19) |
+                    (static_cast<std::uint32_t>(in.local_disable) << 20) |
+                    quick_stop_facts[static_cast<std::uint8_t>(a.options[0]) & 15u] |
+                    ((static_cast<std::uint32_t>(a.flags) & axis_flag::entered_by_fault) << 16) |
+                    ((static_cast<std::uint32_t>(a.flags) & axis_flag::fault_latched) << 17);
+  static_assert(axis_flag::entered_by_fault << 16 == static_cast<std::uint32_t>(fact::entered_by_fault));
+  static_assert(axis_flag::fault_latched << 17 == static_cast<std::uint32_t>(fact::fault_latched));
 
   const int abort_code = option_value(a, option::abort_connection);
-  if (in.connection_lost && abort_code == 2) {
-    f |= bits(fact::disable_voltage);  // S10
-  } else if (in.connection_lost && abort_code == 3) {
-    f |= bits(fact::quick_stop);
-  } else if (in.remote) {
-    f |= bits(command_fact(p.decode(cw)));
-    if (reset_edge) f |= bits(fact::fault_reset);
+  if (!in.connection_lost || abort_code < 2) {
+    if (in.remote) f |= (1u << p.command_of_bits[cw & 0x1Fu]) | (reset_edge << 6);
+  } else {
+    f |= abort_code == 2 ? bits(fact::disable_voltage) : bits(fact::quick_stop);  // S10
   }
   const bool halt = in.remote && (cw & control_bit::halt) && p.spec(option::halt).exists();
   if (halt) f |= bits(fact::halt);
 
-  const fault_now fault = fault_of(p, a, in);
-  if (fault.code != 0) {
-    if (!p.error_classes || fault.error_class >= 2) f |= bits(fact::fault);
-    if (p.error_classes && fault.error_class == 1) f |= bits(fact::fault_quick_stop);
-    if (!p.error_classes || fault.error_class >= 1) f |= bits(fact::fault_present);
-    if (fault.error_class >= 3) f |= bits(fact::fault_immediate);
-    if (p.error_classes && fault.error_class == 4) set_flag(a, axis_flag::fault_latched, true);
+  fault_now fault;
+  if (in.fault_code != 0 || in.connection_lost || (a.flags & axis_flag::torque_on)) {
+    fault = fault_of(p, a, in);
+    if (fault.code != 0) {
+      if (!p.error_classes || fault.error_class >= 2) f |= bits(fact::fault);
+      if (p.error_classes && fault.error_class == 1) f |= bits(fact::fault_quick_stop);
+      if (!p.error_classes || fault.error_class >= 1) f |= bits(fact::fault_present);
+      if (fault.error_class >= 3) f |= bits(fact::fault_immediate);
+      if (p.error_classes && fault.error_class == 4) {
+        a.flags |= axis_flag::fault_latched;
+        f |= bits(fact::fault_latched);
+      }
+    }
   }
-  if (fault_latched(a)) f |= bits(fact::fault_latched);
-  f |= in.dc_link ? bits(fact::dc_link) : bits(fact::undervoltage);
-  if (in.sto) f |= bits(fact::sto);
   if (p.speed_limit_rpm > 0 &&
       (in.actual_speed_rpm > p.speed_limit_rpm || in.actual_speed_rpm < -p.speed_limit_rpm)) {
     f |= bits(fact::overspeed);
   }
-  if (in.local_enable) f |= bits(fact::local_enable);
-  if (in.local_disable) f |= bits(fact::local_disable);
-  const int qs_code = option_value(a, option::quick_stop);
-  if (qs_code >= 1 && qs_code <= 4) f |= bits(fact::quick_stop_ends);
-  if (qs_code >= 5 && qs_code <= 8) f |= bits(fact::quick_stop_stays);
-  if (a.flags & axis_flag::entered_by_fault) f |= bits(fact::entered_by_fault);
 
-  const activity_now before = activity_of(p, a, halt);
+  // A stop is complete at standstill with the brake engaged, or at once when it coasts.
   const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
+  const activity_now before = activity_of(p, a, halt);
   if (before.ramp == stop_ramp::coast || in.sto || (in.standstill && in.brake_engaged)) {
     f |= bits(fact::stop_complete);
   }
@@ -214,7 +233,7 @@ drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noexcept {
     }
   }
 
-  drive_outputs out;
+  activity_now now = before;
   if (commit != no_row) {
     const transition_row& r = p.rows[commit];
     const std::uint32_t why = r.any.bits() & f;
@@ -234,38 +253,43 @@ drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noexcept {
       a.error_code = 0;
       set_flag(a, axis_flag::coast_reaction, false);
     }
+    now = activity_of(p, a, halt);
+  } else if (a.pending_row != no_row) {
+    now = activity_of(p, a, halt);
   } else if ((f & bits(fact::fault)) && (a.current == state::fault_reaction_active ||
                                          a.current == state::fault)) {
     a.error_code = fault.code;  // S4: a new fault there is recorded, no transition
   }
 
   // Outputs of the state the drive is in now.
-  const activity_now now = activity_of(p, a, halt);
   const state s = a.current;
   out.current = s;
+  const bool torque = now.torque_wanted && !in.sto && now.ramp != stop_ramp::coast;
   out.ramp = in.sto && now.torque_wanted ? stop_ramp::coast : now.ramp;
-  out.torque = now.torque_wanted && !in.sto && p.torque_allowed(s) && now.ramp != stop_ramp::coast;
-  out.brake_released = out.torque && !(now.stop_ends_torque && in.standstill);
-  set_flag(a, axis_flag::torque_on, out.torque);
+  out.torque = torque;
+  out.brake_released = torque && !(now.stop_ends_torque && in.standstill);
+  a.flags = static_cast<std::uint8_t>((a.flags & ~axis_flag::torque_on) |
+                                      (torque ? axis_flag::torque_on : 0u));
 
-  std::uint16_t sw = p.status_pattern(s);
-  if (in.dc_link) sw |= status_bit::voltage_enabled;
-  const bool class_warning = p.error_classes && in.fault_code != 0 && in.fault_class <= 1;
-  if (in.warning || in.sto || class_warning) sw |= status_bit::warning;
-  if (in.remote) sw |= status_bit::remote;
-  const state_activity act = p.info(s).activity;
-  const bool holding_stop =
-      (act == state_activity::run && halt) ||
-      (act == state_activity::quick_stop && qs_code >= 5 && qs_code <= 8);
-  const bool target = a.pending_row == no_row &&
-                      (holding_stop ? in.standstill
-                                    : act == state_activity::run && in.target_reached);
-  if (target) sw |= status_bit::target_reached;
-  if (in.internal_limit) sw |= status_bit::internal_limit_active;
-  sw |= in.mode_status_bits & status_bit::mode_specific;
-  out.status_word = sw;
+  const state_info info = p.info(s);
+  std::uint32_t sw = info.status_pattern | (static_cast<std::uint32_t>(in.dc_link) << 4) |
+                     (static_cast<std::uint32_t>(in.warning | in.sto) << 7) |
+                     (static_cast<std::uint32_t>(in.remote) << 9) |
+                     (static_cast<std::uint32_t>(in.internal_limit) << 11) |
+                     (in.mode_status_bits & status_bit::mode_specific);
+  if (p.error_classes && in.fault_code != 0 && in.fault_class <= 1) sw |= status_bit::warning;
+  bool target;
+  if (info.activity == state_activity::run) {
+    target = halt ? in.standstill : in.target_reached;
+  } else {
+    const int qs_code = option_value(a, option::quick_stop);
+    target = info.activity == state_activity::quick_stop && qs_code >= 5 && qs_code <= 8 &&
+             in.standstill;
+  }
+  if (target && a.pending_row == no_row) sw |= status_bit::target_reached;
+  out.status_word = static_cast<std::uint16_t>(sw);
   out.error_code = a.error_code;
-  out.error_register = error_register_of(a.error_code);
+  out.error_register = a.error_code ? error_register_of(a.error_code) : std::uint8_t{0};
   return out;
 }
 

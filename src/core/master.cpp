@@ -234,6 +234,8 @@ const char* master_outcome_name(master_outcome o) noexcept {
 void master::set_target(const master_policy& policy, std::uint64_t now,
                         std::uint64_t timeout) noexcept {
   policy_ = &policy;
+  owned_ = policy.owned;
+  repeatable_ = false;
   since_ = now;
   timeout_ = timeout;
   outcome_ = master_outcome::in_progress;
@@ -243,11 +245,14 @@ void master::set_target(const master_policy& policy, std::uint64_t now,
 
 void master::clear_target() noexcept {
   policy_ = nullptr;
+  repeatable_ = false;
   outcome_ = master_outcome::idle;
 }
 
-std::uint16_t master::step(std::uint16_t status_word, std::uint64_t now,
-                           std::uint16_t error_code) noexcept {
+std::uint16_t master::decide(std::uint16_t status_word, std::uint64_t now,
+                             std::uint16_t error_code) noexcept {
+  repeatable_ = false;
+  last_status_word_ = status_word;
   if (policy_ == nullptr) {
     control_word_ = static_cast<std::uint16_t>(control_word_ & ~control_bit::fault_reset);
     return control_word_;
@@ -303,6 +308,10 @@ std::uint16_t master::step(std::uint16_t status_word, std::uint64_t now,
     outcome_ = master_outcome::in_progress;
   }
   control_word_ = static_cast<std::uint16_t>(e.control_word | keep);
+  command_bits_ = e.control_word;
+  // Repeating is right when the next cycle would pick this same entry: bit 7 unchanged.
+  const int next_bit = (e.control_word & control_bit::fault_reset) ? 1 : 0;
+  repeatable_ = next_bit == reset_bit;
   return control_word_;
 }
 
