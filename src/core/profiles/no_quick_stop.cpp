@@ -9,8 +9,12 @@ namespace {
 // First match wins; T13 first because faults win over any command. There is no T11, T12 or T16:
 // QUICK STOP ACTIVE cannot be reached. A Quick stop command acts as Disable voltage wherever it acts:
 // T7 and T10 as the seed says, and T9 by our choice, so the stop a master asks for is never ignored.
+// This drive has no QUICK STOP ACTIVE, so "all states" of T13 (seed line 143) leaves it out.
+constexpr std::uint16_t every_state_it_has_but_fault =
+    every_state_but_fault & static_cast<std::uint16_t>(~state_bit(S::quick_stop_active));
+
 constexpr transition_row rows[] = {
-    row(13, every_state_but_fault, S::fault_reaction_active, facts(F::fault), {}, {},
+    row(13, every_state_it_has_but_fault, S::fault_reaction_active, facts(F::fault), {}, {},
         row_stop::immediate, interrupts),
     row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic)),
     row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
