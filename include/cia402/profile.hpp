@@ -32,7 +32,7 @@ enum class fact : std::uint32_t {
   fault_immediate = 1u << 11,  ///< the fault reaction is to coast (class 3/4, STO, undervoltage)
   dc_link = 1u << 12,          ///< DC-link (main) voltage present (S13)
   sto = 1u << 13,              ///< safe torque off active (S14)
-  overspeed = 1u << 14,        ///< |actual speed| above the profile's `speed_limit_rpm`
+  overspeed = 1u << 14,        ///< |actual speed| above the profile's `speed_limit_rpm` (seed 001 T7)
   stop_complete = 1u << 15,    ///< the running stop has ended: standstill and brake engaged, or coast
   quick_stop_ends = 1u << 16,  ///< 0x605A is 1..4: QUICK STOP ACTIVE ends by itself (T12)
   quick_stop_stays = 1u << 17, ///< 0x605A is 5..8: QUICK STOP ACTIVE holds; T16 allowed
@@ -42,9 +42,10 @@ enum class fact : std::uint32_t {
   fault_latched = 1u << 21,    ///< a class-4 error was seen: only a power cycle clears it
   undervoltage = 1u << 22,     ///< DC-link voltage absent: the trigger form of !dc_link (seed 001 T7)
   halt = 1u << 23,             ///< control-word bit 8 with 0x605D supported (S8)
+  below_speed_limit = 1u << 24,  ///< |actual speed| below `speed_limit_rpm`, or no limit (seed 001 T2)
 };
 
-inline constexpr int fact_count = 24;
+inline constexpr int fact_count = 25;
 
 /// A set of facts.
 class fact_set {

@@ -59,9 +59,11 @@ struct activity_now {
 activity_now activity_of(const profile& p, const axis& a, bool halt) noexcept {
   activity_now now;
   if (a.pending_row != no_row) {
-    now.ramp = ramp_of_row(a, p.rows[a.pending_row].stop);
+    const transition_row& r = p.rows[a.pending_row];
+    now.ramp = ramp_of_row(a, r.stop);
     now.torque_wanted = true;
-    now.stop_ends_torque = true;
+    // A stop into a state that holds torque (SWITCHED ON of seeds 003/004) keeps the brake open.
+    now.stop_ends_torque = !p.torque_allowed(r.to);
     return now;
   }
   switch (p.info(a.current).activity) {
@@ -187,15 +189,18 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
       }
     }
   }
-  if (p.speed_limit_rpm > 0 &&
-      (in.actual_speed_rpm > p.speed_limit_rpm || in.actual_speed_rpm < -p.speed_limit_rpm)) {
-    f |= bits(fact::overspeed);
-  }
+  // Seed 001: T2 needs "< 1000 RPM", T7 fires on "> 1000 RPM"; exactly 1000 does neither.
+  const std::int32_t limit = p.speed_limit_rpm;
+  const std::int32_t speed = in.actual_speed_rpm;
+  if (limit > 0 && (speed > limit || speed < -limit)) f |= bits(fact::overspeed);
+  if (limit <= 0 || (speed < limit && speed > -limit)) f |= bits(fact::below_speed_limit);
 
-  // A stop is complete at standstill with the brake engaged, or at once when it coasts.
+  // A stop is complete at standstill with the brake engaged (when it ends with torque off), or at
+  // once when it coasts.
   const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
   const activity_now before = activity_of(p, a, halt);
-  if (before.ramp == stop_ramp::coast || in.sto || (in.standstill && in.brake_engaged)) {
+  if (before.ramp == stop_ramp::coast || in.sto ||
+      (in.standstill && (in.brake_engaged || !before.stop_ends_torque))) {
     f |= bits(fact::stop_complete);
   }
 
@@ -214,23 +219,33 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   }
 
   // S7: while a row's stop runs, only rows that interrupt stops may take over; otherwise the
-  // pending row completes when its stop does.
+  // pending row completes when its stop does. A row with a ramp of its own runs it first, also
+  // when it takes over from another stop (T17 during T5 still stops on the quick-stop ramp).
   std::uint8_t commit = no_row;
+  std::uint8_t take = no_row;
   if (a.pending_row != no_row) {
     if (match != no_row && match != a.pending_row &&
         (p.rows[match].flags & row_flag::interrupts_stop)) {
-      commit = match;
+      take = match;
     } else if (f & bits(fact::stop_complete)) {
       commit = a.pending_row;
     }
-  } else if (match != no_row) {
+  } else {
+    take = match;
+  }
+  if (take != no_row) {
     const bool ramp_first = torque_was_on && !in.sto &&
-                            ramp_of_row(a, p.rows[match].stop) != stop_ramp::none;
+                            ramp_of_row(a, p.rows[take].stop) != stop_ramp::none;
     if (ramp_first) {
-      a.pending_row = match;
+      a.pending_row = take;
     } else {
-      commit = match;
+      commit = take;
     }
+  }
+  // S4: in FAULT REACTION ACTIVE and FAULT a new fault is recorded, whatever else happens.
+  if ((f & bits(fact::fault)) &&
+      (a.current == state::fault_reaction_active || a.current == state::fault)) {
+    a.error_code = fault.code;
   }
 
   activity_now now = before;
@@ -256,9 +271,6 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
     now = activity_of(p, a, halt);
   } else if (a.pending_row != no_row) {
     now = activity_of(p, a, halt);
-  } else if ((f & bits(fact::fault)) && (a.current == state::fault_reaction_active ||
-                                         a.current == state::fault)) {
-    a.error_code = fault.code;  // S4: a new fault there is recorded, no transition
   }
 
   // Outputs of the state the drive is in now.

@@ -21,6 +21,7 @@ constexpr const char* fact_names[fact_count] = {
     "dc_link",         "sto",              "overspeed",       "stop_complete",
     "quick_stop_ends", "quick_stop_stays", "entered_by_fault", "local_enable",
     "local_disable",   "fault_latched",    "undervoltage",    "halt",
+    "below_speed_limit",
 };
 
 constexpr const char* command_names[command_count] = {

@@ -30,8 +30,10 @@ inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_
   const std::uint32_t qs_fact = qs - 1u < 4u   ? static_cast<std::uint32_t>(fact::quick_stop_ends)
                                 : qs - 5u < 4u ? static_cast<std::uint32_t>(fact::quick_stop_stays)
                                                : 0u;
+  const bool slow = limit == 0 || (in.actual_speed_rpm < limit && in.actual_speed_rpm > -limit);
   const std::uint32_t f = static_cast<std::uint32_t>(fact::automatic) |
                           static_cast<std::uint32_t>(fact::dc_link) |
+                          (slow ? static_cast<std::uint32_t>(fact::below_speed_limit) : 0u) |
                           (1u << p.command_of_bits[cw & 0x1Fu]) | qs_fact;
   if (p.busy_from[s] & f) return false;
 

@@ -16,7 +16,7 @@ constexpr transition_row rows[] = {
     row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
     // T2: no undervoltage, actual velocity < 1000 rpm, STO = +24 V, Shutdown (seed lines 6..10).
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown),
-        facts(F::dc_link), facts(F::sto, F::overspeed)),
+        facts(F::dc_link, F::below_speed_limit), facts(F::sto)),
     // T7: undervoltage, STO = 0 V, actual velocity > 1000 rpm, or Disable Voltage (seed lines 22..26).
     row(7, from(S::ready_to_switch_on), S::switch_on_disabled,
         facts(F::disable_voltage, F::undervoltage, F::sto, F::overspeed)),
@@ -52,7 +52,10 @@ constexpr transition_row rows[] = {
     row(15, from(S::fault), S::switch_on_disabled, facts(F::fault_reset), {},
         facts(F::fault_present, F::fault_latched)),
     // T16: Enable Operation, or Fault Reset after a quick stop caused by a class-1 error (lines 50..54).
-    row(16, from(S::quick_stop_active), S::operation_enabled, facts(F::enable_operation)),
+    // Enable Operation leaves only a quick stop the fieldbus asked for (footnote 3, line 57): a
+    // class-1 error needs its Fault Reset.
+    row(16, from(S::quick_stop_active), S::operation_enabled, facts(F::enable_operation), {},
+        facts(F::entered_by_fault)),
     row(16, from(S::quick_stop_active), S::operation_enabled, facts(F::fault_reset),
         facts(F::entered_by_fault), facts(F::fault_present)),
 };
