@@ -100,18 +100,17 @@ struct fault_now {
 };
 
 fault_now fault_of(const profile& p, const axis& a, const drive_inputs& in) noexcept {
-  fault_now f;
   const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
-  if (torque_was_on && in.sto) {
-    f = {error_code::safe_torque_off, 3, true};
-  } else if (torque_was_on && !in.dc_link) {
-    f = {error_code::dc_link_undervoltage, 3, true};
-  } else if (in.fault_code != 0) {
-    f = {in.fault_code, p.error_classes ? in.fault_class : std::uint8_t{2}, false};
-  } else if (in.connection_lost && option_value(a, option::abort_connection) == 1) {
-    f = {error_code::heartbeat, 2, false};
+  if (torque_was_on && in.sto) return {error_code::safe_torque_off, 3, true};
+  if (torque_was_on && !in.dc_link) return {error_code::dc_link_undervoltage, 3, true};
+  const std::uint8_t input_class = p.error_classes ? in.fault_class : std::uint8_t{2};
+  if (in.fault_code != 0 && input_class >= 2) return {in.fault_code, input_class, false};
+  // A lost connection with 0x6007 = 1 is a fault even beside a mere warning (class 0 or 1).
+  if (in.connection_lost && option_value(a, option::abort_connection) == 1) {
+    return {error_code::heartbeat, 2, false};
   }
-  return f;
+  if (in.fault_code != 0) return {in.fault_code, input_class, false};
+  return {};
 }
 
 void set_flag(axis& a, std::uint8_t flag, bool on) noexcept {

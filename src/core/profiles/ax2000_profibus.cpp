@@ -25,8 +25,10 @@ constexpr transition_row rows[] = {
     // T2: bits 1 and 2 set, DC bus link voltage present (seed lines 14..16).
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown),
         facts(F::dc_link)),
-    row(3, from(S::ready_to_switch_on), S::switched_on, facts(F::switch_on, F::enable_operation),
-        facts(F::dc_link), facts(F::sto)),
+    // T3: "Bit 0 is also set" (seed line 19), whatever bits 3 and 4 say: with bit 4 clear the word
+    // decodes as fast stop, which still switches on.
+    row(3, from(S::ready_to_switch_on), S::switched_on,
+        facts(F::switch_on, F::enable_operation, F::quick_stop), facts(F::dc_link), facts(F::sto)),
     row(4, from(S::switched_on), S::operation_enabled, facts(F::enable_operation),
         facts(F::dc_link), facts(F::sto)),
     row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},

@@ -1,0 +1,135 @@
+#include "cli/app.hpp"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <istream>
+#include <ostream>
+#include <variant>
+
+#include "cia402/profile_file.hpp"
+#include "cli/common.hpp"
+#include "cli/demo.hpp"
+#include "cli/replay.hpp"
+#include "cli/words.hpp"
+
+namespace cia402::cli {
+namespace {
+
+constexpr int usage_error = 2;
+
+void add_profile_options(CLI::App& cmd, std::string& name, std::string& file) {
+  auto* by_name = cmd.add_option("--profile", name, "built-in profile: " + builtin_profile_names())
+                      ->type_name("NAME")
+                      ->default_str("cia402");
+  cmd.add_option("--profile-file", file, "a TOML profile file instead of a built-in")
+      ->type_name("FILE")
+      ->excludes(by_name);
+}
+
+int list_profiles(std::ostream& out) {
+  std::size_t width = 4;
+  for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
+    width = std::max(width, std::string_view(builtin_profile(i).name).size());
+  }
+  for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
+    const profile& p = builtin_profile(i);
+    const std::string name = p.name;
+    out << name << std::string(width + 2 - name.size(), ' ') << p.seed << "  " << p.title << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+int run(const std::vector<std::string>& args, std::istream& in, std::ostream& out,
+        std::ostream& err) {
+  CLI::App app{"Tools for the CiA 402 drive state machine.", "cia402"};
+  app.require_subcommand(1);
+
+  std::string profile_name = "cia402";
+  std::string profile_file;
+
+  auto* replay = app.add_subcommand(
+      "replay",
+      "Run one drive on an ideal plant, reading events from standard input (cw VALUE, "
+      "fault [CODE [CLASS]], clear, set INDEX VALUE, voltage on|off, sto on|off) and printing one "
+      "JSON line per event");
+  add_profile_options(*replay, profile_name, profile_file);
+  std::vector<std::string> sets;
+  replay->add_option("--set", sets, "write an option code before power-up, e.g. 0x605A=6")
+      ->type_name("INDEX=VALUE");
+
+  auto* decode = app.add_subcommand("decode",
+                                    "Name the state and every bit of a status word, or "
+                                    "the command and every bit of a control word");
+  std::string word_text;
+  decode->add_option("WORD", word_text, "the word, decimal or 0x hex")->required();
+  bool as_control_word = false;
+  decode->add_flag("--controlword", as_control_word, "WORD is a control word (0x6040)");
+  add_profile_options(*decode, profile_name, profile_file);
+
+  auto* profiles =
+      app.add_subcommand("profiles", "List the built-in profiles, or dump one as TOML");
+  std::string dump_name;
+  profiles->add_option("--dump", dump_name, "print this built-in profile as a profile file")
+      ->type_name("NAME");
+
+  auto* demo = app.add_subcommand(
+      "demo",
+      "Take one drive through power-up, enable, quick stop, fault and reset, cycle by cycle");
+  add_profile_options(*demo, profile_name, profile_file);
+
+  try {
+    std::vector<std::string> reversed(args.rbegin(), args.rend());
+    app.parse(reversed);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e, out, err);
+  }
+
+  if (profiles->parsed()) {
+    if (dump_name.empty()) return list_profiles(out);
+    const profile* p = find_builtin_profile(dump_name);
+    if (p == nullptr) {
+      err << "cia402 profiles: unknown profile '" << dump_name
+          << "' (built-in: " << builtin_profile_names() << ")\n";
+      return usage_error;
+    }
+    out << dump_profile_toml(*p);
+    return 0;
+  }
+
+  profile_choice choice;
+  if (!choice.resolve(profile_name, profile_file, err)) return usage_error;
+
+  if (replay->parsed()) {
+    std::vector<option_write> writes;
+    for (const std::string& s : sets) {
+      option_write w;
+      std::string why;
+      if (!parse_option_write(s, w, why)) {
+        err << "cia402 replay: --set " << s << ": " << why << "\n";
+        return usage_error;
+      }
+      writes.push_back(w);
+    }
+    return run_replay(choice.get(), writes, in, out, err);
+  }
+  if (decode->parsed()) {
+    const auto word = parse_number(word_text);
+    if (!word || *word < 0 || *word > 0xFFFF) {
+      err << "cia402 decode: '" << word_text << "' is not a 16-bit word (decimal or 0x hex)\n";
+      return usage_error;
+    }
+    const auto w = static_cast<std::uint16_t>(*word);
+    out << (as_control_word ? describe_control_word(choice.get(), w)
+                            : describe_status_word(choice.get(), w));
+    return 0;
+  }
+  if (demo->parsed()) {
+    run_demo(choice.get(), out);
+    return 0;
+  }
+  return usage_error;
+}
+
+}  // namespace cia402::cli

@@ -1,0 +1,111 @@
+#include "cli/common.hpp"
+
+#include <limits>
+#include <ostream>
+#include <variant>
+
+#include "cia402/profile_file.hpp"
+
+namespace cia402::cli {
+
+std::optional<std::int64_t> parse_number(std::string_view text) {
+  bool negative = false;
+  if (!text.empty() && (text[0] == '-' || text[0] == '+')) {
+    negative = text[0] == '-';
+    text.remove_prefix(1);
+  }
+  unsigned base = 10;
+  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
+    base = 16;
+    text.remove_prefix(2);
+  }
+  if (text.empty()) return std::nullopt;
+  std::int64_t value = 0;
+  for (char c : text) {
+    unsigned digit = 0;
+    if (c >= '0' && c <= '9')
+      digit = static_cast<unsigned>(c - '0');
+    else if (base == 16 && c >= 'a' && c <= 'f')
+      digit = static_cast<unsigned>(c - 'a' + 10);
+    else if (base == 16 && c >= 'A' && c <= 'F')
+      digit = static_cast<unsigned>(c - 'A' + 10);
+    else
+      return std::nullopt;
+    if (digit >= base) return std::nullopt;
+    value = value * base + digit;
+    if (value > std::int64_t{std::numeric_limits<std::uint32_t>::max()}) return std::nullopt;
+  }
+  if (negative) {
+    value = -value;
+    if (value < std::numeric_limits<std::int32_t>::min()) return std::nullopt;
+  }
+  return value;
+}
+
+std::string hex(std::uint32_t value, int digits) {
+  static constexpr char d[] = "0123456789ABCDEF";
+  std::string s = "0x";
+  for (int i = digits - 1; i >= 0; --i) s += d[(value >> (4 * i)) & 0xFu];
+  return s;
+}
+
+std::string json_escape(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          out += "\\u00" + hex(static_cast<unsigned char>(c), 2).substr(2);
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out;
+}
+
+std::string builtin_profile_names() {
+  std::string list;
+  for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
+    list += (i ? ", " : "") + std::string(builtin_profile(i).name);
+  }
+  return list;
+}
+
+bool profile_choice::resolve(const std::string& name, const std::string& file, std::ostream& err) {
+  if (!file.empty()) {
+    profile_load_result result = load_profile_toml_file(file);
+    if (const auto* error = std::get_if<profile_file_error>(&result)) {
+      err << "cia402: profile file refused: " << error->message() << "\n";
+      return false;
+    }
+    loaded_ = std::get<custom_profile>(result);
+    profile_ = &loaded_.get();
+    return true;
+  }
+  const profile* p = find_builtin_profile(name);
+  if (p == nullptr) {
+    err << "cia402: unknown profile '" << name << "' (built-in: " << builtin_profile_names()
+        << ")\n";
+    return false;
+  }
+  profile_ = p;
+  return true;
+}
+
+}  // namespace cia402::cli

@@ -1,0 +1,43 @@
+// Small pieces every subcommand of the `cia402` tool shares: number parsing, hex and JSON text,
+// and choosing a profile by name or file.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "cia402/profile.hpp"
+
+namespace cia402::cli {
+
+/// Parses a decimal ("15", "-1") or hexadecimal ("0x0F") integer, the whole text. Refuses anything
+/// else, including values that do not fit 32 bits signed or unsigned.
+std::optional<std::int64_t> parse_number(std::string_view text);
+
+/// "0x0237": 0x and `digits` upper-case hex digits.
+std::string hex(std::uint32_t value, int digits);
+
+/// The text as the body of a JSON string (quotes, backslashes and control characters escaped).
+std::string json_escape(std::string_view text);
+
+/// The profile a command runs on: a built-in by name, or a profile file. Keeps a loaded file alive.
+class profile_choice {
+ public:
+  profile_choice() = default;
+  profile_choice(const profile_choice&) = delete;  // get() may point into loaded_
+  profile_choice& operator=(const profile_choice&) = delete;
+  /// Resolves the choice; on failure writes a message to `err` and returns false.
+  bool resolve(const std::string& name, const std::string& file, std::ostream& err);
+  const profile& get() const noexcept { return *profile_; }
+
+ private:
+  custom_profile loaded_;
+  const profile* profile_ = &standard_profile();
+};
+
+/// "cia402, no-quick-stop, ..." for messages.
+std::string builtin_profile_names();
+
+}  // namespace cia402::cli
