@@ -8,10 +8,10 @@
 
 namespace cia402 {
 
-/// Graphviz DOT. Every state node has id "state-NAME" and class "state"; every arrow has id
-/// "t<N>-FROM-TO" and class "transition t<N>", so an SVG rendered from it can be styled per state
+/// Graphviz DOT. Every state node has id "state.NAME" and class "state"; every arrow has id
+/// "t<N>.FROM.TO" and class "transition t<N>", so an SVG rendered from it can be styled per state
 /// and per transition number (the instrument page does). A row that leaves three or more states
-/// (T13) is one arrow, id "t<N>-ANY-TO", from a dashed frame around those states.
+/// (T13) is one arrow, id "t<N>.ANY.TO", from a dashed frame around those states.
 std::string diagram_dot(const profile& p);
 
 /// Mermaid stateDiagram-v2.

@@ -78,11 +78,11 @@ std::string diagram_dot(const profile& p) {
   const auto node = [&](int s) {
     const state st = static_cast<state>(s);
     if (st == state::start) {
-      out << "  \"START\" [id=\"state-START\", class=\"state\", shape=point, width=0.15, "
+      out << "  \"START\" [id=\"state.START\", class=\"state\", shape=point, width=0.15, "
              "label=\"\"];\n";
       return;
     }
-    out << "  \"" << state_name(st) << "\" [id=\"state-" << state_name(st)
+    out << "  \"" << state_name(st) << "\" [id=\"state." << state_name(st)
         << "\", class=\"state\", label=\"" << dot_escape(label_of(st)) << "\"];\n";
   };
   int group_member = -1;
@@ -111,14 +111,14 @@ std::string diagram_dot(const profile& p) {
     if (!grouped_drawn.insert({row.number, to}).second) continue;
     const char* t = state_name(row.to);
     out << "  \"" << state_name(static_cast<state>(group_member)) << "\" -> \"" << t << "\" [id=\"t"
-        << int{row.number} << "-ANY-" << t << "\", class=\"transition t" << int{row.number}
+        << int{row.number} << ".ANY." << t << "\", class=\"transition t" << int{row.number}
         << "\", label=\"" << int{row.number} << "\", ltail=cluster_group];\n";
   }
   for (const auto& [from, to, number] : arrows) {
     if (grouped_drawn.count({number, to}) && ((group >> from) & 1u)) continue;
     const char* f = state_name(static_cast<state>(from));
     const char* t = state_name(static_cast<state>(to));
-    out << "  \"" << f << "\" -> \"" << t << "\" [id=\"t" << number << "-" << f << "-" << t
+    out << "  \"" << f << "\" -> \"" << t << "\" [id=\"t" << number << "." << f << "." << t
         << "\", class=\"transition t" << number << "\", label=\"" << number << "\"];\n";
   }
   out << "}\n";

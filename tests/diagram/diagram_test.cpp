@@ -14,14 +14,14 @@ std::set<std::string> expected_arrows(const cia402::profile& p) {
   std::set<std::string> arrows;
   for (std::size_t r = 0; r < p.row_count; ++r) {
     if (__builtin_popcount(p.rows[r].from) >= 3) {
-      arrows.insert("t" + std::to_string(p.rows[r].number) + "-ANY-" +
+      arrows.insert("t" + std::to_string(p.rows[r].number) + ".ANY." +
                     cia402::state_name(p.rows[r].to));
       continue;
     }
     for (int s = 0; s < cia402::state_count; ++s) {
       if ((p.rows[r].from >> s) & 1u) {
-        arrows.insert("t" + std::to_string(p.rows[r].number) + "-" +
-                      cia402::state_name(static_cast<cia402::state>(s)) + "-" +
+        arrows.insert("t" + std::to_string(p.rows[r].number) + "." +
+                      cia402::state_name(static_cast<cia402::state>(s)) + "." +
                       cia402::state_name(p.rows[r].to));
       }
     }
@@ -35,13 +35,13 @@ TEST(diagram, dot_has_one_arrow_per_row_source_with_its_number_on_every_profile)
     const std::string dot = cia402::diagram_dot(p);
     std::set<std::string> drawn;
     const std::regex edge(
-        R"re("(\w+)" -> "(\w+)" \[id="(t(\d+)-(\w+)-\w+)", class="transition t(\d+)", label="(\d+)")re");
+        R"re("(\w+)" -> "(\w+)" \[id="(t(\d+)\.(\w+)\.\w+)", class="transition t(\d+)", label="(\d+)")re");
     for (auto it = std::sregex_iterator(dot.begin(), dot.end(), edge); it != std::sregex_iterator(); ++it) {
       const std::smatch& m = *it;
       EXPECT_EQ(m[4].str(), m[7].str()) << p.name << ": the label is the transition number";
       EXPECT_EQ(m[4].str(), m[6].str()) << p.name << ": the class names the transition number";
       const std::string from = m[5].str() == "ANY" ? "ANY" : m[1].str();
-      EXPECT_EQ(m[3].str(), "t" + m[4].str() + "-" + from + "-" + m[2].str());
+      EXPECT_EQ(m[3].str(), "t" + m[4].str() + "." + from + "." + m[2].str());
       drawn.insert(m[3].str());
     }
     EXPECT_EQ(drawn, expected_arrows(p)) << p.name;
@@ -52,7 +52,7 @@ TEST(diagram, no_quick_stop_draws_no_quick_stop_state) {
   const auto* p = cia402::find_builtin_profile("no-quick-stop");
   ASSERT_NE(p, nullptr);
   EXPECT_EQ(cia402::diagram_dot(*p).find("QUICK_STOP_ACTIVE"), std::string::npos);
-  EXPECT_NE(cia402::diagram_dot(cia402::standard_profile()).find("state-QUICK_STOP_ACTIVE"),
+  EXPECT_NE(cia402::diagram_dot(cia402::standard_profile()).find("state.QUICK_STOP_ACTIVE"),
             std::string::npos);
 }
 
@@ -60,8 +60,8 @@ TEST(diagram, ax2000_draws_t17_from_operation_enabled_and_quick_stop_active) {
   const auto* p = cia402::find_builtin_profile("ax2000-profibus");
   ASSERT_NE(p, nullptr);
   const std::string dot = cia402::diagram_dot(*p);
-  EXPECT_NE(dot.find("t17-OPERATION_ENABLED-SWITCH_ON_DISABLED"), std::string::npos);
-  EXPECT_NE(dot.find("t17-QUICK_STOP_ACTIVE-SWITCH_ON_DISABLED"), std::string::npos);
+  EXPECT_NE(dot.find("t17.OPERATION_ENABLED.SWITCH_ON_DISABLED"), std::string::npos);
+  EXPECT_NE(dot.find("t17.QUICK_STOP_ACTIVE.SWITCH_ON_DISABLED"), std::string::npos);
 }
 
 TEST(diagram, mermaid_lists_every_arrow) {

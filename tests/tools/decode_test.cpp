@@ -164,22 +164,5 @@ TEST(decode_cli, missing_word_is_a_usage_error) {
   EXPECT_NE(test::run_tool({"decode"}).exit_code, 0);
 }
 
-TEST(demo_words, lowest_word_for_each_command_is_the_standard_coding) {
-  // cia402-reference.md §2.2: Shutdown 0x06, Switch on 0x07, Enable operation 0x0F,
-  // Quick stop 0x02, Disable voltage 0x00.
-  const profile& p = standard_profile();
-  EXPECT_EQ(cli::control_word_for(p, command::shutdown), 0x06);
-  EXPECT_EQ(cli::control_word_for(p, command::switch_on), 0x07);
-  EXPECT_EQ(cli::control_word_for(p, command::enable_operation), 0x0F);
-  EXPECT_EQ(cli::control_word_for(p, command::quick_stop), 0x02);
-  EXPECT_EQ(cli::control_word_for(p, command::disable_voltage), 0x00);
-}
-
-TEST(demo_words, ax2000_enable_operation_needs_bit_4_and_fast_stop_clears_it) {
-  const profile& p = *find_builtin_profile("ax2000-profibus");
-  EXPECT_EQ(cli::control_word_for(p, command::enable_operation), 0x1F);
-  EXPECT_EQ(cli::control_word_for(p, command::quick_stop), 0x0F);
-}
-
 }  // namespace
 }  // namespace cia402

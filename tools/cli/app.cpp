@@ -9,6 +9,8 @@
 #include "cia402/profile_file.hpp"
 #include "cli/common.hpp"
 #include "cli/demo.hpp"
+#include "cli/diagram.hpp"
+#include "cli/path.hpp"
 #include "cli/replay.hpp"
 #include "cli/words.hpp"
 
@@ -79,6 +81,25 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
       "Take one drive through power-up, enable, quick stop, fault and reset, cycle by cycle");
   add_profile_options(*demo, profile_name, profile_file);
 
+  auto* path = app.add_subcommand(
+      "path", "Print the fewest-cycles command sequence from one state to another");
+  std::string path_from;
+  std::string path_to;
+  path->add_option("FROM", path_from, "the state the drive is in, e.g. SWITCH_ON_DISABLED")
+      ->required();
+  path->add_option("TO", path_to, "the target state, e.g. OPERATION_ENABLED")->required();
+  add_profile_options(*path, profile_name, profile_file);
+  path->add_option("--set", sets, "option code the plan assumes, e.g. 0x605A=6")
+      ->type_name("INDEX=VALUE");
+
+  auto* diagram = app.add_subcommand(
+      "diagram", "Draw the profile's state machine from its transition table");
+  add_profile_options(*diagram, profile_name, profile_file);
+  std::string diagram_format = "dot";
+  diagram->add_option("--format", diagram_format, "dot, mermaid or svg (svg needs Graphviz)")
+      ->check(CLI::IsMember({"dot", "mermaid", "svg"}))
+      ->default_str("dot");
+
   try {
     std::vector<std::string> reversed(args.rbegin(), args.rend());
     app.parse(reversed);
@@ -101,19 +122,20 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   profile_choice choice;
   if (!choice.resolve(profile_name, profile_file, err)) return usage_error;
 
-  if (replay->parsed()) {
-    std::vector<option_write> writes;
-    for (const std::string& s : sets) {
-      option_write w;
-      std::string why;
-      if (!parse_option_write(s, w, why)) {
-        err << "cia402 replay: --set " << s << ": " << why << "\n";
-        return usage_error;
-      }
-      writes.push_back(w);
+  std::vector<option_write> writes;
+  for (const std::string& s : sets) {
+    option_write w;
+    std::string why;
+    if (!parse_option_write(s, w, why)) {
+      err << "cia402 " << (path->parsed() ? "path" : "replay") << ": --set " << s << ": " << why
+          << "\n";
+      return usage_error;
     }
-    return run_replay(choice.get(), writes, in, out, err);
+    writes.push_back(w);
   }
+  if (replay->parsed()) return run_replay(choice.get(), writes, in, out, err);
+  if (path->parsed()) return run_path(choice.get(), writes, path_from, path_to, out, err);
+  if (diagram->parsed()) return run_diagram(choice.get(), diagram_format, out, err);
   if (decode->parsed()) {
     const auto word = parse_number(word_text);
     if (!word || *word < 0 || *word > 0xFFFF) {

@@ -1,10 +1,12 @@
 #include "cli/demo.hpp"
 
+
 #include <iomanip>
 #include <ostream>
 #include <string>
 
 #include "cia402/drive.hpp"
+#include "cia402/master.hpp"
 #include "cli/common.hpp"
 
 namespace cia402::cli {
@@ -58,7 +60,11 @@ class demo_run {
     }
   }
 
-  void command_word(command c) { inputs_.control_word = control_word_for(p_, c); }
+  void command_word(command c) {
+    std::uint16_t word = 0;
+    encode_command(p_, c, 0, word);
+    inputs_.control_word = word;
+  }
   drive_inputs& inputs() { return inputs_; }
 
  private:
@@ -81,13 +87,6 @@ class demo_run {
 };
 
 }  // namespace
-
-std::uint16_t control_word_for(const profile& p, command c) {
-  for (std::uint16_t word = 0; word < 32; ++word) {
-    if (p.decode(word) == c) return word;
-  }
-  return 0;
-}
 
 void run_demo(const profile& p, std::ostream& out) {
   demo_run d(p, out);

@@ -10,11 +10,6 @@
 
 namespace cia402::cli {
 
-/// The lowest control word the profile decodes to `c` (0x06 shutdown, 0x0F enable operation, ...
-/// in the standard; 0x1F enable operation in seed 004, where bit 4 must be set), so the demo speaks
-/// each profile's own dialect. 0 if no word decodes to `c`.
-std::uint16_t control_word_for(const profile& p, command c);
-
 /// Runs the demo on the profile and prints it.
 void run_demo(const profile& p, std::ostream& out);
 
