@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 #include "cia402/drive.hpp"
+// Every test file of this executable includes it, so gtest's printer for `state` is one definition.
+#include "test_support.hpp"
 using namespace cia402;
 TEST(smoke, power_up_enable) {
   drive d(standard_profile());

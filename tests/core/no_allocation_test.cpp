@@ -1,0 +1,189 @@
+// The core never touches the heap (DEVELOPERS.md: no heap in the per-cycle path; STYLE.md, ETL: "a
+// test that fails if the core calls operator new"). Every global operator new and delete is replaced
+// here by a counting version; the counts are read around stretches of core calls only, since gtest
+// itself allocates. This file is its own executable so the replacement touches nothing else.
+#include <atomic>
+#include <cstdint>
+#include <cstdlib>
+#include <new>
+
+#include "test_support.hpp"
+
+namespace {
+
+std::atomic<long> allocations{0};
+std::atomic<long> deallocations{0};
+
+void* counted_alloc(std::size_t size) {
+  allocations.fetch_add(1, std::memory_order_relaxed);
+  return std::malloc(size == 0 ? 1 : size);
+}
+
+void* counted_aligned_alloc(std::size_t size, std::align_val_t align) {
+  allocations.fetch_add(1, std::memory_order_relaxed);
+  void* p = nullptr;
+  std::size_t a = static_cast<std::size_t>(align);
+  if (a < sizeof(void*)) a = sizeof(void*);
+  if (posix_memalign(&p, a, size == 0 ? 1 : size) != 0) return nullptr;
+  return p;
+}
+
+void counted_free(void* p) {
+  if (p == nullptr) return;
+  deallocations.fetch_add(1, std::memory_order_relaxed);
+  std::free(p);
+}
+
+}  // namespace
+
+// The replaceable global allocation functions ([new.delete]), all of them.
+void* operator new(std::size_t n) {
+  if (void* p = counted_alloc(n)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) {
+  if (void* p = counted_alloc(n)) return p;
+  throw std::bad_alloc();
+}
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return counted_alloc(n); }
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return counted_alloc(n); }
+void* operator new(std::size_t n, std::align_val_t a) {
+  if (void* p = counted_aligned_alloc(n, a)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n, std::align_val_t a) {
+  if (void* p = counted_aligned_alloc(n, a)) return p;
+  throw std::bad_alloc();
+}
+void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+  return counted_aligned_alloc(n, a);
+}
+void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+  return counted_aligned_alloc(n, a);
+}
+void operator delete(void* p) noexcept { counted_free(p); }
+void operator delete[](void* p) noexcept { counted_free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { counted_free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { counted_free(p); }
+void operator delete(void* p, std::size_t) noexcept { counted_free(p); }
+void operator delete[](void* p, std::size_t) noexcept { counted_free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { counted_free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { counted_free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { counted_free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { counted_free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { counted_free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept {
+  counted_free(p);
+}
+
+namespace cia402 {
+namespace {
+
+// Counts heap calls made while `body` runs. Nothing inside may use gtest or the standard library's
+// allocating types.
+template <typename Body>
+long heap_calls_during(Body body) {
+  const long a0 = allocations.load();
+  const long d0 = deallocations.load();
+  body();
+  return (allocations.load() - a0) + (deallocations.load() - d0);
+}
+
+// A deterministic input generator that needs no heap.
+struct lcg {
+  std::uint32_t x;
+  std::uint32_t next() {
+    x = x * 1664525u + 1013904223u;
+    return x >> 8;
+  }
+};
+
+TEST(no_allocation, counter_sees_a_heap_allocation) {
+  // So the zero counts below can mean something.
+  int* volatile p = nullptr;
+  const long calls = heap_calls_during([&] {
+    p = new int(7);
+    delete p;
+    p = new (std::nothrow) int[3];
+    delete[] p;
+  });
+  EXPECT_EQ(calls, 4);
+}
+
+TEST(no_allocation, stepping_every_profile_never_allocates) {
+  for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
+    const profile& p = builtin_profile(i);
+    axis a = make_axis(p);
+    lcg rng{static_cast<std::uint32_t>(1234 + i)};
+    std::uint32_t sink = 0;
+    const long calls = heap_calls_during([&] {
+      const std::uint16_t words[] = {0x00, 0x02, 0x06, 0x07, 0x0F, 0x1F, 0x0B, 0x8F, 0x10F};
+      drive_inputs in;
+      for (int s = 0; s < 50000; ++s) {
+        const std::uint32_t r = rng.next();
+        in.control_word = (r & 7) == 0 ? static_cast<std::uint16_t>(r >> 8) : words[r % 9];
+        in.fault_code = (r & 0x3F0) == 0 ? 0x2310 : 0;
+        in.fault_class = static_cast<std::uint8_t>((r >> 12) % 5);
+        in.sto = (r & 0x7F000) == 0;
+        in.dc_link = (r & 0x3F800) != 0;
+        in.standstill = (r & 0x100000) != 0;
+        in.brake_engaged = (r & 0x200000) != 0;
+        in.connection_lost = (r & 0xF00000) == 0;
+        in.actual_speed_rpm = static_cast<std::int32_t>((r >> 4) % 2001) - 1000;
+        if ((r % 20011) == 0) a = make_axis(p);
+        const drive_outputs o = step(p, a, in);
+        sink += o.status_word + o.transition;
+      }
+      drive d(p);
+      for (int s = 0; s < 1000; ++s) sink += d.step(in).status_word;
+    });
+    EXPECT_EQ(calls, 0) << p.name;
+    EXPECT_NE(sink, 0u);
+  }
+}
+
+TEST(no_allocation, option_writes_and_reads_never_allocate) {
+  for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
+    const profile& p = builtin_profile(i);
+    axis a = make_axis(p);
+    long accepted = 0;
+    const long calls = heap_calls_during([&] {
+      const std::uint16_t indices[] = {0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007, 0x6040};
+      for (std::uint16_t index : indices) {
+        for (std::int32_t v = -40; v <= 40; ++v) {
+          if (write_option(p, a, index, v) == sdo_abort::none) ++accepted;
+          std::int32_t back = 0;
+          read_option(p, a, index, back);
+        }
+      }
+    });
+    EXPECT_EQ(calls, 0) << p.name;
+    EXPECT_GE(accepted, 0);
+  }
+}
+
+TEST(no_allocation, profile_checks_names_and_custom_profiles_never_allocate) {
+  std::uint32_t sink = 0;
+  const long calls = heap_calls_during([&] {
+    for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
+      const profile& p = builtin_profile(i);
+      int row = 0;
+      sink += check_profile(p, row) == nullptr;
+      custom_profile c(p);
+      custom_profile copy = c;
+      copy.set_name("copy");
+      copy.finalize();
+      sink += copy.get().row_count;
+      sink += find_builtin_profile(p.name) != nullptr;
+    }
+    for (int s = 0; s < state_count; ++s) sink += state_name(static_cast<state>(s))[0];
+    state parsed{};
+    sink += parse_state("operation_enabled", parsed);
+    sink += sdo_abort_text(sdo_abort::invalid_value)[0];
+  });
+  EXPECT_EQ(calls, 0);
+  EXPECT_NE(sink, 0u);
+}
+
+}  // namespace
+}  // namespace cia402
