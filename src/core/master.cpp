@@ -111,12 +111,15 @@ command_path search(const profile& p, const axis& from, state target,
       in.control_word = words[w];
       axis next = nodes[head].at;
       const drive_outputs out = step(p, next, in);
+      // The goal test comes before the seen test: whether the target holds depends on the word,
+      // and an axis first reached by a word that moves on may be reached again by one that holds.
+      const bool goal = next.current == target && (!must_hold || word_holds(p, next, words[w]));
       bool seen = false;
-      for (std::size_t k = 0; k < count && !seen; ++k) seen = same_axis(nodes[k].at, next);
+      for (std::size_t k = 0; k < count && !seen && !goal; ++k) seen = same_axis(nodes[k].at, next);
       if (seen || count == max_nodes) continue;
       nodes[count] = {next, static_cast<std::uint16_t>(head), words[w], out.transition};
       depth[count] = static_cast<std::uint8_t>(depth[head] + 1);
-      if (next.current == target && (!must_hold || word_holds(p, next, words[w]))) {
+      if (goal) {
         // Walk back to the start, then write the steps in order.
         path.reachable = true;
         path.length = depth[count];

@@ -173,3 +173,27 @@ TEST(closed_loop, late_status_words_still_reach_the_target_without_a_fault) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(closed_loop, a_path_sets_bit_7_only_for_the_fault_reset_itself) {
+  for (std::size_t i = 0; i < cia402::builtin_profile_count(); ++i) {
+    const cia402::profile& p = cia402::builtin_profile(i);
+    const cia402::axis options = cia402::make_axis(p);
+    for (const state from : fsa_states) {
+      for (const state target : fsa_states) {
+        const cia402::command_path path =
+            cia402::plan_path(p, cia402::axis_at_rest(p, options, from, false), target);
+        for (int k = 0; k < path.length; ++k) {
+          const cia402::path_step& s = path.steps[static_cast<std::size_t>(k)];
+          if (s.control_word & 0x80) {
+            EXPECT_EQ(s.transition, 15) << p.name << " " << cia402::state_name(from) << " -> "
+                                        << cia402::state_name(target) << " step " << k;
+          }
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
