@@ -181,13 +181,12 @@ struct profile {
   bool error_classes = false;
 
   // Derived by finalize(): the decoder as a table over control-word bits 0..4, and per state the
-  // rows that leave it (bit i = rows[i]) and the union of their triggers, so a step that can fire
-  // nothing costs one AND.
+  // rows that leave it (bit i = rows[i]), so a step that can fire nothing costs one AND.
   std::array<std::uint8_t, 32> command_of_bits{};
   std::array<std::uint32_t, state_count> rows_from{};
-  std::array<std::uint32_t, state_count> triggers_from{};
-  /// triggers_from, or every fact for states that stop by an option code (QUICK STOP ACTIVE,
-  /// FAULT REACTION ACTIVE): a cycle with none of these facts changes nothing (drive.hpp quiet step).
+  /// The union of the triggers of the rows leaving each state, or every fact for states that stop
+  /// by an option code (QUICK STOP ACTIVE, FAULT REACTION ACTIVE): a cycle with none of these facts
+  /// changes nothing (the quiet step, drive.hpp), and no row can fire without one.
   std::array<std::uint32_t, state_count> busy_from{};
 
   /// Recomputes the derived tables from the data above. Call after any change to it.
@@ -204,17 +203,17 @@ struct profile {
     }
     for (int s = 0; s < state_count; ++s) {
       rows_from[s] = 0;
-      triggers_from[s] = 0;
+      std::uint32_t triggers = 0;
       for (std::size_t r = 0; r < row_count && r < max_rows; ++r) {
         if ((rows[r].from >> s) & 1u) {
           rows_from[s] |= 1u << r;
-          triggers_from[s] |= rows[r].any.bits();
+          triggers |= rows[r].any.bits();
         }
       }
       const state_activity act = states[s].activity;
       const bool stopping =
           act == state_activity::quick_stop || act == state_activity::fault_reaction;
-      busy_from[s] = stopping ? 0xFFFFFFFFu : triggers_from[s];
+      busy_from[s] = stopping ? 0xFFFFFFFFu : triggers;
     }
   }
 

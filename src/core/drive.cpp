@@ -15,14 +15,6 @@ constexpr std::uint32_t command_facts = bits(fact::disable_voltage) | bits(fact:
                                         bits(fact::stop_and_inhibit) | bits(fact::fault_reset);
 constexpr std::uint32_t fault_facts = bits(fact::fault) | bits(fact::fault_quick_stop);
 
-// The facts 0x605A's value raises, by value (S5): 1..4 end by themselves, 5..8 stay.
-constexpr std::uint32_t quick_stop_facts[16] = {
-    0,
-    bits(fact::quick_stop_ends), bits(fact::quick_stop_ends), bits(fact::quick_stop_ends),
-    bits(fact::quick_stop_ends), bits(fact::quick_stop_stays), bits(fact::quick_stop_stays),
-    bits(fact::quick_stop_stays), bits(fact::quick_stop_stays), 0, 0, 0, 0, 0, 0, 0,
-};
-
 std::int8_t option_value(const axis& a, option o) noexcept {
   return a.options[static_cast<int>(o)];
 }
@@ -159,7 +151,7 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
                     (static_cast<std::uint32_t>(in.sto) << 13) |
                     (static_cast<std::uint32_t>(in.local_enable) << 19) |
                     (static_cast<std::uint32_t>(in.local_disable) << 20) |
-                    quick_stop_facts[static_cast<std::uint8_t>(a.options[0]) & 15u] |
+                    quick_stop_facts(a.options[0]) |
                     ((static_cast<std::uint32_t>(a.flags) & axis_flag::entered_by_fault) << 16) |
                     ((static_cast<std::uint32_t>(a.flags) & axis_flag::fault_latched) << 17);
   static_assert(axis_flag::entered_by_fault << 16 == static_cast<std::uint32_t>(fact::entered_by_fault));
@@ -206,7 +198,7 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   // The first row leaving the present state whose facts hold.
   const int from = static_cast<int>(a.current);
   std::uint8_t match = no_row;
-  if (p.triggers_from[from] & f) {
+  if (p.busy_from[from] & f) {
     for (std::uint32_t rows = p.rows_from[from]; rows != 0; rows &= rows - 1) {
       const std::uint8_t i = static_cast<std::uint8_t>(__builtin_ctz(rows));
       const transition_row& r = p.rows[i];

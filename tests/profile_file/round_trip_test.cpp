@@ -47,7 +47,7 @@ void expect_same_tables(const profile& a, const profile& b) {
   EXPECT_EQ(a.error_classes, b.error_classes);
   EXPECT_EQ(a.command_of_bits, b.command_of_bits);
   EXPECT_EQ(a.rows_from, b.rows_from);
-  EXPECT_EQ(a.triggers_from, b.triggers_from);
+  EXPECT_EQ(a.busy_from, b.busy_from);
 }
 
 // Random plant inputs, biased towards the words and events the tables react to.

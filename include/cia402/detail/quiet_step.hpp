@@ -9,6 +9,14 @@
 
 namespace cia402::detail {
 
+/// The facts 0x605A's value raises (S5): 1..4 end QUICK STOP ACTIVE by themselves, 5..8 stay.
+constexpr std::uint32_t quick_stop_facts(std::int8_t code) noexcept {
+  const unsigned qs = static_cast<std::uint8_t>(code);
+  return qs - 1u < 4u   ? static_cast<std::uint32_t>(fact::quick_stop_ends)
+         : qs - 5u < 4u ? static_cast<std::uint32_t>(fact::quick_stop_stays)
+                        : 0u;
+}
+
 inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_outputs& out) noexcept {
   // The first eight bytes of the inputs must read as the defaults (drive.hpp).
   static constexpr drive_inputs nominal{};
@@ -25,11 +33,7 @@ inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_
     return false;
   }
   const std::size_t s = static_cast<std::size_t>(a.current);
-  const unsigned qs = static_cast<std::uint8_t>(a.options[0]);
-  // S5: 1..4 end QUICK STOP ACTIVE by themselves, 5..8 stay.
-  const std::uint32_t qs_fact = qs - 1u < 4u   ? static_cast<std::uint32_t>(fact::quick_stop_ends)
-                                : qs - 5u < 4u ? static_cast<std::uint32_t>(fact::quick_stop_stays)
-                                               : 0u;
+  const std::uint32_t qs_fact = quick_stop_facts(a.options[0]);
   const bool slow = limit == 0 || (in.actual_speed_rpm < limit && in.actual_speed_rpm > -limit);
   const std::uint32_t f = static_cast<std::uint32_t>(fact::automatic) |
                           static_cast<std::uint32_t>(fact::dc_link) |
