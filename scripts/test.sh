@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Builds cia402 and passes every test: the one command CI runs (.ci/run). As root on a fresh Debian 12
+# it installs what it needs first. Exits non-zero at the first failure.
+#   dev preset: build + ctest; asan-ubsan preset: build + ctest; no-exceptions preset: build the core
+#   alone as C++17 without exceptions or RTTI; then scripts/test-consumer.sh.
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+started=$SECONDS
+step="install-deps"
+done_steps=()
+
+joined() {
+  if [ $# -eq 0 ]; then echo nothing; return; fi
+  local out=$1; shift
+  for s in "$@"; do out+="; $s"; done
+  echo "$out"
+}
+
+finish() {
+  local status=$?
+  local elapsed=$((SECONDS - started))
+  if [ "$status" -eq 0 ]; then
+    printf '\ntest.sh: PASSED in %ss: %s\n' "$elapsed" "$(joined "${done_steps[@]}")"
+  else
+    printf '\ntest.sh: FAILED at step "%s" after %ss (exit %s); passed before it: %s\n' \
+      "$step" "$elapsed" "$status" "$(joined "${done_steps[@]}")" >&2
+  fi
+}
+trap finish EXIT
+
+banner() { step=$1; printf '\n======== %s ========\n' "$step"; }
+
+# Tests in a preset: "N tests" from ctest's own listing.
+test_count() { ctest --preset "$1" -N | sed -n 's/^Total Tests: //p'; }
+
+banner install-deps
+bash scripts/install-deps.sh
+done_steps+=("deps")
+
+for preset in dev asan-ubsan; do
+  banner "$preset"
+  cmake --preset "$preset"
+  cmake --build --preset "$preset"
+  ctest --preset "$preset"
+  done_steps+=("$preset: $(test_count "$preset") tests passed")
+done
+
+banner no-exceptions
+cmake --preset no-exceptions
+cmake --build --preset no-exceptions
+done_steps+=("no-exceptions core built")
+
+banner consumer
+bash scripts/test-consumer.sh
+done_steps+=("consumer: find_package, pkg-config, add_subdirectory")
