@@ -2,7 +2,9 @@
 # Builds cia402 and passes every test: the one command CI runs (.ci/run). As root on a fresh Debian 12
 # it installs what it needs first. Exits non-zero at the first failure.
 #   dev preset: build + ctest; asan-ubsan preset: build + ctest; no-exceptions preset: build the core
-#   alone as C++17 without exceptions or RTTI; then scripts/test-consumer.sh.
+#   alone as C++17 without exceptions or RTTI; release preset: benchmarks (a short run, ratios to the
+#   baseline), the Cortex-M4 flash and RAM, the state diagrams against docs/diagrams; then
+#   scripts/test-consumer.sh.
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -51,6 +53,14 @@ banner no-exceptions
 cmake --preset no-exceptions
 cmake --build --preset no-exceptions
 done_steps+=("no-exceptions core built")
+
+banner release
+cmake --preset release
+cmake --build --preset release
+build/release/bench/cia402_bench --benchmark_min_time=0.05
+bash bench/cortex_m4/size.sh build/cortex-m4
+bash scripts/diagrams.sh build/release/tools/cia402 --check
+done_steps+=("release: bench, cortex-m4 size, diagrams")
 
 banner consumer
 bash scripts/test-consumer.sh
