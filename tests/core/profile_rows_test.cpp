@@ -219,8 +219,10 @@ void fault_class(bench& b, std::uint8_t cls) {
   b.in.fault_code = any_fault;
   b.in.fault_class = cls;
 }
-// QUICK STOP ACTIVE entered by an error of class 1 in OPERATION ENABLED; then the master leaves
-// Enable operation (which would be T16 by itself) and the error is corrected.
+// QUICK STOP ACTIVE entered by an error of class 1 in OPERATION ENABLED; then the error is corrected
+// and the master sends Shutdown, which does nothing in QUICK STOP ACTIVE. Enable operation would not
+// leave either (footnote (3): this quick stop came from an error, not from the fieldbus), but with a
+// neutral word the case's own trigger (a Fault Reset edge, or Enable operation) is the only change.
 void quick_stop_by_class_1(bench& b) {
   fault_class(b, 1);
   b.step();  // T11
