@@ -188,12 +188,18 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
 
   // A stop is complete at standstill with the brake engaged (when it ends with torque off), or at
   // once when it coasts.
+  // Only a pending row, QUICK STOP ACTIVE and FAULT REACTION ACTIVE run stops that can coast or
+  // end with torque off; elsewhere standstill is enough.
   const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
-  const activity_now before = activity_of(p, a, halt);
-  if (before.ramp == stop_ramp::coast || in.sto ||
-      (in.standstill && (in.brake_engaged || !before.stop_ends_torque))) {
-    f |= bits(fact::stop_complete);
+  const state_activity act_before = p.info(a.current).activity;
+  bool complete = in.sto || in.standstill;
+  if (a.pending_row != no_row || act_before == state_activity::quick_stop ||
+      act_before == state_activity::fault_reaction) {
+    const activity_now before = activity_of(p, a, halt);
+    complete = before.ramp == stop_ramp::coast || in.sto ||
+               (in.standstill && (in.brake_engaged || !before.stop_ends_torque));
   }
+  if (complete) f |= bits(fact::stop_complete);
 
   // The first row leaving the present state whose facts hold.
   const int from = static_cast<int>(a.current);
@@ -239,7 +245,6 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
     a.error_code = fault.code;
   }
 
-  activity_now now = before;
   if (commit != no_row) {
     const transition_row& r = p.rows[commit];
     const std::uint32_t why = r.any.bits() & f;
@@ -259,10 +264,8 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
       a.error_code = 0;
       set_flag(a, axis_flag::coast_reaction, false);
     }
-    now = activity_of(p, a, halt);
-  } else if (a.pending_row != no_row) {
-    now = activity_of(p, a, halt);
   }
+  const activity_now now = activity_of(p, a, halt);
 
   // Outputs of the state the drive is in now.
   const state s = a.current;
