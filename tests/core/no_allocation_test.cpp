@@ -1,93 +1,17 @@
 // The core never touches the heap (DEVELOPERS.md: no heap in the per-cycle path; STYLE.md, ETL: "a
 // test that fails if the core calls operator new"). Every global operator new and delete is replaced
-// here by a counting version; the counts are read around stretches of core calls only, since gtest
+// by the counting versions of tests/support/counting_allocator.hpp; the counts are read around
+// stretches of core calls only, since gtest
 // itself allocates. This file is its own executable so the replacement touches nothing else.
-#include <atomic>
-#include <cstdint>
-#include <cstdlib>
-#include <new>
 
 #include "test_support.hpp"
 
-namespace {
-
-std::atomic<long> allocations{0};
-std::atomic<long> deallocations{0};
-
-void* counted_alloc(std::size_t size) {
-  allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
-}
-
-void* counted_aligned_alloc(std::size_t size, std::align_val_t align) {
-  allocations.fetch_add(1, std::memory_order_relaxed);
-  void* p = nullptr;
-  std::size_t a = static_cast<std::size_t>(align);
-  if (a < sizeof(void*)) a = sizeof(void*);
-  if (posix_memalign(&p, a, size == 0 ? 1 : size) != 0) return nullptr;
-  return p;
-}
-
-void counted_free(void* p) {
-  if (p == nullptr) return;
-  deallocations.fetch_add(1, std::memory_order_relaxed);
-  std::free(p);
-}
-
-}  // namespace
-
-// The replaceable global allocation functions ([new.delete]), all of them.
-void* operator new(std::size_t n) {
-  if (void* p = counted_alloc(n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-  if (void* p = counted_alloc(n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return counted_alloc(n); }
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return counted_alloc(n); }
-void* operator new(std::size_t n, std::align_val_t a) {
-  if (void* p = counted_aligned_alloc(n, a)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n, std::align_val_t a) {
-  if (void* p = counted_aligned_alloc(n, a)) return p;
-  throw std::bad_alloc();
-}
-void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
-  return counted_aligned_alloc(n, a);
-}
-void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
-  return counted_aligned_alloc(n, a);
-}
-void operator delete(void* p) noexcept { counted_free(p); }
-void operator delete[](void* p) noexcept { counted_free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { counted_free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { counted_free(p); }
-void operator delete(void* p, std::size_t) noexcept { counted_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { counted_free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { counted_free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { counted_free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { counted_free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { counted_free(p); }
-void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { counted_free(p); }
-void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept {
-  counted_free(p);
-}
+#include "counting_allocator.hpp"
 
 namespace cia402 {
 namespace {
 
-// Counts heap calls made while `body` runs. Nothing inside may use gtest or the standard library's
-// allocating types.
-template <typename Body>
-long heap_calls_during(Body body) {
-  const long a0 = allocations.load();
-  const long d0 = deallocations.load();
-  body();
-  return (allocations.load() - a0) + (deallocations.load() - d0);
-}
+using test::heap_calls_during;
 
 // A deterministic input generator that needs no heap.
 struct lcg {
