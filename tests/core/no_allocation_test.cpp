@@ -1,8 +1,8 @@
 // The core never touches the heap (DEVELOPERS.md: no heap in the per-cycle path; STYLE.md, ETL: "a
 // test that fails if the core calls operator new"). Every global operator new and delete is replaced
 // by the counting versions of tests/support/counting_allocator.hpp; the counts are read around
-// stretches of core calls only, since gtest
-// itself allocates. This file is its own executable so the replacement touches nothing else.
+// stretches of core calls only, since gtest itself allocates. This file is its own executable so
+// the replacement touches nothing else.
 
 #include "test_support.hpp"
 
