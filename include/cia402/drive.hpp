@@ -14,8 +14,8 @@ namespace cia402 {
 /// Everything the drive reads in one cycle. The defaults are an ideal plant: DC link on, no STO, at
 /// standstill with no holding brake to wait for, remote control.
 struct drive_inputs {
-  // The first eight bytes hold what a quiet cycle must find as it is by default (no fault, voltage,
-  // no STO, remote, connection, no local request), so the step checks them with one comparison.
+  // What a quiet cycle must find as it is by default (no fault, voltage, no STO, remote,
+  // connection, no local request) comes first.
   std::uint16_t fault_code = 0;     ///< error code of the present fault cause (0x603F); 0 = none
   bool dc_link = true;              ///< DC-link (main) voltage present (S13)
   bool sto = false;                 ///< safe torque off active (S14)

@@ -12,6 +12,7 @@
 #include "cli/diagram.hpp"
 #include "cli/path.hpp"
 #include "cli/replay.hpp"
+#include "cli/simulate.hpp"
 #include "cli/words.hpp"
 
 namespace cia402::cli {
@@ -100,6 +101,9 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
       ->check(CLI::IsMember({"dot", "mermaid", "svg"}))
       ->default_str("dot");
 
+  simulate_args simulate_options;
+  auto* simulate = add_simulate_subcommand(app, simulate_options);
+
   try {
     std::vector<std::string> reversed(args.rbegin(), args.rend());
     app.parse(reversed);
@@ -107,6 +111,7 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
     return app.exit(e, out, err);
   }
 
+  if (simulate->parsed()) return run_simulate(simulate_options, out, err);
   if (profiles->parsed()) {
     if (dump_name.empty()) return list_profiles(out);
     const profile* p = find_builtin_profile(dump_name);

@@ -5,7 +5,6 @@
 // detail::full_step (src/core/drive.cpp) then does the whole work.
 #pragma once
 
-#include <cstring>
 
 namespace cia402::detail {
 
@@ -18,18 +17,16 @@ constexpr std::uint32_t quick_stop_facts(std::int8_t code) noexcept {
 }
 
 inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_outputs& out) noexcept {
-  // The first eight bytes of the inputs must read as the defaults (drive.hpp).
-  static constexpr drive_inputs nominal{};
-  std::uint64_t head;
-  std::uint64_t expected;
-  std::memcpy(&head, &in, sizeof head);
-  std::memcpy(&expected, &nominal, sizeof expected);
+  // Field by field rather than one 8-byte load: callers fill inputs field by field, and a wide
+  // load over narrow stores stalls store forwarding. Bitwise ORs keep it to one branch.
+  const bool unusual_inputs = (in.fault_code != 0) | !in.dc_link | in.sto | !in.remote |
+                              in.connection_lost | in.local_enable | in.local_disable;
   const std::uint16_t cw = in.control_word;
   const unsigned reset_bit = (cw >> 7) & 1u;
   const unsigned flags = a.flags;
   const std::int32_t limit = p.speed_limit_rpm;  // seed 001: T2/T7 watch the speed
   const bool overspeed = limit != 0 && (in.actual_speed_rpm > limit || in.actual_speed_rpm < -limit);
-  if ((head != expected) | (a.pending_row != 0xFF) | ((reset_bit & ~flags) != 0) | overspeed) {
+  if (unusual_inputs | (a.pending_row != 0xFF) | ((reset_bit & ~flags) != 0) | overspeed) {
     return false;
   }
   const std::size_t s = static_cast<std::size_t>(a.current);

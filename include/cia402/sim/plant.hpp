@@ -1,0 +1,129 @@
+// The simulator's plant: a motor in profile velocity mode with a holding brake, a DC link and an STO
+// input, stepped on a fixed cycle of virtual time. The state machine is the core's: each cycle the
+// plant's feedback goes into cia402::step() and the plant then follows its drive_outputs. Nothing
+// here reads a clock, draws a random number or uses floating point, so the same inputs give the
+// same trajectory bit for bit on every machine.
+//
+// Units: velocities in rpm (0x60FF, 0x606C), ramps in rpm/s (0x6083..0x6085), time in
+// microseconds. Inside, the velocity is kept in micro-rpm (1e-6 rpm) so that a ramp's change per
+// cycle, rate [rpm/s] x cycle [us], is an exact integer.
+#pragma once
+
+#include <cstdint>
+
+#include "cia402/drive.hpp"
+#include "cia402/profile.hpp"
+
+namespace cia402::sim {
+
+/// Physical parameters shared by every axis of a machine. Every field is documented with what the
+/// plant does with it; check_plant_config() says whether a set is usable.
+struct plant_config {
+  /// The cycle of virtual time, 1 us .. 1 s. The core steps once per cycle.
+  std::uint32_t cycle_us = 1000;
+  /// A holding brake is fitted. Without one the drive always reads brake_engaged = true and motion
+  /// never waits for a brake.
+  bool brake_fitted = true;
+  /// From drive_outputs.brake_released going false to the brake holding the shaft (at least one
+  /// cycle: the drive sees the change in the next cycle at the earliest).
+  std::uint32_t brake_engage_delay_us = 20000;
+  /// From drive_outputs.brake_released going true to the brake letting go. Until then the shaft is
+  /// held: no acceleration while the brake is still engaged or releasing.
+  std::uint32_t brake_release_delay_us = 30000;
+  /// How fast an engaged brake stops a turning shaft (rpm/s), added to whatever else decelerates it.
+  std::uint32_t brake_deceleration = 20000;
+  /// Friction: how fast a coasting motor (torque off) slows down (rpm/s). 0 = no friction.
+  std::uint32_t coast_deceleration = 300;
+  /// |velocity| <= this (rpm) is standstill: drive_inputs.standstill, status bit 12 (pv "speed 0").
+  std::uint32_t standstill_window_rpm = 1;
+  /// |velocity - set-point| <= this (rpm) is target reached (status bit 10 in OPERATION ENABLED).
+  std::uint32_t target_window_rpm = 10;
+  /// A stop at the current limit (0x605A/0x605D/0x605E codes 3 and 7) decelerates at this percentage
+  /// of the quick-stop deceleration 0x6085: 200 = twice as hard as the quick-stop ramp.
+  std::uint32_t current_limit_percent = 200;
+  /// A stop at the voltage limit (codes 4 and 8) decelerates at this percentage of the deceleration
+  /// 0x6084: the DC link can take back no more energy than the normal slow-down ramp returns.
+  std::uint32_t voltage_limit_percent = 100;
+};
+
+/// nullptr when the configuration is usable, else the reason ("cycle_us must be 1..1000000").
+const char* check_plant_config(const plant_config& c) noexcept;
+
+/// Values derived once from a plant_config, in the units the per-cycle code uses.
+struct plant_constants {
+  std::uint32_t cycle_us = 1000;
+  std::int64_t coast_step = 0;        ///< micro-rpm lost per cycle when coasting
+  std::int64_t brake_step = 0;        ///< micro-rpm an engaged brake takes per cycle
+  std::int64_t standstill_window = 0; ///< micro-rpm
+  std::int64_t target_window = 0;     ///< micro-rpm
+  std::uint16_t engage_cycles = 1;    ///< cycles from the command to an engaged brake
+  std::uint16_t release_cycles = 1;   ///< cycles from the command to a released brake
+  std::uint16_t current_limit_percent = 200;
+  std::uint16_t voltage_limit_percent = 100;
+  bool brake_fitted = true;
+
+  /// Requires check_plant_config(c) == nullptr.
+  static plant_constants from(const plant_config& c) noexcept;
+};
+
+/// Bits of axis_state::flags.
+namespace sim_flag {
+inline constexpr std::uint8_t dc_link = 1u << 0;          ///< DC-link voltage present
+inline constexpr std::uint8_t sto = 1u << 1;              ///< safe torque off active
+inline constexpr std::uint8_t connection_lost = 1u << 2;  ///< fieldbus connection lost (0x6007)
+inline constexpr std::uint8_t setpoints_cleared = 1u << 3;  ///< 0x60FF reads as 0 until written
+inline constexpr std::uint8_t brake_closed = 1u << 4;     ///< the brake holds the shaft now
+inline constexpr std::uint8_t brake_commanded_open = 1u << 5;  ///< last drive_outputs.brake_released
+}  // namespace sim_flag
+
+/// How many fault causes one axis holds at once.
+inline constexpr int max_fault_causes = 4;
+
+/// Everything one virtual axis keeps between cycles: the core's axis, the motion objects, the plant
+/// and the injected inputs. Plain data, so a machine keeps N of them in one array.
+struct axis_state {
+  axis core;                          ///< the core state machine's memory
+  drive_outputs last;                 ///< what the core decided in the last cycle
+  std::int64_t velocity = 0;          ///< actual velocity, micro-rpm (0x606C = velocity / 1e6)
+  std::int32_t target_velocity = 0;   ///< 0x60FF, rpm
+  std::uint32_t acceleration = 1000;  ///< 0x6083, rpm/s
+  std::uint32_t deceleration = 1000;  ///< 0x6084, rpm/s: the slow-down ramp
+  std::uint32_t quick_stop_deceleration = 10000;  ///< 0x6085, rpm/s
+  std::uint16_t control_word = 0;     ///< 0x6040, read by the next cycle
+  std::uint16_t brake_timer = 0;      ///< cycles until the brake reaches its command
+  /// Present fault causes, oldest first; a free slot holds code 0. The newest is the one the drive
+  /// sees (drive_inputs.fault_code, fault_class).
+  std::uint16_t fault_codes[max_fault_causes] = {};
+  std::uint8_t fault_classes[max_fault_causes] = {};
+  std::uint8_t flags = sim_flag::dc_link | sim_flag::brake_closed;  ///< sim_flag bits
+};
+
+/// A fresh axis at power-on: the profile's default option codes, the motion objects' defaults, DC
+/// link present, brake engaged, at rest. Its first cycles take T0 and T1.
+axis_state make_axis_state(const profile& p) noexcept;
+
+/// The feedback the plant gives the drive at the start of a cycle (drive_inputs as the core reads
+/// them), from the axis's plant and injected inputs.
+drive_inputs plant_inputs(const plant_constants& k, const axis_state& a) noexcept;
+
+/// One cycle of one axis: the plant's feedback into cia402::step(), then the plant follows the
+/// outputs for one cycle (velocity, brake). Returns the outputs, kept in a.last.
+const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_state& a) noexcept;
+
+/// The set-point the motion side follows in OPERATION ENABLED: 0x60FF, or 0 after the drive
+/// cleared the set-points (T4) until 0x60FF is written again.
+inline std::int32_t effective_target(const axis_state& a) noexcept {
+  return (a.flags & sim_flag::setpoints_cleared) ? 0 : a.target_velocity;
+}
+
+/// Actual velocity as 0x606C reports it: rpm, rounded towards zero.
+inline std::int32_t velocity_rpm(const axis_state& a) noexcept {
+  return static_cast<std::int32_t>(a.velocity / 1000000);
+}
+
+/// The brake holds the shaft (always true when none is fitted, as the drive reads it).
+inline bool brake_engaged(const plant_constants& k, const axis_state& a) noexcept {
+  return !k.brake_fitted || (a.flags & sim_flag::brake_closed) != 0;
+}
+
+}  // namespace cia402::sim

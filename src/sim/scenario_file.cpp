@@ -1,0 +1,693 @@
+// Scenario files: TOML in, a checked cia402::sim::scenario out. As with profile files, the whole
+// scenario is built aside and handed over only when every key, name, time and start-up write has
+// passed, so a caller gets a runnable scenario or a line and a reason, never half of one.
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <sstream>
+
+#include "cia402/profile_file.hpp"
+#include "cia402/sim/scenario.hpp"
+#include "cia402/sim/virtual_drive.hpp"
+
+static_assert(TOML_EXCEPTIONS, "the loader relies on toml::parse throwing toml::parse_error");
+
+namespace cia402::sim {
+namespace {
+
+struct refusal {
+  int line = 0;
+  int column = 0;
+  std::string reason;
+};
+
+[[noreturn]] void refuse(const toml::source_region& at, std::string reason) {
+  throw refusal{static_cast<int>(at.begin.line), static_cast<int>(at.begin.column),
+                std::move(reason)};
+}
+[[noreturn]] void refuse(const toml::node& at, std::string reason) {
+  refuse(at.source(), std::move(reason));
+}
+[[noreturn]] void refuse(const toml::key& at, std::string reason) {
+  refuse(at.source(), std::move(reason));
+}
+
+std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
+
+std::string hex(std::uint64_t v, int digits) {
+  static constexpr char d[] = "0123456789ABCDEF";
+  std::string s = "0x";
+  for (int i = digits - 1; i >= 0; --i) s += d[(v >> (4 * i)) & 0xFu];
+  return s;
+}
+
+const char* type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date: return "a date";
+    case toml::node_type::time: return "a time";
+    case toml::node_type::date_time: return "a date-time";
+    case toml::node_type::none: break;
+  }
+  return "nothing";
+}
+
+[[noreturn]] void refuse_type(const toml::node& n, std::string_view what,
+                              std::string_view expected) {
+  refuse(n, std::string(what) + " must be " + std::string(expected) + ", not " + type_name(n));
+}
+
+void check_keys(const toml::table& t, std::initializer_list<std::string_view> allowed,
+                std::string_view where) {
+  for (auto&& [key, value] : t) {
+    (void)value;
+    if (std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end()) {
+      std::string list;
+      for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+      std::string hint;
+      for (std::string_view root_key : {"events", "expect", "objects", "duration", "cycle"}) {
+        if (key.str() == root_key && where != "the scenario") {
+          hint = "; a [table] lasts until the next one, so write '" + std::string(root_key) +
+                 "' before the first [table] header";
+        }
+      }
+      refuse(key, "unknown key " + in_quotes(key.str()) + " in " + std::string(where) +
+                      " (allowed: " + list + ")" + hint);
+    }
+  }
+}
+
+std::int64_t get_int(const toml::node& n, std::string_view what, std::int64_t lo,
+                     std::int64_t hi) {
+  const auto* v = n.as_integer();
+  if (v == nullptr) refuse_type(n, what, "an integer");
+  const std::int64_t x = v->get();
+  if (x < lo || x > hi) {
+    refuse(n, std::string(what) + " " + std::to_string(x) + " is outside " + std::to_string(lo) +
+                  ".." + std::to_string(hi));
+  }
+  return x;
+}
+
+std::string_view get_string(const toml::node& n, std::string_view what) {
+  const auto* v = n.as_string();
+  if (v == nullptr) refuse_type(n, what, "a string");
+  return v->get();
+}
+
+bool get_bool(const toml::node& n, std::string_view what) {
+  const auto* v = n.as_boolean();
+  if (v == nullptr) refuse_type(n, what, "true or false");
+  return v->get();
+}
+
+const toml::table& get_table(const toml::node& n, std::string_view what) {
+  const auto* v = n.as_table();
+  if (v == nullptr) refuse_type(n, what, "a table");
+  return *v;
+}
+
+const toml::array& get_array(const toml::node& n, std::string_view what) {
+  const auto* v = n.as_array();
+  if (v == nullptr) refuse_type(n, what, "an array");
+  return *v;
+}
+
+// A decimal or 0x-hexadecimal integer written as a key ("0x605A").
+bool parse_index(std::string_view text, std::uint16_t& out) {
+  unsigned base = 10;
+  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
+    base = 16;
+    text.remove_prefix(2);
+  }
+  if (text.empty()) return false;
+  std::uint32_t v = 0;
+  for (char c : text) {
+    unsigned d;
+    if (c >= '0' && c <= '9') d = static_cast<unsigned>(c - '0');
+    else if (base == 16 && c >= 'a' && c <= 'f') d = static_cast<unsigned>(c - 'a' + 10);
+    else if (base == 16 && c >= 'A' && c <= 'F') d = static_cast<unsigned>(c - 'A' + 10);
+    else return false;
+    v = v * base + d;
+    if (v > 0xFFFF) return false;
+  }
+  out = static_cast<std::uint16_t>(v);
+  return true;
+}
+
+// "10ms", "1.5s", "250us", "2 s": an exact number of microseconds.
+std::uint64_t get_time_us(const toml::node& n, std::string_view what) {
+  if (n.is_integer() || n.is_floating_point()) {
+    refuse(n, std::string(what) + " must be a string with a unit, e.g. \"10ms\", \"1.5s\" or "
+                                  "\"250us\"");
+  }
+  const std::string text(get_string(n, what));
+  std::size_t i = 0;
+  std::uint64_t whole = 0;
+  std::uint64_t fraction = 0;
+  std::uint64_t scale = 1;  // 10^(fraction digits)
+  auto bad = [&]() {
+    refuse(n, std::string(what) + " " + in_quotes(text) +
+                  " is not a time: write a number and a unit (s, ms, us), e.g. \"1.5s\"");
+  };
+  const std::size_t digits_start = i;
+  while (i < text.size() && text[i] >= '0' && text[i] <= '9') {
+    whole = whole * 10 + static_cast<std::uint64_t>(text[i] - '0');
+    if (whole > 1000000000ull) bad();
+    ++i;
+  }
+  if (i == digits_start) bad();
+  if (i < text.size() && text[i] == '.') {
+    ++i;
+    const std::size_t frac_start = i;
+    while (i < text.size() && text[i] >= '0' && text[i] <= '9') {
+      if (scale >= 1000000000000ull) bad();
+      fraction = fraction * 10 + static_cast<std::uint64_t>(text[i] - '0');
+      scale *= 10;
+      ++i;
+    }
+    if (i == frac_start) bad();
+  }
+  while (i < text.size() && text[i] == ' ') ++i;
+  const std::string unit = text.substr(i);
+  std::uint64_t us_per_unit = 0;
+  if (unit == "s") us_per_unit = 1000000;
+  else if (unit == "ms") us_per_unit = 1000;
+  else if (unit == "us") us_per_unit = 1;
+  else bad();
+  if ((fraction * us_per_unit) % scale != 0) {
+    refuse(n, std::string(what) + " " + in_quotes(text) + " is finer than a microsecond");
+  }
+  return whole * us_per_unit + fraction * us_per_unit / scale;
+}
+
+// "2 s", "1.5 s", "1.5 ms", "250 us": a time as a person writes it.
+std::string seconds_text(std::uint64_t us) {
+  auto decimal = [](std::uint64_t value, std::uint64_t unit, int digits, const char* name) {
+    std::string s = std::to_string(value / unit);
+    const std::uint64_t rest = value % unit;
+    if (rest != 0) {
+      std::string frac = std::to_string(rest);
+      frac.insert(0, static_cast<std::size_t>(digits) - frac.size(), '0');
+      while (frac.back() == '0') frac.pop_back();
+      s += "." + frac;
+    }
+    return s + " " + name;
+  };
+  if (us >= 1000000) return decimal(us, 1000000, 6, "s");
+  if (us >= 1000) return decimal(us, 1000, 3, "ms");
+  return std::to_string(us) + " us";
+}
+
+// A velocity in rpm (integer or float) as micro-rpm.
+std::int64_t get_velocity(const toml::node& n, std::string_view what) {
+  constexpr double limit = 2147483647.0;
+  if (const auto* i = n.as_integer()) {
+    const std::int64_t v = i->get();
+    if (v < -2147483648LL || v > 2147483647LL) {
+      refuse(n, std::string(what) + " " + std::to_string(v) + " rpm is outside the INT32 range");
+    }
+    return v * 1000000;
+  }
+  if (const auto* f = n.as_floating_point()) {
+    const double v = f->get();
+    if (!std::isfinite(v) || v < -limit || v > limit) {
+      refuse(n, std::string(what) + " is outside the INT32 range of rpm");
+    }
+    return std::llround(v * 1e6);
+  }
+  refuse_type(n, what, "a number of rpm");
+}
+
+struct loader {
+  scenario s;
+  std::string base_dir;
+  std::uint64_t duration_us = 0;
+  const toml::node* duration_node = nullptr;
+
+  std::uint64_t cycle_of(const toml::node& n, std::string_view what) {
+    const std::uint64_t us = get_time_us(n, what);
+    const std::uint32_t cycle = s.plant.cycle_us;
+    if (us % cycle != 0) {
+      refuse(n, std::string(what) + " " + seconds_text(us) + " is not a multiple of the cycle (" +
+                    seconds_text(cycle) + ")");
+    }
+    if (us > duration_us) {
+      refuse(n, std::string(what) + " " + seconds_text(us) + " lies after the end of the run (" +
+                    "duration " + seconds_text(duration_us) + ")");
+    }
+    return us / cycle;
+  }
+
+  void load_profile(const toml::table& root) {
+    const toml::node* by_name = root.get("profile");
+    const toml::node* by_file = root.get("profile_file");
+    if (by_name && by_file) refuse(*by_file, "give either 'profile' or 'profile_file', not both");
+    if (by_file) {
+      const std::string_view file = get_string(*by_file, "profile_file");
+      std::filesystem::path path(file);
+      if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
+      profile_load_result loaded = load_profile_toml_file(path.string());
+      if (const auto* e = std::get_if<profile_file_error>(&loaded)) {
+        refuse(*by_file, "profile file refused: " + e->message());
+      }
+      s.drive_profile = std::get<custom_profile>(loaded);
+      return;
+    }
+    std::string_view name = "cia402";
+    if (by_name) name = get_string(*by_name, "profile");
+    const profile* p = find_builtin_profile(name);
+    if (p == nullptr) {
+      std::string list;
+      for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
+        list += (i ? ", " : "") + std::string(builtin_profile(i).name);
+      }
+      refuse(by_name ? *by_name : static_cast<const toml::node&>(root),
+             "unknown profile " + in_quotes(name) + " (built-in: " + list + ")");
+    }
+    s.drive_profile = custom_profile(*p);
+  }
+
+  std::uint32_t get_u32(const toml::node& n, std::string_view what, std::int64_t lo = 0) {
+    return static_cast<std::uint32_t>(get_int(n, what, lo, std::numeric_limits<std::uint32_t>::max()));
+  }
+
+  void load_plant(const toml::table& t) {
+    check_keys(t,
+               {"brake", "brake_engage_delay", "brake_release_delay", "brake_deceleration",
+                "coast_deceleration", "standstill_window", "target_window",
+                "current_limit_percent", "voltage_limit_percent", "voltage", "sto"},
+               "[plant]");
+    plant_config& c = s.plant;
+    if (const auto* n = t.get("brake")) c.brake_fitted = get_bool(*n, "brake");
+    auto delay = [&](const char* key, std::uint32_t& out) {
+      if (const auto* n = t.get(key)) {
+        const std::uint64_t us = get_time_us(*n, key);
+        if (us > std::uint64_t{c.cycle_us} * 65535) {
+          refuse(*n, std::string(key) + " is longer than 65535 cycles");
+        }
+        out = static_cast<std::uint32_t>(us);
+      }
+    };
+    delay("brake_engage_delay", c.brake_engage_delay_us);
+    delay("brake_release_delay", c.brake_release_delay_us);
+    if (const auto* n = t.get("brake_deceleration")) {
+      c.brake_deceleration = get_u32(*n, "brake_deceleration", 1);
+    }
+    if (const auto* n = t.get("coast_deceleration")) {
+      c.coast_deceleration = get_u32(*n, "coast_deceleration");
+    }
+    if (const auto* n = t.get("standstill_window")) {
+      c.standstill_window_rpm =
+          static_cast<std::uint32_t>(get_int(*n, "standstill_window", 0, 1000000));
+    }
+    if (const auto* n = t.get("target_window")) {
+      c.target_window_rpm = static_cast<std::uint32_t>(get_int(*n, "target_window", 0, 1000000));
+    }
+    if (const auto* n = t.get("current_limit_percent")) {
+      c.current_limit_percent =
+          static_cast<std::uint32_t>(get_int(*n, "current_limit_percent", 1, 1000));
+    }
+    if (const auto* n = t.get("voltage_limit_percent")) {
+      c.voltage_limit_percent =
+          static_cast<std::uint32_t>(get_int(*n, "voltage_limit_percent", 1, 1000));
+    }
+    if (const auto* n = t.get("voltage")) s.dc_link_at_start = get_bool(*n, "voltage");
+    if (const auto* n = t.get("sto")) s.sto_at_start = get_bool(*n, "sto");
+    if (const char* why = check_plant_config(c)) refuse(t, std::string("[plant]: ") + why);
+  }
+
+  // Start-up writes go through the object interface of a scratch axis, so a refusal is known now.
+  void load_objects(const toml::table& t) {
+    axis_state scratch = make_axis_state(s.drive_profile.get());
+    for (auto&& [key, value] : t) {
+      std::uint16_t index = 0;
+      if (!parse_index(key.str(), index)) {
+        std::string hint;
+        for (std::string_view root_key : {"events", "expect", "name", "duration", "cycle", "plant"}) {
+          if (key.str() == root_key) {
+            hint = " (a [table] lasts until the next one: write '" + std::string(root_key) +
+                   "' before [objects], or as objects.0x605A = ... dotted keys)";
+          }
+        }
+        refuse(key, "object key " + in_quotes(key.str()) + " is not an index such as 0x605A" + hint);
+      }
+      const std::int64_t v = get_int(value, "object " + hex(index, 4),
+                                     std::numeric_limits<std::int64_t>::min(),
+                                     std::numeric_limits<std::int64_t>::max());
+      const sdo_abort r = write_object(s.drive_profile.get(), scratch, index, 0, v);
+      if (r != sdo_abort::none) {
+        refuse(value, "writing " + hex(index, 4) + " = " + std::to_string(v) + " is refused: SDO abort " +
+                          hex(static_cast<std::uint32_t>(r), 8) + " (" + sdo_abort_text(r) + ")");
+      }
+      s.initial_writes.emplace_back(index, v);
+    }
+  }
+
+  void load_event(const toml::table& t) {
+    check_keys(t,
+               {"at", "write", "acceleration", "deceleration", "quick_stop_deceleration",
+                "target_velocity", "cw", "abort", "voltage", "sto", "connection_lost",
+                "clear_fault", "fault", "fault_class"},
+               "an event");
+    const toml::node* at = t.get("at");
+    if (at == nullptr) refuse(t, "an event needs 'at', the time it happens (e.g. at = \"10ms\")");
+    scenario_event base;
+    base.cycle = cycle_of(*at, "'at'");
+    base.line = static_cast<int>(t.source().begin.line);
+    std::vector<scenario_event> actions;
+
+    auto add_write = [&](std::uint16_t index, const toml::node& n, std::string_view what) {
+      scenario_event e = base;
+      e.what = scenario_event::kind::write;
+      e.index = index;
+      e.value = get_int(n, what, std::numeric_limits<std::int64_t>::min(),
+                        std::numeric_limits<std::int64_t>::max());
+      actions.push_back(e);
+    };
+    if (const auto* n = t.get("write")) {
+      for (auto&& [key, value] : get_table(*n, "'write'")) {
+        std::uint16_t index = 0;
+        if (!parse_index(key.str(), index)) {
+          refuse(key, "object key " + in_quotes(key.str()) + " is not an index such as 0x605A");
+        }
+        add_write(index, value, "object " + hex(index, 4));
+      }
+    }
+    if (const auto* n = t.get("acceleration")) add_write(object::profile_acceleration, *n, "acceleration");
+    if (const auto* n = t.get("deceleration")) add_write(object::profile_deceleration, *n, "deceleration");
+    if (const auto* n = t.get("quick_stop_deceleration")) {
+      add_write(object::quick_stop_deceleration, *n, "quick_stop_deceleration");
+    }
+    if (const auto* n = t.get("target_velocity")) add_write(object::target_velocity, *n, "target_velocity");
+    if (const auto* n = t.get("cw")) add_write(object::control_word, *n, "cw");
+    const std::size_t writes = actions.size();
+    if (const auto* n = t.get("abort")) {
+      if (writes != 1) refuse(*n, "'abort' needs exactly one write in its event");
+      actions.back().expected_abort = static_cast<sdo_abort>(
+          get_int(*n, "abort", 1, std::numeric_limits<std::uint32_t>::max()));
+    }
+    auto add_flag = [&](const char* key, scenario_event::kind k) {
+      if (const auto* n = t.get(key)) {
+        scenario_event e = base;
+        e.what = k;
+        e.flag = get_bool(*n, key);
+        actions.push_back(e);
+      }
+    };
+    add_flag("voltage", scenario_event::kind::dc_link);
+    add_flag("sto", scenario_event::kind::sto);
+    add_flag("connection_lost", scenario_event::kind::connection_lost);
+    if (const auto* n = t.get("clear_fault")) {
+      scenario_event e = base;
+      if (n->is_string()) {
+        if (get_string(*n, "clear_fault") != "all") {
+          refuse(*n, "clear_fault must be an error code or \"all\"");
+        }
+        e.what = scenario_event::kind::clear_faults;
+      } else {
+        e.what = scenario_event::kind::clear_fault;
+        e.code = static_cast<std::uint16_t>(get_int(*n, "clear_fault", 1, 0xFFFF));
+      }
+      actions.push_back(e);
+    }
+    const toml::node* fault_class = t.get("fault_class");
+    if (const auto* n = t.get("fault")) {
+      scenario_event e = base;
+      e.what = scenario_event::kind::inject_fault;
+      e.code = static_cast<std::uint16_t>(get_int(*n, "fault", 1, 0xFFFF));
+      if (fault_class) {
+        if (!s.drive_profile.get().error_classes) {
+          refuse(*fault_class, std::string("profile '") + s.drive_profile.get().name +
+                                   "' has no error classes; leave out fault_class");
+        }
+        e.fault_class = static_cast<std::uint8_t>(get_int(*fault_class, "fault_class", 0, 4));
+      }
+      actions.push_back(e);
+    } else if (fault_class) {
+      refuse(*fault_class, "fault_class needs a fault in the same event");
+    }
+    if (actions.empty()) {
+      refuse(t, "an event needs an action: cw, target_velocity, acceleration, deceleration, "
+                "quick_stop_deceleration, write, fault, clear_fault, voltage, sto or "
+                "connection_lost");
+    }
+    s.events.insert(s.events.end(), actions.begin(), actions.end());
+  }
+
+  void load_expectation(const toml::table& t) {
+    check_keys(t,
+               {"at", "between", "state", "velocity", "statusword", "torque", "brake",
+                "error_code", "transition", "always"},
+               "an expectation");
+    expectation base;
+    base.line = static_cast<int>(t.source().begin.line);
+    base.column = static_cast<int>(t.source().begin.column);
+    const toml::node* at = t.get("at");
+    const toml::node* between = t.get("between");
+    const toml::node* always = t.get("always");
+    if (always) {
+      if (at || between) refuse(*always, "'always' holds for the whole run: leave out at/between");
+      if (t.size() != 1) refuse(t, "'always' stands alone in its expectation");
+      const std::string_view name = get_string(*always, "always");
+      expectation e = base;
+      e.what = expectation::kind::always;
+      bool found = false;
+      for (invariant i : {invariant::brake_engaged_before_torque_off,
+                          invariant::motion_waits_for_brake_release,
+                          invariant::coast_removes_torque_at_once}) {
+        if (name == invariant_name(i)) {
+          e.rule = i;
+          found = true;
+        }
+      }
+      if (!found) {
+        refuse(*always, "unknown rule " + in_quotes(name) +
+                            " (brake_engaged_before_torque_off, motion_waits_for_brake_release, "
+                            "coast_removes_torque_at_once)");
+      }
+      if (e.rule == invariant::motion_waits_for_brake_release && !s.plant.brake_fitted) {
+        refuse(*always, "motion_waits_for_brake_release needs a brake ([plant] brake = true)");
+      }
+      e.first_cycle = 0;
+      e.last_cycle = s.cycles - 1;
+      e.window = true;
+      s.expectations.push_back(e);
+      return;
+    }
+    if (at && between) refuse(*between, "give either 'at' or 'between', not both");
+    if (!at && !between) {
+      refuse(t, "an expectation needs 'at' (a time) or 'between' (two times), or is 'always'");
+    }
+    if (at) {
+      base.first_cycle = base.last_cycle = cycle_of(*at, "'at'");
+    } else {
+      const toml::array& a = get_array(*between, "'between'");
+      if (a.size() != 2) refuse(*between, "'between' takes two times, e.g. [\"1s\", \"1.2s\"]");
+      base.first_cycle = cycle_of(*a.get(0), "the first time of 'between'");
+      base.last_cycle = cycle_of(*a.get(1), "the second time of 'between'");
+      if (base.last_cycle < base.first_cycle) {
+        refuse(*between, "'between' must run forwards: the second time is earlier");
+      }
+      base.window = true;
+    }
+    const std::size_t before = s.expectations.size();
+    if (const auto* n = t.get("state")) {
+      expectation e = base;
+      e.what = expectation::kind::state;
+      const std::string_view name = get_string(*n, "state");
+      if (!parse_state(name, e.expected_state) || e.expected_state == state::start) {
+        refuse(*n, "unknown state " + in_quotes(name) + " (e.g. OPERATION_ENABLED)");
+      }
+      s.expectations.push_back(e);
+    }
+    if (const auto* n = t.get("velocity")) {
+      expectation e = base;
+      e.what = expectation::kind::velocity;
+      if (const auto* cmp = n->as_table()) {
+        if (cmp->size() != 1) {
+          refuse(*n, "velocity takes one comparison: { below = V }, { above = V } or "
+                     "{ within = [LOW, HIGH] }");
+        }
+        check_keys(*cmp, {"below", "above", "within"}, "a velocity comparison");
+        if (const auto* b = cmp->get("below")) {
+          e.how = expectation::compare::below;
+          e.low = get_velocity(*b, "below");
+        } else if (const auto* ab = cmp->get("above")) {
+          e.how = expectation::compare::above;
+          e.low = get_velocity(*ab, "above");
+        } else {
+          const toml::node& w = *cmp->get("within");
+          const toml::array& range = get_array(w, "within");
+          if (range.size() != 2) refuse(w, "within takes [LOW, HIGH]");
+          e.how = expectation::compare::within;
+          e.low = get_velocity(*range.get(0), "the low end of within");
+          e.high = get_velocity(*range.get(1), "the high end of within");
+          if (e.high < e.low) refuse(w, "within [LOW, HIGH] needs LOW <= HIGH");
+        }
+      } else {
+        e.how = expectation::compare::equal;
+        e.low = get_velocity(*n, "velocity");
+      }
+      s.expectations.push_back(e);
+    }
+    if (const auto* n = t.get("statusword")) {
+      expectation e = base;
+      e.what = expectation::kind::statusword;
+      if (const auto* m = n->as_table()) {
+        check_keys(*m, {"mask", "value"}, "a statusword comparison");
+        const toml::node* mask = m->get("mask");
+        const toml::node* value = m->get("value");
+        if (!mask || !value) refuse(*n, "statusword takes { mask = M, value = V }");
+        e.high = get_int(*mask, "mask", 0, 0xFFFF);
+        e.low = get_int(*value, "value", 0, 0xFFFF);
+        if ((e.low & ~e.high) != 0) refuse(*value, "value has bits outside the mask");
+      } else {
+        e.high = 0xFFFF;
+        e.low = get_int(*n, "statusword", 0, 0xFFFF);
+      }
+      s.expectations.push_back(e);
+    }
+    if (const auto* n = t.get("torque")) {
+      expectation e = base;
+      e.what = expectation::kind::torque;
+      e.flag = get_bool(*n, "torque");
+      s.expectations.push_back(e);
+    }
+    if (const auto* n = t.get("brake")) {
+      expectation e = base;
+      e.what = expectation::kind::brake;
+      const std::string_view v = get_string(*n, "brake");
+      if (v != "engaged" && v != "released") refuse(*n, "brake must be \"engaged\" or \"released\"");
+      e.flag = v == "engaged";
+      s.expectations.push_back(e);
+    }
+    if (const auto* n = t.get("error_code")) {
+      expectation e = base;
+      e.what = expectation::kind::error_code;
+      e.low = get_int(*n, "error_code", 0, 0xFFFF);
+      s.expectations.push_back(e);
+    }
+    if (const auto* n = t.get("transition")) {
+      expectation e = base;
+      e.what = expectation::kind::transition;
+      e.transition = static_cast<std::uint8_t>(get_int(*n, "transition", 0, 17));
+      s.expectations.push_back(e);
+    }
+    if (s.expectations.size() == before) {
+      refuse(t, "an expectation needs a claim: state, velocity, statusword, torque, brake, "
+                "error_code or transition");
+    }
+  }
+
+  template <typename Each>
+  void load_list(const toml::node& n, std::string_view what, Each each) {
+    const toml::array& list = get_array(n, what);
+    for (const toml::node& item : list) each(get_table(item, std::string("each entry of ") + std::string(what)));
+  }
+
+  void load(const toml::table& root) {
+    check_keys(root,
+               {"name", "profile", "profile_file", "cycle", "duration", "plant", "objects",
+                "events", "expect"},
+               "the scenario");
+    if (const auto* n = root.get("name")) s.name = get_string(*n, "name");
+    load_profile(root);
+    if (const auto* n = root.get("cycle")) {
+      const std::uint64_t us = get_time_us(*n, "cycle");
+      if (us < 1 || us > 1000000) refuse(*n, "cycle must be 1us .. 1s");
+      s.plant.cycle_us = static_cast<std::uint32_t>(us);
+    }
+    duration_node = root.get("duration");
+    if (duration_node == nullptr) {
+      refuse(root, "the scenario lacks 'duration', how long it runs (e.g. duration = \"2s\")");
+    }
+    duration_us = get_time_us(*duration_node, "duration");
+    if (duration_us % s.plant.cycle_us != 0) {
+      refuse(*duration_node, "duration " + seconds_text(duration_us) +
+                                 " is not a multiple of the cycle (" +
+                                 seconds_text(s.plant.cycle_us) + ")");
+    }
+    if (duration_us / s.plant.cycle_us > 100000000ull) {
+      refuse(*duration_node, "duration is more than 100 million cycles");
+    }
+    s.cycles = duration_us / s.plant.cycle_us + 1;
+    if (const auto* n = root.get("plant")) load_plant(get_table(*n, "[plant]"));
+    if (const auto* n = root.get("objects")) load_objects(get_table(*n, "[objects]"));
+    if (const auto* n = root.get("events")) {
+      load_list(*n, "events", [&](const toml::table& t) { load_event(t); });
+    }
+    if (const auto* n = root.get("expect")) {
+      load_list(*n, "expect", [&](const toml::table& t) { load_expectation(t); });
+    }
+    std::stable_sort(s.events.begin(), s.events.end(),
+                     [](const scenario_event& a, const scenario_event& b) { return a.cycle < b.cycle; });
+  }
+};
+
+std::string stem_of(std::string_view source_name) {
+  const std::filesystem::path p{std::string(source_name)};
+  return p.stem().string();
+}
+
+}  // namespace
+
+std::string scenario_error::message() const {
+  std::string out = source_name.empty() ? std::string("<scenario>") : source_name;
+  if (line > 0) {
+    out += ":" + std::to_string(line);
+    if (column > 0) out += ":" + std::to_string(column);
+  }
+  return out + ": " + reason;
+}
+
+const char* invariant_name(invariant i) noexcept {
+  switch (i) {
+    case invariant::brake_engaged_before_torque_off: return "brake_engaged_before_torque_off";
+    case invariant::motion_waits_for_brake_release: return "motion_waits_for_brake_release";
+    case invariant::coast_removes_torque_at_once: return "coast_removes_torque_at_once";
+  }
+  return "unknown";
+}
+
+scenario_load_result load_scenario_toml(std::string_view text, std::string_view source_name,
+                                        const std::string& base_dir) {
+  const std::string name(source_name);
+  try {
+    const toml::table root = toml::parse(text, std::string_view(name));
+    loader l;
+    l.base_dir = base_dir;
+    l.s.source_name = name;
+    l.load(root);
+    if (l.s.name.empty()) l.s.name = stem_of(name);
+    return std::move(l.s);
+  } catch (const toml::parse_error& e) {
+    return scenario_error{static_cast<int>(e.source().begin.line),
+                          static_cast<int>(e.source().begin.column), std::string(e.description()),
+                          name};
+  } catch (const refusal& r) {
+    return scenario_error{r.line, r.column, r.reason, name};
+  }
+}
+
+scenario_load_result load_scenario_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return scenario_error{0, 0, "cannot open the file", path};
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return scenario_error{0, 0, "cannot read the file", path};
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  return load_scenario_toml(text.str(), path, dir.empty() ? std::string(".") : dir.string());
+}
+
+}  // namespace cia402::sim
