@@ -21,9 +21,12 @@ install(TARGETS ${cia402_exported_targets}
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})  # include dirs: each target's INSTALL_INTERFACE
-set(cia402_header_excludes)
+# Only the headers of the exported libraries: the tools-side layers (diagram, sim, canopen, page)
+# are built for the cia402 tool and are not part of the package.
+set(cia402_header_excludes PATTERN "diagram.hpp" EXCLUDE PATTERN "sim" EXCLUDE
+    PATTERN "canopen" EXCLUDE PATTERN "page" EXCLUDE)
 if(NOT TARGET cia402_profile_file)
-  set(cia402_header_excludes PATTERN "profile_file.hpp" EXCLUDE)  # no library to go with it
+  list(APPEND cia402_header_excludes PATTERN "profile_file.hpp" EXCLUDE)  # no library for it
 endif()
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/include/cia402"
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
