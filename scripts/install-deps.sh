@@ -9,6 +9,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfmt-dev libcpp-httplib-dev
   graphviz
   gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib
+  chromium python3-can python3-pytest
 )
 
 missing=()
@@ -16,9 +17,13 @@ for p in "${packages[@]}"; do
   status=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
   [ "$status" = installed ] || missing+=("$p")
 done
+# Node.js for the browser test: Debian's nodejs and npm, unless a node and npm are already there
+# (a NodeSource nodejs brings its own npm and conflicts with Debian's package).
+command -v node >/dev/null || missing+=(nodejs)
+command -v npm >/dev/null || missing+=(npm)
 
 if [ ${#missing[@]} -eq 0 ]; then
-  echo "install-deps: all ${#packages[@]} packages already installed"
+  echo "install-deps: all ${#packages[@]} packages and Node.js already installed"
   exit 0
 fi
 

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Builds cia402 (release preset) and runs the main job. As root on a fresh Debian 12 it installs what
+# Builds cia402 (release preset) and runs the main job: `cia402 serve`, the virtual drive and its
+# instrument control page. As root on a fresh Debian 12 it installs what
 # it needs first. Arguments are passed to the job.
 set -euo pipefail
 
-# The main job: the one place to change what `bash scripts/run.sh` runs.
-main_job=(demo)
+# The main job: the one place to change what `bash scripts/run.sh` runs. A virtual drive with its
+# instrument control page; it prints the URL (http://127.0.0.1:8402/) and stops on Ctrl-C.
+main_job=(serve)
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"

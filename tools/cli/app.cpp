@@ -12,6 +12,7 @@
 #include "cli/diagram.hpp"
 #include "cli/path.hpp"
 #include "cli/replay.hpp"
+#include "cli/serve.hpp"
 #include "cli/simulate.hpp"
 #include "cli/words.hpp"
 
@@ -104,6 +105,9 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   simulate_args simulate_options;
   auto* simulate = add_simulate_subcommand(app, simulate_options);
 
+  serve_args serve_options;
+  auto* serve = add_serve_subcommand(app, serve_options);
+
   try {
     std::vector<std::string> reversed(args.rbegin(), args.rend());
     app.parse(reversed);
@@ -112,6 +116,7 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   }
 
   if (simulate->parsed()) return run_simulate(simulate_options, out, err);
+  if (serve->parsed()) return run_serve(serve_options, out, err);
   if (profiles->parsed()) {
     if (dump_name.empty()) return list_profiles(out);
     const profile* p = find_builtin_profile(dump_name);

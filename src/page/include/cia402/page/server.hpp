@@ -1,0 +1,78 @@
+// The instrument page over HTTP (cpp-httplib): the page's files, embedded in the binary; a JSON API
+// for commands, bit toggles, object writes and plant inputs; live snapshots as Server-Sent Events.
+//
+//   GET  /                 the page (index.html, app.js, style.css)
+//   GET  /api/info         profile, bit names, transition rows; "control": may this client control
+//   GET  /api/state        the present snapshot
+//   GET  /api/events       text/event-stream: a snapshot at once, then each published one
+//                          (at most 25 a second, only on change), a comment line as keep-alive
+//   POST /api/command      {"command":"shutdown"|...|"fault_reset"|"halt"} or
+//                          {"command":"toggle_bit","bit":N}
+//   POST /api/plant        {"target_velocity":N, "fault":true, "fault_code":"0x1000",
+//                          "fault_class":2, "dc_link":false, "sto":true} (any of them)
+//   POST /api/object       {"index":"0x605A","value":6}
+//
+// Every POST needs Content-Type application/json and a JSON object body of at most
+// server_options::max_body bytes; unknown keys, wrong types and out-of-range values are refused
+// with a 4xx and {"error": reason}, and change nothing. With a token required, a POST without
+// header X-Cia402-Token carrying it is refused with 403 (the page is then view-only). Without a
+// token, a POST must come from a loopback Host (no DNS rebinding), and from the page's own origin.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "cia402/page/instrument.hpp"
+
+namespace cia402::page {
+
+struct server_options {
+  std::string bind = "127.0.0.1";
+  int port = 8402;  ///< 0: any free port (bound_port() tells which)
+  /// Control needs the token. `cia402 serve` turns it on for any non-loopback --bind address and
+  /// for --token-required.
+  bool token_required = false;
+  std::string token;  ///< the token; make_token() when empty and required
+  std::size_t max_body = 4096;
+  int max_event_streams = 16;
+  std::chrono::milliseconds keep_alive{15000};  ///< SSE comment line when nothing was published
+};
+
+/// 32 hex digits (128 bits) from std::random_device.
+std::string make_token();
+
+/// True for 127.0.0.0/8, ::1 and "localhost".
+bool is_loopback_address(std::string_view host);
+
+class server {
+ public:
+  /// The instrument must outlive the server.
+  server(instrument& inst, server_options options);
+  ~server();
+  server(const server&) = delete;
+  server& operator=(const server&) = delete;
+
+  /// Binds the socket. Returns false (and error() says why) if that fails.
+  bool bind();
+  /// The port bound (the real one for port 0), -1 before bind().
+  int bound_port() const;
+  const std::string& error() const;
+  const server_options& options() const;
+
+  /// Serves in a thread of its own until stop(). Requires bind().
+  void start();
+  /// Stops serving: open event streams end, the thread is joined. Idempotent.
+  void stop();
+
+  /// "http://127.0.0.1:8402/" with "?token=..." when a token is required.
+  std::string url() const;
+
+ private:
+  struct impl;
+  std::unique_ptr<impl> impl_;
+};
+
+}  // namespace cia402::page

@@ -1,0 +1,32 @@
+// Names the page shows: the 16 bits of each word as the profile's documents name them, and the
+// objects the page can write.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "cia402/profile.hpp"
+
+namespace cia402::page {
+
+struct bit_names {
+  const char* control_word = "";  ///< "controlword 0x6040" or "STW"
+  const char* status_word = "";
+  std::array<const char*, 16> control{};
+  std::array<const char*, 16> status{};
+};
+
+/// CiA 402 names (cia402-reference.md §1.2, §2.1), or the DRIVECOM STW / ZSW names (§6.1) for the
+/// PROFIBUS profiles of seeds 003 and 004 (s300-profibus, ax2000-profibus).
+bit_names bit_names_for(const profile& p);
+
+struct object_name {
+  std::uint16_t index = 0;
+  const char* name = "";
+};
+
+/// The objects the page offers to write: the profile's option codes, then the ramps.
+std::vector<object_name> object_names(const profile& p);
+
+}  // namespace cia402::page

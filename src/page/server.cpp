@@ -1,0 +1,434 @@
+#include "cia402/page/server.hpp"
+
+#include <arpa/inet.h>
+#include <httplib.h>
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <cstdio>
+#include <random>
+#include <set>
+#include <thread>
+
+#include "web_assets.hpp"
+
+namespace cia402::page {
+namespace {
+
+using json = nlohmann::json;
+
+constexpr const char* token_header = "X-Cia402-Token";
+
+void send_json(httplib::Response& res, int status, const json& body) {
+  res.status = status;
+  res.set_content(body.dump(), "application/json");
+}
+
+void send_error(httplib::Response& res, int status, const std::string& reason) {
+  send_json(res, status, json{{"error", reason}});
+}
+
+// Equal-time comparison, so the time a refusal takes tells nothing about the token.
+bool same_secret(std::string_view a, std::string_view b) {
+  unsigned char diff = a.size() == b.size() ? 0 : 1;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    diff |= static_cast<unsigned char>(a[i] ^ (i < b.size() ? b[i] : 0));
+  }
+  return diff == 0;
+}
+
+// The host part of a Host header: "127.0.0.1:8402" -> "127.0.0.1", "[::1]:8402" -> "::1".
+std::string_view host_of(std::string_view host_header) {
+  if (!host_header.empty() && host_header.front() == '[') {
+    const std::size_t close = host_header.find(']');
+    return close == std::string_view::npos ? host_header : host_header.substr(1, close - 1);
+  }
+  const std::size_t colon = host_header.find(':');
+  return colon == std::string_view::npos ? host_header : host_header.substr(0, colon);
+}
+
+// An integer from a JSON number or a string "0x605A" / "24666"; nothing for anything else.
+std::optional<std::int64_t> integer_of(const json& v) {
+  if (v.is_number_integer()) return v.get<std::int64_t>();
+  if (v.is_number_unsigned()) {
+    const auto u = v.get<std::uint64_t>();
+    if (u > static_cast<std::uint64_t>(INT64_MAX)) return std::nullopt;
+    return static_cast<std::int64_t>(u);
+  }
+  if (!v.is_string()) return std::nullopt;
+  const std::string& s = v.get_ref<const std::string&>();
+  std::size_t i = 0;
+  bool negative = false;
+  if (i < s.size() && (s[i] == '-' || s[i] == '+')) negative = s[i++] == '-';
+  int base = 10;
+  if (s.size() - i > 2 && s[i] == '0' && (s[i + 1] == 'x' || s[i + 1] == 'X')) {
+    base = 16;
+    i += 2;
+  }
+  if (i >= s.size() || s.size() - i > 12) return std::nullopt;
+  std::int64_t value = 0;
+  for (; i < s.size(); ++i) {
+    const char c = s[i];
+    int d = -1;
+    if (c >= '0' && c <= '9') d = c - '0';
+    if (base == 16 && c >= 'a' && c <= 'f') d = c - 'a' + 10;
+    if (base == 16 && c >= 'A' && c <= 'F') d = c - 'A' + 10;
+    if (d < 0) return std::nullopt;
+    value = value * base + d;
+  }
+  return negative ? -value : value;
+}
+
+// Every key of `body` must be one of `allowed`; the first one that is not is named.
+std::optional<std::string> unknown_key(const json& body, std::initializer_list<const char*> allowed) {
+  for (auto it = body.begin(); it != body.end(); ++it) {
+    bool known = false;
+    for (const char* a : allowed) known = known || it.key() == a;
+    if (!known) return "unknown key '" + it.key() + "'";
+  }
+  return std::nullopt;
+}
+
+struct request_error {
+  int status;
+  std::string reason;
+};
+
+}  // namespace
+
+std::string make_token() {
+  std::random_device rd;
+  std::string token;
+  char buf[9];
+  for (int i = 0; i < 4; ++i) {
+    std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(rd()));
+    token += buf;
+  }
+  return token;
+}
+
+bool is_loopback_address(std::string_view host) {
+  if (host == "localhost" || host == "::1") return true;
+  in_addr v4{};
+  const std::string h(host);
+  if (inet_pton(AF_INET, h.c_str(), &v4) == 1) {
+    return (ntohl(v4.s_addr) >> 24) == 127;
+  }
+  in6_addr v6{};
+  if (inet_pton(AF_INET6, h.c_str(), &v6) == 1) return IN6_IS_ADDR_LOOPBACK(&v6);
+  return false;
+}
+
+struct server::impl {
+  impl(instrument& i, server_options o) : inst(i), options(std::move(o)) {
+    if (options.token_required && options.token.empty()) options.token = make_token();
+  }
+
+  instrument& inst;
+  server_options options;
+  httplib::Server http;
+  std::thread thread;
+  std::atomic<bool> stopping{false};
+  std::atomic<int> streams{0};
+  int port = -1;
+  std::string error;
+
+  bool has_token(const httplib::Request& req) const {
+    return req.has_header(token_header) &&
+           same_secret(req.get_header_value(token_header), options.token);
+  }
+
+  bool may_control(const httplib::Request& req) const {
+    return !options.token_required || has_token(req);
+  }
+
+  // The checks every POST passes before its body is read as JSON.
+  std::optional<request_error> check_post(const httplib::Request& req) const {
+    if (options.token_required) {
+      if (!has_token(req)) {
+        return request_error{403,
+                             "control needs the token printed by cia402 serve (header " +
+                                 std::string(token_header) + "); without it the page is view-only"};
+      }
+    } else if (!is_loopback_address(host_of(req.get_header_value("Host")))) {
+      // Bound to loopback without a token: only a page reached by a loopback name may control, so
+      // a foreign site cannot reach the drive by DNS rebinding.
+      return request_error{403, "control without a token is only for a loopback Host"};
+    }
+    if (req.has_header("Origin") &&
+        req.get_header_value("Origin") != "http://" + req.get_header_value("Host")) {
+      return request_error{403, "cross-origin request refused"};
+    }
+    const std::string type = req.get_header_value("Content-Type");
+    if (type.rfind("application/json", 0) != 0) {
+      return request_error{415, "Content-Type must be application/json"};
+    }
+    if (req.body.size() > options.max_body) {
+      return request_error{413, "body larger than " + std::to_string(options.max_body) + " bytes"};
+    }
+    return std::nullopt;
+  }
+
+  // Checks, parses and hands a POST body to `act`, which returns the instrument's reply or a
+  // request error of its own.
+  template <typename Act>
+  void post(const httplib::Request& req, httplib::Response& res, Act act) {
+    if (const auto e = check_post(req)) return send_error(res, e->status, e->reason);
+    const json body = json::parse(req.body, nullptr, false);
+    if (body.is_discarded()) return send_error(res, 400, "body is not valid JSON");
+    if (!body.is_object()) return send_error(res, 400, "body must be a JSON object");
+    std::variant<reply, request_error> r = act(body);
+    if (auto* e = std::get_if<request_error>(&r)) return send_error(res, e->status, e->reason);
+    const reply& rep = std::get<reply>(r);
+    if (const auto* ok = std::get_if<accepted>(&rep)) return send_json(res, 200, {{"id", ok->id}});
+    const refused& no = std::get<refused>(rep);
+    json j{{"error", no.reason}};
+    if (no.abort != sdo_abort::none) {
+      char buf[16];
+      std::snprintf(buf, sizeof buf, "0x%08X", static_cast<unsigned>(no.abort));
+      j["abort"] = buf;
+    }
+    send_json(res, no.http_status, j);
+  }
+
+  std::variant<reply, request_error> on_command(const json& body) {
+    if (auto k = unknown_key(body, {"command", "bit"})) return request_error{400, *k};
+    if (!body.contains("command") || !body["command"].is_string()) {
+      return request_error{400, "'command' (a string) is required"};
+    }
+    const std::string& name = body["command"].get_ref<const std::string&>();
+    if (name == "toggle_bit") {
+      if (!body.contains("bit")) return request_error{400, "toggle_bit needs 'bit' (0..15)"};
+      const auto bit = integer_of(body["bit"]);
+      if (!bit || *bit < 0 || *bit > 15) return request_error{400, "'bit' must be 0..15"};
+      return inst.toggle_control_bit(static_cast<int>(*bit));
+    }
+    if (body.contains("bit")) return request_error{400, "'bit' belongs to toggle_bit only"};
+    page_command c{};
+    if (!parse_page_command(name, c)) {
+      return request_error{400, "unknown command '" + name +
+                                    "' (shutdown, switch_on, enable_operation, disable_operation, "
+                                    "disable_voltage, quick_stop, fault_reset, halt, toggle_bit)"};
+    }
+    return inst.command(c);
+  }
+
+  std::variant<reply, request_error> on_plant(const json& body) {
+    if (auto k = unknown_key(body, {"target_velocity", "fault", "fault_code", "fault_class",
+                                    "dc_link", "sto"})) {
+      return request_error{400, *k};
+    }
+    if (body.empty()) return request_error{400, "nothing to change"};
+    plant_change c;
+    if (body.contains("target_velocity")) {
+      const json& v = body["target_velocity"];
+      if (!v.is_number_integer() && !v.is_number_unsigned()) {
+        return request_error{400, "'target_velocity' must be an integer (rpm)"};
+      }
+      const auto n = integer_of(v);
+      if (!n) return request_error{400, "'target_velocity' is out of range"};
+      c.target_velocity = *n;
+    }
+    for (const char* key : {"fault", "dc_link", "sto"}) {
+      if (body.contains(key) && !body[key].is_boolean()) {
+        return request_error{400, "'" + std::string(key) + "' must be true or false"};
+      }
+    }
+    if (body.contains("fault")) c.fault = body["fault"].get<bool>();
+    const bool fault_on = c.fault && *c.fault;
+    if (body.contains("fault_code")) {
+      if (!fault_on) return request_error{400, "'fault_code' goes with \"fault\": true"};
+      const auto code = integer_of(body["fault_code"]);
+      if (!code || *code < 1 || *code > 0xFFFF) {
+        return request_error{400, "'fault_code' must be 0x0001..0xFFFF"};
+      }
+      c.fault_code = static_cast<std::uint16_t>(*code);
+    }
+    if (body.contains("fault_class")) {
+      if (!fault_on) return request_error{400, "'fault_class' goes with \"fault\": true"};
+      const auto cls = integer_of(body["fault_class"]);
+      if (!cls || *cls < 0 || *cls > 4) return request_error{400, "'fault_class' must be 0..4"};
+      c.fault_class = static_cast<std::uint8_t>(*cls);
+    }
+    if (body.contains("dc_link")) c.dc_link = body["dc_link"].get<bool>();
+    if (body.contains("sto")) c.sto = body["sto"].get<bool>();
+    return inst.change_plant(c);
+  }
+
+  std::variant<reply, request_error> on_object(const json& body) {
+    if (auto k = unknown_key(body, {"index", "value"})) return request_error{400, *k};
+    if (!body.contains("index") || !body.contains("value")) {
+      return request_error{400, "'index' and 'value' are required"};
+    }
+    const auto index = integer_of(body["index"]);
+    if (!index || *index < 0 || *index > 0xFFFF) {
+      return request_error{400, "'index' must be an object index 0x0000..0xFFFF"};
+    }
+    const auto value = integer_of(body["value"]);
+    if (!value) return request_error{400, "'value' must be an integer"};
+    return inst.write_object(static_cast<std::uint16_t>(*index), *value);
+  }
+
+  void routes() {
+    http.set_payload_max_length(options.max_body);
+    // Event streams hold a thread each while open; leave room for ordinary requests.
+    const auto threads = static_cast<std::size_t>(options.max_event_streams) + 8;
+    http.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+    http.set_default_headers({
+        {"Content-Security-Policy",
+         "default-src 'self'; img-src 'self' data:; style-src 'self'; script-src 'self'; "
+         "connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; form-action 'none'"},
+        {"X-Content-Type-Options", "nosniff"},
+        {"Referrer-Policy", "no-referrer"},
+        {"Cache-Control", "no-store"},
+    });
+    http.set_error_handler(httplib::Server::HandlerWithResponse(
+        [this](const httplib::Request& req, httplib::Response& res) {
+      if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+      std::string reason;
+      switch (res.status) {
+        case 404: reason = "no such resource: " + req.path; break;
+        case 413: reason = "body larger than " + std::to_string(options.max_body) + " bytes"; break;
+        case 400: reason = "malformed request"; break;
+        default: reason = "HTTP status " + std::to_string(res.status); break;
+      }
+      send_error(res, res.status, reason);
+      return httplib::Server::HandlerResponse::Handled;
+    }));
+    http.set_exception_handler(
+        [](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
+          send_error(res, 500, "internal error");
+        });
+
+    for (const web::asset& a : web::assets()) {
+      const std::string content_type = a.content_type;
+      const std::string_view data(reinterpret_cast<const char*>(a.data), a.size);
+      auto serve = [content_type, data](const httplib::Request&, httplib::Response& res) {
+        res.set_content(data.data(), data.size(), content_type);
+      };
+      http.Get(a.path, serve);
+      if (std::string_view(a.path) == "/index.html") http.Get("/", serve);
+    }
+    http.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
+
+    http.Get("/api/info", [this](const httplib::Request& req, httplib::Response& res) {
+      res.set_content(inst.info_json(may_control(req), options.token_required), "application/json");
+    });
+    http.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(inst.snapshot_json(), "application/json");
+    });
+    http.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
+      events(res);
+    });
+    http.Post("/api/command", [this](const httplib::Request& req, httplib::Response& res) {
+      post(req, res, [this](const json& b) { return on_command(b); });
+    });
+    http.Post("/api/plant", [this](const httplib::Request& req, httplib::Response& res) {
+      post(req, res, [this](const json& b) { return on_plant(b); });
+    });
+    http.Post("/api/object", [this](const httplib::Request& req, httplib::Response& res) {
+      post(req, res, [this](const json& b) { return on_object(b); });
+    });
+    for (const char* path : {"/api/command", "/api/plant", "/api/object"}) {
+      http.Get(path, [](const httplib::Request&, httplib::Response& res) {
+        send_error(res, 405, "use POST with a JSON body");
+      });
+    }
+  }
+
+  void events(httplib::Response& res) {
+    if (streams.fetch_add(1) >= options.max_event_streams) {
+      streams.fetch_sub(1);
+      return send_error(res, 503, "too many event streams open");
+    }
+    struct stream_state {
+      bool started = false;
+      std::uint64_t seen = 0;
+      std::chrono::steady_clock::time_point last_write = std::chrono::steady_clock::now();
+    };
+    auto st = std::make_shared<stream_state>();
+    res.set_chunked_content_provider(
+        "text/event-stream",
+        [this, st](std::size_t, httplib::DataSink& sink) {
+          std::string chunk;
+          if (!st->started) {
+            st->started = true;
+            st->seen = inst.latest().version;
+            chunk = "retry: 1000\ndata: " + inst.snapshot_json() + "\n\n";
+          } else {
+            // Short waits, so a stopping server ends the stream promptly.
+            const auto slice = std::chrono::milliseconds(200);
+            while (chunk.empty()) {
+              if (stopping || inst.closed()) {
+                sink.done();
+                return true;
+              }
+              if (auto u = inst.wait_for_update(st->seen, slice)) {
+                st->seen = u->version;
+                chunk = "data: " + u->json + "\n\n";
+              } else if (std::chrono::steady_clock::now() - st->last_write >= options.keep_alive) {
+                chunk = ": keep-alive\n\n";
+              }
+            }
+          }
+          st->last_write = std::chrono::steady_clock::now();
+          return sink.write(chunk.data(), chunk.size());
+        },
+        [this](bool) { streams.fetch_sub(1); });
+  }
+};
+
+server::server(instrument& inst, server_options options)
+    : impl_(std::make_unique<impl>(inst, std::move(options))) {
+  impl_->routes();
+}
+
+server::~server() { stop(); }
+
+bool server::bind() {
+  impl& m = *impl_;
+  if (m.port >= 0) return true;
+  if (m.options.port < 0 || m.options.port > 65535) {
+    m.error = "port must be 0..65535";
+    return false;
+  }
+  int port = -1;
+  if (m.options.port == 0) {
+    port = m.http.bind_to_any_port(m.options.bind);
+  } else if (m.http.bind_to_port(m.options.bind, m.options.port)) {
+    port = m.options.port;
+  }
+  if (port < 0) {
+    m.error = "cannot listen on " + m.options.bind + " port " + std::to_string(m.options.port) +
+              " (address in use, or not an address of this machine)";
+    return false;
+  }
+  m.port = port;
+  return true;
+}
+
+int server::bound_port() const { return impl_->port; }
+const std::string& server::error() const { return impl_->error; }
+const server_options& server::options() const { return impl_->options; }
+
+void server::start() {
+  if (impl_->port < 0 || impl_->thread.joinable()) return;
+  impl_->thread = std::thread([this] { impl_->http.listen_after_bind(); });
+}
+
+void server::stop() {
+  impl_->stopping = true;
+  impl_->http.stop();
+  if (impl_->thread.joinable()) impl_->thread.join();
+}
+
+std::string server::url() const {
+  const std::string& host = impl_->options.bind;
+  const bool v6 = host.find(':') != std::string::npos;
+  std::string u = "http://" + (v6 ? "[" + host + "]" : host) + ":" + std::to_string(impl_->port) + "/";
+  if (impl_->options.token_required) u += "?token=" + impl_->options.token;
+  return u;
+}
+
+}  // namespace cia402::page

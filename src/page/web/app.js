@@ -1,0 +1,634 @@
+// The instrument control page. It shows what the server sends and sends commands; every decision
+// of the state machine is the server's (the core's): nothing here knows which transition a command
+// leads to.
+'use strict';
+
+const SVG = 'http://www.w3.org/2000/svg';
+const token = new URLSearchParams(location.search).get('token') || '';
+const el = (id) => document.getElementById(id);
+
+let info = null;       // /api/info
+let snapshot = null;   // the newest snapshot
+let received = 0;      // performance.now() when it came
+const samples = [];    // {t, v, target} for the plot, server time in ms
+
+// ---------------------------------------------------------------------------------------------
+// Requests
+
+async function post(path, body) {
+  const headers = { 'Content-Type': 'application/json' };
+  if (token) headers['X-Cia402-Token'] = token;
+  let reply;
+  try {
+    const res = await fetch(path, { method: 'POST', headers, body: JSON.stringify(body) });
+    reply = await res.json().catch(() => ({}));
+    if (!res.ok) {
+      showResult('refused', reply.error || `HTTP ${res.status}`);
+      return null;
+    }
+  } catch (e) {
+    showResult('refused', `no connection to the server (${e.message})`);
+    return null;
+  }
+  return reply;
+}
+
+function showResult(outcome, text) {
+  const r = el('result');
+  r.textContent = text;
+  r.dataset.outcome = outcome;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The state machine diagram: 8 states at fixed places as in the standard's figure, arrows drawn
+// from the profile's rows.
+
+const W = 180, H = 44;
+const POS = {
+  START: [185, 20],
+  NOT_READY_TO_SWITCH_ON: [185, 78],
+  SWITCH_ON_DISABLED: [185, 165],
+  READY_TO_SWITCH_ON: [185, 255],
+  SWITCHED_ON: [185, 345],
+  OPERATION_ENABLED: [185, 435],
+  FAULT_REACTION_ACTIVE: [460, 78],
+  FAULT: [460, 165],
+  QUICK_STOP_ACTIVE: [460, 435],
+};
+const RIGHT_COLUMN = new Set(['FAULT_REACTION_ACTIVE', 'FAULT', 'QUICK_STOP_ACTIVE']);
+
+// Routes of the standard's arrows: a polyline and where its number goes.
+const ROUTES = {
+  'START>NOT_READY_TO_SWITCH_ON': { pts: [[185, 28], [185, 56]], label: [200, 43] },
+  'NOT_READY_TO_SWITCH_ON>SWITCH_ON_DISABLED': { pts: [[185, 100], [185, 143]], label: [200, 122] },
+  'SWITCH_ON_DISABLED>READY_TO_SWITCH_ON': { pts: [[165, 187], [165, 233]], label: [148, 210] },
+  'READY_TO_SWITCH_ON>SWITCH_ON_DISABLED': { pts: [[205, 233], [205, 187]], label: [222, 210] },
+  'READY_TO_SWITCH_ON>SWITCHED_ON': { pts: [[165, 277], [165, 323]], label: [148, 300] },
+  'SWITCHED_ON>READY_TO_SWITCH_ON': { pts: [[205, 323], [205, 277]], label: [222, 300] },
+  'SWITCHED_ON>OPERATION_ENABLED': { pts: [[165, 367], [165, 413]], label: [148, 390] },
+  'OPERATION_ENABLED>SWITCHED_ON': { pts: [[205, 413], [205, 367]], label: [222, 390] },
+  'OPERATION_ENABLED>READY_TO_SWITCH_ON': {
+    pts: [[95, 440], [70, 440], [70, 260], [95, 260]], label: [70, 345], vertical: true },
+  'OPERATION_ENABLED>SWITCH_ON_DISABLED': {
+    pts: [[95, 452], [42, 452], [42, 160], [95, 160]], label: [42, 300], vertical: true },
+  'SWITCHED_ON>SWITCH_ON_DISABLED': {
+    pts: [[275, 345], [302, 345], [302, 179], [275, 179]], label: [302, 262], vertical: true },
+  'QUICK_STOP_ACTIVE>SWITCH_ON_DISABLED': {
+    pts: [[400, 413], [400, 395], [334, 395], [334, 167], [275, 167]], label: [334, 300],
+    vertical: true },
+  'OPERATION_ENABLED>QUICK_STOP_ACTIVE': { pts: [[275, 427], [375, 427]], label: [350, 418] },
+  'QUICK_STOP_ACTIVE>OPERATION_ENABLED': { pts: [[375, 447], [275, 447]], label: [350, 463] },
+  'FAULT_REACTION_ACTIVE>FAULT': { pts: [[460, 100], [460, 143]], label: [475, 122] },
+  'FAULT>SWITCH_ON_DISABLED': { pts: [[375, 155], [275, 155]], label: [355, 146] },
+};
+
+function svg(tag, attrs, parent) {
+  const n = document.createElementNS(SVG, tag);
+  for (const [k, v] of Object.entries(attrs || {})) n.setAttribute(k, v);
+  if (parent) parent.appendChild(n);
+  return n;
+}
+
+function label(name) {
+  return name.replace(/_/g, ' ');
+}
+
+// Long names on two lines, split at the space nearest the middle.
+function lines(name) {
+  const text = label(name);
+  if (text.length <= 17) return [text];
+  const mid = text.length / 2;
+  let best = -1;
+  for (let i = 0; i < text.length; i++) {
+    if (text[i] === ' ' && (best < 0 || Math.abs(i - mid) < Math.abs(best - mid))) best = i;
+  }
+  return best < 0 ? [text] : [text.slice(0, best), text.slice(best + 1)];
+}
+
+function box(name, pad) {
+  const [cx, cy] = POS[name];
+  return { x: cx - W / 2 - pad, y: cy - H / 2 - pad, w: W + 2 * pad, h: H + 2 * pad };
+}
+
+// A straight arrow between two boxes, for pairs the standard figure does not have.
+function straightRoute(from, to) {
+  const [x1, y1] = POS[from], [x2, y2] = POS[to];
+  const clip = (cx, cy, dx, dy) => {
+    const sx = dx === 0 ? Infinity : (W / 2) / Math.abs(dx);
+    const sy = dy === 0 ? Infinity : (H / 2) / Math.abs(dy);
+    const s = Math.min(sx, sy);
+    return [cx + dx * s, cy + dy * s];
+  };
+  const a = clip(x1, y1, x2 - x1, y2 - y1), b = clip(x2, y2, x1 - x2, y1 - y2);
+  return { pts: [a, b], label: [(a[0] + b[0]) / 2 + 10, (a[1] + b[1]) / 2 - 6] };
+}
+
+// The frame around the states a row leaves from (T13 leaves six): one rectangle for the left
+// column and one strip out to each right-column state, drawn as their union's outline.
+function frameRects(states) {
+  const left = states.filter((s) => !RIGHT_COLUMN.has(s) && s !== 'START');
+  const right = states.filter((s) => RIGHT_COLUMN.has(s));
+  const rects = [];
+  let edge = 275;
+  if (left.length) {
+    const bs = left.map((s) => box(s, 8));
+    const y0 = Math.min(...bs.map((b) => b.y)), y1 = Math.max(...bs.map((b) => b.y + b.h));
+    rects.push({ x: bs[0].x, y: y0, w: bs[0].w, h: y1 - y0 });
+    edge = bs[0].x + bs[0].w;
+  }
+  for (const s of right) {
+    const b = box(s, 8);
+    const x0 = left.length ? edge - 14 : b.x;
+    rects.push({ x: x0, y: b.y, w: b.x + b.w - x0, h: b.h });
+  }
+  return rects;
+}
+
+function drawDiagram() {
+  const root = el('diagram');
+  root.textContent = '';
+  const defs = svg('defs', {}, root);
+  const marker = svg('marker', {
+    id: 'arrow', viewBox: '0 0 10 10', refX: '9', refY: '5', markerWidth: '7', markerHeight: '7',
+    orient: 'auto-start-reverse',
+  }, defs);
+  svg('path', { d: 'M0,0 L10,5 L0,10 z', class: 'arrowhead' }, marker);
+
+  const frames = svg('g', { class: 'frames' }, root);
+  const arrows = svg('g', { class: 'arrows' }, root);
+  const nodes = svg('g', { class: 'states' }, root);
+  const labels = svg('g', { class: 'labels' }, root);
+
+  // Group rows by route, so two numbers on one route (T9 and T17) sit side by side.
+  const onRoute = new Map();
+  for (const row of info.rows) {
+    if (row.from.length >= 3) {
+      drawGroupRow(row, frames, arrows, labels);
+      continue;
+    }
+    for (const from of row.from) {
+      const key = `${from}>${row.to}`;
+      if (!onRoute.has(key)) onRoute.set(key, []);
+      onRoute.get(key).push(row.number);
+    }
+  }
+  for (const [key, numbers] of onRoute) {
+    const [from, to] = key.split('>');
+    const route = ROUTES[key] || straightRoute(from, to);
+    numbers.forEach((n, i) => {
+      const g = svg('g', { id: `t${n}.${from}.${to}`, class: `transition t${n}` }, arrows);
+      g.dataset.number = n;
+      svg('polyline', { points: route.pts.map((p) => p.join(',')).join(' '),
+        'marker-end': 'url(#arrow)' }, g);
+      const [lx, ly] = route.label;
+      const offset = route.vertical ? [0, i * 24] : [i * 24, 0];
+      drawNumber(labels, n, `${from}.${to}`, lx + offset[0], ly + offset[1]);
+    });
+  }
+
+  for (const name of info.states) {
+    const [cx, cy] = POS[name];
+    const g = svg('g', { id: `state.${name}`, class: 'state other' }, nodes);
+    g.dataset.state = name;
+    svg('title', {}, g).textContent = label(name);
+    if (name === 'START') {
+      svg('circle', { cx, cy, r: 8 }, g);
+      const t = svg('text', { x: cx + 14, y: cy + 4, class: 'start-label' }, g);
+      t.textContent = 'power on';
+      continue;
+    }
+    svg('rect', { x: cx - W / 2, y: cy - H / 2, width: W, height: H, rx: 6 }, g);
+    const ls = lines(name);
+    ls.forEach((line, i) => {
+      const t = svg('text', { x: cx, y: cy + 4.5 + (i - (ls.length - 1) / 2) * 15 }, g);
+      t.textContent = line;
+    });
+  }
+}
+
+function drawGroupRow(row, frames, arrows, labels) {
+  const rects = frameRects(row.from);
+  const g = svg('g', { class: `frame t${row.number}` }, frames);
+  for (const r of rects) svg('rect', { x: r.x, y: r.y, width: r.w, height: r.h, class: 'outline' }, g);
+  for (const r of rects) {
+    svg('rect', { x: r.x + 1.5, y: r.y + 1.5, width: r.w - 3, height: r.h - 3, class: 'fill' }, g);
+  }
+  const t = box(row.to, 0);
+  const first = rects[0];
+  const startX = first.x + first.w;
+  const ty = POS[row.to][1];
+  let pts;
+  if (ty > first.y && ty < first.y + first.h && t.x > startX) {
+    pts = [[startX, ty], [t.x, ty]];
+  } else {
+    pts = [[startX, first.y + 10], [t.x, ty]];
+  }
+  const a = svg('g', { id: `t${row.number}.ANY.${row.to}`, class: `transition t${row.number}` }, arrows);
+  a.dataset.number = row.number;
+  svg('polyline', { points: pts.map((p) => p.join(',')).join(' '), 'marker-end': 'url(#arrow)' }, a);
+  const lx = (pts[0][0] + pts[1][0]) / 2, ly = (pts[0][1] + pts[1][1]) / 2 - 9;
+  drawNumber(labels, row.number, `ANY.${row.to}`, lx, ly);
+  const note = document.createElement('span');
+  note.textContent = ` The dashed frame holds the states transition ${row.number} leaves.`;
+  el('legend').appendChild(note);
+}
+
+function drawNumber(parent, n, ends, x, y) {
+  const g = svg('g', { id: `n${n}.${ends}`, class: `number t${n}` }, parent);
+  g.dataset.number = n;
+  svg('rect', { x: x - 13, y: y - 11, width: 26, height: 22, rx: 3 }, g);
+  const t = svg('text', { x, y: y + 5 }, g);
+  t.textContent = String(n);
+}
+
+function updateDiagram(s) {
+  for (const g of document.querySelectorAll('#diagram .state')) {
+    const present = g.dataset.state === s.state;
+    g.classList.toggle('present', present);
+    g.classList.toggle('other', !present);
+  }
+  const last = s.last_transition;
+  for (const g of document.querySelectorAll('#diagram .number, #diagram .transition')) {
+    g.classList.remove('last');
+  }
+  if (!last) return;
+  // The arrow of this row from that state; for a row drawn from a frame (T13), the frame's.
+  const ends = [`${last.from}.${last.to}`, `ANY.${last.to}`];
+  for (const e of ends) {
+    const n = document.getElementById(`n${last.number}.${e}`);
+    const t = document.getElementById(`t${last.number}.${e}`);
+    if (n) {
+      n.classList.add('last');
+      if (t) t.classList.add('last');
+      return;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Words, commands, plant
+
+function buildBits() {
+  el('h-control').textContent = info.control_word_name.replace(/^./, (c) => c.toUpperCase());
+  el('h-status').textContent = info.status_word_name.replace(/^./, (c) => c.toUpperCase());
+  const cw = el('control-bits');
+  cw.textContent = '';
+  for (const b of info.control_bits) {
+    const li = document.createElement('li');
+    const btn = document.createElement('button');
+    btn.type = 'button';
+    btn.className = 'bit control';
+    btn.setAttribute('role', 'switch');
+    btn.setAttribute('aria-checked', 'false');
+    btn.dataset.bit = b.bit;
+    btn.innerHTML = '<span class="n"></span><span class="v">0</span><span class="name"></span>';
+    btn.querySelector('.n').textContent = b.bit;
+    btn.querySelector('.name').textContent = b.name;
+    if (b.owned) {
+      const sm = document.createElement('span');
+      sm.className = 'sm';
+      sm.title = "read by the profile's state machine";
+      sm.textContent = 'SM';
+      btn.appendChild(sm);
+    }
+    btn.addEventListener('click', () => post('/api/command', { command: 'toggle_bit', bit: b.bit }));
+    li.appendChild(btn);
+    cw.appendChild(li);
+  }
+  const sw = el('status-bits');
+  sw.textContent = '';
+  for (const b of info.status_bits) {
+    const li = document.createElement('li');
+    li.className = 'bit';
+    li.dataset.bit = b.bit;
+    li.innerHTML = '<span class="n"></span><span class="v">0</span><span class="name"></span>';
+    li.querySelector('.n').textContent = b.bit;
+    li.querySelector('.name').textContent = b.name;
+    sw.appendChild(li);
+  }
+}
+
+const COMMAND_LABELS = {
+  shutdown: 'Shutdown', switch_on: 'Switch on', enable_operation: 'Enable operation',
+  disable_operation: 'Disable operation', disable_voltage: 'Disable voltage',
+  quick_stop: 'Quick stop', fault_reset: 'Fault reset', halt: 'Halt',
+};
+
+function buildCommands() {
+  const box = el('commands');
+  box.textContent = '';
+  for (const c of info.commands) {
+    const b = document.createElement('button');
+    b.type = 'button';
+    b.className = 'command control';
+    b.dataset.command = c.key;
+    b.textContent = COMMAND_LABELS[c.key] || c.action;
+    if (!c.available) {
+      b.disabled = true;
+      b.dataset.unavailable = 'true';
+      b.title = 'this profile has no control word for it';
+    }
+    if (c.key === 'halt') {
+      b.setAttribute('aria-pressed', 'false');
+      b.title = info.halt_supported ? 'toggles bit 8' : 'toggles bit 8 (this profile has no halt)';
+    }
+    b.addEventListener('click', () => post('/api/command', { command: c.key }));
+    box.appendChild(b);
+  }
+}
+
+function buildObjects() {
+  const sel = el('object-index');
+  sel.textContent = '';
+  for (const o of info.objects) {
+    const opt = document.createElement('option');
+    opt.value = o.index;
+    opt.textContent = `${o.index} ${o.name}`;
+    sel.appendChild(opt);
+  }
+  el('object-form').addEventListener('submit', (e) => {
+    e.preventDefault();
+    const v = el('object-value').value.trim();
+    if (v === '' || !/^-?\d+$/.test(v)) {
+      showResult('refused', 'the value must be an integer');
+      return;
+    }
+    post('/api/object', { index: sel.value, value: Number(v) });
+  });
+  sel.addEventListener('change', () => fillObjectValue());
+}
+
+function fillObjectValue() {
+  if (!snapshot) return;
+  const v = snapshot.objects[el('object-index').value];
+  if (v !== undefined) el('object-value').value = v;
+}
+
+function buildPlant() {
+  el('fault-class-wrap').hidden = !info.error_classes;
+  el('target-form').addEventListener('submit', (e) => {
+    e.preventDefault();
+    const v = el('target-input').value.trim();
+    if (!/^-?\d+$/.test(v)) {
+      showResult('refused', 'the target velocity must be an integer (rpm)');
+      return;
+    }
+    post('/api/plant', { target_velocity: Number(v) });
+  });
+  el('fault-switch').addEventListener('change', (e) => {
+    const on = e.target.checked;
+    const body = { fault: on };
+    if (on) {
+      body.fault_code = el('fault-code').value.trim();
+      if (info.error_classes) body.fault_class = Number(el('fault-class').value);
+    }
+    post('/api/plant', body).then((r) => { if (!r) e.target.checked = !on; });
+  });
+  el('dc-switch').addEventListener('change', (e) => post('/api/plant', { dc_link: !e.target.checked }));
+  el('sto-switch').addEventListener('change', (e) => post('/api/plant', { sto: e.target.checked }));
+}
+
+// A switch the user just changed is not overwritten by a snapshot older than the change.
+const touched = {};
+function syncSwitch(id, value) {
+  if (performance.now() - (touched[id] || 0) > 800) el(id).checked = value;
+}
+for (const id of ['fault-switch', 'dc-switch', 'sto-switch']) {
+  document.addEventListener('change', (e) => { if (e.target.id === id) touched[id] = performance.now(); },
+    true);
+}
+
+function setLamp(id, on, text) {
+  const l = el(id);
+  l.classList.toggle('on', on);
+  l.querySelector('b').textContent = text || (on ? 'ON' : 'OFF');
+}
+
+function hexBits(hex) {
+  return parseInt(hex, 16);
+}
+
+function update(s) {
+  snapshot = s;
+  received = performance.now();
+  el('state-name').textContent = label(s.state);
+  const last = s.last_transition;
+  el('last-transition').textContent = last
+    ? `${last.number} (${label(last.from)} → ${label(last.to)})` : 'none';
+  updateDiagram(s);
+
+  el('sw-hex').textContent = s.status_word;
+  const sw = hexBits(s.status_word);
+  for (const li of el('status-bits').children) {
+    const on = ((sw >> Number(li.dataset.bit)) & 1) === 1;
+    li.classList.toggle('on', on);
+    li.querySelector('.v').textContent = on ? '1' : '0';
+  }
+  el('cw-hex').textContent = s.control_word;
+  el('cw-decodes').textContent = label(s.decodes_to);
+  const cw = hexBits(s.control_word);
+  for (const btn of el('control-bits').querySelectorAll('button')) {
+    const on = ((cw >> Number(btn.dataset.bit)) & 1) === 1;
+    btn.classList.toggle('on', on);
+    btn.setAttribute('aria-checked', on ? 'true' : 'false');
+    btn.querySelector('.v').textContent = on ? '1' : '0';
+  }
+  const halt = document.querySelector('button[data-command="halt"]');
+  if (halt) halt.setAttribute('aria-pressed', ((cw >> 8) & 1) ? 'true' : 'false');
+
+  el('velocity').textContent = s.velocity;
+  el('target').textContent = s.target_velocity;
+  el('setpoint-note').textContent = s.effective_target !== s.target_velocity
+    ? `(set-points cleared: following ${s.effective_target})` : '';
+  el('error-code').textContent = s.error_code;
+  el('error-register').textContent = s.error_register;
+  setLamp('lamp-torque', s.torque);
+  setLamp('lamp-brake', s.brake_engaged, s.brake_engaged ? 'ON (holding)' : 'OFF (released)');
+  setLamp('lamp-dc', s.dc_link);
+  setLamp('lamp-sto', s.sto);
+  const cause = s.fault_cause !== '0x0000';
+  setLamp('lamp-fault', cause, cause ? `ON ${s.fault_cause}` : 'OFF');
+  syncSwitch('fault-switch', cause);
+  syncSwitch('dc-switch', !s.dc_link);
+  syncSwitch('sto-switch', s.sto);
+
+  const rows = el('object-values');
+  rows.textContent = '';
+  for (const o of info.objects) {
+    const tr = document.createElement('tr');
+    const a = document.createElement('th');
+    a.scope = 'row';
+    a.textContent = `${o.index} ${o.name}`;
+    const b = document.createElement('td');
+    b.textContent = s.objects[o.index] !== undefined ? s.objects[o.index] : '–';
+    tr.append(a, b);
+    rows.appendChild(tr);
+  }
+  if (document.activeElement !== el('object-value') && el('object-value').value === '') {
+    fillObjectValue();
+  }
+
+  const [latest, ...older] = s.results;
+  if (latest) showResult(latest.outcome, `${label(latest.action)}: ${latest.text}`);
+  const list = el('results');
+  list.textContent = '';
+  for (const r of older.slice(0, 3)) {
+    const li = document.createElement('li');
+    li.dataset.outcome = r.outcome;
+    li.textContent = `${label(r.action)}: ${r.text}`;
+    list.appendChild(li);
+  }
+
+  samples.push({ t: s.time_ms, v: s.velocity, target: s.effective_target });
+  while (samples.length && samples[0].t < s.time_ms - 12000) samples.shift();
+}
+
+// ---------------------------------------------------------------------------------------------
+// The velocity plot: the last 10 s, the newest value held up to now between updates (updates come
+// only when something changed).
+
+function drawPlot() {
+  const canvas = el('plot');
+  const dpr = window.devicePixelRatio || 1;
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
+    canvas.width = Math.round(w * dpr);
+    canvas.height = Math.round(h * dpr);
+  }
+  const g = canvas.getContext('2d');
+  g.setTransform(dpr, 0, 0, dpr, 0, 0);
+  g.clearRect(0, 0, w, h);
+  const css = getComputedStyle(canvas);
+  const ink = css.color, grid = css.getPropertyValue('--grid').trim() || '#ccc';
+  const left = 48, right = 8, top = 8, bottom = 20;
+  const pw = w - left - right, ph = h - top - bottom;
+  const now = snapshot ? snapshot.time_ms + (performance.now() - received) : 0;
+  const t0 = now - 10000;
+  let lo = 0, hi = 0;
+  for (const p of samples) {
+    lo = Math.min(lo, p.v, p.target);
+    hi = Math.max(hi, p.v, p.target);
+  }
+  const span = Math.max(hi - lo, 100);
+  const step = niceStep(span / 4);
+  lo = Math.floor(lo / step) * step;
+  hi = Math.max(Math.ceil(hi / step) * step, lo + step);
+  const period = (info && info.publish_ms) || 40;
+  const x = (t) => left + ((t - t0) / 10000) * pw;
+  const y = (v) => top + (1 - (v - lo) / (hi - lo)) * ph;
+
+  g.font = '11px system-ui, sans-serif';
+  g.lineWidth = 1;
+  g.strokeStyle = grid;
+  g.fillStyle = ink;
+  g.textAlign = 'right';
+  for (let v = lo; v <= hi + 1e-9; v += step) {
+    g.beginPath();
+    g.moveTo(left, y(v) + 0.5);
+    g.lineTo(left + pw, y(v) + 0.5);
+    g.stroke();
+    g.fillText(String(Math.round(v)), left - 4, y(v) + 4);
+  }
+  g.textAlign = 'center';
+  for (let s = 0; s <= 10; s += 2) {
+    const xs = left + (s / 10) * pw;
+    g.fillText(s === 10 ? 'now' : `-${10 - s} s`, xs, h - 5);
+  }
+  g.strokeStyle = ink;
+  g.beginPath();
+  g.moveTo(left, y(0) + 0.5);
+  g.lineTo(left + pw, y(0) + 0.5);
+  g.stroke();
+
+  const trace = (key, dashed, width) => {
+    if (!samples.length) return;
+    g.save();
+    g.beginPath();
+    g.rect(left, top - 2, pw, ph + 4);
+    g.clip();
+    g.setLineDash(dashed ? [6, 4] : []);
+    g.lineWidth = width;
+    g.strokeStyle = ink;
+    g.beginPath();
+    let prev = null;
+    for (const p of samples) {
+      const px = x(p.t), py = y(p[key]);
+      if (prev === null) {
+        g.moveTo(px, py);
+      } else {
+        // Snapshots come only on change, at most every `period` ms: the value before a gap held
+        // until one period before the next sample.
+        if (p.t - prev.t > 1.5 * period) g.lineTo(x(p.t - period), y(prev[key]));
+        g.lineTo(px, py);
+      }
+      prev = p;
+    }
+    g.lineTo(x(now), y(prev[key]));
+    g.stroke();
+    g.restore();
+  };
+  trace('target', true, 1.5);
+  trace('v', false, 2.5);
+}
+
+function niceStep(raw) {
+  const p = Math.pow(10, Math.floor(Math.log10(raw)));
+  for (const m of [1, 2, 5, 10]) if (raw <= m * p) return m * p;
+  return 10 * p;
+}
+
+function animate() {
+  drawPlot();
+  setTimeout(() => requestAnimationFrame(animate), 50);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+function setControl(allowed) {
+  document.body.classList.toggle('view-only', !allowed);
+  el('view-only').hidden = allowed;
+  for (const c of document.querySelectorAll('.control, .command, #target-input')) {
+    c.disabled = !allowed || c.dataset.unavailable === 'true';
+  }
+}
+
+function connect() {
+  const source = new EventSource('/api/events');
+  source.onopen = () => {
+    el('link').textContent = 'live';
+    el('link').dataset.live = 'true';
+  };
+  source.onerror = () => {
+    el('link').textContent = 'connection lost, retrying…';
+    el('link').dataset.live = 'false';
+  };
+  source.onmessage = (e) => {
+    try {
+      update(JSON.parse(e.data));
+      document.body.dataset.version = snapshot.version;
+    } catch (err) {
+      console.error(err);
+    }
+  };
+}
+
+async function main() {
+  const headers = token ? { 'X-Cia402-Token': token } : {};
+  const res = await fetch('/api/info', { headers });
+  info = await res.json();
+  const p = info.profile;
+  el('profile').textContent = `profile ${p.name}${p.seed ? ` (seed ${p.seed})` : ''}: ${p.title}`;
+  document.title = `${p.name}: instrument control`;
+  drawDiagram();
+  buildBits();
+  buildCommands();
+  buildObjects();
+  buildPlant();
+  setControl(info.control);
+  connect();
+  animate();
+}
+
+main().catch((e) => {
+  el('link').textContent = `cannot load the page's data: ${e.message}`;
+});

@@ -1,0 +1,398 @@
+// The instrument page in a real browser: Debian's chromium, headless, driven by playwright-core,
+// against `cia402 serve --port 0` on loopback. What it checks is what seed 003_83442f2f4b0b2bb9.txt
+// asks of the screen page: the present state black, all others gray, the number of the last
+// transition accented; the status word; commands, a fault and its reset; refused commands shown
+// as refused; view-only without the token; phone width.
+//
+//   node instrument_page.test.mjs CIA402_BINARY OUTPUT_DIR SCREENSHOT_PNG
+// Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
+import { spawn } from 'node:child_process';
+import fs from 'node:fs';
+import { createRequire } from 'node:module';
+import os from 'node:os';
+import path from 'node:path';
+
+const args = process.argv.slice(2);
+if (args.length !== 3) {
+  console.error('usage: node instrument_page.test.mjs CIA402_BINARY OUTPUT_DIR SCREENSHOT_PNG');
+  process.exit(2);
+}
+const [cia402, outDir, screenshotPath] = args.map((a) => path.resolve(a));
+const modules = path.resolve(process.env.CIA402_NODE_MODULES || 'node_modules');
+const { chromium } = createRequire(path.join(modules, 'resolve-from-here.js'))('playwright-core');
+const executablePath = process.env.CIA402_CHROMIUM || '/usr/bin/chromium';
+fs.mkdirSync(outDir, { recursive: true });
+
+const STATES = ['NOT_READY_TO_SWITCH_ON', 'SWITCH_ON_DISABLED', 'READY_TO_SWITCH_ON', 'SWITCHED_ON',
+  'OPERATION_ENABLED', 'QUICK_STOP_ACTIVE', 'FAULT_REACTION_ACTIVE', 'FAULT'];
+
+let passed = 0;
+const servers = [];
+let context = null;
+let currentPage = null;
+
+function fail(message) {
+  throw new Error(message);
+}
+
+function expect(condition, message) {
+  if (!condition) fail(message);
+}
+
+async function check(name, fn) {
+  await fn();
+  passed += 1;
+  console.log(`ok ${passed} - ${name}`);
+}
+
+// --- cia402 serve ----------------------------------------------------------------------------
+
+function startServer(extraArgs) {
+  return new Promise((resolve, reject) => {
+    const proc = spawn(cia402, ['serve', '--port', '0', ...extraArgs], {
+      stdio: ['ignore', 'pipe', 'pipe'],
+    });
+    const server = { proc, output: '', url: null, exit: null };
+    servers.push(server);
+    const timer = setTimeout(() => reject(new Error(`no URL from cia402 serve:\n${server.output}`)),
+      15000);
+    proc.stdout.on('data', (d) => {
+      server.output += d;
+      const m = /(http:\/\/\S+)/.exec(server.output);
+      if (m && !server.url) {
+        server.url = m[1];
+        clearTimeout(timer);
+        resolve(server);
+      }
+    });
+    proc.stderr.on('data', (d) => { server.output += d; });
+    proc.on('exit', (code, signal) => {
+      server.exit = { code, signal };
+      if (!server.url) {
+        clearTimeout(timer);
+        reject(new Error(`cia402 serve exited (${code}, ${signal}):\n${server.output}`));
+      }
+    });
+  });
+}
+
+// Ctrl-C: the server must stop cleanly, exit status 0.
+async function stopServer(server) {
+  if (server.exit) return server.exit;
+  const exited = new Promise((resolve) => server.proc.on('exit', (code, signal) => resolve({ code, signal })));
+  server.proc.kill('SIGINT');
+  const timeout = new Promise((resolve) => setTimeout(() => resolve(null), 5000));
+  const result = await Promise.race([exited, timeout]);
+  if (!result) {
+    server.proc.kill('SIGKILL');
+    fail(`cia402 serve did not stop within 5 s of SIGINT:\n${server.output}`);
+  }
+  return result;
+}
+
+// --- reading the page ------------------------------------------------------------------------
+
+function waitPresent(page, state, timeout = 8000) {
+  return page.waitForSelector(`#diagram [id="state.${state}"].present`, { timeout });
+}
+
+function waitResult(page, text, timeout = 8000) {
+  return page.waitForFunction((t) => document.getElementById('result').textContent.includes(t),
+    text, { timeout });
+}
+
+// Computed colours of every state box: what a reader actually sees.
+function diagramStyle(page) {
+  return page.evaluate(() => {
+    const rgb = (s) => (s.match(/\d+(\.\d+)?/g) || []).slice(0, 3).map(Number);
+    const states = [...document.querySelectorAll('#diagram .state')]
+      .filter((g) => g.dataset.state !== 'START')
+      .map((g) => {
+        const rect = g.querySelector('rect');
+        const text = g.querySelector('text');
+        return {
+          name: g.dataset.state,
+          label: [...g.querySelectorAll('text')].map((t) => t.textContent).join(' '),
+          present: g.classList.contains('present'),
+          fill: rgb(getComputedStyle(rect).fill),
+          stroke: rgb(getComputedStyle(rect).stroke),
+          text: rgb(getComputedStyle(text).fill),
+        };
+      });
+    const numbers = [...document.querySelectorAll('#diagram .number')].map((g) => {
+      const t = g.querySelector('text');
+      const r = g.querySelector('rect');
+      const cs = getComputedStyle(t);
+      return {
+        number: Number(g.dataset.number),
+        id: g.id,
+        last: g.classList.contains('last'),
+        weight: Number(cs.fontWeight),
+        size: parseFloat(cs.fontSize),
+        underline: cs.textDecorationLine.includes('underline'),
+        boxed: getComputedStyle(r).stroke !== 'none' && parseFloat(getComputedStyle(r).strokeWidth) > 0,
+      };
+    });
+    return { states, numbers };
+  });
+}
+
+const isBlack = ([r, g, b]) => r === 0 && g === 0 && b === 0;
+const isWhite = ([r, g, b]) => r === 255 && g === 255 && b === 255;
+const isGray = ([r, g, b]) => r === g && g === b && r >= 100 && r <= 220;
+
+async function expectPresentState(page, state) {
+  await waitPresent(page, state);
+  const { states } = await diagramStyle(page);
+  const present = states.filter((s) => s.present);
+  expect(present.length === 1 && present[0].name === state,
+    `exactly ${state} should be present, got ${JSON.stringify(present.map((s) => s.name))}`);
+  const p = present[0];
+  expect(p.label === state.replace(/_/g, ' '), `the present box reads "${p.label}"`);
+  expect(isBlack(p.fill), `${state} should be drawn black, fill is rgb(${p.fill})`);
+  for (const s of states.filter((x) => !x.present)) {
+    expect(isWhite(s.fill) && isGray(s.stroke) && isGray(s.text),
+      `${s.name} should be gray (fill ${s.fill}, stroke ${s.stroke}, text ${s.text})`);
+  }
+  expect(states.length === STATES.length, `8 states drawn, got ${states.length}`);
+}
+
+async function expectAccented(page, number) {
+  await page.waitForSelector(`#diagram .number.last[data-number="${number}"]`, { timeout: 8000 });
+  const { numbers } = await diagramStyle(page);
+  const last = numbers.filter((n) => n.last);
+  expect(last.length === 1 && last[0].number === number,
+    `only transition ${number} should be accented, got ${JSON.stringify(last.map((n) => n.id))}`);
+  const a = last[0];
+  const others = numbers.filter((n) => !n.last);
+  expect(a.weight >= 700 && a.underline && a.boxed,
+    `transition ${number} is accented by shape: weight ${a.weight}, underline ${a.underline}, box ${a.boxed}`);
+  expect(others.every((n) => n.size < a.size && n.weight < 700 && !n.boxed && !n.underline),
+    'the other transition numbers are plain');
+}
+
+async function statusWord(page) {
+  return parseInt(await page.textContent('#sw-hex'), 16);
+}
+
+async function click(page, command) {
+  await page.click(`button[data-command="${command}"]`);
+}
+
+// --- the test --------------------------------------------------------------------------------
+
+async function main() {
+  const main = await startServer([]);
+  await check('cia402 serve prints a loopback URL without a token', async () => {
+    expect(/^http:\/\/127\.0\.0\.1:\d+\/$/.test(main.url), `URL ${main.url}`);
+  });
+
+  const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'cia402-chromium-'));
+  context = await chromium.launchPersistentContext(userDataDir, {
+    executablePath,
+    headless: true,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+    viewport: { width: 1280, height: 800 },
+  });
+  const page = context.pages()[0] || await context.newPage();
+  currentPage = page;
+  const problems = [];
+  page.on('console', (m) => { if (m.type() === 'error') problems.push(m.text()); });
+  page.on('pageerror', (e) => problems.push(String(e)));
+
+  await page.goto(main.url);
+
+  await check('power-up: SWITCH ON DISABLED black, the others gray, transition 1 accented', async () => {
+    await page.waitForSelector('#link[data-live="true"]', { timeout: 8000 });
+    await expectPresentState(page, 'SWITCH_ON_DISABLED');
+    await expectAccented(page, 1);
+  });
+
+  await check('all 16 control-word and 16 status-word bits are shown with names', async () => {
+    const n = await page.evaluate(() => [
+      document.querySelectorAll('#control-bits button.bit').length,
+      document.querySelectorAll('#status-bits .bit').length,
+      document.querySelector('#control-bits button[data-bit="8"] .name').textContent,
+    ]);
+    expect(n[0] === 16 && n[1] === 16, `bits shown: ${n}`);
+    expect(n[2] === 'Halt', `bit 8 is named "${n[2]}"`);
+  });
+
+  await check('Enable operation from SWITCH ON DISABLED is shown as refused', async () => {
+    await click(page, 'enable_operation');
+    await waitResult(page, 'refused: no transition from SWITCH_ON_DISABLED for ENABLE_OPERATION');
+    expect(await page.getAttribute('#result', 'data-outcome') === 'refused', 'marked refused');
+    await expectPresentState(page, 'SWITCH_ON_DISABLED');
+  });
+
+  await check('Shutdown, Switch on: READY TO SWITCH ON by T2, SWITCHED ON by T3', async () => {
+    await click(page, 'shutdown');
+    await expectPresentState(page, 'READY_TO_SWITCH_ON');
+    await expectAccented(page, 2);
+    await click(page, 'switch_on');
+    await expectPresentState(page, 'SWITCHED_ON');
+    await expectAccented(page, 3);
+  });
+
+  await check('Enable operation: OPERATION ENABLED black, the others gray, transition 4 accented', async () => {
+    await click(page, 'enable_operation');
+    await expectPresentState(page, 'OPERATION_ENABLED');
+    await expectAccented(page, 4);
+    expect((await page.textContent('#state-name')) === 'OPERATION ENABLED', 'summary names the state');
+  });
+
+  await check('status word 0x0237 in bits 0..9 and its bits lit', async () => {
+    const sw = await statusWord(page);
+    // Bits 10..15 are the mode's and the plant's (target reached, pv speed 0 at standstill).
+    expect((sw & 0x03ff) === 0x0237, `status word ${sw.toString(16)}: bits 0..9 should read 0x237`);
+    const lit = await page.evaluate(() => [...document.querySelectorAll('#status-bits .bit')]
+      .filter((li) => li.classList.contains('on')).map((li) => Number(li.dataset.bit)));
+    for (const b of [0, 1, 2, 4, 5, 9]) expect(lit.includes(b), `status bit ${b} lit`);
+    for (const b of [3, 6]) expect(!lit.includes(b), `status bit ${b} dark`);
+    expect((await page.textContent('#cw-hex')) === '0x000F', 'control word 0x000F');
+  });
+
+  await check('target velocity: the motor turns, torque ON, brake released, the plot draws', async () => {
+    await page.fill('#target-input', '1500');
+    await page.click('#target-form button[type="submit"]');
+    await page.waitForFunction(() => Number(document.getElementById('velocity').textContent) > 300,
+      null, { timeout: 8000 });
+    expect((await page.textContent('#lamp-torque b')) === 'ON', 'torque lamp ON');
+    expect((await page.textContent('#lamp-brake b')).startsWith('OFF'), 'brake lamp OFF (released)');
+    const inked = await page.evaluate(() => {
+      const c = document.getElementById('plot');
+      const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+      let n = 0;
+      for (let i = 3; i < d.length; i += 4) if (d[i] > 0) n += 1;
+      return n;
+    });
+    expect(inked > 500, `the plot has ink (${inked} pixels)`);
+  });
+
+  await page.waitForTimeout(2200);  // let the plot show the ramp and the plateau
+  await page.evaluate(() => { document.activeElement.blur(); window.scrollTo(0, 0); });
+  fs.mkdirSync(path.dirname(screenshotPath), { recursive: true });
+  await page.screenshot({ path: screenshotPath, fullPage: true });
+  await page.screenshot({ path: path.join(outDir, 'operation-enabled-1280x800.png') });
+
+  await check('injected fault 0x2310: T13, T14 to FAULT, error code shown, transition 14 accented', async () => {
+    await page.fill('#fault-code', '0x2310');
+    await page.click('label:has(#fault-switch)');
+    await expectPresentState(page, 'FAULT');
+    await expectAccented(page, 14);
+    await page.waitForFunction(() => document.getElementById('error-code').textContent === '0x2310',
+      null, { timeout: 8000 });
+    expect((await page.textContent('#lamp-fault b')).startsWith('ON'), 'fault lamp ON');
+    expect((await page.textContent('#lamp-torque b')) === 'OFF', 'torque lamp OFF');
+  });
+  await page.screenshot({ path: path.join(outDir, 'fault-1280x800.png') });
+
+  await check('Fault reset while the cause persists is shown as refused', async () => {
+    await click(page, 'fault_reset');
+    await waitResult(page, 'refused: no transition from FAULT for FAULT_RESET');
+    await expectPresentState(page, 'FAULT');
+  });
+
+  await check('cause gone, Fault reset: SWITCH ON DISABLED by T15, transition 15 accented', async () => {
+    await page.click('label:has(#fault-switch)');
+    await page.waitForFunction(() => document.getElementById('lamp-fault').textContent.includes('OFF'),
+      null, { timeout: 8000 });
+    await click(page, 'fault_reset');
+    await expectPresentState(page, 'SWITCH_ON_DISABLED');
+    await expectAccented(page, 15);
+    await waitResult(page, 'done: T15');
+    const cw = parseInt(await page.textContent('#cw-hex'), 16);
+    expect((cw & 0x80) === 0, `bit 7 cleared after the edge (control word ${cw.toString(16)})`);
+  });
+  await page.screenshot({ path: path.join(outDir, 'after-fault-reset-1280x800.png') });
+
+  await check('a control-word bit toggles by click, the other bits kept', async () => {
+    const bit4 = '#control-bits button[data-bit="4"]';
+    const before = parseInt(await page.textContent('#cw-hex'), 16);
+    const was = await page.getAttribute(bit4, 'aria-checked');
+    await page.click(bit4);
+    await page.waitForFunction((w) => document.getElementById('cw-hex').textContent === w,
+      `0x${(before ^ 0x10).toString(16).toUpperCase().padStart(4, '0')}`, { timeout: 8000 });
+    expect(await page.getAttribute(bit4, 'aria-checked') !== was, 'bit 4 shows the new value');
+    await page.click(bit4);
+    await page.waitForFunction((w) => document.getElementById('cw-hex').textContent === w,
+      `0x${before.toString(16).toUpperCase().padStart(4, '0')}`, { timeout: 8000 });
+  });
+
+  await check('phone width 390x844: one column, diagram first, nothing wider than the screen', async () => {
+    await page.setViewportSize({ width: 390, height: 844 });
+    await page.waitForTimeout(300);
+    const m = await page.evaluate(() => {
+      const top = (sel) => document.querySelector(sel).getBoundingClientRect().top;
+      const d = document.getElementById('diagram').getBoundingClientRect();
+      return {
+        scrollWidth: document.documentElement.scrollWidth,
+        diagramWidth: d.width,
+        order: top('.panel-diagram') < top('.panel-commands') && top('.panel-commands') < top('.panel-plant'),
+      };
+    });
+    expect(m.scrollWidth <= 390, `page is ${m.scrollWidth} px wide`);
+    expect(m.diagramWidth > 300 && m.diagramWidth <= 390, `diagram is ${m.diagramWidth} px wide`);
+    expect(m.order, 'diagram, commands, plant from the top');
+    await expectPresentState(page, 'SWITCH_ON_DISABLED');
+    await page.screenshot({ path: path.join(outDir, 'phone-390x844.png') });
+    await page.screenshot({ path: path.join(outDir, 'phone-390x844-full.png'), fullPage: true });
+  });
+
+  await check('no errors in the browser console (CSP, script)', async () => {
+    expect(problems.length === 0, `console errors: ${JSON.stringify(problems)}`);
+  });
+
+  await check('Ctrl-C stops cia402 serve cleanly with exit status 0', async () => {
+    const r = await stopServer(main);
+    expect(r.code === 0, `exit ${JSON.stringify(r)}:\n${main.output}`);
+    expect(main.output.includes('stopping (SIGINT)'), 'it says it stops');
+  });
+
+  // --- a server that requires its token -------------------------------------------------------
+  const guarded = await startServer(['--token-required']);
+  await check('--token-required prints a URL with ?token=', async () => {
+    expect(/\?token=[0-9a-f]{32}$/.test(guarded.url), `URL ${guarded.url}`);
+  });
+  const viewer = await context.newPage();
+  currentPage = viewer;
+  await viewer.setViewportSize({ width: 1280, height: 800 });
+  await check('without the token the page is view-only: banner shown, controls disabled', async () => {
+    await viewer.goto(guarded.url.replace(/\?token=.*$/, ''));
+    await waitPresent(viewer, 'SWITCH_ON_DISABLED');
+    await viewer.waitForSelector('#view-only:not([hidden])', { timeout: 8000 });
+    const enabled = await viewer.evaluate(() =>
+      [...document.querySelectorAll('button, input, select')].filter((c) => !c.disabled).length);
+    expect(enabled === 0, `${enabled} controls still enabled`);
+  });
+  await viewer.screenshot({ path: path.join(outDir, 'view-only-1280x800.png') });
+  await check('with the token the same server obeys: Shutdown leads to READY TO SWITCH ON', async () => {
+    await viewer.goto(guarded.url);
+    await waitPresent(viewer, 'SWITCH_ON_DISABLED');
+    expect(await viewer.isHidden('#view-only'), 'no view-only banner');
+    await click(viewer, 'shutdown');
+    await expectPresentState(viewer, 'READY_TO_SWITCH_ON');
+    await expectAccented(viewer, 2);
+  });
+  const r = await stopServer(guarded);
+  expect(r.code === 0, `guarded server exit ${JSON.stringify(r)}`);
+
+  await context.close();
+  context = null;
+  fs.rmSync(userDataDir, { recursive: true, force: true });
+  console.log(`# ${passed} checks passed; screenshot: ${screenshotPath}`);
+}
+
+main().then(() => process.exit(0), async (e) => {
+  console.error(`not ok ${passed + 1} - ${e.message}`);
+  try {
+    if (currentPage) await currentPage.screenshot({ path: path.join(outDir, 'failure.png'), fullPage: true });
+  } catch { /* the page may be gone */ }
+  for (const s of servers) {
+    if (!s.exit) s.proc.kill('SIGKILL');
+    console.error(`--- cia402 serve output ---\n${s.output}`);
+  }
+  if (context) await context.close().catch(() => {});
+  process.exit(1);
+});

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The browser test of the instrument page, as CTest runs it:
+#   run.sh CIA402_BINARY WORK_DIR SCREENSHOT_PNG   (SCREENSHOT_PNG is written with
+#                                                  CIA402_UPDATE_SCREENSHOT=1)
+# Installs playwright-core with `npm ci` from this folder's package-lock.json into WORK_DIR (no
+# browser download: Debian's /usr/bin/chromium is used), then runs instrument_page.test.mjs.
+# Exit 77 (CTest: skipped) with the reason printed when node, npm or chromium is missing, or when
+# npm ci cannot install (no registry).
+set -euo pipefail
+
+cia402=${1:?usage: run.sh CIA402_BINARY WORK_DIR SCREENSHOT_PNG}
+work=${2:?usage: run.sh CIA402_BINARY WORK_DIR SCREENSHOT_PNG}
+screenshot=${3:?usage: run.sh CIA402_BINARY WORK_DIR SCREENSHOT_PNG}
+here=$(cd "$(dirname "$0")" && pwd)
+chromium=${CIA402_CHROMIUM:-/usr/bin/chromium}
+
+skip() { echo "SKIPPED: $*"; exit 77; }
+command -v node >/dev/null || skip "node is not installed (apt-get install nodejs npm)"
+command -v npm >/dev/null || skip "npm is not installed (apt-get install npm)"
+[ -x "$chromium" ] || skip "$chromium is missing (apt-get install chromium)"
+
+mkdir -p "$work"
+# Reinstall only when the lock file changed.
+if ! cmp -s "$here/package-lock.json" "$work/package-lock.json" || [ ! -d "$work/node_modules/playwright-core" ]; then
+  cp "$here/package.json" "$here/package-lock.json" "$work/"
+  if ! (cd "$work" && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error); then
+    rm -f "$work/package-lock.json"
+    skip "npm ci could not install playwright-core (no access to the npm registry?)"
+  fi
+fi
+
+# The screenshot in docs/ changes only when asked for (CIA402_UPDATE_SCREENSHOT=1), so a test run
+# leaves the source tree as it was; otherwise it goes beside the other outputs.
+if [ "${CIA402_UPDATE_SCREENSHOT:-0}" != 1 ]; then
+  screenshot="$work/output/instrument-page.png"
+fi
+
+export CIA402_NODE_MODULES="$work/node_modules"
+export CIA402_CHROMIUM="$chromium"
+exec node "$here/instrument_page.test.mjs" "$cia402" "$work/output" "$screenshot"

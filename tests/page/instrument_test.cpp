@@ -1,0 +1,310 @@
+// The instrument behind the page, without HTTP: commands reach the drive as the control words the
+// standard gives them, each action is reported as done (with its transitions) or refused, and
+// snapshots are published only when something changed. Expected words and transition numbers come
+// from the standard's tables (cia402-reference.md §2.2) and the seeds, not from the code.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <set>
+
+#include "cia402/page/instrument.hpp"
+#include "cia402/profile.hpp"
+
+namespace {
+
+using cia402::page::accepted;
+using cia402::page::instrument;
+using cia402::page::page_command;
+using cia402::page::plant_change;
+using cia402::page::refused;
+using json = nlohmann::json;
+
+const cia402::profile& by_name(const char* name) {
+  const cia402::profile* p = cia402::find_builtin_profile(name);
+  EXPECT_NE(p, nullptr) << name;
+  return p != nullptr ? *p : cia402::standard_profile();
+}
+
+void run(instrument& inst, int cycles) {
+  for (int i = 0; i < cycles; ++i) inst.step();
+}
+
+json snapshot(const instrument& inst) { return json::parse(inst.snapshot_json()); }
+
+// The newest result, after the drive had time to settle (an action settles 50 quiet cycles after
+// its last transition).
+json settled_result(instrument& inst) {
+  run(inst, 300);
+  const json s = snapshot(inst);
+  EXPECT_FALSE(s["results"].empty());
+  return s["results"].empty() ? json::object() : s["results"][0];
+}
+
+std::uint64_t id_of(const cia402::page::reply& r) {
+  const auto* ok = std::get_if<accepted>(&r);
+  EXPECT_NE(ok, nullptr);
+  return ok != nullptr ? ok->id : 0;
+}
+
+int hex_value(const json& v) { return std::stoi(v.get<std::string>(), nullptr, 16); }
+
+TEST(instrument, power_up_reaches_switch_on_disabled_by_t0_t1) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  const json s = snapshot(inst);
+  EXPECT_EQ(s["state"], "SWITCH_ON_DISABLED");
+  EXPECT_EQ(s["last_transition"]["number"], 1);
+  EXPECT_EQ(s["last_transition"]["from"], "NOT_READY_TO_SWITCH_ON");
+}
+
+TEST(instrument, shutdown_switch_on_enable_operation_reach_operation_enabled_with_t4_last) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  inst.command(page_command::shutdown);
+  EXPECT_EQ(settled_result(inst)["transitions"], json::array({2}));
+  inst.command(page_command::switch_on);
+  EXPECT_EQ(settled_result(inst)["transitions"], json::array({3}));
+  const std::uint64_t id = id_of(inst.command(page_command::enable_operation));
+  const json r = settled_result(inst);
+  EXPECT_EQ(r["id"], id);
+  EXPECT_EQ(r["outcome"], "done");
+  EXPECT_EQ(r["transitions"], json::array({4}));
+  const json s = snapshot(inst);
+  EXPECT_EQ(s["state"], "OPERATION_ENABLED");
+  EXPECT_EQ(s["control_word"], "0x000F");  // Enable operation, §2.2
+  EXPECT_EQ(s["last_transition"]["number"], 4);
+  // Bits 0..9 as the standard's OPERATION ENABLED with voltage and remote: 0x0237. Bits 10..15
+  // belong to the mode and the plant (target reached, pv speed 0).
+  EXPECT_EQ(hex_value(s["status_word"]) & 0x03FF, 0x0237);
+}
+
+TEST(instrument, enable_operation_from_switch_on_disabled_is_reported_refused) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  inst.command(page_command::enable_operation);
+  const json r = settled_result(inst);
+  EXPECT_EQ(r["outcome"], "refused");
+  EXPECT_EQ(r["text"], "refused: no transition from SWITCH_ON_DISABLED for ENABLE_OPERATION");
+  EXPECT_EQ(snapshot(inst)["state"], "SWITCH_ON_DISABLED");
+}
+
+TEST(instrument, enable_operation_from_ready_to_switch_on_reports_t3_then_t4) {
+  // S3: T3 then T4 in consecutive steps, one action.
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  inst.command(page_command::shutdown);
+  run(inst, 100);
+  inst.command(page_command::enable_operation);
+  EXPECT_EQ(settled_result(inst)["transitions"], json::array({3, 4}));
+}
+
+TEST(instrument, commands_keep_the_bits_the_state_machine_does_not_own) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  inst.toggle_control_bit(4);   // operation-mode specific
+  inst.toggle_control_bit(13);  // manufacturer specific
+  inst.command(page_command::shutdown);
+  run(inst, 5);
+  EXPECT_EQ(snapshot(inst)["control_word"], "0x2016");
+}
+
+TEST(instrument, halt_toggles_bit_8_and_keeps_the_command) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  inst.command(page_command::shutdown);
+  run(inst, 5);
+  inst.command(page_command::halt);
+  run(inst, 5);
+  EXPECT_EQ(snapshot(inst)["control_word"], "0x0106");
+  inst.command(page_command::halt);
+  run(inst, 5);
+  EXPECT_EQ(snapshot(inst)["control_word"], "0x0006");
+}
+
+TEST(instrument, fault_reset_is_one_edge_of_bit_7_and_leads_fault_to_switch_on_disabled_by_t15) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  plant_change fault;
+  fault.fault = true;
+  fault.fault_code = 0x2310;
+  inst.change_plant(fault);
+  const json fr = settled_result(inst);
+  EXPECT_EQ(fr["transitions"], json::array({13, 14}));
+  EXPECT_EQ(snapshot(inst)["state"], "FAULT");
+  EXPECT_EQ(snapshot(inst)["error_code"], "0x2310");
+
+  plant_change clear;
+  clear.fault = false;
+  inst.change_plant(clear);
+  run(inst, 100);
+  inst.command(page_command::fault_reset);
+  inst.step();
+  EXPECT_EQ(hex_value(snapshot(inst)["control_word"]) & 0x80, 0x80);  // the edge
+  const json r = settled_result(inst);
+  EXPECT_EQ(r["transitions"], json::array({15}));
+  const json s = snapshot(inst);
+  EXPECT_EQ(s["state"], "SWITCH_ON_DISABLED");
+  EXPECT_EQ(s["last_transition"]["number"], 15);
+  EXPECT_EQ(hex_value(s["control_word"]) & 0x80, 0);  // cleared after it was seen
+}
+
+TEST(instrument, fault_reset_after_bit_7_was_left_set_still_makes_an_edge) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  inst.toggle_control_bit(7);
+  plant_change fault;
+  fault.fault = true;
+  inst.change_plant(fault);
+  run(inst, 300);
+  plant_change clear;
+  clear.fault = false;
+  inst.change_plant(clear);
+  run(inst, 100);
+  ASSERT_EQ(snapshot(inst)["state"], "FAULT");
+  inst.command(page_command::fault_reset);
+  EXPECT_EQ(settled_result(inst)["transitions"], json::array({15}));
+}
+
+TEST(instrument, fault_reset_while_the_cause_persists_is_refused_and_names_the_cause) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  plant_change fault;
+  fault.fault = true;
+  fault.fault_code = 0x4310;
+  inst.change_plant(fault);
+  run(inst, 300);
+  inst.command(page_command::fault_reset);
+  const json r = settled_result(inst);
+  EXPECT_EQ(r["outcome"], "refused");
+  EXPECT_EQ(r["text"],
+            "refused: no transition from FAULT for FAULT_RESET (fault cause 0x4310 present)");
+  EXPECT_EQ(snapshot(inst)["state"], "FAULT");
+}
+
+TEST(instrument, switch_on_without_dc_link_is_refused_and_says_so) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  inst.command(page_command::shutdown);
+  run(inst, 100);
+  plant_change drop;
+  drop.dc_link = false;
+  inst.change_plant(drop);
+  run(inst, 100);
+  inst.command(page_command::switch_on);
+  EXPECT_EQ(settled_result(inst)["text"],
+            "refused: no transition from READY_TO_SWITCH_ON for SWITCH_ON (no DC-link voltage)");
+}
+
+TEST(instrument, option_write_the_profile_refuses_is_an_sdo_abort_and_changes_nothing) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  const auto r = inst.write_object(0x605A, 9);  // 9..32767 reserved (§3)
+  const auto* no = std::get_if<refused>(&r);
+  ASSERT_NE(no, nullptr);
+  EXPECT_EQ(no->http_status, 422);
+  EXPECT_EQ(static_cast<std::uint32_t>(no->abort), 0x06090030u);
+  const json s = snapshot(inst);
+  EXPECT_EQ(s["objects"]["0x605A"], 2);  // the default stays
+  EXPECT_EQ(s["results"][0]["outcome"], "refused");
+}
+
+TEST(instrument, target_velocity_outside_int32_is_refused_and_nothing_else_changes) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  plant_change c;
+  c.target_velocity = std::int64_t{1} << 40;
+  c.sto = true;
+  c.dc_link = false;
+  const auto r = inst.change_plant(c);
+  ASSERT_TRUE(std::holds_alternative<refused>(r));
+  const json s = snapshot(inst);
+  EXPECT_EQ(s["sto"], false);
+  EXPECT_EQ(s["dc_link"], true);
+  EXPECT_EQ(s["target_velocity"], 0);
+}
+
+TEST(instrument, toggle_of_a_bit_outside_0_to_15_is_refused) {
+  instrument inst(cia402::standard_profile());
+  EXPECT_TRUE(std::holds_alternative<refused>(inst.toggle_control_bit(16)));
+  EXPECT_TRUE(std::holds_alternative<refused>(inst.toggle_control_bit(-1)));
+}
+
+TEST(instrument, ax2000_enable_operation_word_sets_fast_stop_bit_4) {
+  // 004_e07fd68605b3a8c6.txt: fast stop is bit 4 (T11 "Bit 4 is canceled", T16 "Bit 4 is set"),
+  // so enabling needs bits 0..4: 0x001F.
+  instrument inst(by_name("ax2000-profibus"));
+  run(inst, 10);
+  inst.command(page_command::shutdown);
+  run(inst, 100);
+  inst.command(page_command::enable_operation);
+  EXPECT_EQ(settled_result(inst)["transitions"], json::array({3, 4}));
+  EXPECT_EQ(snapshot(inst)["control_word"], "0x001F");
+}
+
+TEST(instrument, drivecom_profiles_name_bits_as_stw_and_zsw) {
+  instrument s300(by_name("s300-profibus"));
+  const json info = json::parse(s300.info_json(true, false));
+  EXPECT_EQ(info["control_bits"][1]["name"], "Inhibit voltage");  // §6.1 STW
+  EXPECT_EQ(info["control_bits"][8]["name"], "Jog");
+  EXPECT_EQ(info["status_bits"][6]["name"], "Switch-on inhibit");  // §6.1 ZSW
+  instrument standard(cia402::standard_profile());
+  const json std_info = json::parse(standard.info_json(true, false));
+  EXPECT_EQ(std_info["control_bits"][8]["name"], "Halt");
+}
+
+TEST(instrument, info_rows_come_from_the_profile_table_with_t13_from_six_states) {
+  instrument inst(cia402::standard_profile());
+  const json info = json::parse(inst.info_json(false, true));
+  EXPECT_EQ(info["control"], false);
+  EXPECT_EQ(info["token_required"], true);
+  std::set<int> numbers;
+  for (const json& r : info["rows"]) {
+    numbers.insert(r["number"].get<int>());
+    if (r["number"] == 13) {
+      EXPECT_EQ(r["from"].size(), 6u);
+      EXPECT_EQ(r["to"], "FAULT_REACTION_ACTIVE");
+    }
+  }
+  // The standard's transitions 0..16 (seed 002_522d2c0bb8f5a5f8.txt, table 7.8).
+  for (int n = 0; n <= 16; ++n) EXPECT_TRUE(numbers.count(n)) << n;
+  EXPECT_FALSE(numbers.count(17));
+}
+
+TEST(instrument, a_snapshot_is_published_only_when_something_changed) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 400);  // power-up settles
+  const std::uint64_t before = inst.latest().version;
+  run(inst, 400);  // nothing happens
+  EXPECT_EQ(inst.latest().version, before);
+  inst.command(page_command::shutdown);
+  run(inst, 40);
+  EXPECT_GT(inst.latest().version, before);
+}
+
+TEST(instrument, snapshots_are_published_at_most_once_per_40_cycles) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  inst.command(page_command::shutdown);
+  run(inst, 5);
+  inst.command(page_command::enable_operation);
+  run(inst, 60);  // T3, T4, the brake lets go
+  ASSERT_EQ(snapshot(inst)["state"], "OPERATION_ENABLED");
+  plant_change c;
+  c.target_velocity = 3000;  // after T4, which clears the set-points
+  inst.change_plant(c);
+  const std::uint64_t before = inst.latest().version;
+  run(inst, 400);  // the motor accelerates: every snapshot differs
+  EXPECT_LE(inst.latest().version - before, 10u);
+  EXPECT_GE(inst.latest().version - before, 9u);
+}
+
+TEST(instrument, wait_for_update_returns_after_close_without_an_update) {
+  instrument inst(cia402::standard_profile());
+  inst.close();
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(inst.wait_for_update(0, std::chrono::seconds(5)).has_value());
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(1));
+}
+
+}  // namespace

@@ -1,0 +1,362 @@
+// The page's HTTP server in-process on a free loopback port, driven by cpp-httplib's client: bad
+// requests get a 4xx with a JSON reason and change nothing; with a token required the page is
+// view-only without it; the event stream delivers snapshots as the drive changes.
+#include <gtest/gtest.h>
+#include <httplib.h>
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <mutex>
+#include <thread>
+
+#include "cia402/page/instrument.hpp"
+#include "cia402/page/runner.hpp"
+#include "cia402/page/server.hpp"
+#include "cia402/profile.hpp"
+
+namespace {
+
+using cia402::page::instrument;
+using cia402::page::server;
+using cia402::page::server_options;
+using json = nlohmann::json;
+
+constexpr const char* token = "0123456789abcdef0123456789abcdef";
+
+class page_server : public ::testing::Test {
+ protected:
+  void start(bool token_required) {
+    server_options o;
+    o.bind = "127.0.0.1";
+    o.port = 0;
+    o.token_required = token_required;
+    o.token = token;
+    o.keep_alive = std::chrono::milliseconds(300);
+    http = std::make_unique<server>(inst, o);
+    ASSERT_TRUE(http->bind()) << http->error();
+    ASSERT_GT(http->bound_port(), 0);
+    http->start();
+    client = std::make_unique<httplib::Client>("127.0.0.1", http->bound_port());
+    client->set_read_timeout(5, 0);
+    step(10);  // power-up: T0, T1
+  }
+
+  void TearDown() override {
+    if (http) http->stop();
+  }
+
+  void step(int cycles) {
+    for (int i = 0; i < cycles; ++i) inst.step();
+  }
+
+  httplib::Result post(const std::string& path, const std::string& body,
+                       const httplib::Headers& headers = {},
+                       const std::string& type = "application/json") {
+    return client->Post(path.c_str(), headers, body, type.c_str());
+  }
+
+  // The parts of the snapshot a request could change.
+  json observable() {
+    json s = json::parse(inst.snapshot_json());
+    return {s["state"], s["control_word"], s["dc_link"], s["sto"], s["fault_cause"],
+            s["target_velocity"], s["objects"], s["results"]};
+  }
+
+  void expect_refused(const httplib::Result& r, int status, const std::string& reason_part) {
+    ASSERT_TRUE(r) << "no response";
+    EXPECT_EQ(r->status, status) << r->body;
+    EXPECT_NE(r->get_header_value("Content-Type").find("application/json"), std::string::npos);
+    const json body = json::parse(r->body, nullptr, false);
+    ASSERT_TRUE(body.is_object()) << r->body;
+    ASSERT_TRUE(body.contains("error")) << r->body;
+    EXPECT_NE(body["error"].get<std::string>().find(reason_part), std::string::npos)
+        << body["error"];
+  }
+
+  instrument inst{cia402::standard_profile()};
+  std::unique_ptr<server> http;
+  std::unique_ptr<httplib::Client> client;
+};
+
+TEST_F(page_server, page_and_its_files_are_served_from_the_binary) {
+  start(false);
+  const auto page = client->Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("<svg id=\"diagram\""), std::string::npos);
+  EXPECT_NE(page->get_header_value("Content-Security-Policy").find("script-src 'self'"),
+            std::string::npos);
+  for (const char* f : {"/app.js", "/style.css"}) {
+    const auto r = client->Get(f);
+    ASSERT_TRUE(r) << f;
+    EXPECT_EQ(r->status, 200) << f;
+    EXPECT_GT(r->body.size(), 1000u) << f;
+  }
+}
+
+TEST_F(page_server, a_valid_command_is_obeyed) {
+  start(false);
+  const auto r = post("/api/command", R"({"command":"shutdown"})");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200) << r->body;
+  step(5);
+  EXPECT_EQ(json::parse(inst.snapshot_json())["state"], "READY_TO_SWITCH_ON");
+}
+
+TEST_F(page_server, malformed_json_is_400_with_a_reason_and_changes_nothing) {
+  start(false);
+  const json before = observable();
+  expect_refused(post("/api/command", R"({"command":"shutdown")"), 400, "not valid JSON");
+  expect_refused(post("/api/command", R"(["shutdown"])"), 400, "JSON object");
+  expect_refused(post("/api/plant", ""), 400, "not valid JSON");
+  step(5);
+  EXPECT_EQ(observable(), before);
+}
+
+TEST_F(page_server, unknown_commands_keys_and_values_are_400_and_change_nothing) {
+  start(false);
+  const json before = observable();
+  expect_refused(post("/api/command", R"({"command":"launch"})"), 400, "unknown command");
+  expect_refused(post("/api/command", R"({"command":"shutdown","extra":1})"), 400,
+                 "unknown key 'extra'");
+  expect_refused(post("/api/command", R"({"command":5})"), 400, "'command'");
+  expect_refused(post("/api/command", R"({"command":"toggle_bit","bit":16})"), 400, "0..15");
+  expect_refused(post("/api/command", R"({"command":"toggle_bit","bit":"x"})"), 400, "0..15");
+  expect_refused(post("/api/command", R"({"command":"shutdown","bit":1})"), 400, "toggle_bit");
+  expect_refused(post("/api/plant", R"({})"), 400, "nothing to change");
+  expect_refused(post("/api/plant", R"({"sto":"yes"})"), 400, "true or false");
+  expect_refused(post("/api/plant", R"({"target_velocity":1.5})"), 400, "integer");
+  expect_refused(post("/api/object", R"({"index":"0x605A"})"), 400, "required");
+  expect_refused(post("/api/object", R"({"index":"0x1FFFF","value":1})"), 400, "'index'");
+  step(5);
+  EXPECT_EQ(observable(), before);
+}
+
+TEST_F(page_server, a_plant_request_with_one_bad_field_applies_none_of_it) {
+  start(false);
+  const json before = observable();
+  expect_refused(post("/api/plant", R"({"sto":true,"dc_link":false,"fault":true,"fault_code":0})"),
+                 400, "fault_code");
+  expect_refused(post("/api/plant", R"({"sto":true,"fault":true,"fault_class":5})"), 400,
+                 "fault_class");
+  expect_refused(post("/api/plant", R"({"sto":true,"fault_code":"0x1000"})"), 400,
+                 "goes with");
+  // The drive refuses the velocity (beyond INT32): the STO in the same request is not applied.
+  expect_refused(post("/api/plant", R"({"sto":true,"target_velocity":1099511627776})"), 422,
+                 "SDO abort");
+  step(5);
+  json after = observable();
+  // The refused velocity write is reported as a result; everything else is as before.
+  EXPECT_EQ(after[0], before[0]);
+  EXPECT_EQ(after[1], before[1]);
+  EXPECT_EQ(after[2], before[2]);
+  EXPECT_EQ(after[3], before[3]);
+  EXPECT_EQ(after[4], before[4]);
+  EXPECT_EQ(after[5], before[5]);
+  EXPECT_EQ(after[6], before[6]);
+}
+
+TEST_F(page_server, body_over_4_kib_is_413_with_a_reason_and_changes_nothing) {
+  start(false);
+  const json before = observable();
+  const std::string big = R"({"command":"shutdown","pad":")" + std::string(5000, 'x') + "\"}";
+  expect_refused(post("/api/command", big), 413, "4096");
+  step(5);
+  EXPECT_EQ(observable(), before);
+}
+
+TEST_F(page_server, wrong_content_type_is_415_and_changes_nothing) {
+  start(false);
+  const json before = observable();
+  expect_refused(post("/api/command", R"({"command":"shutdown"})", {}, "text/plain"), 415,
+                 "application/json");
+  step(5);
+  EXPECT_EQ(observable(), before);
+}
+
+TEST_F(page_server, option_write_refused_by_the_drive_is_422_with_its_sdo_abort) {
+  start(false);
+  const auto r = post("/api/object", R"({"index":"0x605A","value":9})");
+  expect_refused(r, 422, "0x06090030");
+  EXPECT_EQ(json::parse(r->body)["abort"], "0x06090030");
+  EXPECT_EQ(json::parse(inst.snapshot_json())["objects"]["0x605A"], 2);
+  const auto ok = post("/api/object", R"({"index":"0x605A","value":6})");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200);
+  EXPECT_EQ(json::parse(inst.snapshot_json())["objects"]["0x605A"], 6);
+}
+
+TEST_F(page_server, unknown_paths_are_404_and_get_on_a_command_path_is_405_both_json) {
+  start(false);
+  const auto r = client->Get("/etc/passwd");
+  expect_refused(r, 404, "no such resource");
+  expect_refused(client->Get("/api/command"), 405, "POST");
+}
+
+TEST_F(page_server, cross_origin_post_is_403_and_changes_nothing) {
+  start(false);
+  const json before = observable();
+  expect_refused(post("/api/command", R"({"command":"shutdown"})",
+                      {{"Origin", "http://evil.example"}}),
+                 403, "cross-origin");
+  step(5);
+  EXPECT_EQ(observable(), before);
+}
+
+TEST_F(page_server, without_token_a_post_naming_a_foreign_host_is_403) {
+  // DNS rebinding: a foreign name resolving to 127.0.0.1 arrives with its own Host header.
+  start(false);
+  const json before = observable();
+  expect_refused(post("/api/command", R"({"command":"shutdown"})", {{"Host", "evil.example"}}),
+                 403, "loopback");
+  step(5);
+  EXPECT_EQ(observable(), before);
+}
+
+TEST_F(page_server, token_required_refuses_control_without_the_token_and_changes_nothing) {
+  start(true);
+  const json before = observable();
+  expect_refused(post("/api/command", R"({"command":"shutdown"})"), 403, "token");
+  expect_refused(post("/api/command", R"({"command":"shutdown"})", {{"X-Cia402-Token", "wrong"}}),
+                 403, "token");
+  expect_refused(post("/api/plant", R"({"sto":true})"), 403, "token");
+  expect_refused(post("/api/object", R"({"index":"0x605A","value":6})"), 403, "token");
+  step(5);
+  EXPECT_EQ(observable(), before);
+
+  const auto ok = post("/api/command", R"({"command":"shutdown"})", {{"X-Cia402-Token", token}});
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200) << ok->body;
+  step(5);
+  EXPECT_EQ(json::parse(inst.snapshot_json())["state"], "READY_TO_SWITCH_ON");
+}
+
+TEST_F(page_server, token_required_info_says_view_only_without_the_token) {
+  start(true);
+  const auto view = client->Get("/api/info");
+  ASSERT_TRUE(view);
+  EXPECT_EQ(json::parse(view->body)["control"], false);
+  EXPECT_EQ(json::parse(view->body)["token_required"], true);
+  const auto control = client->Get("/api/info", {{"X-Cia402-Token", token}});
+  ASSERT_TRUE(control);
+  EXPECT_EQ(json::parse(control->body)["control"], true);
+  // Viewing needs no token: state and events are open.
+  const auto state = client->Get("/api/state");
+  ASSERT_TRUE(state);
+  EXPECT_EQ(state->status, 200);
+  EXPECT_NE(http->url().find("?token=" + std::string(token)), std::string::npos);
+}
+
+TEST_F(page_server, loopback_without_token_required_gives_control) {
+  start(false);
+  const auto r = client->Get("/api/info");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(json::parse(r->body)["control"], true);
+  EXPECT_EQ(http->url().find("token"), std::string::npos);
+}
+
+// Reads /api/events on a thread of its own until `done` says the text is enough.
+class event_reader {
+ public:
+  event_reader(int port, std::function<bool(const std::string&)> done) : done_(std::move(done)) {
+    thread_ = std::thread([this, port] {
+      httplib::Client c("127.0.0.1", port);
+      c.set_read_timeout(5, 0);
+      c.Get("/api/events", [this](const char* data, std::size_t n) {
+        std::lock_guard lock(mutex_);
+        text_.append(data, n);
+        finished_ = done_(text_);
+        return !finished_;
+      });
+      std::lock_guard lock(mutex_);
+      ended_ = true;
+    });
+  }
+  ~event_reader() { join(); }
+  void join() {
+    if (thread_.joinable()) thread_.join();
+  }
+  std::string text() {
+    std::lock_guard lock(mutex_);
+    return text_;
+  }
+  bool finished() {
+    std::lock_guard lock(mutex_);
+    return finished_;
+  }
+
+ private:
+  std::function<bool(const std::string&)> done_;
+  std::mutex mutex_;
+  std::string text_;
+  bool finished_ = false;
+  bool ended_ = false;
+  std::thread thread_;
+};
+
+TEST_F(page_server, event_stream_sends_a_snapshot_at_once_then_the_states_the_drive_takes) {
+  start(false);
+  cia402::page::cycle_runner runner(inst, std::chrono::microseconds(1000));
+  runner.start();
+  event_reader events(http->bound_port(), [](const std::string& t) {
+    return t.find(R"("state":"OPERATION_ENABLED")") != std::string::npos;
+  });
+  // The first event comes at once, before anything changes.
+  for (int i = 0; i < 200 && events.text().find("data: {") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_NE(events.text().find(R"(data: {"state":"SWITCH_ON_DISABLED")"), std::string::npos)
+      << events.text();
+  post("/api/command", R"({"command":"shutdown"})");
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  post("/api/command", R"({"command":"enable_operation"})");
+  events.join();
+  runner.stop();
+  const std::string t = events.text();
+  EXPECT_TRUE(events.finished()) << t;
+  EXPECT_NE(t.find(R"("state":"READY_TO_SWITCH_ON")"), std::string::npos);
+  EXPECT_NE(t.find(R"("last_transition":{"number":4)"), std::string::npos);
+}
+
+TEST_F(page_server, event_stream_sends_keep_alive_comments_when_nothing_changes) {
+  start(false);  // nothing steps: nothing is published
+  event_reader events(http->bound_port(), [](const std::string& t) {
+    return t.find(": keep-alive\n\n") != std::string::npos;
+  });
+  events.join();
+  EXPECT_TRUE(events.finished()) << events.text();
+}
+
+TEST_F(page_server, stop_ends_open_event_streams_promptly) {
+  start(false);
+  event_reader events(http->bound_port(), [](const std::string&) { return false; });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const auto t0 = std::chrono::steady_clock::now();
+  http->stop();
+  events.join();
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(2));
+}
+
+TEST(page_server_address, loopback_addresses_are_recognised) {
+  using cia402::page::is_loopback_address;
+  EXPECT_TRUE(is_loopback_address("127.0.0.1"));
+  EXPECT_TRUE(is_loopback_address("127.1.2.3"));
+  EXPECT_TRUE(is_loopback_address("::1"));
+  EXPECT_TRUE(is_loopback_address("localhost"));
+  EXPECT_FALSE(is_loopback_address("0.0.0.0"));
+  EXPECT_FALSE(is_loopback_address("::"));
+  EXPECT_FALSE(is_loopback_address("192.168.1.10"));
+  EXPECT_FALSE(is_loopback_address("128.0.0.1"));
+  EXPECT_FALSE(is_loopback_address("localhost.evil.example"));
+}
+
+TEST(page_server_token, tokens_are_32_hex_digits_and_differ) {
+  const std::string a = cia402::page::make_token();
+  const std::string b = cia402::page::make_token();
+  EXPECT_EQ(a.size(), 32u);
+  EXPECT_EQ(a.find_first_not_of("0123456789abcdef"), std::string::npos);
+  EXPECT_NE(a, b);
+}
+
+}  // namespace

@@ -1,0 +1,101 @@
+#include "cli/serve.hpp"
+
+#include <CLI/CLI.hpp>
+#include <csignal>
+#include <ostream>
+#include <pthread.h>
+
+#include "cia402/page/instrument.hpp"
+#include "cia402/page/runner.hpp"
+#include "cia402/page/server.hpp"
+#include "cli/common.hpp"
+
+namespace cia402::cli {
+namespace {
+
+constexpr int refused = 2;
+
+}  // namespace
+
+CLI::App* add_serve_subcommand(CLI::App& app, serve_args& args) {
+  auto* cmd = app.add_subcommand(
+      "serve",
+      "Run a virtual drive in real time and serve its instrument control page (control and status "
+      "word bits, the state machine, the plant) on http://127.0.0.1:8402/; Ctrl-C stops");
+  auto* by_name =
+      cmd->add_option("--profile", args.profile_name, "built-in profile: " + builtin_profile_names())
+          ->type_name("NAME")
+          ->default_str("cia402");
+  cmd->add_option("--profile-file", args.profile_file, "a TOML profile file instead of a built-in")
+      ->type_name("FILE")
+      ->excludes(by_name);
+  cmd->add_option("--bind", args.bind,
+                  "address to listen on; anything but loopback makes control need the token "
+                  "printed at start")
+      ->type_name("ADDRESS")
+      ->default_str("127.0.0.1");
+  cmd->add_option("--port", args.port, "TCP port; 0 picks a free one")
+      ->type_name("PORT")
+      ->check(CLI::Range(0, 65535))
+      ->default_str("8402");
+  cmd->add_flag("--token-required", args.token_required,
+                "require the printed token for control even on loopback");
+  return cmd;
+}
+
+int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
+  profile_choice choice;
+  if (!choice.resolve(args.profile_name, args.profile_file, err)) return refused;
+
+  page::server_options options;
+  options.bind = args.bind;
+  options.port = args.port;
+  const bool loopback = page::is_loopback_address(args.bind);
+  options.token_required = args.token_required || !loopback;
+
+  page::instrument inst(choice.get());
+  page::server http(inst, options);
+
+  // SIGINT and SIGTERM are blocked in every thread (the server's and the cycle thread inherit the
+  // mask) and taken here by sigwait, so stopping is ordinary code, not a signal handler.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  sigset_t previous;
+  pthread_sigmask(SIG_BLOCK, &stop_signals, &previous);
+  // A client that goes away mid-write must not kill the process.
+  std::signal(SIGPIPE, SIG_IGN);
+
+  if (!http.bind()) {
+    pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+    err << "cia402 serve: " << http.error() << "\n";
+    return refused;
+  }
+  page::cycle_runner runner(inst, std::chrono::microseconds(1000));
+  runner.start();
+  http.start();
+
+  out << "cia402 serve: profile " << choice.get().name << ", instrument page at " << http.url()
+      << "\n";
+  if (!loopback) {
+    out << "cia402 serve: listening on " << args.bind
+        << ", not loopback: control needs the token in that URL, without it the page is "
+           "view-only\n";
+  } else if (options.token_required) {
+    out << "cia402 serve: control needs the token in that URL; without it the page is view-only\n";
+  }
+  out << "cia402 serve: Ctrl-C stops" << std::endl;
+
+  int signal_number = 0;
+  sigwait(&stop_signals, &signal_number);
+  out << "cia402 serve: stopping (" << (signal_number == SIGINT ? "SIGINT" : "SIGTERM") << ")"
+      << std::endl;
+  inst.close();
+  http.stop();
+  runner.stop();
+  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  return 0;
+}
+
+}  // namespace cia402::cli
