@@ -9,7 +9,10 @@
 #include "cia402/profile_file.hpp"
 #include "cli/common.hpp"
 #include "cli/demo.hpp"
+#include "cli/bus.hpp"
 #include "cli/diagram.hpp"
+#include "cli/eds.hpp"
+#include "cli/master.hpp"
 #include "cli/path.hpp"
 #include "cli/replay.hpp"
 #include "cli/serve.hpp"
@@ -108,6 +111,13 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   serve_args serve_options;
   auto* serve = add_serve_subcommand(app, serve_options);
 
+  bus_args bus_options;
+  auto* bus = add_bus_subcommand(app, bus_options);
+  master_args master_options;
+  auto* master = add_master_subcommand(app, master_options);
+  eds_args eds_options;
+  auto* eds = add_eds_subcommand(app, eds_options);
+
   try {
     std::vector<std::string> reversed(args.rbegin(), args.rend());
     app.parse(reversed);
@@ -117,6 +127,9 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
 
   if (simulate->parsed()) return run_simulate(simulate_options, out, err);
   if (serve->parsed()) return run_serve(serve_options, out, err);
+  if (bus->parsed()) return run_bus(bus_options, out, err);
+  if (master->parsed()) return run_master(master_options, out, err);
+  if (eds->parsed()) return run_eds(eds_options, out, err);
   if (profiles->parsed()) {
     if (dump_name.empty()) return list_profiles(out);
     const profile* p = find_builtin_profile(dump_name);

@@ -1,0 +1,40 @@
+// The object dictionary of a CiA 402 drive node: the communication objects of CiA 301 and the drive
+// objects of CiA 402 that the virtual drive has. The slave serves this table and `cia402 eds` prints
+// it; nothing else lists objects.
+//
+// Choices, with the reason:
+// - 0x1000 device type = 0x00020192: the low word is the device profile number, 402 = 0x0192; bits
+//   16..23 are CiA 402's "type" field, 0x02 = servo drive; bits 24..31 are 0.
+// - 0x1018 identity: vendor-ID 0 (no CiA-assigned ID), product code 0x00000402, revision 0x00010000,
+//   serial number = node-ID, so each virtual drive on a bus differs.
+// - 0x1008 device name "cia402 virtual drive" and 0x2000 (device label, rw, up to 64 characters) are
+//   VISIBLE_STRINGs longer than 4 bytes: they travel by segmented SDO transfer.
+// - 0x2001 "fault injection" (wo, UNSIGNED16): writing an error code raises a fault cause in the
+//   virtual drive, 0 clears every cause. Write-only because it is a command, not a state.
+// - PDO defaults are the CiA 402 predefined set (as drive manuals restate it, e.g. Kollmorgen S300
+//   CANopen manual §5.3.1.3): RPDO1 = 0x6040; RPDO2 = 0x6040 + 0x6060; RPDO3 = 0x6040 + 0x607A
+//   (target position: not in a pv-only drive, so RPDO3 starts disabled and empty); RPDO4 = 0x6040 +
+//   0x60FF. TPDO1 = 0x6041; TPDO2 = 0x6041 + 0x6061; TPDO3 = 0x6041 + 0x6064 (position: disabled and
+//   empty, as RPDO3); TPDO4 = 0x6041 + 0x606C. Transmission type 255 (event-driven) everywhere.
+// - 0x1016 has 4 consumer entries; 0x1017 defaults to 0 (no heartbeat) as CiA 301 does.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "cia402/canopen/object_dictionary.hpp"
+
+namespace cia402::canopen {
+
+inline constexpr std::uint32_t device_type_cia402_servo = 0x00020192;
+inline constexpr std::uint16_t fault_injection_index = 0x2001;
+inline constexpr std::uint16_t device_label_index = 0x2000;
+inline constexpr std::size_t device_label_capacity = 64;
+inline constexpr int pdo_count = 4;             ///< RPDOs and TPDOs each
+inline constexpr int max_mapped_objects = 8;    ///< entries per mapping object
+inline constexpr int heartbeat_consumers = 4;   ///< sub-indices 1..4 of 0x1016
+
+/// The table; 0x6xxx objects are backed by the device.
+std::vector<object_entry> drive_objects();
+
+}  // namespace cia402::canopen

@@ -1,0 +1,73 @@
+// SDO server (CiA 301 §7.2.4): expedited and segmented upload and download over one default SDO
+// channel (requests on 0x600 + node-ID, responses on 0x580 + node-ID). Block transfer is not offered:
+// its command specifiers are refused with 0x05040001. Every refused request gets an abort frame with
+// the object dictionary's reason, and a transfer left idle for `timeout_us` is aborted with
+// 0x05040000. Frames whose length is not 8 are ignored, as CiA 301 defines SDO frames as 8 bytes.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "cia402/canopen/channel.hpp"
+#include "cia402/canopen/timing.hpp"
+#include "cia402/sdo_abort.hpp"
+
+namespace cia402::canopen {
+
+/// What the SDO server reads and writes: the node's object dictionary.
+class object_access {
+ public:
+  virtual ~object_access() = default;
+  /// Whether a download of `size` bytes (if known) may start: existence, access, size.
+  virtual sdo_abort check_download(std::uint16_t index, std::uint8_t sub, std::size_t size,
+                                   bool size_known) noexcept = 0;
+  /// The whole value. Without `size_indicated` (an expedited download that gave no size) the object
+  /// takes as many bytes as its type needs.
+  virtual sdo_abort download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
+                             bool size_indicated) noexcept = 0;
+  virtual sdo_abort upload(std::uint16_t index, std::uint8_t sub,
+                           std::vector<std::uint8_t>& data) noexcept = 0;
+};
+
+class sdo_server {
+ public:
+  /// Longest value a segmented download may carry.
+  static constexpr std::size_t max_download = 1024;
+
+  sdo_server(object_access& od, channel& out, std::uint8_t node_id,
+             std::uint32_t timeout_us = 1000000) noexcept
+      : od_(&od), out_(&out), node_id_(node_id), timeout_us_(timeout_us) {}
+
+  /// One request frame (the caller has checked its identifier is 0x600 + node-ID).
+  void on_request(const frame& request);
+  /// Advances the transfer timeout; returns when it would expire.
+  std::uint32_t process(std::uint32_t elapsed_us) noexcept;
+  /// Drops any transfer without a word (NMT reset, stopped).
+  void reset() noexcept { mode_ = mode::idle; }
+  bool busy() const noexcept { return mode_ != mode::idle; }
+
+ private:
+  enum class mode : std::uint8_t { idle, downloading, uploading };
+  void respond(std::uint8_t command, std::span<const std::uint8_t> data = {});
+  void abort(std::uint16_t index, std::uint8_t sub, sdo_abort code);
+
+  object_access* od_;
+  channel* out_;
+  std::uint8_t node_id_;
+  std::uint32_t timeout_us_;
+  mode mode_ = mode::idle;
+  std::uint16_t index_ = 0;
+  std::uint8_t sub_ = 0;
+  std::uint8_t toggle_ = 0;
+  bool size_known_ = false;
+  std::size_t size_ = 0;
+  std::size_t offset_ = 0;
+  std::uint32_t idle_us_ = 0;
+  std::vector<std::uint8_t> buffer_;
+};
+
+/// An SDO abort frame: 0x80, index, sub-index, code.
+frame sdo_abort_frame(std::uint32_t cob_id, std::uint16_t index, std::uint8_t sub, sdo_abort code) noexcept;
+
+}  // namespace cia402::canopen

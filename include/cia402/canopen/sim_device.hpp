@@ -1,0 +1,43 @@
+// The node's device (device.hpp) implemented by the simulator's virtual drive (sim/virtual_drive.hpp):
+// the core state machine and a plant, stepped once per plant cycle of the time the node passes in.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "cia402/canopen/device.hpp"
+#include "cia402/profile.hpp"
+#include "cia402/sim/virtual_drive.hpp"
+
+namespace cia402::canopen {
+
+class sim_device final : public device {
+ public:
+  /// Most cycles one step() runs; a longer gap (a stalled host) is dropped, not replayed.
+  static constexpr std::uint32_t max_catch_up_cycles = 1000;
+
+  /// Throws std::invalid_argument for a plant configuration the simulator refuses. The profile
+  /// must outlive the device.
+  explicit sim_device(const profile& p, const sim::plant_config& config = {});
+
+  sdo_abort read(std::uint16_t index, std::uint8_t sub, std::int64_t& value) noexcept override {
+    return drive_->read(index, sub, value);
+  }
+  sdo_abort write(std::uint16_t index, std::uint8_t sub, std::int64_t value) noexcept override {
+    return drive_->write(index, sub, value);
+  }
+  std::uint32_t step(std::uint32_t elapsed_us) noexcept override;
+  void set_connection_lost(bool lost) noexcept override { drive_->view().set_connection_lost(lost); }
+  sdo_abort inject_fault(std::uint16_t code) noexcept override;
+  void reset() noexcept override;
+
+  sim::virtual_drive& drive() noexcept { return *drive_; }
+
+ private:
+  const profile* profile_;
+  sim::plant_config config_;
+  std::unique_ptr<sim::virtual_drive> drive_;
+  std::uint32_t pending_us_ = 0;
+};
+
+}  // namespace cia402::canopen

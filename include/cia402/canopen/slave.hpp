@@ -1,0 +1,156 @@
+// A CiA 301 slave node around a device (device.hpp) with the CiA 402 drive dictionary
+// (drive_objects.hpp): NMT slave with boot-up, heartbeat producer (0x1017) and consumer (0x1016),
+// SDO server, EMCY producer, SYNC consumer and 4 RPDOs / 4 TPDOs whose parameters and mappings are
+// changed over SDO with the CiA 301 rules.
+//
+// The node never reads a clock: process(elapsed) runs its timers and gives the device its time, and
+// returns when it next wants to run. Frames come in through on_frame(); frames go out on the channel
+// given at construction.
+//
+// Behaviour, where CiA 301 leaves a choice:
+// - PDOs only in OPERATIONAL; SDO and EMCY in PRE-OPERATIONAL and OPERATIONAL; in STOPPED only NMT
+//   and heartbeats. Reset node restarts the device (power-on) and every object; reset communication
+//   resets 0x1000..0x1FFF. Both send the boot-up message and enter PRE-OPERATIONAL.
+// - A heartbeat consumer timeout (0x1016) tells the device the connection is lost, so 0x6007 acts
+//   (S10), and sends EMCY 0x8130; the next heartbeat from that node clears it.
+// - EMCY (0x80 + node-ID) on every new drive fault (0x603F becomes non-zero or changes): bytes 0..1
+//   the error code, byte 2 the error register 0x1001, bytes 3..4 the status word 0x6041 at that
+//   moment, bytes 5..7 zero. Node errors (heartbeat lost 0x8130, RPDO too short 0x8210) send their
+//   own EMCY. When the last error is gone, EMCY 0x0000 ("error reset").
+// - 0x1001 reads as the drive's register, plus bits 0 and 4 (communication) while a node error is
+//   active.
+// - Mapping changes follow CANopenNode: mapping entries need the PDO invalid (COB-ID bit 31) and
+//   sub-index 0 = 0, else 0x06010000; a mapped object must exist (0x06020000 / 0x06090011), be
+//   mappable in that direction with its full length (0x06040041); sub-index 0 above 8 is 0x06090031,
+//   more than 64 bits 0x06040042. A COB-ID that enables a PDO without mapping, changes the CAN-ID of
+//   a valid PDO, sets reserved bits or uses a restricted CAN-ID is 0x06090030; so are transmission
+//   types 241..253 (RTR-only 252/253 is not offered) and an inhibit time change while the TPDO is
+//   valid.
+// - A synchronous RPDO's data acts at the next SYNC; an event RPDO's at once. A synchronous TPDO
+//   (1..240) is sampled and sent on every n-th SYNC; type 0 on a SYNC if its data changed; 254/255
+//   when its data changes (after the inhibit time) and every event-timer period.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cia402/canopen/channel.hpp"
+#include "cia402/canopen/device.hpp"
+#include "cia402/canopen/nmt.hpp"
+#include "cia402/canopen/object_dictionary.hpp"
+#include "cia402/canopen/pdo.hpp"
+#include "cia402/canopen/sdo_server.hpp"
+#include "cia402/canopen/timing.hpp"
+
+namespace cia402::canopen {
+
+struct slave_config {
+  std::uint8_t node_id = 1;
+  std::uint32_t sdo_timeout_us = 1000000;
+  /// Default of 0x1017 (also after a reset); 0 = no heartbeat until a master asks for one.
+  std::uint16_t heartbeat_ms = 0;
+};
+
+/// Error codes the node raises itself (not the drive).
+namespace node_error {
+inline constexpr std::uint16_t heartbeat_lost = 0x8130;   ///< life guard / heartbeat error
+inline constexpr std::uint16_t pdo_length = 0x8210;       ///< PDO not processed: length error
+}  // namespace node_error
+
+class slave final : private object_access {
+ public:
+  /// Sends the boot-up message and enters PRE-OPERATIONAL. Device and channel must outlive it.
+  slave(device& d, channel& out, const slave_config& config);
+  slave(const slave&) = delete;
+  slave& operator=(const slave&) = delete;
+
+  /// A frame from the bus (any identifier; the node picks what concerns it).
+  void on_frame(const frame& f);
+  /// Every frame waiting on `in`, then process(elapsed).
+  std::uint32_t poll(channel& in, std::uint32_t elapsed_us);
+  std::uint32_t process(std::uint32_t elapsed_us);
+
+  nmt_state state() const noexcept { return state_; }
+  std::uint8_t node_id() const noexcept { return config_.node_id; }
+  bool connection_lost() const noexcept { return consumer_.any_lost(); }
+  const object_dictionary& dictionary() const noexcept { return od_; }
+
+  /// Local object access with every rule the SDO server applies (what an application on the node
+  /// would use). Values travel as int64; strings through read_text / write_text.
+  sdo_abort read(std::uint16_t index, std::uint8_t sub, std::int64_t& value);
+  sdo_abort write(std::uint16_t index, std::uint8_t sub, std::int64_t value);
+  /// Any object as its bytes on the bus (strings as text).
+  sdo_abort read_bytes(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t>& bytes) {
+    return upload(index, sub, bytes);
+  }
+
+  /// The resolved configuration of RPDO/TPDO n (0..3).
+  const pdo_config& rpdo(int n) const noexcept { return rpdo_[static_cast<std::size_t>(n)].cfg; }
+  const pdo_config& tpdo(int n) const noexcept { return tpdo_[static_cast<std::size_t>(n)].cfg; }
+
+ private:
+  struct rpdo_state {
+    pdo_config cfg;
+    std::array<std::uint8_t, 8> buffer{};
+    bool pending = false;  // synchronous data waiting for the next SYNC
+  };
+  struct tpdo_state {
+    pdo_config cfg;
+    std::array<std::uint8_t, 8> last{};
+    bool sent = false;
+    std::uint8_t sync_count = 0;
+    std::uint32_t inhibit_left_us = 0;
+    std::uint32_t event_left_us = 0;
+    bool event_pending = false;
+  };
+
+  // object_access (the SDO server's view)
+  sdo_abort check_download(std::uint16_t index, std::uint8_t sub, std::size_t size,
+                           bool size_known) noexcept override;
+  sdo_abort download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
+                     bool size_indicated) noexcept override;
+  sdo_abort upload(std::uint16_t index, std::uint8_t sub,
+                   std::vector<std::uint8_t>& data) noexcept override;
+
+  sdo_abort write_checked(object_dictionary::slot& s, std::int64_t v);
+  sdo_abort write_pdo_parameter(object_dictionary::slot& s, std::int64_t v);
+  sdo_abort read_value(const object_dictionary::slot& s, std::int64_t& v);
+  sdo_abort check_mapping_entry(bool receive, std::uint32_t entry) const;
+  void resolve_pdos();
+  pdo_config resolve(std::uint16_t comm, std::uint16_t mapping) const;
+  void configure_consumer();
+
+  void boot();
+  void enter(nmt_state s);
+  void on_nmt(const frame& f);
+  void on_sync();
+  void apply_rpdo(rpdo_state& r, const std::uint8_t* data);
+  bool sample(const tpdo_state& t, std::array<std::uint8_t, 8>& out);
+  void send_tpdo(tpdo_state& t, const std::array<std::uint8_t, 8>& data);
+  std::uint32_t process_tpdo_events(std::uint32_t elapsed_us);
+  void check_errors();
+  void set_node_error(std::uint16_t code, bool active);
+  void send_emcy(std::uint16_t code);
+
+  device* device_;
+  channel* out_;
+  slave_config config_;
+  object_dictionary od_;
+  sdo_server sdo_;
+  heartbeat_producer producer_;
+  heartbeat_consumer consumer_;
+  nmt_state state_ = nmt_state::initialising;
+  std::array<rpdo_state, 4> rpdo_{};
+  std::array<tpdo_state, 4> tpdo_{};
+  std::uint32_t sync_id_ = cob::sync;
+  std::uint16_t drive_error_ = 0;      // the drive's 0x603F as last reported by EMCY
+  bool heartbeat_error_ = false;
+  bool pdo_length_error_ = false;
+  bool any_error_reported_ = false;    // an EMCY other than 0x0000 went out since the last reset one
+};
+
+}  // namespace cia402::canopen

@@ -1,0 +1,527 @@
+#include "cia402/canopen/slave.hpp"
+
+#include <algorithm>
+
+#include "cia402/canopen/drive_objects.hpp"
+
+namespace cia402::canopen {
+namespace {
+
+std::vector<object_entry> table_for(const slave_config& c) {
+  std::vector<object_entry> t = drive_objects();
+  for (object_entry& o : t) {
+    if (o.index == 0x1017) o.subs[0].default_value = c.heartbeat_ms;
+  }
+  return t;
+}
+
+constexpr std::uint32_t saturating_sub(std::uint32_t a, std::uint32_t b) noexcept {
+  return a > b ? a - b : 0;
+}
+
+bool is_pdo_parameter(std::uint16_t index) noexcept {
+  const std::uint16_t base = index & 0xFFFC;
+  return base == 0x1400 || base == 0x1600 || base == 0x1800 || base == 0x1A00;
+}
+
+}  // namespace
+
+slave::slave(device& d, channel& out, const slave_config& config)
+    : device_(&d),
+      out_(&out),
+      config_(config),
+      od_(table_for(config), config.node_id),
+      sdo_(*this, out, config.node_id, config.sdo_timeout_us) {
+  consumer_.on_change = [this](std::uint8_t, bool) {
+    const bool lost = consumer_.any_lost();
+    device_->set_connection_lost(lost);
+    set_node_error(node_error::heartbeat_lost, lost);
+  };
+  boot();
+}
+
+// ---- NMT ------------------------------------------------------------------------------------
+
+void slave::boot() {
+  sdo_.reset();
+  sync_id_ = static_cast<std::uint32_t>(od_.number(0x1005, 0)) & max_base_id;
+  resolve_pdos();
+  configure_consumer();
+  producer_.configure(static_cast<std::uint16_t>(od_.number(0x1017, 0)));
+  state_ = nmt_state::initialising;
+  (void)out_->send(heartbeat_frame(config_.node_id, nmt_state::initialising));
+  enter(nmt_state::pre_operational);
+}
+
+void slave::enter(nmt_state s) {
+  if (s != nmt_state::operational) {
+    for (rpdo_state& r : rpdo_) r.pending = false;
+  }
+  if (s != state_) {
+    for (tpdo_state& t : tpdo_) {
+      t.sent = false;  // an event TPDO sends its data on entering OPERATIONAL
+      t.sync_count = 0;
+      t.inhibit_left_us = 0;
+      t.event_left_us = t.cfg.event_timer_ms * 1000u;
+    }
+  }
+  if (s == nmt_state::stopped) sdo_.reset();
+  state_ = s;
+}
+
+void slave::on_nmt(const frame& f) {
+  if (f.len < 2) return;
+  if (f.data[1] != 0 && f.data[1] != config_.node_id) return;
+  switch (static_cast<nmt_command>(f.data[0])) {
+    case nmt_command::start: enter(nmt_state::operational); break;
+    case nmt_command::stop: enter(nmt_state::stopped); break;
+    case nmt_command::enter_pre_operational: enter(nmt_state::pre_operational); break;
+    case nmt_command::reset_node:
+      device_->reset();
+      od_.reset(0x0000, 0xFFFF);
+      drive_error_ = 0;
+      pdo_length_error_ = false;
+      boot();
+      break;
+    case nmt_command::reset_communication:
+      od_.reset(0x1000, 0x1FFF);
+      pdo_length_error_ = false;
+      boot();
+      break;
+  }
+}
+
+// ---- frames and time -------------------------------------------------------------------------
+
+void slave::on_frame(const frame& f) {
+  if (f.extended || f.rtr) return;  // no 29-bit COB-IDs, no RTR (node guarding is not offered)
+  if (f.id == cob::nmt) return on_nmt(f);
+  if (consumer_.on_frame(f)) return;
+  if (state_ == nmt_state::stopped) return;
+  if (f.id == sync_id_) {
+    if (state_ == nmt_state::operational) on_sync();
+    return;
+  }
+  if (f.id == cob::sdo_rx + config_.node_id) return sdo_.on_request(f);
+  if (state_ != nmt_state::operational) return;
+  for (rpdo_state& r : rpdo_) {
+    if (!r.cfg.valid || r.cfg.can_id != f.id) continue;
+    if (f.len < r.cfg.length) {
+      set_node_error(node_error::pdo_length, true);
+      return;
+    }
+    set_node_error(node_error::pdo_length, false);
+    if (synchronous_type(r.cfg.transmission_type)) {
+      r.buffer = f.data;
+      r.pending = true;
+    } else {
+      apply_rpdo(r, f.data.data());
+    }
+  }
+}
+
+std::uint32_t slave::poll(channel& in, std::uint32_t elapsed_us) {
+  frame f;
+  while (in.receive(f)) on_frame(f);
+  return process(elapsed_us);
+}
+
+std::uint32_t slave::process(std::uint32_t elapsed_us) {
+  std::uint32_t next = device_->step(elapsed_us);
+  check_errors();
+  next = earliest(next, producer_.process(elapsed_us, *out_, config_.node_id, state_));
+  next = earliest(next, consumer_.process(elapsed_us));
+  if (state_ != nmt_state::stopped) next = earliest(next, sdo_.process(elapsed_us));
+  if (state_ == nmt_state::operational) next = earliest(next, process_tpdo_events(elapsed_us));
+  return next;
+}
+
+// ---- PDO ------------------------------------------------------------------------------------
+
+void slave::on_sync() {
+  for (rpdo_state& r : rpdo_) {
+    if (r.cfg.valid && r.pending) {
+      r.pending = false;
+      apply_rpdo(r, r.buffer.data());
+    }
+  }
+  for (tpdo_state& t : tpdo_) {
+    if (!t.cfg.valid || !synchronous_type(t.cfg.transmission_type)) continue;
+    std::array<std::uint8_t, 8> data{};
+    if (t.cfg.transmission_type == 0) {
+      if (sample(t, data) && (!t.sent || data != t.last)) send_tpdo(t, data);
+      continue;
+    }
+    if (++t.sync_count >= t.cfg.transmission_type) {
+      t.sync_count = 0;
+      if (sample(t, data)) send_tpdo(t, data);
+    }
+  }
+}
+
+void slave::apply_rpdo(rpdo_state& r, const std::uint8_t* data) {
+  std::size_t offset = 0;
+  for (std::uint8_t i = 0; i < r.cfg.count; ++i) {
+    const mapped_object& m = r.cfg.map[i];
+    const std::int64_t v = decode_value(m.type, std::span<const std::uint8_t>(data + offset, m.bytes));
+    offset += m.bytes;
+    // A value the object refuses is dropped: a PDO has no answer to carry an abort code.
+    (void)write(m.index, m.sub, v);
+  }
+}
+
+bool slave::sample(const tpdo_state& t, std::array<std::uint8_t, 8>& out) {
+  out.fill(0);
+  std::size_t offset = 0;
+  for (std::uint8_t i = 0; i < t.cfg.count; ++i) {
+    const mapped_object& m = t.cfg.map[i];
+    std::int64_t v = 0;
+    if (read(m.index, m.sub, v) != sdo_abort::none) return false;
+    put_le(out.data() + offset, static_cast<std::uint64_t>(v), m.bytes);
+    offset += m.bytes;
+  }
+  return true;
+}
+
+void slave::send_tpdo(tpdo_state& t, const std::array<std::uint8_t, 8>& data) {
+  frame f;
+  f.id = t.cfg.can_id;
+  f.len = t.cfg.length;
+  f.data = data;
+  (void)out_->send(f);
+  t.last = data;
+  t.sent = true;
+  t.event_pending = false;
+  t.inhibit_left_us = t.cfg.inhibit_100us * 100u;
+  t.event_left_us = t.cfg.event_timer_ms * 1000u;
+}
+
+std::uint32_t slave::process_tpdo_events(std::uint32_t elapsed_us) {
+  std::uint32_t next = no_deadline;
+  for (tpdo_state& t : tpdo_) {
+    if (!t.cfg.valid || !event_type(t.cfg.transmission_type)) continue;
+    t.inhibit_left_us = saturating_sub(t.inhibit_left_us, elapsed_us);
+    if (t.cfg.event_timer_ms != 0) {
+      t.event_left_us = saturating_sub(t.event_left_us, elapsed_us);
+      if (t.event_left_us == 0) t.event_pending = true;
+    }
+    std::array<std::uint8_t, 8> data{};
+    if (!sample(t, data)) continue;
+    if (!t.sent || data != t.last) t.event_pending = true;
+    if (t.event_pending && t.inhibit_left_us == 0) send_tpdo(t, data);
+    if (t.event_pending) next = earliest(next, t.inhibit_left_us);
+    if (t.cfg.event_timer_ms != 0) next = earliest(next, t.event_left_us);
+  }
+  return next;
+}
+
+pdo_config slave::resolve(std::uint16_t comm, std::uint16_t mapping) const {
+  pdo_config c;
+  const auto cob_id = static_cast<std::uint32_t>(od_.number(comm, 1));
+  c.valid = (cob_id & pdo_cob_invalid) == 0;
+  c.can_id = cob_id & max_base_id;
+  c.transmission_type = static_cast<std::uint8_t>(od_.number(comm, 2));
+  c.inhibit_100us = static_cast<std::uint16_t>(od_.number(comm, 3));
+  c.event_timer_ms = static_cast<std::uint16_t>(od_.number(comm, 5));
+  c.count = static_cast<std::uint8_t>(od_.number(mapping, 0));
+  for (std::uint8_t i = 0; i < c.count && i < c.map.size(); ++i) {
+    const auto entry = static_cast<std::uint32_t>(od_.number(mapping, static_cast<std::uint8_t>(i + 1)));
+    const object_dictionary::slot* s = od_.find(map_index(entry), map_sub(entry));
+    if (s == nullptr) {  // cannot happen: entries are checked when written
+      c.valid = false;
+      c.count = i;
+      break;
+    }
+    c.map[i] = mapped_object{map_index(entry), map_sub(entry), s->entry->type,
+                             static_cast<std::uint8_t>(map_bits(entry) / 8)};
+    c.length = static_cast<std::uint8_t>(c.length + c.map[i].bytes);
+  }
+  return c;
+}
+
+void slave::resolve_pdos() {
+  for (int n = 0; n < pdo_count; ++n) {
+    const auto i = static_cast<std::size_t>(n);
+    rpdo_[i].cfg = resolve(static_cast<std::uint16_t>(0x1400 + n), static_cast<std::uint16_t>(0x1600 + n));
+    rpdo_[i].pending = false;
+    tpdo_[i].cfg = resolve(static_cast<std::uint16_t>(0x1800 + n), static_cast<std::uint16_t>(0x1A00 + n));
+  }
+}
+
+sdo_abort slave::check_mapping_entry(bool receive, std::uint32_t entry) const {
+  sdo_abort a = sdo_abort::none;
+  const object_dictionary::slot* s =
+      const_cast<object_dictionary&>(od_).find(map_index(entry), map_sub(entry), a);
+  if (s == nullptr) return a;
+  const sub_entry& e = *s->entry;
+  if (!e.pdo_mappable || (receive ? !writable(e.acc) : !readable(e.acc)) ||
+      map_bits(entry) != type_size(e.type) * 8) {
+    return sdo_abort::cannot_map_to_pdo;
+  }
+  return sdo_abort::none;
+}
+
+sdo_abort slave::write_pdo_parameter(object_dictionary::slot& s, std::int64_t v) {
+  const std::uint16_t index = s.object->index;
+  const std::uint8_t sub = s.entry->sub;
+  const bool receive = index < 0x1800;
+  const int n = index & 0x3;
+  const auto comm = static_cast<std::uint16_t>((receive ? 0x1400 : 0x1800) + n);
+  const auto mapping = static_cast<std::uint16_t>((receive ? 0x1600 : 0x1A00) + n);
+  const pdo_config& cfg = receive ? rpdo_[static_cast<std::size_t>(n)].cfg
+                                  : tpdo_[static_cast<std::size_t>(n)].cfg;
+  const auto u = static_cast<std::uint32_t>(v);
+
+  if (index == comm) {
+    switch (sub) {
+      case 1: {
+        const bool valid = (u & pdo_cob_invalid) == 0;
+        const std::uint32_t can_id = u & max_base_id;
+        // Bits 11..29 (29-bit identifiers are not offered) must be 0; a valid PDO keeps its
+        // CAN-ID; an enabled PDO needs a mapping and an identifier it may use.
+        if ((u & 0x3FFFF800u) != 0 || (valid && cfg.valid && can_id != cfg.can_id) ||
+            (valid && restricted_can_id(can_id)) || (valid && cfg.count == 0)) {
+          return sdo_abort::invalid_value;
+        }
+        break;
+      }
+      case 2:
+        if (u > 240 && u < 254) return sdo_abort::invalid_value;
+        break;
+      case 3:
+        if (cfg.valid && u != cfg.inhibit_100us) return sdo_abort::invalid_value;
+        break;
+      default: break;
+    }
+    s.number = v;
+  } else if (sub == 0) {
+    if (cfg.valid) return sdo_abort::unsupported_access;
+    unsigned bits = 0;
+    for (std::uint8_t i = 1; i <= u; ++i) {
+      const auto entry = static_cast<std::uint32_t>(od_.number(mapping, i));
+      if (entry == 0) return sdo_abort::cannot_map_to_pdo;
+      const sdo_abort a = check_mapping_entry(receive, entry);
+      if (a != sdo_abort::none) return a;
+      bits += map_bits(entry);
+      if (bits > 64) return sdo_abort::pdo_length_exceeded;
+    }
+    s.number = v;
+  } else {
+    if (cfg.valid || od_.number(mapping, 0) != 0) return sdo_abort::unsupported_access;
+    if (u != 0) {
+      const sdo_abort a = check_mapping_entry(receive, u);
+      if (a != sdo_abort::none) return a;
+    }
+    s.number = v;
+  }
+
+  const auto i = static_cast<std::size_t>(n);
+  if (receive) {
+    rpdo_[i].cfg = resolve(comm, mapping);
+    rpdo_[i].pending = false;
+  } else {
+    tpdo_state& t = tpdo_[i];
+    const bool was_valid = t.cfg.valid;
+    t.cfg = resolve(comm, mapping);
+    if (t.cfg.valid != was_valid || index != comm || sub != 3) {
+      t.sent = false;
+      t.sync_count = 0;
+      t.event_left_us = t.cfg.event_timer_ms * 1000u;
+    }
+  }
+  return sdo_abort::none;
+}
+
+// ---- object access -----------------------------------------------------------------------------
+
+void slave::configure_consumer() {
+  std::vector<heartbeat_consumer::entry> entries;
+  for (int i = 1; i <= heartbeat_consumers; ++i) {
+    const auto v = static_cast<std::uint32_t>(od_.number(0x1016, static_cast<std::uint8_t>(i)));
+    entries.push_back({static_cast<std::uint8_t>((v >> 16) & 0x7F), static_cast<std::uint16_t>(v)});
+  }
+  consumer_.configure(entries);
+}
+
+sdo_abort slave::read_value(const object_dictionary::slot& s, std::int64_t& v) {
+  if (s.entry->where == backing::device) {
+    const sdo_abort a = device_->read(s.object->index, s.entry->sub, v);
+    if (a == sdo_abort::none && s.object->index == 0x1001 && (heartbeat_error_ || pdo_length_error_)) {
+      v |= 0x11;  // generic + communication error (CiA 301 §7.5.2.2)
+    }
+    return a;
+  }
+  v = s.number;
+  return sdo_abort::none;
+}
+
+sdo_abort slave::write_checked(object_dictionary::slot& s, std::int64_t v) {
+  const std::uint16_t index = s.object->index;
+  const std::uint8_t sub = s.entry->sub;
+  if (s.entry->where == backing::device) return device_->write(index, sub, v);
+  if (is_pdo_parameter(index)) return write_pdo_parameter(s, v);
+  const auto u = static_cast<std::uint32_t>(v);
+  switch (index) {
+    case 0x1005:
+      // This node consumes SYNC only (bit 30 would make it the producer); 11-bit identifiers.
+      if ((u & 0x7FFFF800u) != 0) return sdo_abort::invalid_value;
+      s.number = v;
+      sync_id_ = u & max_base_id;
+      return sdo_abort::none;
+    case 0x1016: {
+      const std::uint32_t node = (u >> 16) & 0xFF;
+      const std::uint32_t time = u & 0xFFFF;
+      if ((u >> 24) != 0 || (time != 0 && (node == 0 || node > max_node_id))) {
+        return sdo_abort::invalid_value;
+      }
+      // Two entries watching one node cannot both hold: CiA 301 answers 0x06040043.
+      for (int i = 1; i <= heartbeat_consumers; ++i) {
+        if (i == sub) continue;
+        const auto other = static_cast<std::uint32_t>(od_.number(0x1016, static_cast<std::uint8_t>(i)));
+        if (time != 0 && (other & 0xFFFF) != 0 && ((other >> 16) & 0xFF) == node) {
+          return sdo_abort::general_parameter_incompatibility;
+        }
+      }
+      s.number = v;
+      configure_consumer();
+      return sdo_abort::none;
+    }
+    case 0x1017:
+      s.number = v;
+      producer_.configure(static_cast<std::uint16_t>(u));
+      return sdo_abort::none;
+    case fault_injection_index:
+      return device_->inject_fault(static_cast<std::uint16_t>(u));
+    default:
+      s.number = v;
+      return sdo_abort::none;
+  }
+}
+
+sdo_abort slave::read(std::uint16_t index, std::uint8_t sub, std::int64_t& value) {
+  sdo_abort a = sdo_abort::none;
+  const object_dictionary::slot* s = od_.find(index, sub, a);
+  if (s == nullptr) return a;
+  if (!readable(s->entry->acc)) return sdo_abort::write_only_object;
+  if (s->entry->type == data_type::visible_string) return sdo_abort::unsupported_access;
+  return read_value(*s, value);
+}
+
+sdo_abort slave::write(std::uint16_t index, std::uint8_t sub, std::int64_t value) {
+  sdo_abort a = sdo_abort::none;
+  object_dictionary::slot* s = od_.find(index, sub, a);
+  if (s == nullptr) return a;
+  const sub_entry& e = *s->entry;
+  if (!writable(e.acc)) return sdo_abort::read_only_object;
+  if (e.type == data_type::visible_string) return sdo_abort::unsupported_access;
+  if (value < type_min(e.type)) return sdo_abort::value_too_low;
+  if (value > type_max(e.type)) return sdo_abort::value_too_high;
+  if (e.has_limits && value < e.low) return sdo_abort::value_too_low;
+  if (e.has_limits && value > e.high) return sdo_abort::value_too_high;
+  return write_checked(*s, value);
+}
+
+sdo_abort slave::check_download(std::uint16_t index, std::uint8_t sub, std::size_t size,
+                                bool size_known) noexcept {
+  sdo_abort a = sdo_abort::none;
+  const object_dictionary::slot* s = od_.find(index, sub, a);
+  if (s == nullptr) return a;
+  const sub_entry& e = *s->entry;
+  if (!writable(e.acc)) return sdo_abort::read_only_object;
+  if (!size_known) return sdo_abort::none;
+  if (e.type == data_type::visible_string) {
+    return size > e.capacity ? sdo_abort::data_type_length_too_high : sdo_abort::none;
+  }
+  if (size > type_size(e.type)) return sdo_abort::data_type_length_too_high;
+  if (size < type_size(e.type)) return sdo_abort::data_type_length_too_low;
+  return sdo_abort::none;
+}
+
+sdo_abort slave::download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
+                          bool size_indicated) noexcept {
+  sdo_abort a = sdo_abort::none;
+  object_dictionary::slot* s = od_.find(index, sub, a);
+  if (s == nullptr) return a;
+  const sub_entry& e = *s->entry;
+  if (e.type == data_type::visible_string) {
+    if (!size_indicated) {  // an expedited download without size: up to the first NUL
+      data = data.first(static_cast<std::size_t>(std::find(data.begin(), data.end(), 0) - data.begin()));
+    }
+    a = check_download(index, sub, data.size(), true);
+    if (a != sdo_abort::none) return a;
+    s->text.assign(data.begin(), data.end());
+    return sdo_abort::none;
+  }
+  if (!size_indicated && data.size() > type_size(e.type)) data = data.first(type_size(e.type));
+  a = check_download(index, sub, data.size(), true);
+  if (a != sdo_abort::none) return a;
+  const std::int64_t v = decode_value(e.type, data);
+  if (v > type_max(e.type)) return sdo_abort::value_too_high;  // BOOLEAN above 1
+  if (e.has_limits && v < e.low) return sdo_abort::value_too_low;
+  if (e.has_limits && v > e.high) return sdo_abort::value_too_high;
+  return write_checked(*s, v);
+}
+
+sdo_abort slave::upload(std::uint16_t index, std::uint8_t sub,
+                        std::vector<std::uint8_t>& data) noexcept {
+  sdo_abort a = sdo_abort::none;
+  const object_dictionary::slot* s = od_.find(index, sub, a);
+  if (s == nullptr) return a;
+  if (!readable(s->entry->acc)) return sdo_abort::write_only_object;
+  if (s->entry->type == data_type::visible_string) {
+    data.assign(s->text.begin(), s->text.end());
+    return sdo_abort::none;
+  }
+  std::int64_t v = 0;
+  a = read_value(*s, v);
+  if (a != sdo_abort::none) return a;
+  encode_value(s->entry->type, v, data);
+  return sdo_abort::none;
+}
+
+// ---- EMCY -------------------------------------------------------------------------------------
+
+void slave::check_errors() {
+  std::int64_t code = 0;
+  if (device_->read(0x603F, 0, code) != sdo_abort::none) return;
+  const auto c = static_cast<std::uint16_t>(code);
+  if (c == drive_error_) return;
+  drive_error_ = c;
+  if (c != 0) {
+    send_emcy(c);
+  } else if (!heartbeat_error_ && !pdo_length_error_) {
+    send_emcy(0);
+  }
+}
+
+void slave::set_node_error(std::uint16_t code, bool active) {
+  bool& flag = code == node_error::heartbeat_lost ? heartbeat_error_ : pdo_length_error_;
+  if (flag == active) return;
+  flag = active;
+  if (active) {
+    send_emcy(code);
+  } else if (drive_error_ == 0 && !heartbeat_error_ && !pdo_length_error_) {
+    send_emcy(0);
+  }
+}
+
+void slave::send_emcy(std::uint16_t code) {
+  if (state_ == nmt_state::stopped || state_ == nmt_state::initialising) return;
+  if (code == 0 && !any_error_reported_) return;  // nothing to reset
+  any_error_reported_ = code != 0;
+  std::int64_t reg = 0;
+  std::int64_t status = 0;
+  if (code != 0) {
+    (void)read(0x1001, 0, reg);
+    (void)device_->read(0x6041, 0, status);
+  }
+  frame f;
+  f.id = static_cast<std::uint32_t>(od_.number(0x1014, 0)) & max_base_id;
+  f.len = 8;
+  put_le(&f.data[0], code, 2);
+  f.data[2] = static_cast<std::uint8_t>(reg);
+  put_le(&f.data[3], static_cast<std::uint64_t>(status), 2);
+  (void)out_->send(f);
+}
+
+}  // namespace cia402::canopen

@@ -1,0 +1,137 @@
+#include "cia402/canopen/eds.hpp"
+
+#include <cstdio>
+#include <ostream>
+#include <vector>
+
+#include "cia402/canopen/drive_objects.hpp"
+
+namespace cia402::canopen {
+namespace {
+
+std::string hex(std::uint64_t v, int digits) {
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "0x%0*llX", digits, static_cast<unsigned long long>(v));
+  return buf;
+}
+
+std::string section_name(std::uint16_t index) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "%04X", index);
+  return buf;
+}
+
+// The value at power-up as the EDS writes it; false if the device lacks the object.
+bool default_text(slave& node, const object_entry& o, const sub_entry& e, std::string& out) {
+  if (e.type == data_type::visible_string) {
+    std::vector<std::uint8_t> bytes;
+    if (readable(e.acc)) (void)node.read_bytes(o.index, e.sub, bytes);
+    out.assign(bytes.begin(), bytes.end());
+    return true;
+  }
+  if (e.plus_node_id) {
+    out = "$NODEID+" + hex(static_cast<std::uint64_t>(e.default_value), 0);
+    return true;
+  }
+  std::int64_t v = e.default_value;
+  if (e.where == backing::device) {
+    const sdo_abort a = node.read(o.index, e.sub, v);
+    if (a == sdo_abort::object_does_not_exist) return false;
+    if (a != sdo_abort::none) v = 0;
+  }
+  if (type_is_signed(e.type)) {
+    out = std::to_string(v);
+  } else {
+    out = hex(static_cast<std::uint64_t>(v), static_cast<int>(type_size(e.type) * 2));
+  }
+  return true;
+}
+
+void write_sub(std::ostream& out, const std::string& section, const object_entry& o,
+               const sub_entry& e, const std::string& value) {
+  out << "[" << section << "]\n"
+      << "ParameterName=" << (o.subs.size() == 1 && o.code == object_code::var ? o.name : e.name) << "\n"
+      << "ObjectType=0x7\n"
+      << "DataType=" << hex(static_cast<std::uint16_t>(e.type), 4) << "\n"
+      << "AccessType=" << access_name(e.acc) << "\n"
+      << "DefaultValue=" << value << "\n";
+  if (e.has_limits) {
+    const bool sign = type_is_signed(e.type);
+    out << "LowLimit=" << (sign ? std::to_string(e.low) : hex(static_cast<std::uint64_t>(e.low), 0)) << "\n"
+        << "HighLimit=" << (sign ? std::to_string(e.high) : hex(static_cast<std::uint64_t>(e.high), 0))
+        << "\n";
+  }
+  out << "PDOMapping=" << (e.pdo_mappable ? 1 : 0) << "\n\n";
+}
+
+}  // namespace
+
+void write_eds(slave& node, const eds_info& info, std::ostream& out) {
+  // Which objects the node really has (a profile may lack an option-code object).
+  std::vector<const object_entry*> present;
+  for (const object_entry& o : node.dictionary().table()) {
+    std::string ignored;
+    if (default_text(node, o, o.subs.front(), ignored)) present.push_back(&o);
+  }
+
+  std::int64_t vendor = 0, product = 0, revision = 0;
+  (void)node.read(0x1018, 1, vendor);
+  (void)node.read(0x1018, 2, product);
+  (void)node.read(0x1018, 3, revision);
+
+  out << "[FileInfo]\n"
+      << "FileName=" << info.file_name << "\n"
+      << "FileVersion=1\nFileRevision=0\nEDSVersion=4.0\n"
+      << "Description=" << info.description << "\n"
+      << "CreationTime=" << info.time << "\nCreationDate=" << info.date << "\n"
+      << "CreatedBy=" << info.created_by << "\n"
+      << "ModificationTime=" << info.time << "\nModificationDate=" << info.date << "\n"
+      << "ModifiedBy=" << info.created_by << "\n\n";
+  out << "[DeviceInfo]\n"
+      << "VendorName=" << info.vendor_name << "\n"
+      << "VendorNumber=" << hex(static_cast<std::uint64_t>(vendor), 8) << "\n"
+      << "ProductName=" << info.product_name << "\n"
+      << "ProductNumber=" << hex(static_cast<std::uint64_t>(product), 8) << "\n"
+      << "RevisionNumber=" << hex(static_cast<std::uint64_t>(revision), 8) << "\n"
+      << "OrderCode=\n";
+  for (int rate : {10, 20, 50, 125, 250, 500, 800, 1000}) out << "BaudRate_" << rate << "=1\n";
+  out << "SimpleBootUpMaster=0\nSimpleBootUpSlave=1\nGranularity=8\nDynamicChannelsSupported=0\n"
+      << "GroupMessaging=0\nNrOfRxPDO=" << pdo_count << "\nNrOfTxPDO=" << pdo_count
+      << "\nLSS_Supported=0\n\n";
+  out << "[DummyUsage]\n";
+  for (int i = 1; i <= 7; ++i) out << "Dummy000" << i << "=0\n";
+  out << "\n[Comments]\nLines=1\nLine1=Generated from the node's object dictionary (cia402 eds).\n\n";
+
+  const object_category categories[3] = {object_category::mandatory, object_category::optional,
+                                         object_category::manufacturer};
+  const char* list_names[3] = {"MandatoryObjects", "OptionalObjects", "ManufacturerObjects"};
+  for (int c = 0; c < 3; ++c) {
+    std::vector<const object_entry*> in;
+    for (const object_entry* o : present) {
+      if (o->category == categories[c]) in.push_back(o);
+    }
+    out << "[" << list_names[c] << "]\nSupportedObjects=" << in.size() << "\n";
+    for (std::size_t i = 0; i < in.size(); ++i) out << i + 1 << "=" << hex(in[i]->index, 4) << "\n";
+    out << "\n";
+    for (const object_entry* o : in) {
+      const std::string name = section_name(o->index);
+      if (o->code == object_code::var) {
+        std::string value;
+        default_text(node, *o, o->subs.front(), value);
+        write_sub(out, name, *o, o->subs.front(), value);
+        continue;
+      }
+      out << "[" << name << "]\n"
+          << "ParameterName=" << o->name << "\n"
+          << "ObjectType=" << hex(static_cast<unsigned>(o->code), 0) << "\n"
+          << "SubNumber=" << hex(o->subs.size(), 0) << "\n\n";
+      for (const sub_entry& e : o->subs) {
+        std::string value;
+        default_text(node, *o, e, value);
+        write_sub(out, name + "sub" + hex(e.sub, 0).substr(2), *o, e, value);
+      }
+    }
+  }
+}
+
+}  // namespace cia402::canopen

@@ -1,0 +1,218 @@
+#include "cia402/canopen/drive_objects.hpp"
+
+#include <string>
+
+namespace cia402::canopen {
+namespace {
+
+sub_entry var(std::uint8_t sub, std::string name, data_type t, access a, std::int64_t def = 0) {
+  sub_entry e;
+  e.sub = sub;
+  e.name = std::move(name);
+  e.type = t;
+  e.acc = a;
+  e.default_value = def;
+  return e;
+}
+
+sub_entry mappable(sub_entry e) {
+  e.pdo_mappable = true;
+  return e;
+}
+
+sub_entry on_device(sub_entry e) {
+  e.where = backing::device;
+  return e;
+}
+
+sub_entry plus_node(sub_entry e) {
+  e.plus_node_id = true;
+  return e;
+}
+
+sub_entry limited(sub_entry e, std::int64_t low, std::int64_t high) {
+  e.has_limits = true;
+  e.low = low;
+  e.high = high;
+  return e;
+}
+
+sub_entry text(std::uint8_t sub, std::string name, access a, std::string def, std::size_t cap) {
+  sub_entry e = var(sub, std::move(name), data_type::visible_string, a);
+  e.default_text = std::move(def);
+  e.capacity = cap;
+  return e;
+}
+
+object_entry single(std::uint16_t index, object_category c, sub_entry e) {
+  object_entry o;
+  o.index = index;
+  o.name = e.name;
+  o.code = object_code::var;
+  o.category = c;
+  o.subs.push_back(std::move(e));
+  return o;
+}
+
+object_entry group(std::uint16_t index, std::string name, object_code code, object_category c,
+                   std::vector<sub_entry> subs) {
+  object_entry o;
+  o.index = index;
+  o.name = std::move(name);
+  o.code = code;
+  o.category = c;
+  o.subs = std::move(subs);
+  return o;
+}
+
+std::uint32_t map_entry(std::uint16_t index, std::uint8_t sub, std::uint8_t bits) {
+  return (static_cast<std::uint32_t>(index) << 16) | (static_cast<std::uint32_t>(sub) << 8) | bits;
+}
+
+constexpr std::uint32_t pdo_invalid = 0x80000000u;
+
+object_entry pdo_mapping(std::uint16_t index, std::string name,
+                         const std::vector<std::uint32_t>& defaults) {
+  std::vector<sub_entry> subs;
+  subs.push_back(limited(var(0, "Number of mapped objects", data_type::unsigned8, access::rw,
+                             static_cast<std::int64_t>(defaults.size())),
+                         0, max_mapped_objects));
+  for (int i = 1; i <= max_mapped_objects; ++i) {
+    const std::uint32_t def = i <= static_cast<int>(defaults.size()) ? defaults[i - 1] : 0;
+    subs.push_back(var(static_cast<std::uint8_t>(i), "Mapped object " + std::to_string(i),
+                       data_type::unsigned32, access::rw, def));
+  }
+  return group(index, std::move(name), object_code::record, object_category::optional,
+               std::move(subs));
+}
+
+}  // namespace
+
+std::vector<object_entry> drive_objects() {
+  using enum object_category;
+  std::vector<object_entry> t;
+
+  t.push_back(single(0x1000, mandatory, var(0, "Device type", data_type::unsigned32, access::ro,
+                                            device_type_cia402_servo)));
+  // 0x1001 is the drive's register; the node adds bit 4 (communication) for its own errors.
+  t.push_back(single(0x1001, mandatory, mappable(on_device(var(0, "Error register",
+                                                               data_type::unsigned8, access::ro)))));
+  t.push_back(single(0x1005, optional,
+                     var(0, "COB-ID SYNC message", data_type::unsigned32, access::rw, 0x80)));
+  t.push_back(single(0x1008, optional, text(0, "Manufacturer device name", access::constant,
+                                            "cia402 virtual drive", 0)));
+  t.push_back(single(0x1009, optional,
+                     text(0, "Manufacturer hardware version", access::constant, "virtual", 0)));
+  t.push_back(single(0x100A, optional,
+                     text(0, "Manufacturer software version", access::constant, "0.1.0", 0)));
+  t.push_back(single(0x1014, optional,
+                     plus_node(var(0, "COB-ID EMCY", data_type::unsigned32, access::ro, 0x80))));
+  {
+    std::vector<sub_entry> subs;
+    subs.push_back(var(0, "Highest sub-index supported", data_type::unsigned8, access::ro,
+                       heartbeat_consumers));
+    for (int i = 1; i <= heartbeat_consumers; ++i) {
+      subs.push_back(var(static_cast<std::uint8_t>(i), "Consumer heartbeat time " + std::to_string(i),
+                         data_type::unsigned32, access::rw));
+    }
+    t.push_back(group(0x1016, "Consumer heartbeat time", object_code::array, optional,
+                      std::move(subs)));
+  }
+  t.push_back(single(0x1017, optional,
+                     var(0, "Producer heartbeat time", data_type::unsigned16, access::rw)));
+  t.push_back(group(0x1018, "Identity object", object_code::record, mandatory,
+                    {var(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 4),
+                     var(1, "Vendor-ID", data_type::unsigned32, access::ro, 0),
+                     var(2, "Product code", data_type::unsigned32, access::ro, 0x402),
+                     var(3, "Revision number", data_type::unsigned32, access::ro, 0x00010000),
+                     plus_node(var(4, "Serial number", data_type::unsigned32, access::ro, 0))}));
+  t.push_back(group(
+      0x1200, "SDO server parameter", object_code::record, optional,
+      {var(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 2),
+       plus_node(var(1, "COB-ID client to server", data_type::unsigned32, access::ro, 0x600)),
+       plus_node(var(2, "COB-ID server to client", data_type::unsigned32, access::ro, 0x580))}));
+
+  // CiA 402 predefined PDO set; PDO 3 (position) has no objects in a pv-only drive.
+  const std::vector<std::uint32_t> rpdo_maps[pdo_count] = {
+      {map_entry(0x6040, 0, 16)},
+      {map_entry(0x6040, 0, 16), map_entry(0x6060, 0, 8)},
+      {},
+      {map_entry(0x6040, 0, 16), map_entry(0x60FF, 0, 32)}};
+  const std::vector<std::uint32_t> tpdo_maps[pdo_count] = {
+      {map_entry(0x6041, 0, 16)},
+      {map_entry(0x6041, 0, 16), map_entry(0x6061, 0, 8)},
+      {},
+      {map_entry(0x6041, 0, 16), map_entry(0x606C, 0, 32)}};
+  for (int n = 0; n < pdo_count; ++n) {
+    const auto num = std::to_string(n + 1);
+    const std::int64_t off = 0x100 * n;
+    const std::int64_t invalid = rpdo_maps[n].empty() ? pdo_invalid : 0;
+    t.push_back(group(
+        static_cast<std::uint16_t>(0x1400 + n), "RPDO" + num + " communication parameter",
+        object_code::record, optional,
+        {var(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 2),
+         plus_node(var(1, "COB-ID used by RPDO", data_type::unsigned32, access::rw,
+                       invalid + 0x200 + off)),
+         var(2, "Transmission type", data_type::unsigned8, access::rw, 255)}));
+    t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1600 + n), "RPDO" + num + " mapping parameter",
+                            rpdo_maps[n]));
+  }
+  for (int n = 0; n < pdo_count; ++n) {
+    const auto num = std::to_string(n + 1);
+    const std::int64_t off = 0x100 * n;
+    const std::int64_t invalid = tpdo_maps[n].empty() ? pdo_invalid : 0;
+    t.push_back(group(
+        static_cast<std::uint16_t>(0x1800 + n), "TPDO" + num + " communication parameter",
+        object_code::record, optional,
+        {var(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 5),
+         plus_node(var(1, "COB-ID used by TPDO", data_type::unsigned32, access::rw,
+                       invalid + 0x180 + off)),
+         var(2, "Transmission type", data_type::unsigned8, access::rw, 255),
+         var(3, "Inhibit time", data_type::unsigned16, access::rw, 0),
+         var(5, "Event timer", data_type::unsigned16, access::rw, 0)}));
+    t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1A00 + n), "TPDO" + num + " mapping parameter",
+                            tpdo_maps[n]));
+  }
+
+  t.push_back(single(device_label_index, manufacturer,
+                     text(0, "Device label", access::rw, "", device_label_capacity)));
+  t.push_back(single(fault_injection_index, manufacturer,
+                     var(0, "Fault injection", data_type::unsigned16, access::wo)));
+
+  const auto option_code = [](const char* name) {
+    return on_device(var(0, name, data_type::integer16, access::rw));
+  };
+  t.push_back(single(0x6007, optional, option_code("Abort connection option code")));
+  t.push_back(single(0x603F, optional,
+                     mappable(on_device(var(0, "Error code", data_type::unsigned16, access::ro)))));
+  t.push_back(single(0x6040, mandatory,
+                     mappable(on_device(var(0, "Controlword", data_type::unsigned16, access::rw)))));
+  t.push_back(single(0x6041, mandatory,
+                     mappable(on_device(var(0, "Statusword", data_type::unsigned16, access::ro)))));
+  t.push_back(single(0x605A, optional, option_code("Quick stop option code")));
+  t.push_back(single(0x605B, optional, option_code("Shutdown option code")));
+  t.push_back(single(0x605C, optional, option_code("Disable operation option code")));
+  t.push_back(single(0x605D, optional, option_code("Halt option code")));
+  t.push_back(single(0x605E, optional, option_code("Fault reaction option code")));
+  t.push_back(single(0x6060, optional, mappable(on_device(var(0, "Modes of operation",
+                                                              data_type::integer8, access::rw)))));
+  t.push_back(single(0x6061, optional, mappable(on_device(var(0, "Modes of operation display",
+                                                              data_type::integer8, access::ro)))));
+  t.push_back(single(0x606C, optional, mappable(on_device(var(0, "Velocity actual value",
+                                                              data_type::integer32, access::ro)))));
+  const auto ramp = [](const char* name) {
+    // A ramp of 0 would never end (the simulator refuses it too): the EDS says so as LowLimit.
+    return limited(mappable(on_device(var(0, name, data_type::unsigned32, access::rw))), 1,
+                   type_max(data_type::unsigned32));
+  };
+  t.push_back(single(0x6083, optional, ramp("Profile acceleration")));
+  t.push_back(single(0x6084, optional, ramp("Profile deceleration")));
+  t.push_back(single(0x6085, optional, ramp("Quick stop deceleration")));
+  t.push_back(single(0x60FF, optional, mappable(on_device(var(0, "Target velocity",
+                                                              data_type::integer32, access::rw)))));
+  t.push_back(single(0x6502, optional,
+                     var(0, "Supported drive modes", data_type::unsigned32, access::ro, 1u << 2)));
+  return t;
+}
+
+}  // namespace cia402::canopen

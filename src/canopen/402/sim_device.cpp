@@ -1,0 +1,39 @@
+#include "cia402/canopen/sim_device.hpp"
+
+#include <algorithm>
+
+namespace cia402::canopen {
+
+sim_device::sim_device(const profile& p, const sim::plant_config& config)
+    : profile_(&p), config_(config), drive_(std::make_unique<sim::virtual_drive>(p, config)) {}
+
+std::uint32_t sim_device::step(std::uint32_t elapsed_us) noexcept {
+  const std::uint32_t cycle = drive_->constants().cycle_us;
+  const std::uint64_t pending = static_cast<std::uint64_t>(pending_us_) + elapsed_us;
+  pending_us_ = static_cast<std::uint32_t>(
+      std::min<std::uint64_t>(pending, static_cast<std::uint64_t>(max_catch_up_cycles) * cycle));
+  while (pending_us_ >= cycle) {
+    drive_->step();
+    pending_us_ -= cycle;
+  }
+  return cycle - pending_us_;
+}
+
+sdo_abort sim_device::inject_fault(std::uint16_t code) noexcept {
+  if (code == 0) {
+    drive_->view().clear_faults();
+  } else {
+    (void)drive_->view().inject_fault(code);
+  }
+  return sdo_abort::none;
+}
+
+void sim_device::reset() noexcept {
+  // The configuration was accepted when the device was made, so this cannot throw.
+  const bool lost = drive_->view().connection_lost();
+  drive_ = std::make_unique<sim::virtual_drive>(*profile_, config_);
+  drive_->view().set_connection_lost(lost);
+  pending_us_ = 0;
+}
+
+}  // namespace cia402::canopen

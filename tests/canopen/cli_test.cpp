@@ -1,0 +1,90 @@
+// The `cia402 master`, `cia402 eds` and `cia402 bus` commands through the tool's run(): the virtual
+// bus path runs a virtual drive in-process in virtual time; bad options get exit status 2.
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli/app.hpp"
+#include "cli/bus.hpp"
+
+namespace cia402::cli {
+namespace {
+
+struct result {
+  int status;
+  std::string out;
+  std::string err;
+};
+
+result run_tool(std::vector<std::string> args) {
+  std::istringstream in;
+  std::ostringstream out, err;
+  const int status = run(args, in, out, err);
+  return {status, out.str(), err.str()};
+}
+
+TEST(cli_master, enable_on_the_virtual_bus_reaches_operation_enabled) {
+  const result r = run_tool({"master", "--can", "virtual", "--node", "5", "enable"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("node 5: configured and started"), std::string::npos);
+  EXPECT_NE(r.out.find("node 5: READY_TO_SWITCH_ON"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("node 5: reached OPERATION_ENABLED"), std::string::npos) << r.out;
+}
+
+TEST(cli_master, state_reads_the_status_word_over_sdo) {
+  const result r = run_tool({"master", "--can", "virtual", "state"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "node 1: SWITCH_ON_DISABLED (statusword 0x1250)\n");
+}
+
+TEST(cli_master, reset_of_a_drive_not_in_fault_does_nothing) {
+  const result r = run_tool({"master", "--can", "virtual", "reset"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("not in FAULT (SWITCH_ON_DISABLED), nothing to reset"), std::string::npos) << r.out;
+}
+
+TEST(cli_master, bad_url_command_or_node_is_refused_with_status_2) {
+  EXPECT_EQ(run_tool({"master", "--can", "tcp://x", "enable"}).status, 2);
+  EXPECT_NE(run_tool({"master", "--can", "tcp://x", "enable"}).err.find("is not socketcand://"),
+            std::string::npos);
+  EXPECT_NE(run_tool({"master", "--can", "virtual", "fly"}).status, 0);
+  EXPECT_NE(run_tool({"master", "--can", "virtual", "--node", "128", "state"}).status, 0);
+}
+
+TEST(cli_master, unreachable_socketcand_server_fails_with_status_1) {
+  const result r = run_tool({"master", "--can", "socketcand://no.such.host.invalid:29536/can0", "state"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("cia402 master:"), std::string::npos);
+}
+
+TEST(cli_eds, eds_starts_with_file_info_and_names_the_profile) {
+  const result r = run_tool({"eds", "--profile", "lexium32"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("[FileInfo]\n", 0), 0u);
+  EXPECT_NE(r.out.find("profile lexium32"), std::string::npos);
+  EXPECT_NE(r.out.find("[MandatoryObjects]"), std::string::npos);
+}
+
+TEST(cli_bus, bad_options_are_refused_before_listening) {
+  EXPECT_EQ(run_tool({"bus", "--nodes", "0-3"}).status, 2);
+  EXPECT_EQ(run_tool({"bus", "--nodes", "1,1"}).status, 2);
+  EXPECT_EQ(run_tool({"bus", "--listen", "nowhere"}).status, 2);
+  EXPECT_EQ(run_tool({"bus", "--profile", "nosuch"}).status, 2);
+}
+
+TEST(cli_bus, node_lists_parse_ranges_and_singles) {
+  std::vector<std::uint8_t> ids;
+  std::string why;
+  ASSERT_TRUE(parse_node_list("1-3,7", ids, why)) << why;
+  EXPECT_EQ(ids, (std::vector<std::uint8_t>{1, 2, 3, 7}));
+  EXPECT_FALSE(parse_node_list("5-2", ids, why));
+  EXPECT_FALSE(parse_node_list("127-128", ids, why));
+  EXPECT_FALSE(parse_node_list("", ids, why));
+  EXPECT_FALSE(parse_node_list("2,1-3", ids, why));
+  EXPECT_NE(why.find("node 2 is listed twice"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cia402::cli

@@ -1,0 +1,120 @@
+// The EDS (CiA 306) printed from the node's dictionary: sections, keys, the three object lists and
+// their counts, and that it follows the profile (an option code the profile lacks is left out).
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "cia402/canopen/eds.hpp"
+#include "cia402/canopen/sim_device.hpp"
+#include "cia402/canopen/virtual_bus.hpp"
+
+namespace cia402::canopen {
+namespace {
+
+using ini = std::map<std::string, std::map<std::string, std::string>>;
+
+ini parse_ini(const std::string& text) {
+  ini out;
+  std::istringstream in(text);
+  std::string line;
+  std::string section;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == ';') continue;
+    if (line.front() == '[') {
+      section = line.substr(1, line.find(']') - 1);
+      EXPECT_EQ(out.count(section), 0u) << "section [" << section << "] twice";
+      out[section];
+      continue;
+    }
+    const auto eq = line.find('=');
+    EXPECT_NE(eq, std::string::npos) << line;
+    out[section][line.substr(0, eq)] = line.substr(eq + 1);
+  }
+  return out;
+}
+
+std::string eds_of(const profile& p) {
+  virtual_bus bus;
+  auto ch = bus.attach();
+  sim_device dev(p);
+  slave node(dev, *ch, slave_config{});
+  std::ostringstream out;
+  write_eds(node, eds_info{}, out);
+  return out.str();
+}
+
+unsigned number(const std::string& s) { return static_cast<unsigned>(std::stoul(s, nullptr, 0)); }
+
+TEST(eds, object_lists_count_and_name_every_object_section) {
+  const ini eds = parse_ini(eds_of(standard_profile()));
+  std::set<std::string> listed;
+  std::map<std::string, std::size_t> counts;
+  for (const char* list : {"MandatoryObjects", "OptionalObjects", "ManufacturerObjects"}) {
+    ASSERT_TRUE(eds.count(list)) << list;
+    const auto& l = eds.at(list);
+    const unsigned n = number(l.at("SupportedObjects"));
+    EXPECT_EQ(l.size(), n + 1) << list;
+    counts[list] = n;
+    for (unsigned i = 1; i <= n; ++i) {
+      char name[8];
+      std::snprintf(name, sizeof name, "%04X", number(l.at(std::to_string(i))));
+      EXPECT_TRUE(eds.count(name)) << name;
+      EXPECT_TRUE(listed.insert(name).second) << name << " listed twice";
+    }
+  }
+  EXPECT_EQ(counts["MandatoryObjects"], 5u);    // 1000, 1001, 1018, 6040, 6041
+  EXPECT_EQ(counts["ManufacturerObjects"], 2u); // 2000, 2001
+  for (const auto& [section, keys] : eds) {
+    if (section.size() == 4 && section.find_first_not_of("0123456789ABCDEF") == std::string::npos) {
+      EXPECT_TRUE(listed.count(section)) << section << " is in no list";
+      for (const char* key : {"ParameterName", "ObjectType"}) EXPECT_TRUE(keys.count(key)) << section;
+      const unsigned type = number(keys.at("ObjectType"));
+      if (type == 7) {
+        for (const char* key : {"DataType", "AccessType", "DefaultValue", "PDOMapping"}) {
+          EXPECT_TRUE(keys.count(key)) << section << " " << key;
+        }
+      } else {
+        std::size_t subs = 0;
+        for (const auto& [other, k] : eds) subs += other.rfind(section + "sub", 0) == 0;
+        EXPECT_EQ(subs, number(keys.at("SubNumber"))) << section;
+      }
+    }
+  }
+}
+
+TEST(eds, entries_carry_type_access_default_and_mapping_of_the_dictionary) {
+  const ini eds = parse_ini(eds_of(standard_profile()));
+  EXPECT_EQ(eds.at("1000").at("DefaultValue"), "0x00020192");
+  EXPECT_EQ(eds.at("1000").at("DataType"), "0x0007");
+  EXPECT_EQ(eds.at("6040").at("AccessType"), "rw");
+  EXPECT_EQ(eds.at("6040").at("DataType"), "0x0006");
+  EXPECT_EQ(eds.at("6040").at("PDOMapping"), "1");
+  EXPECT_EQ(eds.at("6041").at("AccessType"), "ro");
+  EXPECT_EQ(eds.at("605A").at("DefaultValue"), "2");  // the profile's default (S5)
+  EXPECT_EQ(eds.at("605A").at("DataType"), "0x0003");
+  EXPECT_EQ(eds.at("6083").at("LowLimit"), "0x1");
+  EXPECT_EQ(eds.at("1008").at("DefaultValue"), "cia402 virtual drive");
+  EXPECT_EQ(eds.at("1008").at("AccessType"), "const");
+  EXPECT_EQ(eds.at("2001").at("AccessType"), "wo");
+  EXPECT_EQ(eds.at("1018").at("SubNumber"), "0x5");
+  EXPECT_EQ(eds.at("1018sub4").at("DefaultValue"), "$NODEID+0x0");
+  EXPECT_EQ(eds.at("1A01sub2").at("DefaultValue"), "0x60610008");
+  EXPECT_EQ(eds.at("1802sub1").at("DefaultValue"), "$NODEID+0x80000380") << "TPDO3 starts invalid";
+  EXPECT_EQ(eds.at("1800").at("SubNumber"), "0x5") << "sub 4 is reserved";
+  EXPECT_EQ(eds.at("DeviceInfo").at("NrOfRxPDO"), "4");
+  EXPECT_EQ(eds.at("FileInfo").at("EDSVersion"), "4.0");
+}
+
+TEST(eds, option_code_the_profile_lacks_is_left_out) {
+  const profile* p = find_builtin_profile("no-quick-stop");
+  ASSERT_NE(p, nullptr);
+  const ini eds = parse_ini(eds_of(*p));
+  EXPECT_EQ(eds.count("605A"), 0u);
+  EXPECT_EQ(eds.count("6040"), 1u);
+}
+
+}  // namespace
+}  // namespace cia402::canopen

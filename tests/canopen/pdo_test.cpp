@@ -1,0 +1,252 @@
+// PDOs: the CiA 402 default mappings, mapping changes over SDO with the CiA 301 rules and their abort
+// codes, and the transmission types (synchronous 0 / 1..240, event-driven 254/255 with inhibit time
+// and event timer). The node runs on the test double, so the status word comes from the core.
+#include <gtest/gtest.h>
+
+#include "network.hpp"
+
+namespace cia402::canopen::test {
+namespace {
+
+constexpr std::uint8_t id = 3;
+
+class pdo_test : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    net.add(id);
+    net.settle();
+  }
+  std::uint32_t write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, unsigned bytes) {
+    static constexpr std::uint8_t commands[5] = {0, 0x2F, 0x2B, 0x27, 0x23};
+    net.received.clear();
+    net.send(sdo_request(id, commands[bytes], index, sub, value));
+    net.settle();
+    const auto r = net.with_id(cob::sdo_tx + id);
+    EXPECT_EQ(r.size(), 1u);
+    return r.empty() ? 0xFFFFFFFFu : abort_code_of(r.back());
+  }
+  void start() {
+    net.send(nmt_frame(nmt_command::start, id));
+    net.settle();
+  }
+  void sync() {
+    net.send(make_frame(cob::sync, {}));
+    net.settle();
+  }
+  slave& node() { return net.at(0); }
+  test_device& dev() { return net.device_at(0); }
+
+  network net;
+};
+
+TEST_F(pdo_test, defaults_are_the_cia402_predefined_set_with_pdo3_disabled) {
+  const pdo_config& r1 = node().rpdo(0);
+  EXPECT_TRUE(r1.valid);
+  EXPECT_EQ(r1.can_id, 0x203u);
+  ASSERT_EQ(r1.count, 1);
+  EXPECT_EQ(r1.map[0].index, 0x6040);
+  EXPECT_EQ(r1.length, 2);
+  const pdo_config& r2 = node().rpdo(1);
+  EXPECT_EQ(r2.can_id, 0x303u);
+  ASSERT_EQ(r2.count, 2);
+  EXPECT_EQ(r2.map[1].index, 0x6060);
+  EXPECT_EQ(r2.length, 3);
+  EXPECT_FALSE(node().rpdo(2).valid);
+  const pdo_config& r4 = node().rpdo(3);
+  EXPECT_EQ(r4.can_id, 0x503u);
+  EXPECT_EQ(r4.map[1].index, 0x60FF);
+  EXPECT_EQ(r4.length, 6);
+  EXPECT_EQ(node().tpdo(0).can_id, 0x183u);
+  EXPECT_EQ(node().tpdo(0).map[0].index, 0x6041);
+  EXPECT_EQ(node().tpdo(1).map[1].index, 0x6061);
+  EXPECT_FALSE(node().tpdo(2).valid);
+  EXPECT_EQ(node().tpdo(3).can_id, 0x483u);
+  EXPECT_EQ(node().tpdo(3).map[1].index, 0x606C);
+  for (int n = 0; n < 4; ++n) EXPECT_EQ(node().tpdo(n).transmission_type, 255);
+}
+
+TEST_F(pdo_test, no_pdo_flows_before_operational) {
+  net.send(make_frame(0x203, {0x06, 0x00}));
+  net.run(5000, 1000);
+  EXPECT_EQ(dev().control_word(), 0);
+  EXPECT_TRUE(net.with_id(0x183).empty());
+}
+
+TEST_F(pdo_test, event_rpdo_acts_at_once_and_event_tpdo_sends_each_new_status_word) {
+  start();
+  net.run(3000, 1000);  // T0, T1: SWITCH ON DISABLED
+  net.received.clear();
+  net.send(make_frame(0x203, {0x06, 0x00}));  // Shutdown
+  net.settle();
+  EXPECT_EQ(dev().control_word(), 0x0006);
+  net.run(2000, 1000);
+  const auto status = net.with_id(0x183);
+  ASSERT_FALSE(status.empty());
+  EXPECT_EQ(get_le(status.back().data.data(), 2) & 0x6F, 0x21u);  // READY TO SWITCH ON
+  EXPECT_EQ(status.back().len, 2);
+}
+
+TEST_F(pdo_test, entering_operational_sends_every_event_tpdo_once) {
+  net.run(3000, 1000);
+  net.received.clear();
+  start();
+  net.run(100);
+  EXPECT_EQ(net.with_id(0x183).size(), 1u);
+  EXPECT_EQ(net.with_id(0x283).size(), 1u);
+  EXPECT_EQ(net.with_id(0x483).size(), 1u);
+  EXPECT_EQ(net.with_id(0x283)[0].len, 3);
+  EXPECT_EQ(net.with_id(0x283)[0].data[2], 3);  // 0x6061 = pv
+}
+
+TEST_F(pdo_test, synchronous_rpdo_data_waits_for_the_next_sync) {
+  ASSERT_EQ(write(0x1400, 2, 1, 1), 0u);
+  start();
+  net.send(make_frame(0x203, {0x06, 0x00}));
+  net.settle();
+  EXPECT_EQ(dev().control_word(), 0);
+  sync();
+  EXPECT_EQ(dev().control_word(), 0x0006);
+}
+
+TEST_F(pdo_test, tpdo_type_2_is_sent_on_every_second_sync_only) {
+  ASSERT_EQ(write(0x1800, 2, 2, 1), 0u);
+  start();
+  net.received.clear();
+  for (int i = 0; i < 6; ++i) sync();
+  EXPECT_EQ(net.with_id(0x183).size(), 3u);
+}
+
+TEST_F(pdo_test, tpdo_type_0_is_sent_on_sync_only_when_its_data_changed) {
+  ASSERT_EQ(write(0x1800, 2, 0, 1), 0u);
+  start();
+  net.run(3000, 1000);
+  net.received.clear();
+  sync();
+  sync();
+  EXPECT_EQ(net.with_id(0x183).size(), 1u);
+  net.send(make_frame(0x203, {0x06, 0x00}));
+  net.run(2000, 1000);
+  sync();
+  EXPECT_EQ(net.with_id(0x183).size(), 2u);
+}
+
+TEST_F(pdo_test, event_timer_repeats_an_unchanged_tpdo) {
+  ASSERT_EQ(write(0x1800, 5, 10, 2), 0u);  // 10 ms
+  start();
+  net.run(3000, 1000);
+  net.received.clear();
+  net.run(50000, 1000);
+  const auto n = net.with_id(0x183).size();
+  EXPECT_GE(n, 4u);
+  EXPECT_LE(n, 5u);
+}
+
+TEST_F(pdo_test, inhibit_time_holds_back_a_change_until_it_has_passed) {
+  ASSERT_EQ(write(0x1800, 1, 0x80000183, 4), 0u);
+  ASSERT_EQ(write(0x1800, 3, 200, 2), 0u);  // 200 x 100 us = 20 ms
+  ASSERT_EQ(write(0x1800, 1, 0x183, 4), 0u);
+  net.run(3000, 1000);
+  start();  // TPDO1 goes at once (SWITCH ON DISABLED); the inhibit time starts
+  net.received.clear();
+  net.send(make_frame(0x203, {0x06, 0x00}));  // READY TO SWITCH ON 1 ms later
+  net.run(19000, 1000);
+  EXPECT_TRUE(net.with_id(0x183).empty());
+  net.run(2000, 1000);
+  const auto sent = net.with_id(0x183);
+  ASSERT_EQ(sent.size(), 1u);
+  EXPECT_EQ(get_le(sent[0].data.data(), 2) & 0x6F, 0x21u);
+}
+
+TEST_F(pdo_test, changing_the_mapping_of_a_valid_pdo_aborts_with_0x06010000) {
+  EXPECT_EQ(write(0x1A00, 1, 0x60410010, 4), 0x06010000u);
+  EXPECT_EQ(write(0x1A00, 0, 0, 1), 0x06010000u);
+  EXPECT_EQ(node().tpdo(0).count, 1) << "nothing changed";
+}
+
+TEST_F(pdo_test, changing_an_entry_while_sub0_is_not_zero_aborts_with_0x06010000) {
+  ASSERT_EQ(write(0x1800, 1, 0x80000183, 4), 0u);
+  EXPECT_EQ(write(0x1A00, 1, 0x60410010, 4), 0x06010000u);  // sub 0 is still 1
+}
+
+TEST_F(pdo_test, mapping_rules_give_the_standard_abort_codes) {
+  ASSERT_EQ(write(0x1800, 1, 0x80000183, 4), 0u);
+  ASSERT_EQ(write(0x1A00, 0, 0, 1), 0u);
+  EXPECT_EQ(write(0x1A00, 1, 0x20FF0010, 4), 0x06020000u);   // no such object
+  EXPECT_EQ(write(0x1A00, 1, 0x60410110, 4), 0x06090011u);   // no such sub-index
+  EXPECT_EQ(write(0x1A00, 1, 0x10170010, 4), 0x06040041u);   // not mappable
+  EXPECT_EQ(write(0x1A00, 1, 0x60410008, 4), 0x06040041u);   // wrong length
+  EXPECT_EQ(write(0x1A00, 1, 0x20010010, 4), 0x06040041u);   // write-only into a TPDO
+  EXPECT_EQ(write(0x1600 + 0, 1, 0x60410010, 4), 0x06010000u);  // RPDO1 still valid
+  ASSERT_EQ(write(0x1400, 1, 0x80000203, 4), 0u);
+  ASSERT_EQ(write(0x1600, 0, 0, 1), 0u);
+  EXPECT_EQ(write(0x1600, 1, 0x60410010, 4), 0x06040041u);   // read-only into an RPDO
+  // 3 x 32 bits = 96 > 64.
+  ASSERT_EQ(write(0x1A00, 1, 0x606C0020, 4), 0u);
+  ASSERT_EQ(write(0x1A00, 2, 0x606C0020, 4), 0u);
+  ASSERT_EQ(write(0x1A00, 3, 0x606C0020, 4), 0u);
+  EXPECT_EQ(write(0x1A00, 0, 3, 1), 0x06040042u);
+  ASSERT_EQ(write(0x1A00, 3, 0, 4), 0u);
+  EXPECT_EQ(write(0x1A00, 0, 3, 1), 0x06040041u) << "entry 3 is empty";
+  EXPECT_EQ(write(0x1A00, 0, 2, 1), 0u);
+}
+
+TEST_F(pdo_test, cob_id_rules_give_0x06090030) {
+  EXPECT_EQ(write(0x1800, 1, 0x184, 4), 0x06090030u);          // new CAN-ID while valid
+  EXPECT_EQ(write(0x1800, 1, 0x00000983, 4), 0x06090030u);      // reserved bits
+  ASSERT_EQ(write(0x1800, 1, 0x80000183, 4), 0u);
+  EXPECT_EQ(write(0x1800, 1, 0x603, 4), 0x06090030u);           // the SDO server's identifier
+  ASSERT_EQ(write(0x1A00, 0, 0, 1), 0u);
+  EXPECT_EQ(write(0x1800, 1, 0x183, 4), 0x06090030u);           // enabled without a mapping
+  EXPECT_EQ(write(0x1800, 2, 241, 1), 0x06090030u);             // reserved transmission type
+  EXPECT_EQ(write(0x1800, 2, 252, 1), 0x06090030u);             // RTR-only: not offered
+  EXPECT_EQ(write(0x1400, 2, 253, 1), 0x06090030u);
+}
+
+TEST_F(pdo_test, inhibit_time_of_a_valid_tpdo_cannot_change) {
+  EXPECT_EQ(write(0x1800, 3, 10, 2), 0x06090030u);
+  ASSERT_EQ(write(0x1800, 1, 0x80000183, 4), 0u);
+  EXPECT_EQ(write(0x1800, 3, 10, 2), 0u);
+}
+
+TEST_F(pdo_test, remapped_tpdo_carries_the_new_objects_in_mapping_order) {
+  ASSERT_EQ(write(0x1800, 1, 0x80000183, 4), 0u);
+  ASSERT_EQ(write(0x1A00, 0, 0, 1), 0u);
+  ASSERT_EQ(write(0x1A00, 1, 0x603F0010, 4), 0u);
+  ASSERT_EQ(write(0x1A00, 2, 0x60410010, 4), 0u);
+  ASSERT_EQ(write(0x1A00, 3, 0x10010008, 4), 0u);
+  ASSERT_EQ(write(0x1A00, 0, 3, 1), 0u);
+  ASSERT_EQ(write(0x1800, 1, 0x183, 4), 0u);
+  EXPECT_EQ(node().tpdo(0).length, 5);
+  dev().inject_fault(0x2310);
+  start();
+  net.run(5000, 1000);
+  const auto sent = net.with_id(0x183);
+  ASSERT_FALSE(sent.empty());
+  const frame& last = sent.back();
+  EXPECT_EQ(last.len, 5);
+  EXPECT_EQ(get_le(&last.data[0], 2), 0x2310u);
+  EXPECT_EQ(get_le(&last.data[2], 2) & 0x4F, 0x08u);  // FAULT
+  EXPECT_EQ(last.data[4], 0x03);                      // generic + current
+}
+
+TEST_F(pdo_test, rpdo_shorter_than_its_mapping_is_dropped_with_emcy_0x8210) {
+  start();
+  net.received.clear();
+  net.send(make_frame(0x503, {0x06, 0x00, 0x01}));  // RPDO4 needs 6 bytes
+  net.settle();
+  EXPECT_EQ(dev().control_word(), 0);
+  const auto emcy = net.with_id(0x83);
+  ASSERT_EQ(emcy.size(), 1u);
+  EXPECT_EQ(get_le(emcy[0].data.data(), 2), 0x8210u);
+  EXPECT_EQ(emcy[0].data[2] & 0x11, 0x11);
+  net.send(make_frame(0x503, {0x06, 0x00, 0x10, 0x00, 0x00, 0x00}));
+  net.settle();
+  EXPECT_EQ(dev().control_word(), 0x0006);
+  EXPECT_EQ(dev().target_velocity(), 16);
+  const auto after = net.with_id(0x83);
+  ASSERT_EQ(after.size(), 2u);
+  EXPECT_EQ(get_le(after[1].data.data(), 2), 0x0000u) << "error reset";
+}
+
+}  // namespace
+}  // namespace cia402::canopen::test

@@ -1,0 +1,210 @@
+"""`cia402 bus` seen by a third-party CANopen client: python-can's socketcand interface sends raw
+NMT, SDO and PDO frames and reads heartbeats, EMCY and PDOs. Expected values are CiA 301 / CiA 402
+numbers written out here, not taken from our code."""
+import configparser
+import os
+import socket
+import subprocess
+import time
+
+import can
+
+NODE = 1
+
+
+def send(bus, cob_id, data):
+    bus.send(can.Message(arbitration_id=cob_id, data=bytes(data), is_extended_id=False))
+
+
+def wait_for(bus, match, timeout=2.0):
+    """The first received frame for which match(msg) is true, or None."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        msg = bus.recv(timeout=max(0.0, end - time.monotonic()))
+        if msg is not None and match(msg):
+            return msg
+    return None
+
+
+def sdo_upload_expedited(bus, node, index, sub):
+    send(bus, 0x600 + node, [0x40, index & 0xFF, index >> 8, sub, 0, 0, 0, 0])
+    msg = wait_for(bus, lambda m: m.arbitration_id == 0x580 + node)
+    assert msg is not None, "no SDO answer"
+    assert msg.data[0] & 0xE0 == 0x40, "SDO abort 0x%08X" % int.from_bytes(msg.data[4:8], "little")
+    size = 4 - ((msg.data[0] >> 2) & 3)
+    return int.from_bytes(msg.data[4:4 + size], "little")
+
+
+def sdo_download(bus, node, index, sub, value, size):
+    command = {1: 0x2F, 2: 0x2B, 4: 0x23}[size]
+    send(bus, 0x600 + node, [command, index & 0xFF, index >> 8, sub]
+         + list(value.to_bytes(4, "little")))
+    msg = wait_for(bus, lambda m: m.arbitration_id == 0x580 + node)
+    assert msg is not None, "no SDO answer"
+    return msg
+
+
+def status_state(word):
+    """CiA 402 state from a status word (masks 0x4F / 0x6F)."""
+    if word & 0x4F == 0x40:
+        return "SWITCH_ON_DISABLED"
+    if word & 0x6F == 0x21:
+        return "READY_TO_SWITCH_ON"
+    if word & 0x6F == 0x23:
+        return "SWITCHED_ON"
+    if word & 0x6F == 0x27:
+        return "OPERATION_ENABLED"
+    if word & 0x6F == 0x07:
+        return "QUICK_STOP_ACTIVE"
+    if word & 0x4F == 0x0F:
+        return "FAULT_REACTION_ACTIVE"
+    if word & 0x4F == 0x08:
+        return "FAULT"
+    return "NOT_READY_TO_SWITCH_ON"
+
+
+def test_sdo_upload_reads_device_type_of_a_cia402_servo(client):
+    assert sdo_upload_expedited(client, NODE, 0x1000, 0) == 0x00020192
+    assert sdo_upload_expedited(client, 2, 0x1018, 4) == 2  # serial number = node-ID
+
+
+def test_sdo_segmented_upload_reads_the_device_name(client):
+    send(client, 0x601, [0x40, 0x08, 0x10, 0, 0, 0, 0, 0])
+    first = wait_for(client, lambda m: m.arbitration_id == 0x581)
+    assert first.data[0] == 0x41
+    size = int.from_bytes(first.data[4:8], "little")
+    text, toggle = b"", 0
+    while True:
+        send(client, 0x601, [0x60 | (toggle << 4), 0, 0, 0, 0, 0, 0, 0])
+        seg = wait_for(client, lambda m: m.arbitration_id == 0x581)
+        assert seg.data[0] & 0x10 == toggle << 4
+        text += bytes(seg.data[1:8 - ((seg.data[0] >> 1) & 7)])
+        toggle ^= 1
+        if seg.data[0] & 1:
+            break
+    assert size == len(text)
+    assert text == b"cia402 virtual drive"
+
+
+def test_sdo_abort_for_an_unknown_object(client):
+    msg = sdo_download(client, NODE, 0x2FFF, 0, 1, 1)
+    assert msg.data[0] == 0x80
+    assert int.from_bytes(msg.data[4:8], "little") == 0x06020000
+
+
+def test_heartbeat_follows_nmt_states(client):
+    assert sdo_download(client, NODE, 0x1017, 0, 50, 2).data[0] == 0x60
+    hb = wait_for(client, lambda m: m.arbitration_id == 0x701)
+    assert hb is not None and list(hb.data) == [0x7F]  # pre-operational
+    send(client, 0x000, [0x01, NODE])  # NMT start
+    hb = wait_for(client, lambda m: m.arbitration_id == 0x701 and m.data[0] == 0x05)
+    assert hb is not None
+    send(client, 0x000, [0x02, NODE])  # NMT stop
+    assert wait_for(client, lambda m: m.arbitration_id == 0x701 and m.data[0] == 0x04) is not None
+
+
+def test_reset_node_sends_boot_up(client):
+    send(client, 0x000, [0x81, 2])
+    boot = wait_for(client, lambda m: m.arbitration_id == 0x702)
+    assert boot is not None and list(boot.data) == [0x00]
+
+
+def test_drive_reaches_operation_enabled_over_pdos(client):
+    log = []
+    send(client, 0x000, [0x01, NODE])  # NMT start: TPDO1 (0x6041) comes at once, then on change
+
+    def status(m):
+        return m.arbitration_id == 0x181 and len(m.data) == 2
+
+    msg = wait_for(client, status)
+    assert msg is not None
+    log.append(status_state(int.from_bytes(msg.data, "little")))
+    for control_word in (0x0006, 0x000F):  # Shutdown, then Enable operation (T2, T3, T4)
+        send(client, 0x201, control_word.to_bytes(2, "little"))
+        time.sleep(0.05)
+    deadline = time.monotonic() + 3
+    state = log[-1]
+    while state != "OPERATION_ENABLED" and time.monotonic() < deadline:
+        msg = wait_for(client, status, timeout=0.5)
+        if msg is not None:
+            state = status_state(int.from_bytes(msg.data, "little"))
+            log.append(state)
+    assert state == "OPERATION_ENABLED", log
+    assert "READY_TO_SWITCH_ON" in log
+    assert sdo_upload_expedited(client, NODE, 0x6041, 0) & 0x6F == 0x27
+    # Velocity through RPDO4 (0x6040 + 0x60FF), read back through TPDO4 (0x6041 + 0x606C).
+    send(client, 0x501, list((0x000F).to_bytes(2, "little")) + list((100).to_bytes(4, "little", signed=True)))
+    fast = wait_for(client, lambda m: m.arbitration_id == 0x481
+                    and int.from_bytes(m.data[2:6], "little", signed=True) >= 90, timeout=3)
+    assert fast is not None
+
+
+def test_fault_sends_emcy_and_fault_reset_sends_emcy_0000(client):
+    send(client, 0x000, [0x01, NODE])
+    assert sdo_download(client, NODE, 0x2001, 0, 0x2310, 2).data[0] == 0x60  # inject over-current
+    emcy = wait_for(client, lambda m: m.arbitration_id == 0x081)
+    assert emcy is not None
+    assert int.from_bytes(emcy.data[0:2], "little") == 0x2310
+    assert emcy.data[2] & 0x03 == 0x03  # generic + current
+    assert wait_for(client, lambda m: m.arbitration_id == 0x181
+                    and status_state(int.from_bytes(m.data[0:2], "little")) == "FAULT") is not None
+    assert sdo_download(client, NODE, 0x2001, 0, 0, 2).data[0] == 0x60  # cause gone
+    send(client, 0x201, [0x00, 0x00])
+    time.sleep(0.02)
+    send(client, 0x201, [0x80, 0x00])  # fault reset edge (T15)
+    reset = wait_for(client, lambda m: m.arbitration_id == 0x081)
+    assert reset is not None and int.from_bytes(reset.data[0:2], "little") == 0x0000
+
+
+def test_two_clients_see_each_others_frames_and_bad_input_does_not_stop_the_bus(bus_server, client):
+    raw = socket.create_connection(("127.0.0.1", bus_server["port"]), timeout=2)
+    assert raw.recv(64) == b"< hi >"
+    raw.sendall(b"< open can0 >")
+    assert raw.recv(64) == b"< ok >"
+    raw.sendall(b"< bogus >< send 12X 1 00 >< " + b"x" * 400 + b" >")
+    got = b""
+    end = time.monotonic() + 2
+    while got.count(b"< error") < 3 and time.monotonic() < end:
+        got += raw.recv(4096)
+    assert got.count(b"< error") == 3, got
+    raw.sendall(b"< send 7E4 2 de ad >")
+    msg = wait_for(client, lambda m: m.arbitration_id == 0x7E4)
+    assert msg is not None and bytes(msg.data) == b"\xde\xad"
+    raw.close()
+    assert sdo_upload_expedited(client, NODE, 0x1000, 0) == 0x00020192
+
+
+def test_sigterm_stops_the_bus_cleanly(bus_server):
+    bus_server["proc"].send_signal(15)
+    bus_server["proc"].wait(timeout=5)
+    assert bus_server["proc"].returncode == 0
+
+
+def test_eds_loads_with_configparser_and_lists_are_consistent():
+    text = subprocess.run([os.environ["CIA402_BIN"], "eds"], check=True, capture_output=True,
+                          text=True).stdout
+    eds = configparser.RawConfigParser()
+    eds.optionxform = str
+    eds.read_string(text)
+    listed = set()
+    for group in ("MandatoryObjects", "OptionalObjects", "ManufacturerObjects"):
+        count = int(eds[group]["SupportedObjects"], 0)
+        entries = [int(eds[group][str(i)], 0) for i in range(1, count + 1)]
+        assert len(entries) == count
+        for index in entries:
+            name = "%04X" % index
+            assert name in eds, name
+            obj = eds[name]
+            assert int(obj["ObjectType"], 0) in (7, 8, 9)
+            if int(obj["ObjectType"], 0) != 7:
+                subs = [s for s in eds.sections() if s.startswith(name + "sub")]
+                assert len(subs) == int(obj["SubNumber"], 0)
+            listed.add(index)
+    for mandatory in (0x1000, 0x1001, 0x1018):
+        assert mandatory in [int(eds["MandatoryObjects"][k], 0)
+                             for k in eds["MandatoryObjects"] if k != "SupportedObjects"]
+    assert eds["1000"]["DefaultValue"] == "0x00020192"
+    assert eds["1800sub1"]["DefaultValue"] == "$NODEID+0x180"
+    assert eds["2001"]["AccessType"] == "wo"
+    sections = {int(s, 16) for s in eds.sections() if len(s) == 4 and all(c in "0123456789ABCDEF" for c in s)}
+    assert sections == listed

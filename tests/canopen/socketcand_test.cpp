@@ -1,0 +1,425 @@
+// socketcand over loopback TCP (free port): the protocol as python-can and socketcand speak it, bad
+// input, limits, and the drive master joining the virtual bus through our own socketcand client.
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <memory>
+#include <atomic>
+#include <thread>
+#include <string>
+#include <vector>
+
+#include "cia402/canopen/drive_master.hpp"
+#include "cia402/canopen/sim_device.hpp"
+#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/socketcand.hpp"
+
+namespace cia402::canopen {
+namespace {
+
+using socketcand::element_reader;
+
+TEST(socketcand_protocol, frames_format_as_socketcand_prints_them) {
+  EXPECT_EQ(socketcand::format_frame(make_frame(0x181, {0x37, 0x02}), 12000345),
+            "< frame 181 12.000345 3702 >");
+  EXPECT_EQ(socketcand::format_frame(make_frame(0x080, {}), 1000000), "< frame 080 1.000000  >");
+  frame ext = make_frame(0x1AAAAAAA, {1});
+  ext.extended = true;
+  EXPECT_EQ(socketcand::format_frame(ext, 0), "< frame 1AAAAAAA 0.000000 01 >");
+  EXPECT_EQ(socketcand::format_send(make_frame(0x601, {0x40, 0x00, 0x10})), "< send 601 3 40 00 10 >");
+}
+
+TEST(socketcand_protocol, send_parses_python_can_style_lower_case_unpadded_bytes) {
+  frame f;
+  std::string why;
+  ASSERT_TRUE(socketcand::parse_send("< send 605 8 40 0 10 0 0 0 0 0 >", f, why)) << why;
+  EXPECT_EQ(f.id, 0x605u);
+  EXPECT_EQ(f.len, 8);
+  EXPECT_EQ(f.data[2], 0x10);
+  ASSERT_TRUE(socketcand::parse_send("< send 0 2 1 a >", f, why)) << why;
+  EXPECT_EQ(f.data[1], 0x0A);
+  ASSERT_TRUE(socketcand::parse_send("< send 1AAAAAAA 2 1 F1 >", f, why)) << why;
+  EXPECT_TRUE(f.extended);
+  ASSERT_TRUE(socketcand::parse_send("< send 123 0  >", f, why)) << why;
+  EXPECT_EQ(f.len, 0);
+}
+
+TEST(socketcand_protocol, malformed_send_is_refused_with_a_reason) {
+  frame f;
+  std::string why;
+  EXPECT_FALSE(socketcand::parse_send("< send 12G 1 00 >", f, why));
+  EXPECT_FALSE(socketcand::parse_send("< send 123 9 0 0 0 0 0 0 0 0 0 >", f, why));
+  EXPECT_FALSE(socketcand::parse_send("< send 123 2 01 >", f, why));
+  EXPECT_NE(why.find("length 2 but 1"), std::string::npos);
+  EXPECT_FALSE(socketcand::parse_send("< send 123 1 100 >", f, why));
+  EXPECT_FALSE(socketcand::parse_send("< send 123456789 0 >", f, why));
+  EXPECT_FALSE(socketcand::parse_send("< send >", f, why));
+}
+
+TEST(socketcand_protocol, reader_splits_elements_skips_noise_and_flags_overlong_ones) {
+  element_reader r(16);
+  r.feed("junk< hi >\n< o");
+  std::string e;
+  ASSERT_EQ(r.next(e), element_reader::result::element);
+  EXPECT_EQ(e, "< hi >");
+  EXPECT_EQ(r.next(e), element_reader::result::none);
+  r.feed("k >< 0123456789abcdefghij >< echo >");
+  ASSERT_EQ(r.next(e), element_reader::result::element);
+  EXPECT_EQ(e, "< ok >");
+  EXPECT_EQ(r.next(e), element_reader::result::too_long);
+  ASSERT_EQ(r.next(e), element_reader::result::element);
+  EXPECT_EQ(e, "< echo >");
+}
+
+// A raw TCP peer: what a socketcand client sends and receives, byte for byte.
+class tcp_peer {
+ public:
+  explicit tcp_peer(std::uint16_t port, int receive_buffer = 0) {
+    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (receive_buffer != 0) {
+      ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof receive_buffer);
+    }
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  }
+  ~tcp_peer() { close(); }
+  void close() {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+  }
+  bool connected() const { return connected_; }
+  void send(const std::string& s) { ASSERT_EQ(::send(fd_, s.data(), s.size(), MSG_NOSIGNAL), static_cast<ssize_t>(s.size())); }
+  /// Everything readable now; sets `closed` on EOF.
+  std::string take() {
+    std::string out;
+    char buf[4096];
+    for (;;) {
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, 0) <= 0) break;
+      const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+      if (n <= 0) {
+        closed = true;
+        break;
+      }
+      out.append(buf, static_cast<std::size_t>(n));
+    }
+    return out;
+  }
+  bool closed = false;
+
+ private:
+  int fd_ = -1;
+  bool connected_ = false;
+};
+
+struct drive_on_bus {
+  std::unique_ptr<sim_device> dev;
+  std::unique_ptr<virtual_channel> ch;
+  std::unique_ptr<slave> sl;
+};
+
+class socketcand_server_test : public ::testing::Test {
+ protected:
+  void SetUp() override { start({}); }
+  void start(socketcand::server_config cfg) {
+    cfg.port = 0;
+    if (cfg.join_grace_us == socketcand::server_config{}.join_grace_us) cfg.join_grace_us = 0;
+    srv.reset();
+    srv = std::make_unique<socketcand::server>(bus, cfg);
+    ASSERT_FALSE(srv->open());
+    ASSERT_NE(srv->port(), 0);
+  }
+  void add_drive(std::uint8_t id) {
+    drive_on_bus d;
+    d.dev = std::make_unique<sim_device>(standard_profile());
+    d.ch = bus.attach();
+    d.sl = std::make_unique<slave>(*d.dev, *d.ch, slave_config{id, 1000000, 0});
+    drives.push_back(std::move(d));
+  }
+  /// One cycle of the server loop: sockets, time, nodes, output.
+  void spin(int cycles = 1, std::uint32_t us = 1000) {
+    for (int i = 0; i < cycles; ++i) {
+      srv->poll_sockets(0);
+      srv->advance(us);
+      for (auto& d : drives) d.sl->poll(*d.ch, us);
+      srv->flush();
+    }
+  }
+  /// Runs the server loop (waiting on its sockets) until `done`: for a client whose connect()
+  /// blocks in the test's own thread.
+  void serve_until(const std::atomic<bool>& done) {
+    while (!done) {
+      srv->poll_sockets(5);
+      srv->advance(1000);
+      for (auto& d : drives) d.sl->poll(*d.ch, 1000);
+      srv->flush();
+    }
+  }
+  /// A peer that has joined in raw mode.
+  std::unique_ptr<tcp_peer> join(int receive_buffer = 0) {
+    auto p = std::make_unique<tcp_peer>(srv->port(), receive_buffer);
+    spin();
+    EXPECT_EQ(p->take(), "< hi >");
+    p->send("< open can0 >");
+    spin();
+    EXPECT_EQ(p->take(), "< ok >");
+    p->send("< rawmode >");
+    spin();
+    EXPECT_EQ(p->take(), "< ok >");
+    return p;
+  }
+
+  virtual_bus bus;
+  std::vector<drive_on_bus> drives;
+  std::unique_ptr<socketcand::server> srv;
+};
+
+TEST_F(socketcand_server_test, handshake_answers_exactly_hi_ok_ok) {
+  auto p = join();
+  EXPECT_EQ(srv->clients(), 1u);
+}
+
+TEST_F(socketcand_server_test, unknown_bus_gets_an_error_and_the_connection_closes) {
+  tcp_peer p(srv->port());
+  spin();
+  EXPECT_EQ(p.take(), "< hi >");
+  p.send("< open can7 >");
+  spin(3);
+  EXPECT_EQ(p.take(), "< error could not open bus >");
+  EXPECT_TRUE(p.closed || (spin(2), p.take(), p.closed));
+  EXPECT_EQ(srv->clients(), 0u);
+}
+
+TEST_F(socketcand_server_test, frames_reach_every_other_client_but_not_the_sender) {
+  auto a = join();
+  auto b = join();
+  a->send("< send 123 2 ab 1 >");
+  spin();
+  const std::string got = b->take();
+  EXPECT_EQ(got.substr(0, 13), "\n< frame 123 ");
+  EXPECT_EQ(got.substr(got.size() - 7), " AB01 >") << got;
+  EXPECT_EQ(a->take(), "");
+}
+
+TEST_F(socketcand_server_test, bad_input_gets_errors_and_the_session_goes_on) {
+  auto a = join();
+  auto b = join();
+  a->send("< launch rockets >< send 123 2 01 >< send 1x3 0 >< " + std::string(300, 'x') + " >");
+  spin();
+  const std::string errors = a->take();
+  EXPECT_NE(errors.find("< error unknown command >"), std::string::npos) << errors;
+  EXPECT_NE(errors.find("< error syntax error in send command: length 2 but 1 data bytes >"),
+            std::string::npos) << errors;
+  EXPECT_NE(errors.find("identifier '1x3' is not hexadecimal"), std::string::npos) << errors;
+  EXPECT_NE(errors.find("< error element longer than 256 characters >"), std::string::npos) << errors;
+  EXPECT_EQ(b->take(), "") << "nothing bad reached the bus";
+  a->send("< echo >< send 7E5 1 4 >");
+  spin();
+  EXPECT_EQ(a->take(), "< echo >");
+  EXPECT_EQ(b->take().substr(0, 15), "\n< frame 7E5 0.");
+}
+
+TEST_F(socketcand_server_test, commands_before_open_are_refused) {
+  tcp_peer p(srv->port());
+  spin();
+  p.take();
+  p.send("< send 123 0 >< rawmode >");
+  spin();
+  EXPECT_EQ(p.take(), "< error open a bus first >< error open a bus first >");
+}
+
+TEST_F(socketcand_server_test, seventeenth_client_is_refused_and_the_others_go_on) {
+  std::vector<std::unique_ptr<tcp_peer>> peers;
+  for (int i = 0; i < 16; ++i) peers.push_back(join());
+  tcp_peer extra(srv->port());
+  spin(2);
+  EXPECT_EQ(extra.take(), "< error too many clients >");
+  EXPECT_EQ(srv->clients(), 16u);
+  peers[0]->send("< send 100 0 >");
+  spin();
+  EXPECT_FALSE(peers[15]->take().empty());
+}
+
+TEST_F(socketcand_server_test, client_that_never_reads_is_dropped_without_stalling_the_others) {
+  socketcand::server_config cfg;
+  cfg.max_backlog = 8192;
+  start(cfg);
+  auto lazy = join(4096);
+  auto busy = join();
+  auto reader = join();
+  // Fill the lazy client's socket buffers and backlog; the reader keeps up.
+  std::size_t seen = 0;
+  for (int i = 0; i < 20000 && srv->clients() == 3; ++i) {
+    busy->send("< send 100 8 1 2 3 4 5 6 7 8 >");
+    spin();
+    seen += reader->take().size();
+  }
+  EXPECT_EQ(srv->clients(), 2u) << "the lazy client was dropped";
+  EXPECT_FALSE(reader->closed);
+  busy->take();
+  EXPECT_FALSE(busy->closed);
+  busy->send("< send 101 0 >");
+  std::string last;
+  for (int i = 0; i < 200 && last.find("< frame 101 ") == std::string::npos; ++i) {
+    spin();
+    last += reader->take();
+    if (last.find("< frame 101 ") == std::string::npos) ::usleep(1000);  // Nagle on the sender
+  }
+  EXPECT_NE(last.find("< frame 101 "), std::string::npos);
+  EXPECT_GT(seen, 0u);
+}
+
+TEST_F(socketcand_server_test, client_leaving_mid_sdo_transfer_leaves_the_node_usable) {
+  add_drive(4);
+  auto a = join();
+  auto b = join();
+  a->send("< send 604 8 40 08 10 00 00 00 00 00 >");  // segmented upload of 0x1008
+  spin();
+  EXPECT_NE(b->take().find("< frame 584 "), std::string::npos);
+  a->close();
+  spin(1100);  // the server's SDO timeout is 1 s
+  const std::string seen = b->take();
+  EXPECT_NE(seen.find("8008100000000405"), std::string::npos) << "abort 0x05040000 after 1 s: " << seen;
+  EXPECT_EQ(srv->clients(), 1u);
+  b->send("< send 604 8 40 00 10 00 00 00 00 00 >");
+  spin();
+  EXPECT_NE(b->take().find("4300100092010200"), std::string::npos);
+}
+
+TEST_F(socketcand_server_test, frames_for_unknown_nodes_pass_by_without_an_answer) {
+  add_drive(4);
+  auto a = join();
+  a->send("< send 67F 8 40 00 10 00 00 00 00 00 >< send 0 2 1 7f >");
+  spin(10);
+  EXPECT_EQ(a->take(), "");
+  EXPECT_EQ(drives[0].sl->state(), nmt_state::pre_operational);
+}
+
+TEST_F(socketcand_server_test, our_client_channel_joins_and_exchanges_frames) {
+  auto peer = join();
+  std::error_code ec;
+  std::string why;
+  std::unique_ptr<socketcand::client_channel> ch;
+  // connect() blocks for the handshake, so the server runs on the handshake's own schedule: let
+  // the kernel queue the greeting by accepting first.
+  std::atomic<bool> connected{false};
+  std::thread server_loop([&] { serve_until(connected); });
+  ch = socketcand::client_channel::connect("127.0.0.1", srv->port(), "can0", ec, why, 3000);
+  connected = true;
+  server_loop.join();
+  ASSERT_TRUE(ch) << why;
+  ASSERT_FALSE(ch->send(make_frame(0x222, {9})));
+  spin(2);
+  EXPECT_EQ(peer->take().substr(0, 15), "\n< frame 222 0.");
+  peer->send("< send 333 1 7 >");
+  spin(2);
+  frame f;
+  ASSERT_TRUE(ch->receive(f));
+  EXPECT_EQ(f.id, 0x333u);
+  EXPECT_EQ(f.data[0], 7);
+}
+
+// The drive master over socketcand on loopback: the same checks as over the in-process bus.
+class master_over_socketcand : public socketcand_server_test {
+ protected:
+  std::unique_ptr<drive_master> connect_master(drive_master_config mc = {}) {
+    std::error_code ec;
+    std::string why;
+    std::atomic<bool> connected{false};
+    std::thread server_loop([&] { serve_until(connected); });
+    channel_ = socketcand::client_channel::connect("127.0.0.1", srv->port(), "can0", ec, why, 3000);
+    connected = true;
+    server_loop.join();
+    EXPECT_TRUE(channel_) << why;
+    return std::make_unique<drive_master>(*channel_, mc);
+  }
+  void run(drive_master& m, int ms, bool alive = true) {
+    for (int i = 0; i < ms; ++i) {
+      if (alive) m.poll(*channel_, 1000);
+      spin(1);
+      if (alive) m.poll(*channel_, 0);
+      spin(1, 0);
+    }
+  }
+  bool run_until_reached(drive_master& m, int ms) {
+    for (int i = 0; i < ms; ++i) {
+      run(m, 1);
+      if (m.outcome() == master_outcome::reached) return true;
+      if (m.phase() == master_phase::failed) return false;
+    }
+    return false;
+  }
+  sim::virtual_drive& drive() { return drives[0].dev->drive(); }
+  std::unique_ptr<socketcand::client_channel> channel_;
+};
+
+TEST_F(master_over_socketcand, enable_then_fault_and_reset) {
+  add_drive(1);
+  auto m = connect_master();
+  std::vector<std::uint16_t> emcy;
+  m->on_emcy = [&](std::uint16_t code, std::uint8_t, const std::uint8_t*) { emcy.push_back(code); };
+  m->set_target(state::operation_enabled);
+  ASSERT_TRUE(run_until_reached(*m, 3000)) << m->failure_text();
+  EXPECT_EQ(drive().view().current(), state::operation_enabled);
+  drive().view().inject_fault(0x3210);
+  run(*m, 300);
+  EXPECT_EQ(m->outcome(), master_outcome::fault);
+  EXPECT_EQ(m->error_code(), 0x3210);
+  ASSERT_FALSE(emcy.empty());
+  EXPECT_EQ(emcy[0], 0x3210);
+  drive().view().clear_faults();
+  m->set_target(state::operation_enabled);
+  ASSERT_TRUE(run_until_reached(*m, 3000));
+  EXPECT_EQ(emcy.back(), 0x0000);
+}
+
+class quick_stop_over_socketcand : public master_over_socketcand,
+                                   public ::testing::WithParamInterface<int> {};
+
+TEST_P(quick_stop_over_socketcand, quick_stop_follows_0x605A) {
+  const int code = GetParam();
+  add_drive(1);
+  ASSERT_EQ(drives[0].sl->write(0x605A, 0, code), sdo_abort::none);
+  auto m = connect_master();
+  m->set_target(state::operation_enabled);
+  ASSERT_TRUE(run_until_reached(*m, 3000)) << m->failure_text();
+  m->set_command(command::quick_stop);
+  run(*m, 500);
+  const bool ends = code >= 1 && code <= 4;
+  EXPECT_EQ(drive().view().current(), ends ? state::switch_on_disabled : state::quick_stop_active);
+  EXPECT_EQ(m->observed(), drive().view().current());
+}
+
+INSTANTIATE_TEST_SUITE_P(codes_0_to_8, quick_stop_over_socketcand, ::testing::Range(0, 9));
+
+class heartbeat_over_socketcand : public master_over_socketcand,
+                                  public ::testing::WithParamInterface<int> {};
+
+TEST_P(heartbeat_over_socketcand, silent_master_makes_the_drive_apply_0x6007) {
+  const int code = GetParam();
+  add_drive(1);
+  ASSERT_EQ(drives[0].sl->write(0x6007, 0, code), sdo_abort::none);
+  drive_master_config mc;
+  mc.master_heartbeat_ms = 20;
+  auto m = connect_master(mc);
+  m->set_target(state::operation_enabled);
+  ASSERT_TRUE(run_until_reached(*m, 3000)) << m->failure_text();
+  run(*m, 100);
+  ASSERT_FALSE(drives[0].sl->connection_lost());
+  run(*m, 500, /*alive=*/false);
+  EXPECT_TRUE(drives[0].sl->connection_lost());
+  const state expected[4] = {state::operation_enabled, state::fault, state::switch_on_disabled,
+                             state::switch_on_disabled};
+  EXPECT_EQ(drive().view().current(), expected[code]);
+}
+
+INSTANTIATE_TEST_SUITE_P(codes_0_to_3, heartbeat_over_socketcand, ::testing::Range(0, 4));
+
+}  // namespace
+}  // namespace cia402::canopen

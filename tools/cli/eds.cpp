@@ -1,0 +1,63 @@
+#include "cli/eds.hpp"
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <ctime>
+#include <fstream>
+#include <ostream>
+
+#include "cia402/canopen/eds.hpp"
+#include "cia402/canopen/sim_device.hpp"
+#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/virtual_bus.hpp"
+#include "cli/common.hpp"
+
+namespace cia402::cli {
+
+CLI::App* add_eds_subcommand(CLI::App& app, eds_args& args) {
+  auto* cmd = app.add_subcommand("eds", "Write the CiA 306 EDS of the virtual drive (the objects `cia402 bus` serves)");
+  auto* by_name = cmd->add_option("--profile", args.profile, "built-in profile: " + builtin_profile_names())
+                      ->type_name("NAME")
+                      ->default_str("cia402");
+  cmd->add_option("--profile-file", args.profile_file, "a TOML profile file instead of a built-in")
+      ->type_name("FILE")
+      ->excludes(by_name);
+  cmd->add_option("--node", args.node, "node-ID whose values the EDS shows")->check(CLI::Range(1, 127))->default_str("1");
+  cmd->add_option("-o,--output", args.output, "write to this file instead of standard output");
+  return cmd;
+}
+
+int run_eds(const eds_args& args, std::ostream& out, std::ostream& err) {
+  profile_choice choice;
+  if (!choice.resolve(args.profile, args.profile_file, err)) return 2;
+  canopen::virtual_bus bus;
+  auto ch = bus.attach();
+  canopen::sim_device dev(choice.get());
+  canopen::slave node(dev, *ch, canopen::slave_config{static_cast<std::uint8_t>(args.node), 1000000, 0});
+
+  canopen::eds_info info;
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char date[16];
+  char time[16];
+  std::strftime(date, sizeof date, "%m-%d-%Y", &tm);
+  std::strftime(time, sizeof time, "%I:%M%p", &tm);
+  info.date = date;
+  info.time = time;
+  info.description += std::string(", profile ") + choice.get().name;
+  if (args.output.empty()) {
+    canopen::write_eds(node, info, out);
+    return 0;
+  }
+  std::ofstream file(args.output);
+  if (!file) {
+    err << "cia402 eds: cannot write " << args.output << "\n";
+    return 2;
+  }
+  info.file_name = args.output.substr(args.output.find_last_of('/') + 1);
+  canopen::write_eds(node, info, file);
+  return file ? 0 : 2;
+}
+
+}  // namespace cia402::cli

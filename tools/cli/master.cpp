@@ -1,0 +1,314 @@
+#include "cli/master.hpp"
+
+#include <poll.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <csignal>
+#include <memory>
+#include <ostream>
+
+#include "cia402/canopen/channel_url.hpp"
+#include "cia402/canopen/drive_master.hpp"
+#include "cia402/canopen/sdo_client.hpp"
+#include "cia402/canopen/sim_device.hpp"
+#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/virtual_bus.hpp"
+#include "cli/common.hpp"
+
+namespace cia402::cli {
+namespace {
+
+constexpr int usage_error = 2;
+constexpr int failed = 1;
+volatile std::sig_atomic_t stop_requested = 0;
+extern "C" void request_master_stop(int) { stop_requested = 1; }
+
+// The bus the master runs on: a real channel with real time, or an in-process bus holding one
+// virtual drive, run in virtual time (no waiting).
+class bus_session {
+ public:
+  bool open(const master_args& a, const profile& p, std::ostream& err) {
+    canopen::channel_url url;
+    std::string why;
+    if (!canopen::parse_channel_url(a.can, url, why)) {
+      err << "cia402 master: --can " << a.can << ": " << why << "\n";
+      return false;
+    }
+    if (url.type == canopen::channel_url::kind::virtual_bus) {
+      virtual_ = true;
+      dev_ = std::make_unique<canopen::sim_device>(p);
+      drive_ch_ = bus_.attach();
+      canopen::slave_config sc;
+      sc.node_id = static_cast<std::uint8_t>(a.node);
+      slave_ = std::make_unique<canopen::slave>(*dev_, *drive_ch_, sc);
+      master_ch_ = bus_.attach();
+      channel_ = master_ch_.get();
+      for (int i = 0; i < 10; ++i) slave_->poll(*drive_ch_, 1000);  // past power-up (T0, T1)
+      frame_drain();
+      return true;
+    }
+    real_ = canopen::open_channel(url, why);
+    if (!real_) {
+      err << "cia402 master: " << why << "\n";
+      open_failed_ = true;
+      return false;
+    }
+    channel_ = real_.get();
+    last_ = std::chrono::steady_clock::now();
+    return true;
+  }
+  canopen::channel& channel() { return *channel_; }
+  /// Waits for the next thing to do (at most `wait_us`) and returns the microseconds that passed.
+  std::uint32_t wait(std::uint32_t wait_us) {
+    if (virtual_) {
+      const std::uint32_t step = 1000;
+      slave_->poll(*drive_ch_, step);
+      return step;
+    }
+    pollfd p{channel_->native_handle(), POLLIN, 0};
+    const int ms = static_cast<int>(std::min<std::uint32_t>(wait_us / 1000 + 1, 10));
+    if (p.fd >= 0) ::poll(&p, 1, ms);
+    const auto now = std::chrono::steady_clock::now();
+    const auto us = std::chrono::duration_cast<std::chrono::microseconds>(now - last_).count();
+    const auto step = static_cast<std::uint32_t>(std::min<long long>(us, 1000000));
+    last_ += std::chrono::microseconds(step);
+    return step;
+  }
+  /// Lets the virtual drive answer at once (no time passes).
+  void settle() {
+    if (virtual_) slave_->poll(*drive_ch_, 0);
+  }
+  std::error_code failure() const { return channel_->failure(); }
+  /// Drops what the virtual drive said while powering up (its boot-up message).
+  void frame_drain() {
+    canopen::frame f;
+    while (master_ch_->receive(f)) {}
+  }
+
+ private:
+  bool virtual_ = false;
+  canopen::virtual_bus bus_;
+  std::unique_ptr<canopen::sim_device> dev_;
+  std::unique_ptr<canopen::virtual_channel> drive_ch_;
+  std::unique_ptr<canopen::slave> slave_;
+  std::unique_ptr<canopen::virtual_channel> master_ch_;
+  std::unique_ptr<canopen::channel> real_;
+  canopen::channel* channel_ = nullptr;
+  std::chrono::steady_clock::time_point last_;
+
+ public:
+  bool open_failed_ = false;  // the URL was fine, the bus could not be reached
+};
+
+std::string word(std::uint16_t w) { return hex(w, 4); }
+
+int read_state(bus_session& s, const master_args& a, const profile& p, std::ostream& out,
+               std::ostream& err) {
+  canopen::sdo_client sdo(s.channel(), static_cast<std::uint8_t>(a.node), 500000);
+  std::uint64_t waited = 0;
+  const auto transfer = [&](std::uint16_t index) {
+    sdo.clear();
+    sdo.start_upload(index, 0);
+    while (!sdo.finished() && waited < a.timeout_ms * 1000ull) {
+      s.settle();
+      canopen::frame f;
+      while (s.channel().receive(f)) sdo.on_frame(f);
+      if (sdo.finished()) break;
+      const std::uint32_t us = s.wait(1000);
+      waited += us;
+      sdo.process(us);
+    }
+    return sdo.state() == canopen::sdo_client::status::done;
+  };
+  if (!transfer(0x6041)) {
+    if (sdo.abort_code() == sdo_abort::sdo_protocol_timed_out || !sdo.finished()) {
+      err << "cia402 master: node " << a.node << " does not answer (SDO timeout reading 0x6041)\n";
+    } else {
+      err << "cia402 master: node " << a.node << " refused 0x6041: SDO abort "
+          << hex(static_cast<std::uint32_t>(sdo.abort_code()), 8) << " ("
+          << sdo_abort_text(sdo.abort_code()) << ")\n";
+    }
+    return failed;
+  }
+  const auto sw = static_cast<std::uint16_t>(sdo.value());
+  state st = state::start;
+  const bool known = decode_status(p, sw, st);
+  out << "node " << a.node << ": " << (known ? state_name(st) : "UNKNOWN") << " (statusword "
+      << word(sw) << ")";
+  if (transfer(0x603F) && sdo.value() != 0) out << ", error code " << hex(static_cast<std::uint32_t>(sdo.value()), 4);
+  out << "\n";
+  return 0;
+}
+
+}  // namespace
+
+CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
+  auto* cmd = app.add_subcommand(
+      "master",
+      "Drive one CiA 402 drive over CANopen: NMT start, PDO set-up over SDO, then the master step over "
+      "PDOs with SYNC");
+  cmd->add_option("--can", args.can,
+                  "socketcand://HOST:PORT/BUS, socketcan://IFACE, or virtual (a virtual drive in-process)")
+      ->default_str("virtual");
+  cmd->add_option("--node", args.node, "the drive's node-ID")->check(CLI::Range(1, 127))->default_str("1");
+  cmd->add_option("COMMAND", args.command, "state, enable, disable, quick-stop, reset or watch")
+      ->required()
+      ->check(CLI::IsMember({"state", "enable", "disable", "quick-stop", "reset", "watch"}));
+  auto* by_name = cmd->add_option("--profile", args.profile, "the drive's profile: " + builtin_profile_names())
+                      ->type_name("NAME")
+                      ->default_str("cia402");
+  cmd->add_option("--profile-file", args.profile_file, "a TOML profile file instead of a built-in")
+      ->type_name("FILE")
+      ->excludes(by_name);
+  cmd->add_option("--cycle", args.cycle_ms, "SYNC period in ms")->check(CLI::Range(1, 1000))->default_str("10");
+  cmd->add_option("--timeout", args.timeout_ms, "give up after this many ms (watch: stop after it; 0 = never)")
+      ->default_str("10000");
+  cmd->add_option("--heartbeat", args.heartbeat_ms, "the drive's heartbeat period in ms, watched (0 = off)")
+      ->default_str("100");
+  cmd->add_option("--guard", args.guard_ms,
+                  "send the master's heartbeat at this period in ms and have the drive watch it, so "
+                  "0x6007 acts if the master stops (0 = off)")
+      ->default_str("0");
+  cmd->add_flag("--hold", args.hold, "after reaching the target, keep the drive there until SIGINT");
+  return cmd;
+}
+
+int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
+  profile_choice choice;
+  if (!choice.resolve(a.profile, a.profile_file, err)) return usage_error;
+  const profile& p = choice.get();
+  bus_session session;
+  if (!session.open(a, p, err)) return session.open_failed_ ? failed : usage_error;
+  if (a.command == "state") return read_state(session, a, p, out, err);
+
+  canopen::drive_master_config mc;
+  mc.node_id = static_cast<std::uint8_t>(a.node);
+  mc.cycle_us = a.cycle_ms * 1000;
+  mc.drive_heartbeat_ms = a.heartbeat_ms;
+  mc.master_heartbeat_ms = a.guard_ms;
+  mc.drive_profile = &p;
+  canopen::drive_master m(session.channel(), mc);
+  m.on_state = [&](state, state to, std::uint16_t sw) {
+    out << "node " << a.node << ": " << state_name(to) << " (statusword " << word(sw) << ")\n";
+  };
+  m.on_emcy = [&](std::uint16_t code, std::uint8_t reg, const std::uint8_t*) {
+    out << "node " << a.node << ": EMCY " << hex(code, 4) << " error register " << hex(reg, 2)
+        << (code == 0 ? " (error reset)" : "") << "\n";
+  };
+  const bool watching = a.command == "watch";
+  if (a.command == "enable") m.set_target(state::operation_enabled);
+  if (a.command == "disable") m.set_target(state::switch_on_disabled);
+  bool reset_decided = false;  // reset acts only on a drive seen in FAULT (T15)
+  if (a.command == "quick-stop") m.set_command(command::quick_stop);
+
+  stop_requested = 0;
+  struct sigaction action {};
+  action.sa_handler = request_master_stop;
+  sigemptyset(&action.sa_mask);
+  struct sigaction old_int {}, old_term {};
+  sigaction(SIGINT, &action, &old_int);
+  sigaction(SIGTERM, &action, &old_term);
+
+  int status = failed;
+  bool reported_running = false;
+  std::uint64_t elapsed = 0;
+  std::uint32_t next = 0;
+  for (;;) {
+    if (stop_requested) {
+      status = watching || a.hold ? 0 : failed;
+      if (status != 0) err << "cia402 master: interrupted\n";
+      break;
+    }
+    if (const auto ec = session.failure()) {
+      err << "cia402 master: the bus connection failed: " << ec.message() << "\n";
+      break;
+    }
+    const std::uint32_t us = session.wait(next);
+    elapsed += us;
+    canopen::frame f;
+    while (session.channel().receive(f)) m.on_frame(f);
+    next = m.process(us);
+    session.settle();
+    while (session.channel().receive(f)) m.on_frame(f);
+    next = std::min(next, m.process(0));
+
+    if (m.phase() == canopen::master_phase::failed) {
+      err << "cia402 master: " << m.failure_text() << "\n";
+      break;
+    }
+    if (m.phase() == canopen::master_phase::running && !reported_running) {
+      reported_running = true;
+      out << "node " << a.node << ": configured and started (TPDO1 = statusword, RPDO1 = "
+          << "controlword, SYNC every " << a.cycle_ms << " ms)\n";
+    }
+    if (a.timeout_ms != 0 && elapsed >= a.timeout_ms * 1000ull) {
+      if (watching) {
+        status = 0;
+      } else {
+        err << "cia402 master: node " << a.node << " did not get there within " << a.timeout_ms
+            << " ms (last seen " << state_name(m.observed()) << ")\n";
+      }
+      break;
+    }
+    if (watching || !m.status_known()) continue;
+    if (a.command == "reset" && !reset_decided) {
+      reset_decided = true;
+      const state s = m.observed();
+      if (s != state::fault && s != state::fault_reaction_active) {
+        out << "node " << a.node << ": not in FAULT (" << state_name(s) << "), nothing to reset\n";
+        status = 0;
+        break;
+      }
+      m.set_target(state::switch_on_disabled);
+      continue;
+    }
+    if (a.command == "quick-stop") {
+      // Done when the stop has ended as 0x605A says (S5): 1..4 in SWITCH ON DISABLED (T12), 5..8 in
+      // QUICK STOP ACTIVE at standstill (bit 10), 0 in QUICK STOP ACTIVE (coasting). A drive that was
+      // not running goes to SWITCH ON DISABLED at once (T7, T10).
+      const state s = m.observed();
+      const int code = m.option_code(option::quick_stop);
+      const bool held = s == state::quick_stop_active &&
+                        (code == 0 || (code >= 5 && (m.status_word() & status_bit::target_reached)));
+      if (status != 0 && (held || s == state::switch_on_disabled)) {
+        out << "node " << a.node << ": quick stop done, " << state_name(s) << "\n";
+        status = 0;
+        if (!a.hold) break;
+      }
+      continue;
+    }
+    switch (m.outcome()) {
+      case master_outcome::reached:
+        if (status != 0) out << "node " << a.node << ": reached " << state_name(m.observed()) << "\n";
+        status = 0;
+        if (!a.hold) goto done;
+        break;
+      case master_outcome::fault:
+        err << "cia402 master: node " << a.node << " faulted, error code " << hex(m.error_code(), 4) << "\n";
+        status = failed;
+        goto done;
+      case master_outcome::timed_out:
+        err << "cia402 master: node " << a.node << ": transition T" << int(m.core_master().transition())
+            << " did not happen in time (in " << state_name(m.observed())
+            << (m.observed() == state::fault ? "; is a fault cause still present?" : "") << ")\n";
+        status = failed;
+        goto done;
+      case master_outcome::unreachable:
+        err << "cia402 master: node " << a.node << ": no command sequence leads from "
+            << state_name(m.observed()) << " to the target in profile " << p.name << "\n";
+        status = failed;
+        goto done;
+      case master_outcome::not_remote:
+      case master_outcome::bad_status_word:
+      case master_outcome::idle:
+      case master_outcome::in_progress: break;
+    }
+  }
+done:
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
+  return status;
+}
+
+}  // namespace cia402::cli

@@ -1,0 +1,36 @@
+// `cia402 master --can URL --node N COMMAND`: a CANopen master for one CiA 402 drive on a real or
+// virtual bus: NMT start, PDO set-up over SDO, then the core's master step over PDOs with SYNC
+// (canopen/drive_master.hpp). COMMAND: state (read 0x6041 over SDO and print), enable, disable,
+// quick-stop, reset (fault reset), watch (print state changes and EMCYs).
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+namespace CLI {
+class App;
+}
+
+namespace cia402::cli {
+
+struct master_args {
+  std::string can = "virtual";  ///< socketcand://HOST:PORT/BUS, socketcan://IFACE, or virtual
+  int node = 1;
+  std::string command;
+  std::string profile = "cia402";
+  std::string profile_file;
+  std::uint32_t cycle_ms = 10;       ///< SYNC period
+  std::uint32_t timeout_ms = 10000;  ///< the whole command; watch: how long to watch (0 = until a signal)
+  std::uint16_t heartbeat_ms = 100;  ///< the drive's heartbeat, watched by the master
+  std::uint16_t guard_ms = 0;        ///< the master's heartbeat, watched by the drive (0x6007)
+  bool hold = false;                 ///< after reaching the target, keep cycling until a signal
+};
+
+CLI::App* add_master_subcommand(CLI::App& app, master_args& args);
+
+/// Exit status: 0 done; 1 the drive or the bus failed (missing node, SDO abort, lost heartbeat,
+/// fault, timeout); 2 a refused option.
+int run_master(const master_args& args, std::ostream& out, std::ostream& err);
+
+}  // namespace cia402::cli
