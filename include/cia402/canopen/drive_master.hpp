@@ -14,7 +14,8 @@
 //   6. NMT start.
 // Then each cycle: SYNC; the drive answers with TPDO1; the master step turns the status word into the
 // next control word, sent at once in RPDO1. Nothing is sent in RPDO1 until a target or a command is
-// set, so watching a drive never changes it. The clock is passed in (process(elapsed)).
+// set, so watching a drive never commands it; the configuration above (PDO mapping, 0x1017, NMT
+// start) is still written. The clock is passed in (process(elapsed)).
 #pragma once
 
 #include <cstdint>

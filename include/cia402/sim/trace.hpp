@@ -64,7 +64,8 @@ void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_
 void write_jsonl(std::ostream& out, const std::vector<trace_row>& rows, std::size_t every = 1);
 /// Value change dump, timescale 1 us, for GTKWave: scope `drive` with controlword, statusword,
 /// velocity_rpm and target_rpm (real), state and ramp (GTKWave's string type: `$var string`),
-/// transition (integer), torque, brake_released, brake_engaged, dc_link, sto (wires), error_code;
+/// last_transition (integer) with a transition_taken pulse in the cycle one is taken, torque,
+/// brake_released, brake_engaged, dc_link, sto (wires), error_code;
 /// sub-scopes `cw` and `sw` with one wire per control-word and status-word bit, named by number and
 /// meaning (cw.0_switch_on ... sw.10_target_reached). Only changes are written.
 void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trace_info& info);

@@ -1,19 +1,20 @@
-// Real time for the instrument: a thread that steps it once per cycle on the steady clock. The
-// simulator never reads a clock; this is the one place that does.
+// Real time for the page's backend: a thread that steps it once per cycle on the steady clock. The
+// simulator and the CANopen stack never read a clock; the page layer does, here for the cycle and in
+// server.cpp for the event stream's keep-alive.
 #pragma once
 
 #include <atomic>
 #include <chrono>
 #include <thread>
 
-#include "cia402/page/instrument.hpp"
+#include "cia402/page/backend.hpp"
 
 namespace cia402::page {
 
 class cycle_runner {
  public:
-  /// The instrument must outlive the runner.
-  cycle_runner(instrument& inst, std::chrono::microseconds cycle);
+  /// The backend must outlive the runner.
+  cycle_runner(backend& inst, std::chrono::microseconds cycle);
   ~cycle_runner();
   cycle_runner(const cycle_runner&) = delete;
   cycle_runner& operator=(const cycle_runner&) = delete;
@@ -27,7 +28,7 @@ class cycle_runner {
  private:
   void run();
 
-  instrument& inst_;
+  backend& inst_;
   std::chrono::microseconds cycle_;
   std::atomic<bool> stopping_{false};
   std::atomic<std::uint64_t> skips_{0};
