@@ -24,13 +24,17 @@ for src in "${core_sources[@]}"; do
 done
 link=(-Wl,--gc-sections --specs=nosys.specs)
 "$cxx" "${flags[@]}" "$here/firmware.cpp" "${objects[@]}" "${link[@]}" -o "$out/firmware.elf"
+"$cxx" "${flags[@]}" "$here/firmware_one_profile.cpp" "${objects[@]}" "${link[@]}" -o "$out/firmware_one_profile.elf"
 "$cxx" "${flags[@]}" "$here/empty.cpp" "${link[@]}" -o "$out/empty.elf"
 echo "== Cortex-M4 objects of the core (-Os, no exceptions, no RTTI)"
 arm-none-eabi-size "${objects[@]}"
-echo "== firmware with every built-in profile, and without the core"
-arm-none-eabi-size "$out/firmware.elf" "$out/empty.elf"
-read -r fw_text fw_data fw_bss _ < <(arm-none-eabi-size "$out/firmware.elf" | tail -1)
+echo "== firmware with every built-in profile, with the standard profile alone, and without the core"
+arm-none-eabi-size "$out/firmware.elf" "$out/firmware_one_profile.elf" "$out/empty.elf"
 read -r e_text e_data e_bss _ < <(arm-none-eabi-size "$out/empty.elf" | tail -1)
-flash=$(( (fw_text + fw_data) - (e_text + e_data) ))
-ram=$(( (fw_data + fw_bss) - (e_data + e_bss) ))
-echo "cortex-m4: drive-side machine with all built-in profiles: flash $flash bytes, RAM $ram bytes (5 axes of $(( ram / 5 )) bytes or less)"
+report() {  # ELF, what it holds
+  local text data bss
+  read -r text data bss _ < <(arm-none-eabi-size "$1" | tail -1)
+  echo "cortex-m4: $2: flash $(( (text + data) - (e_text + e_data) )) bytes, RAM $(( (data + bss) - (e_data + e_bss) )) bytes"
+}
+report "$out/firmware.elf" "drive-side machine with all built-in profiles, 5 axes"
+report "$out/firmware_one_profile.elf" "drive-side machine with the cia402 profile alone, 1 axis"
