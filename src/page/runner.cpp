@@ -2,7 +2,7 @@
 
 namespace cia402::page {
 
-cycle_runner::cycle_runner(instrument& inst, std::chrono::microseconds cycle)
+cycle_runner::cycle_runner(backend& inst, std::chrono::microseconds cycle)
     : inst_(inst), cycle_(cycle.count() > 0 ? cycle : std::chrono::microseconds(1000)) {}
 
 cycle_runner::~cycle_runner() { stop(); }

@@ -121,11 +121,11 @@ bool is_loopback_address(std::string_view host) {
 }
 
 struct server::impl {
-  impl(instrument& i, server_options o) : inst(i), options(std::move(o)) {
+  impl(backend& i, server_options o) : inst(i), options(std::move(o)) {
     if (options.token_required && options.token.empty()) options.token = make_token();
   }
 
-  instrument& inst;
+  backend& inst;
   server_options options;
   httplib::Server http;
   std::thread thread;
@@ -379,7 +379,7 @@ struct server::impl {
   }
 };
 
-server::server(instrument& inst, server_options options)
+server::server(backend& inst, server_options options)
     : impl_(std::make_unique<impl>(inst, std::move(options))) {
   impl_->routes();
 }

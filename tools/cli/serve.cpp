@@ -2,10 +2,13 @@
 
 #include <CLI/CLI.hpp>
 #include <csignal>
+#include <memory>
 #include <ostream>
 #include <pthread.h>
 
+#include "cia402/canopen/channel_url.hpp"
 #include "cia402/page/instrument.hpp"
+#include "cia402/page/remote_drive.hpp"
 #include "cia402/page/runner.hpp"
 #include "cia402/page/server.hpp"
 #include "cli/common.hpp"
@@ -14,16 +17,20 @@ namespace cia402::cli {
 namespace {
 
 constexpr int refused = 2;
+constexpr int unreachable = 1;
 
 }  // namespace
 
 CLI::App* add_serve_subcommand(CLI::App& app, serve_args& args) {
   auto* cmd = app.add_subcommand(
       "serve",
-      "Run a virtual drive in real time and serve its instrument control page (control and status "
-      "word bits, the state machine, the plant) on http://127.0.0.1:8402/; Ctrl-C stops");
+      "Run a virtual drive in real time, or with --can show a drive on a CAN bus, and serve its "
+      "instrument control page (control and status word bits, the state machine, the plant) on "
+      "http://127.0.0.1:8402/; Ctrl-C stops");
   auto* by_name =
-      cmd->add_option("--profile", args.profile_name, "built-in profile: " + builtin_profile_names())
+      cmd->add_option("--profile", args.profile_name,
+                      "built-in profile (with --can: the drive's, to read its words): " +
+                          builtin_profile_names())
           ->type_name("NAME")
           ->default_str("cia402");
   cmd->add_option("--profile-file", args.profile_file, "a TOML profile file instead of a built-in")
@@ -40,6 +47,15 @@ CLI::App* add_serve_subcommand(CLI::App& app, serve_args& args) {
       ->default_str("8402");
   cmd->add_flag("--token-required", args.token_required,
                 "require the printed token for control even on loopback");
+  auto* can = cmd->add_option("--can", args.can,
+                              "show a drive on a CAN bus instead of running a virtual drive here: "
+                              "socketcand://HOST:PORT/BUS (e.g. a cia402 bus) or socketcan://IFACE")
+                  ->type_name("URL");
+  cmd->add_option("--node", args.node, "with --can: the drive's node-ID")
+      ->type_name("N")
+      ->check(CLI::Range(1, 127))
+      ->default_str("1")
+      ->needs(can);
   return cmd;
 }
 
@@ -53,7 +69,34 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   const bool loopback = page::is_loopback_address(args.bind);
   options.token_required = args.token_required || !loopback;
 
-  page::instrument inst(choice.get());
+  // The drive behind the page: a virtual drive here, or a remote one on a bus.
+  std::unique_ptr<canopen::channel> channel;
+  std::unique_ptr<page::backend> drive;
+  if (args.can.empty()) {
+    drive = std::make_unique<page::instrument>(choice.get());
+  } else {
+    canopen::channel_url url;
+    std::string why;
+    if (!canopen::parse_channel_url(args.can, url, why)) {
+      err << "cia402 serve: --can " << args.can << ": " << why << "\n";
+      return refused;
+    }
+    if (url.type == canopen::channel_url::kind::virtual_bus) {
+      err << "cia402 serve: --can virtual: without --can, serve runs a virtual drive here; for one "
+             "on a CAN bus start `cia402 bus` and give its socketcand:// URL\n";
+      return refused;
+    }
+    channel = canopen::open_channel(url, why);
+    if (!channel) {
+      err << "cia402 serve: cannot reach the bus " << args.can << ": " << why << "\n";
+      return unreachable;
+    }
+    page::remote_config rc;
+    rc.node_id = static_cast<std::uint8_t>(args.node);
+    rc.bus_name = args.can;
+    drive = std::make_unique<page::remote_drive>(choice.get(), *channel, rc);
+  }
+  page::backend& inst = *drive;
   page::server http(inst, options);
 
   // SIGINT and SIGTERM are blocked in every thread (the server's and the cycle thread inherit the
@@ -76,8 +119,13 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   runner.start();
   http.start();
 
-  out << "cia402 serve: profile " << choice.get().name << ", instrument page at " << http.url()
-      << "\n";
+  if (args.can.empty()) {
+    out << "cia402 serve: profile " << choice.get().name << ", instrument page at " << http.url()
+        << "\n";
+  } else {
+    out << "cia402 serve: node " << args.node << " on " << args.can << " (profile "
+        << choice.get().name << "), instrument page at " << http.url() << "\n";
+  }
   if (!loopback) {
     out << "cia402 serve: listening on " << args.bind
         << ", not loopback: control needs the token in that URL, without it the page is "

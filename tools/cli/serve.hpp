@@ -1,5 +1,7 @@
 // `cia402 serve`: the instrument control page (seed 003_83442f2f4b0b2bb9.txt) for one virtual drive
-// run in real time, served over HTTP; see src/page/include/cia402/page/server.hpp.
+// run in real time, or with --can URL --node N for a drive on a CAN bus (a `cia402 bus` node or a
+// real drive; src/page/include/cia402/page/remote_drive.hpp), served over HTTP; see
+// src/page/include/cia402/page/server.hpp.
 #pragma once
 
 #include <iosfwd>
@@ -17,13 +19,16 @@ struct serve_args {
   std::string bind = "127.0.0.1";
   int port = 8402;              ///< 0: any free port (the URL printed names it)
   bool token_required = false;  ///< also on for any --bind address that is not loopback
+  std::string can;              ///< socketcand://HOST:PORT/BUS or socketcan://IFACE; "" = virtual drive
+  int node = 1;                 ///< with --can: the drive's node-ID
 };
 
 /// Registers the subcommand on `app`, filling `args` when it is parsed.
 CLI::App* add_serve_subcommand(CLI::App& app, serve_args& args);
 
 /// Serves until SIGINT or SIGTERM, then stops the server and the cycle thread and returns 0.
-/// Returns 2 without serving if the profile is refused or the address cannot be bound.
+/// Returns 2 without serving if the profile or the --can URL is refused or the address cannot be
+/// bound, 1 if the bus cannot be reached.
 int run_serve(const serve_args& args, std::ostream& out, std::ostream& err);
 
 }  // namespace cia402::cli

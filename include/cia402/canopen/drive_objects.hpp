@@ -27,6 +27,8 @@
 namespace cia402::canopen {
 
 inline constexpr std::uint32_t device_type_cia402_servo = 0x00020192;
+/// 0x1008 of every virtual drive: how a master tells a `cia402 bus` node (and its 0x2001) apart.
+inline constexpr const char* virtual_drive_device_name = "cia402 virtual drive";
 inline constexpr std::uint16_t fault_injection_index = 0x2001;
 inline constexpr std::uint16_t device_label_index = 0x2000;
 inline constexpr std::size_t device_label_capacity = 64;

@@ -100,7 +100,7 @@ std::vector<object_entry> drive_objects() {
   t.push_back(single(0x1005, optional,
                      var(0, "COB-ID SYNC message", data_type::unsigned32, access::rw, 0x80)));
   t.push_back(single(0x1008, optional, text(0, "Manufacturer device name", access::constant,
-                                            "cia402 virtual drive", 0)));
+                                            virtual_drive_device_name, 0)));
   t.push_back(single(0x1009, optional,
                      text(0, "Manufacturer hardware version", access::constant, "virtual", 0)));
   t.push_back(single(0x100A, optional,

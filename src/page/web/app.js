@@ -391,17 +391,65 @@ function buildPlant() {
 // A switch the user just changed is not overwritten by a snapshot older than the change.
 const touched = {};
 function syncSwitch(id, value) {
+  if (value === null || value === undefined) return;
   if (performance.now() - (touched[id] || 0) > 800) el(id).checked = value;
+}
+
+// The plant switches a backend cannot serve (DC link and STO on a remote drive; fault injection on
+// any remote drive but a node of `cia402 bus`) are disabled, with the server's reason.
+const SWITCHES = { fault: 'fault-switch', dc_link: 'dc-switch', sto: 'sto-switch' };
+let capabilitiesShown = '';
+function applyCapabilities(caps) {
+  if (!caps) return;
+  const key = JSON.stringify(caps);
+  if (key === capabilitiesShown) return;
+  capabilitiesShown = key;
+  const notes = [];
+  for (const [name, id] of Object.entries(SWITCHES)) {
+    const available = caps[name] !== false;
+    const reason = (caps.reasons && caps.reasons[name]) || '';
+    const inputs = [el(id)];
+    if (name === 'fault') inputs.push(el('fault-code'), el('fault-class'));
+    for (const input of inputs) {
+      input.dataset.unavailable = available ? 'false' : 'true';
+      input.disabled = !available || !(info && info.control);
+      input.title = available ? '' : reason;
+    }
+    el(id).closest('.row').dataset.unavailable = available ? 'false' : 'true';
+    if (!available && reason) notes.push(`${el(id).nextElementSibling.textContent}: ${reason}`);
+  }
+  el('switches-note').textContent = notes.join('. ');
+  el('switches-note').hidden = notes.length === 0;
+}
+
+function showRemote(s) {
+  const r = s.remote;
+  const banner = el('remote');
+  if (!r) {
+    banner.hidden = true;
+    return;
+  }
+  banner.hidden = false;
+  banner.dataset.status = r.status;
+  const where = `node ${r.node}${r.bus ? ` on ${r.bus}` : ''}`;
+  let text = r.status === 'running'
+    ? `Remote drive: ${where}${r.device_name ? ` (${r.device_name})` : ''}` +
+      `${r.nmt ? `, NMT ${label(r.nmt)}` : ''}. Transition numbers are inferred from the observed states.`
+    : `Remote drive: ${r.text || `${where}: ${r.status}`}`;
+  banner.textContent = text;
 }
 for (const id of ['fault-switch', 'dc-switch', 'sto-switch']) {
   document.addEventListener('change', (e) => { if (e.target.id === id) touched[id] = performance.now(); },
     true);
 }
 
+// A lamp whose value is null is one a remote drive does not show over the bus.
 function setLamp(id, on, text) {
   const l = el(id);
-  l.classList.toggle('on', on);
-  l.querySelector('b').textContent = text || (on ? 'ON' : 'OFF');
+  const unknown = on === null || on === undefined;
+  l.classList.toggle('on', !unknown && on);
+  l.classList.toggle('unknown', unknown);
+  l.querySelector('b').textContent = unknown ? 'unknown' : text || (on ? 'ON' : 'OFF');
 }
 
 function hexBits(hex) {
@@ -413,9 +461,13 @@ function update(s) {
   received = performance.now();
   el('state-name').textContent = label(s.state);
   const last = s.last_transition;
+  const number = last && last.number !== null ? last.number : '?';
   el('last-transition').textContent = last
-    ? `${last.number} (${label(last.from)} → ${label(last.to)})` : 'none';
+    ? `${number} (${label(last.from)} → ${label(last.to)})${last.inferred ? ', inferred' : ''}`
+    : 'none';
   updateDiagram(s);
+  showRemote(s);
+  applyCapabilities(s.capabilities);
 
   el('sw-hex').textContent = s.status_word;
   const sw = hexBits(s.status_word);
@@ -436,7 +488,7 @@ function update(s) {
   const halt = document.querySelector('button[data-command="halt"]');
   if (halt) halt.setAttribute('aria-pressed', ((cw >> 8) & 1) ? 'true' : 'false');
 
-  el('velocity').textContent = s.velocity;
+  el('velocity').textContent = s.velocity === null ? '–' : s.velocity;
   el('target').textContent = s.target_velocity;
   el('setpoint-note').textContent = s.effective_target !== s.target_velocity
     ? `(set-points cleared: following ${s.effective_target})` : '';
@@ -446,7 +498,7 @@ function update(s) {
   setLamp('lamp-brake', s.brake_engaged, s.brake_engaged ? 'ON (holding)' : 'OFF (released)');
   setLamp('lamp-dc', s.dc_link);
   setLamp('lamp-sto', s.sto);
-  const cause = s.fault_cause !== '0x0000';
+  const cause = s.fault_cause === null ? null : s.fault_cause !== '0x0000';
   setLamp('lamp-fault', cause, cause ? `ON ${s.fault_cause}` : 'OFF');
   syncSwitch('fault-switch', cause);
   syncSwitch('dc-switch', !s.dc_link);
@@ -479,7 +531,7 @@ function update(s) {
     list.appendChild(li);
   }
 
-  samples.push({ t: s.time_ms, v: s.velocity, target: s.effective_target });
+  if (s.velocity !== null) samples.push({ t: s.time_ms, v: s.velocity, target: s.effective_target });
   while (samples.length && samples[0].t < s.time_ms - 12000) samples.shift();
 }
 
@@ -625,6 +677,7 @@ async function main() {
   buildObjects();
   buildPlant();
   setControl(info.control);
+  applyCapabilities(info.capabilities);
   connect();
   animate();
 }

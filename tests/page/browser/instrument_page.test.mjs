@@ -2,7 +2,9 @@
 // against `cia402 serve --port 0` on loopback. What it checks is what seed 003_83442f2f4b0b2bb9.txt
 // asks of the screen page: the present state black, all others gray, the number of the last
 // transition accented; the status word; commands, a fault and its reset; refused commands shown
-// as refused; view-only without the token; phone width.
+// as refused; view-only without the token; phone width. Then the same page for a drive on a CAN
+// bus: `cia402 serve --can` against a `cia402 bus` node over socketcand (inferred transition
+// numbers, the DC-link and STO switches disabled with the reason, the bus going away).
 //
 //   node instrument_page.test.mjs CIA402_BINARY OUTPUT_DIR SCREENSHOT_PNG
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
@@ -71,6 +73,36 @@ function startServer(extraArgs) {
       if (!server.url) {
         clearTimeout(timer);
         reject(new Error(`cia402 serve exited (${code}, ${signal}):\n${server.output}`));
+      }
+    });
+  });
+}
+
+// `cia402 bus --listen 127.0.0.1:0`: resolves with the socketcand port it printed.
+function startBus(extraArgs) {
+  return new Promise((resolve, reject) => {
+    const proc = spawn(cia402, ['bus', '--listen', '127.0.0.1:0', ...extraArgs], {
+      stdio: ['ignore', 'pipe', 'pipe'],
+    });
+    const bus = { proc, output: '', url: null, exit: null };
+    servers.push(bus);
+    const timer = setTimeout(() => reject(new Error(`no port from cia402 bus:\n${bus.output}`)),
+      15000);
+    proc.stdout.on('data', (d) => {
+      bus.output += d;
+      const m = /socketcand on (127\.0\.0\.1:\d+)/.exec(bus.output);
+      if (m && !bus.url) {
+        bus.url = m[1];
+        clearTimeout(timer);
+        resolve(bus);
+      }
+    });
+    proc.stderr.on('data', (d) => { bus.output += d; });
+    proc.on('exit', (code, signal) => {
+      bus.exit = { code, signal };
+      if (!bus.url) {
+        clearTimeout(timer);
+        reject(new Error(`cia402 bus exited (${code}, ${signal}):\n${bus.output}`));
       }
     });
   });
@@ -377,6 +409,82 @@ async function main() {
   });
   const r = await stopServer(guarded);
   expect(r.code === 0, `guarded server exit ${JSON.stringify(r)}`);
+
+  // --- a drive on a CAN bus: cia402 serve --can against a cia402 bus node ----------------------
+  const bus = await startBus(['--nodes', '1']);
+  const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
+  const rp = await context.newPage();
+  currentPage = rp;
+  // Its own list: the earlier pages keep retrying their stopped servers.
+  const remoteProblems = [];
+  rp.on('console', (m) => { if (m.type() === 'error') remoteProblems.push(m.text()); });
+  rp.on('pageerror', (e) => remoteProblems.push(String(e)));
+  await rp.setViewportSize({ width: 1280, height: 800 });
+  await check('--can: the page shows node 1 of the bus, its state, and says numbers are inferred', async () => {
+    await rp.goto(remote.url);
+    await rp.waitForSelector('#remote[data-status="running"]', { timeout: 10000 });
+    const text = await rp.textContent('#remote');
+    expect(text.includes('node 1') && text.includes('inferred'), `banner: "${text}"`);
+    await expectPresentState(rp, 'SWITCH_ON_DISABLED');
+  });
+  await check('--can: DC-link and STO switches disabled with the reason, fault injection offered', async () => {
+    await rp.waitForFunction(() => !document.getElementById('fault-switch').disabled, null,
+      { timeout: 8000 });
+    const sw = await rp.evaluate(() => ['dc-switch', 'sto-switch'].map((id) => {
+      const e = document.getElementById(id);
+      return { disabled: e.disabled, title: e.title };
+    }));
+    for (const s of sw) {
+      expect(s.disabled && s.title === 'not available on a remote drive', `switch ${JSON.stringify(s)}`);
+    }
+    const note = await rp.textContent('#switches-note');
+    expect(note.includes('not available on a remote drive'), `note: "${note}"`);
+    expect((await rp.textContent('#lamp-sto b')) === 'unknown', 'STO lamp says unknown');
+  });
+  await check('--can: Shutdown, Switch on, Enable operation: T2, T3, T4 accented, inferred', async () => {
+    await click(rp, 'shutdown');
+    await expectPresentState(rp, 'READY_TO_SWITCH_ON');
+    await expectAccented(rp, 2);
+    await click(rp, 'switch_on');
+    await expectPresentState(rp, 'SWITCHED_ON');
+    await expectAccented(rp, 3);
+    await click(rp, 'enable_operation');
+    await expectPresentState(rp, 'OPERATION_ENABLED');
+    await expectAccented(rp, 4);
+    const last = await rp.textContent('#last-transition');
+    expect(last.includes('inferred'), `last transition "${last}"`);
+    expect((await rp.textContent('#cw-hex')) === '0x000F', 'control word 0x000F');
+  });
+  await rp.screenshot({ path: path.join(outDir, 'remote-operation-enabled-1280x800.png') });
+  await check('--can: fault through 0x2001 gives FAULT (T14), reset after clearing gives T15', async () => {
+    await rp.fill('#fault-code', '0x2310');
+    await rp.click('label:has(#fault-switch)');
+    await expectPresentState(rp, 'FAULT');
+    await expectAccented(rp, 14);
+    await rp.waitForFunction(() => document.getElementById('error-code').textContent === '0x2310',
+      null, { timeout: 8000 });
+    await rp.click('label:has(#fault-switch)');
+    await rp.waitForFunction(() => document.getElementById('lamp-fault').textContent.includes('OFF'),
+      null, { timeout: 8000 });
+    await click(rp, 'fault_reset');
+    await expectPresentState(rp, 'SWITCH_ON_DISABLED');
+    await expectAccented(rp, 15);
+  });
+  await check('--can: when the bus goes away the page says so and shows no present state', async () => {
+    const b = await stopServer(bus);
+    expect(b.code === 0, `cia402 bus exit ${JSON.stringify(b)}`);
+    await rp.waitForSelector('#remote:not([data-status="running"])', { timeout: 8000 });
+    const text = await rp.textContent('#remote');
+    expect(text.includes('bus connection failed'), `banner: "${text}"`);
+    await rp.waitForFunction(() => document.querySelectorAll('#diagram .state.present').length === 0,
+      null, { timeout: 8000 });
+  });
+  await rp.screenshot({ path: path.join(outDir, 'remote-bus-gone-1280x800.png') });
+  await check('--can: no console errors; Ctrl-C stops the server with exit status 0', async () => {
+    expect(remoteProblems.length === 0, `console errors: ${JSON.stringify(remoteProblems)}`);
+    const x = await stopServer(remote);
+    expect(x.code === 0, `exit ${JSON.stringify(x)}:\n${remote.output}`);
+  });
 
   await context.close();
   context = null;

@@ -18,54 +18,13 @@
 #include <variant>
 #include <vector>
 
+#include "cia402/page/backend.hpp"
 #include "cia402/profile.hpp"
 #include "cia402/sdo_abort.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 #include "cia402/state.hpp"
 
 namespace cia402::page {
-
-/// An action the instrument took on: its id, reported again in the snapshots' `results`.
-struct accepted {
-  std::uint64_t id = 0;
-};
-
-/// An action refused before anything changed: the HTTP status it maps to and the reason.
-struct refused {
-  int http_status = 400;
-  std::string reason;
-  sdo_abort abort = sdo_abort::none;  ///< set when the drive's object interface refused a write
-};
-
-using reply = std::variant<accepted, refused>;
-
-/// The page's command buttons. `disable_operation` sends the same word as `switch_on` (the state
-/// tells them apart); `fault_reset` is an edge of bit 7; `halt` toggles bit 8.
-enum class page_command : std::uint8_t {
-  shutdown,
-  switch_on,
-  enable_operation,
-  disable_operation,
-  disable_voltage,
-  quick_stop,
-  fault_reset,
-  halt,
-};
-
-/// "shutdown", "switch_on", ... as the HTTP API spells them.
-const char* page_command_key(page_command c) noexcept;
-bool parse_page_command(std::string_view key, page_command& out) noexcept;
-
-/// Plant inputs to change in one request. Validated as a whole by the caller's parser; applied
-/// only if the drive accepts the target velocity (the one part it can refuse).
-struct plant_change {
-  std::optional<std::int64_t> target_velocity;  ///< 0x60FF, rpm
-  std::optional<bool> fault;                    ///< true: a fault cause appears; false: all go
-  std::uint16_t fault_code = 0x1000;            ///< with fault = true, 1..0xFFFF
-  std::uint8_t fault_class = 2;                 ///< with fault = true, 0..4 (profiles with classes)
-  std::optional<bool> dc_link;                  ///< DC-link voltage present
-  std::optional<bool> sto;                      ///< safe torque off asserted
-};
 
 /// Timing of the instrument, in cycles of the virtual drive.
 struct instrument_config {
@@ -81,50 +40,45 @@ struct instrument_config {
   std::size_t results_kept = 8;
 };
 
-/// One published snapshot: its sequence number and JSON text.
-struct published {
-  std::uint64_t version = 0;
-  std::string json;
-};
-
-class instrument {
+class instrument final : public backend {
  public:
   /// The profile must outlive the instrument. Throws std::invalid_argument for a plant
   /// configuration the simulator refuses.
   explicit instrument(const profile& p, const instrument_config& config = {});
-  ~instrument();
+  ~instrument() override;
   instrument(const instrument&) = delete;
   instrument& operator=(const instrument&) = delete;
 
   /// One cycle of the virtual drive (the control word the page built goes in first).
-  void step();
+  void step() override;
   /// Cycles stepped so far.
   std::uint64_t cycle() const;
 
   /// A command button: its control word from cia402::encode_command, keeping the other bits.
-  reply command(page_command c);
+  reply command(page_command c) override;
   /// Flips one bit (0..15) of the control word.
-  reply toggle_control_bit(int bit);
+  reply toggle_control_bit(int bit) override;
   /// Writes an object through the drive's object interface (option codes, ramps, 0x60FF, ...).
   /// A write the drive refuses gives its SDO abort code and changes nothing.
-  reply write_object(std::uint16_t index, std::int64_t value);
+  reply write_object(std::uint16_t index, std::int64_t value) override;
   /// Plant inputs: target velocity, fault, DC link, STO.
-  reply change_plant(const plant_change& change);
+  reply change_plant(const plant_change& change) override;
 
   /// The profile, the bit names, the transition rows: what the page draws once. `control` tells the
   /// page whether its requests will be obeyed.
-  std::string info_json(bool control, bool token_required) const;
+  std::string info_json(bool control, bool token_required) const override;
   /// The present snapshot (state, words, plant, results), built now.
-  std::string snapshot_json() const;
+  std::string snapshot_json() const override;
 
   /// Waits until a snapshot newer than `seen` is published, or `timeout` passes, or close() is
   /// called. Returns the newest snapshot if it is newer than `seen`, else nothing.
-  std::optional<published> wait_for_update(std::uint64_t seen, std::chrono::milliseconds timeout);
+  std::optional<published> wait_for_update(std::uint64_t seen,
+                                           std::chrono::milliseconds timeout) override;
   /// The newest published snapshot (version 0 before the first).
-  published latest() const;
+  published latest() const override;
   /// Wakes every waiter for good (shutdown).
-  void close();
-  bool closed() const;
+  void close() override;
+  bool closed() const override;
 
  private:
   struct impl;

@@ -25,7 +25,7 @@
 #include <string>
 #include <string_view>
 
-#include "cia402/page/instrument.hpp"
+#include "cia402/page/backend.hpp"
 
 namespace cia402::page {
 
@@ -49,8 +49,8 @@ bool is_loopback_address(std::string_view host);
 
 class server {
  public:
-  /// The instrument must outlive the server.
-  server(instrument& inst, server_options options);
+  /// The backend (the in-process instrument or a remote drive) must outlive the server.
+  server(backend& inst, server_options options);
   ~server();
   server(const server&) = delete;
   server& operator=(const server&) = delete;

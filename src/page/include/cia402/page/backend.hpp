@@ -1,0 +1,102 @@
+// What the instrument page's server talks to: one drive behind the page. Two kinds exist: the
+// in-process virtual drive (instrument.hpp) and a remote drive on a CAN bus (remote_drive.hpp). The
+// server (server.hpp) and the cycle thread (runner.hpp) see only this interface; the page learns
+// from /api/info and the snapshots which kind it shows and what it can do.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+
+#include "cia402/sdo_abort.hpp"
+
+namespace cia402::page {
+
+/// An action the backend took on: its id, reported again in the snapshots' `results`.
+struct accepted {
+  std::uint64_t id = 0;
+};
+
+/// An action refused before anything changed: the HTTP status it maps to and the reason.
+struct refused {
+  int http_status = 400;
+  std::string reason;
+  sdo_abort abort = sdo_abort::none;  ///< set when the drive's object interface refused a write
+};
+
+using reply = std::variant<accepted, refused>;
+
+/// The page's command buttons. `disable_operation` sends the same word as `switch_on` (the state
+/// tells them apart); `fault_reset` is an edge of bit 7; `halt` toggles bit 8.
+enum class page_command : std::uint8_t {
+  shutdown,
+  switch_on,
+  enable_operation,
+  disable_operation,
+  disable_voltage,
+  quick_stop,
+  fault_reset,
+  halt,
+};
+
+/// "shutdown", "switch_on", ... as the HTTP API spells them.
+const char* page_command_key(page_command c) noexcept;
+bool parse_page_command(std::string_view key, page_command& out) noexcept;
+
+/// Plant inputs to change in one request. Validated as a whole by the caller's parser; applied
+/// only if the drive accepts the target velocity (the one part it can refuse).
+struct plant_change {
+  std::optional<std::int64_t> target_velocity;  ///< 0x60FF, rpm
+  std::optional<bool> fault;                    ///< true: a fault cause appears; false: all go
+  std::uint16_t fault_code = 0x1000;            ///< with fault = true, 1..0xFFFF
+  std::uint8_t fault_class = 2;                 ///< with fault = true, 0..4 (profiles with classes)
+  std::optional<bool> dc_link;                  ///< DC-link voltage present
+  std::optional<bool> sto;                      ///< safe torque off asserted
+};
+
+/// One published snapshot: its sequence number and JSON text.
+struct published {
+  std::uint64_t version = 0;
+  std::string json;
+};
+
+/// The drive behind the page. Thread-safe: the cycle thread calls step(), the HTTP threads the rest.
+class backend {
+ public:
+  virtual ~backend() = default;
+
+  /// One cycle (the cycle thread calls it once per cycle of real time; tests call it directly).
+  virtual void step() = 0;
+
+  /// A command button: its control word from cia402::encode_command, keeping the other bits.
+  virtual reply command(page_command c) = 0;
+  /// Flips one bit (0..15) of the control word.
+  virtual reply toggle_control_bit(int bit) = 0;
+  /// Writes an object (option codes, ramps, 0x60FF, ...). A write the drive refuses gives its SDO
+  /// abort code and changes nothing.
+  virtual reply write_object(std::uint16_t index, std::int64_t value) = 0;
+  /// Plant inputs: target velocity, fault, DC link, STO. A backend that cannot change one refuses
+  /// the request (and says so in the `capabilities` of its info).
+  virtual reply change_plant(const plant_change& change) = 0;
+
+  /// The profile, the bit names, the transition rows, the capabilities: what the page draws once.
+  /// `control` tells the page whether its requests will be obeyed.
+  virtual std::string info_json(bool control, bool token_required) const = 0;
+  /// The present snapshot, built now.
+  virtual std::string snapshot_json() const = 0;
+
+  /// Waits until a snapshot newer than `seen` is published, or `timeout` passes, or close() is
+  /// called. Returns the newest snapshot if it is newer than `seen`, else nothing.
+  virtual std::optional<published> wait_for_update(std::uint64_t seen,
+                                                   std::chrono::milliseconds timeout) = 0;
+  /// The newest published snapshot (version 0 before the first).
+  virtual published latest() const = 0;
+  /// Wakes every waiter for good (shutdown).
+  virtual void close() = 0;
+  virtual bool closed() const = 0;
+};
+
+}  // namespace cia402::page

@@ -1,0 +1,115 @@
+// The instrument page's second backend: a CiA 402 drive on a CAN bus, reached as a CANopen master
+// (a `cia402 bus` node over socketcand, or a real drive). Same interface as the in-process
+// instrument, so the server and the page are the same; what the page cannot do on a remote drive it
+// learns from `capabilities` and the `remote` part of each snapshot.
+//
+// Set-up, each an SDO transfer (the first required one that fails ends it, "does not answer" for a
+// timeout; after `retry_us` it starts again, so a node that comes later is picked up):
+//   1. 0x1000 must name device profile 402 (low word 0x0192);
+//   2. 0x1008 device name (optional); if it is "cia402 virtual drive" (a node of `cia402 bus`), an
+//      upload of 0x2001 must answer "write-only" (0x06010001): then the page may inject faults by
+//      writing error codes to 0x2001 (0 clears). No other drive's 0x2001 is ever written: on a real
+//      drive it is some manufacturer object of unknown meaning;
+//   3. the page's objects (option codes, ramps), 0x6040 (the word the page starts from, so
+//      connecting changes nothing), 0x60FF, 0x6041, 0x603F;
+//   4. 0x1017 = heartbeat_ms (optional; without it a silent node is found by SDO polling);
+//   5. TPDO1 = 0x6041 + 0x603F (0x603F only if mappable), event-driven (255), no inhibit time, so
+//      every state the drive reports arrives; TPDO2 = 0x606C, event-driven, 20 ms inhibit time
+//      (optional: without it 0x606C is polled by SDO); RPDO1 = 0x6040, event-driven;
+//   6. NMT start.
+// Then: commands go out in RPDO1 (the word from cia402::encode_command, other bits kept; a fault
+// reset is bit 7 high for reset_pulse_us, then low); writes of objects and 0x60FF are SDO downloads
+// and their refusals carry the drive's abort code; what no TPDO carries (0x1001, and 0x606C / 0x603F
+// when not mapped) is polled by SDO every poll_us. The transition numbers are inferred from the
+// observed states (transition_inference.hpp) and marked "inferred" in the snapshots.
+//
+// A lost heartbeat or any SDO timeout shows as status "no_answer" with "node N does not answer
+// (...)" on the page; the state is then UNKNOWN, commands are refused with 503, and set-up starts
+// again after retry_us. A boot-up message starts set-up again at once. A failed channel (the
+// socketcand server went away) is "bus_failed", for good.
+//
+// All CAN traffic happens in step()/process(): HTTP threads only queue requests and wait for them,
+// so the channel is used by one thread. The clock is passed in: step() stands for cycle_us.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "cia402/canopen/channel.hpp"
+#include "cia402/page/backend.hpp"
+#include "cia402/profile.hpp"
+
+namespace cia402::page {
+
+struct remote_config {
+  std::uint8_t node_id = 1;
+  std::string bus_name;                   ///< shown on the page, e.g. the URL
+  std::uint32_t cycle_us = 1000;          ///< the time one step() stands for
+  std::uint32_t sdo_timeout_us = 500000;
+  std::uint16_t heartbeat_ms = 100;       ///< written to 0x1017, watched at 3x; 0 = not used
+  std::uint32_t retry_us = 1000000;       ///< set-up starts again this long after a failure
+  std::uint32_t poll_us = 100000;         ///< SDO polling of what no TPDO carries
+  std::uint32_t publish_us = 40000;       ///< at most one snapshot this often, only on change
+  std::uint32_t settle_quiet_us = 150000; ///< an action settles after this long without change
+  std::uint32_t settle_limit_us = 15000000;
+  std::uint32_t reset_pulse_us = 20000;   ///< bit 7 high this long for a fault-reset edge
+  std::uint16_t velocity_inhibit_100us = 200;  ///< TPDO2 inhibit time (20 ms)
+  std::size_t results_kept = 8;
+  /// Wall time an HTTP request waits for its SDO transfer before it is answered 504 (the transfer
+  /// itself ends by its own timeout in bus time).
+  std::chrono::milliseconds request_timeout{10000};
+};
+
+/// Where the link to the node stands.
+enum class remote_status : std::uint8_t {
+  configuring,  ///< set-up transfers running
+  running,      ///< PDOs flow, commands are obeyed
+  no_answer,    ///< SDO timeout or heartbeat lost; set-up starts again after retry_us
+  refused,      ///< the node refused a required set-up request, or is not a CiA 402 drive
+  bus_failed,   ///< the channel failed (e.g. the socketcand server went away): for good
+};
+const char* remote_status_name(remote_status s) noexcept;
+
+class remote_drive final : public backend {
+ public:
+  /// The profile and the channel must outlive the backend. Nothing is sent before the first step.
+  remote_drive(const profile& p, canopen::channel& bus, const remote_config& config = {});
+  ~remote_drive() override;
+  remote_drive(const remote_drive&) = delete;
+  remote_drive& operator=(const remote_drive&) = delete;
+
+  /// process(cycle_us).
+  void step() override;
+  /// Takes every frame waiting on the channel, advances the timers by `elapsed_us`, sends what is
+  /// due. process(0) lets answers already received take effect without time passing.
+  void process(std::uint32_t elapsed_us);
+
+  reply command(page_command c) override;
+  reply toggle_control_bit(int bit) override;
+  /// Blocks until the drive answered the SDO download (or it timed out).
+  reply write_object(std::uint16_t index, std::int64_t value) override;
+  /// Target velocity (SDO 0x60FF) or a fault (SDO 0x2001, on a `cia402 bus` node only), one per
+  /// request; DC link and STO are refused. Blocks like write_object.
+  reply change_plant(const plant_change& change) override;
+
+  std::string info_json(bool control, bool token_required) const override;
+  std::string snapshot_json() const override;
+  std::optional<published> wait_for_update(std::uint64_t seen,
+                                           std::chrono::milliseconds timeout) override;
+  published latest() const override;
+  void close() override;
+  bool closed() const override;
+
+  remote_status status() const;
+  /// "node 1 does not answer (SDO timeout reading 0x1000:0)", or "" while all is well.
+  std::string status_text() const;
+  bool fault_injection_available() const;
+
+ private:
+  struct impl;
+  std::unique_ptr<impl> impl_;
+};
+
+}  // namespace cia402::page

@@ -1,0 +1,171 @@
+#include "page_json.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <tuple>
+
+#include "cia402/master.hpp"
+#include "page_names.hpp"
+
+namespace cia402::page {
+namespace detail {
+namespace {
+
+constexpr command_entry commands[] = {
+    {page_command::shutdown, "shutdown", "SHUTDOWN"},
+    {page_command::switch_on, "switch_on", "SWITCH_ON"},
+    {page_command::enable_operation, "enable_operation", "ENABLE_OPERATION"},
+    {page_command::disable_operation, "disable_operation", "DISABLE_OPERATION"},
+    {page_command::disable_voltage, "disable_voltage", "DISABLE_VOLTAGE"},
+    {page_command::quick_stop, "quick_stop", "QUICK_STOP"},
+    {page_command::fault_reset, "fault_reset", "FAULT_RESET"},
+    {page_command::halt, "halt", "HALT"},
+};
+
+}  // namespace
+
+std::string hex(std::uint32_t value, int digits) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%0*X", digits, value);
+  return buf;
+}
+
+std::string abort_text(sdo_abort code) {
+  return "SDO abort " + hex(static_cast<std::uint32_t>(code), 8) + " (" + sdo_abort_text(code) +
+         ")";
+}
+
+const command_entry& entry_of(page_command c) noexcept {
+  for (const command_entry& e : commands) {
+    if (e.id == c) return e;
+  }
+  return commands[0];
+}
+
+bool core_command_of(page_command c, command& out) noexcept {
+  switch (c) {
+    case page_command::shutdown: out = command::shutdown; return true;
+    case page_command::switch_on: out = command::switch_on; return true;
+    // Disable operation is the Switch on word (S1); the state tells them apart (T5 vs T3).
+    case page_command::disable_operation: out = command::switch_on; return true;
+    case page_command::enable_operation: out = command::enable_operation; return true;
+    case page_command::disable_voltage: out = command::disable_voltage; return true;
+    case page_command::quick_stop: out = command::quick_stop; return true;
+    case page_command::fault_reset:
+    case page_command::halt: return false;
+  }
+  return false;
+}
+
+void push_result(std::deque<result_entry>& results, result_entry r, std::size_t kept) {
+  for (result_entry& e : results) {
+    if (e.id == r.id) {
+      e = std::move(r);
+      return;
+    }
+  }
+  results.push_front(std::move(r));
+  while (results.size() > kept) results.pop_back();
+}
+
+json results_json(const std::deque<result_entry>& results) {
+  json rs = json::array();
+  for (const result_entry& r : results) {
+    rs.push_back({{"id", r.id},
+                  {"action", r.action},
+                  {"outcome", r.outcome},
+                  {"text", r.text},
+                  {"transitions", r.transitions}});
+  }
+  return rs;
+}
+
+std::string transitions_text(const std::vector<int>& transitions, state now) {
+  std::string text = "done: ";
+  for (std::size_t i = 0; i < transitions.size(); ++i) {
+    text += (i ? ", T" : "T") + std::to_string(transitions[i]);
+  }
+  return text + " -> " + state_name(now);
+}
+
+json profile_info(const profile& p) {
+  json j;
+  j["profile"] = {{"name", p.name}, {"title", p.title}, {"seed", p.seed}};
+  json states = json::array();
+  for (int i = 0; i < state_count; ++i) states.push_back(state_name(static_cast<state>(i)));
+  j["states"] = std::move(states);
+
+  // One entry per (number, from set, to): T12 may be two rows with the same ends.
+  json rows = json::array();
+  std::vector<std::tuple<int, std::uint16_t, int>> seen;
+  for (std::size_t r = 0; r < p.row_count; ++r) {
+    const transition_row& row = p.rows[r];
+    const auto key = std::make_tuple(int{row.number}, row.from, static_cast<int>(row.to));
+    if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
+    seen.push_back(key);
+    json from = json::array();
+    for (int s = 0; s < state_count; ++s) {
+      if ((row.from >> s) & 1u) from.push_back(state_name(static_cast<state>(s)));
+    }
+    rows.push_back({{"number", row.number}, {"from", std::move(from)}, {"to", state_name(row.to)}});
+  }
+  j["rows"] = std::move(rows);
+
+  const std::uint16_t owned = owned_control_bits(p);
+  const bit_names names = bit_names_for(p);
+  json cbits = json::array();
+  json sbits = json::array();
+  for (int b = 0; b < 16; ++b) {
+    cbits.push_back({{"bit", b}, {"name", names.control[b]}, {"owned", ((owned >> b) & 1u) != 0}});
+    sbits.push_back({{"bit", b},
+                     {"name", names.status[b]},
+                     {"state", ((status_bit::state_bits >> b) & 1u) != 0}});
+  }
+  j["control_word_name"] = names.control_word;
+  j["status_word_name"] = names.status_word;
+  j["control_bits"] = std::move(cbits);
+  j["status_bits"] = std::move(sbits);
+
+  json cmds = json::array();
+  for (const command_entry& e : commands) {
+    cia402::command c{};
+    std::uint16_t word = 0;
+    const bool plain = core_command_of(e.id, c);
+    cmds.push_back({{"key", e.key},
+                    {"action", e.action},
+                    {"available", !plain || encode_command(p, c, 0, word)}});
+  }
+  j["commands"] = std::move(cmds);
+  j["halt_supported"] = p.spec(option::halt).exists();
+  j["error_classes"] = p.error_classes;
+
+  json objects = json::array();
+  for (const object_name& o : object_names(p)) {
+    json values = json::array();
+    option opt{};
+    if (option_of_index(o.index, opt)) {
+      for (int v = 0; v < 16; ++v) {
+        if (p.spec(opt).allows(v)) values.push_back(v);
+      }
+    }
+    objects.push_back({{"index", hex(o.index, 4)}, {"name", o.name}, {"values", values}});
+  }
+  j["objects"] = std::move(objects);
+  return j;
+}
+
+}  // namespace detail
+
+const char* page_command_key(page_command c) noexcept { return detail::entry_of(c).key; }
+
+bool parse_page_command(std::string_view key, page_command& out) noexcept {
+  for (const detail::command_entry& e : detail::commands) {
+    if (key == e.key) {
+      out = e.id;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace cia402::page

@@ -1,0 +1,328 @@
+// The page's remote backend against a `cia402 bus`-equivalent node (the simulator's drive behind a
+// CiA 301 slave) on the in-process virtual bus, in virtual time, no sockets: set-up over SDO, the
+// page's commands in RPDO1, states from TPDO1 with inferred transition numbers, fault injection
+// through 0x2001, SDO refusals with their abort codes, and a node that stops answering. Expected
+// words, states and transition numbers are the standard's (cia402-reference.md §1.3, §2.2; seed
+// 002_522d2c0bb8f5a5f8.txt), not the code's output.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <future>
+#include <memory>
+#include <thread>
+
+#include "cia402/canopen/sim_device.hpp"
+#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/page/remote_drive.hpp"
+#include "cia402/profile.hpp"
+
+namespace {
+
+namespace co = cia402::canopen;
+using cia402::page::accepted;
+using cia402::page::page_command;
+using cia402::page::plant_change;
+using cia402::page::refused;
+using cia402::page::remote_config;
+using cia402::page::remote_drive;
+using cia402::page::remote_status;
+using cia402::page::reply;
+using json = nlohmann::json;
+
+remote_config test_config(std::uint8_t node = 1) {
+  remote_config c;
+  c.node_id = node;
+  c.bus_name = "virtual (test)";
+  c.request_timeout = std::chrono::milliseconds(20000);
+  return c;
+}
+
+// One virtual drive as node 1 and the page's backend on the same in-process bus. Each virtual
+// millisecond: the backend runs, the node answers and steps its drive, the backend reads the
+// answers. `silence()` stops the node (it neither answers nor sends heartbeats).
+class remote_bench {
+ public:
+  explicit remote_bench(remote_config config = test_config(),
+                        const cia402::profile& p = cia402::standard_profile())
+      : dev_(std::make_unique<co::sim_device>(p)), drive_ch_(bus_.attach()) {
+    co::slave_config sc;
+    sc.node_id = 1;
+    node_ = std::make_unique<co::slave>(*dev_, *drive_ch_, sc);
+    for (int i = 0; i < 10; ++i) node_->poll(*drive_ch_, 1000);  // power-up: T0, T1
+    page_ch_ = bus_.attach();
+    remote_ = std::make_unique<remote_drive>(p, *page_ch_, config);
+  }
+
+  void run_ms(int ms) {
+    for (int i = 0; i < ms; ++i) {
+      remote_->step();
+      if (alive_) node_->poll(*drive_ch_, 1000);
+      remote_->process(0);
+      if (alive_) node_->poll(*drive_ch_, 0);
+      remote_->process(0);
+      if (!alive_) {
+        co::frame f;
+        while (drive_ch_->receive(f)) {}
+      }
+    }
+  }
+
+  bool run_until_running(int ms = 2000) {
+    for (int i = 0; i < ms; ++i) {
+      run_ms(1);
+      if (remote_->status() == remote_status::running) return true;
+    }
+    return false;
+  }
+
+  // A request that waits for an SDO transfer: made on another thread while this one runs the bus.
+  template <typename Request>
+  reply blocking(Request request) {
+    auto result = std::async(std::launch::async, request);
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (result.wait_for(std::chrono::microseconds(50)) != std::future_status::ready &&
+           std::chrono::steady_clock::now() < give_up) {
+      run_ms(1);
+    }
+    return result.get();
+  }
+
+  void silence() { alive_ = false; }
+  void revive() { alive_ = true; }
+
+  json snapshot() const { return json::parse(remote_->snapshot_json()); }
+  json newest_result() const {
+    const json s = snapshot();
+    return s["results"].empty() ? json::object() : s["results"][0];
+  }
+  remote_drive& remote() { return *remote_; }
+  cia402::sim::virtual_drive& drive() { return dev_->drive(); }
+
+ private:
+  co::virtual_bus bus_;
+  std::unique_ptr<co::sim_device> dev_;
+  std::unique_ptr<co::virtual_channel> drive_ch_;
+  std::unique_ptr<co::slave> node_;
+  std::unique_ptr<co::virtual_channel> page_ch_;
+  std::unique_ptr<remote_drive> remote_;
+  bool alive_ = true;
+};
+
+bool is_accepted(const reply& r) { return std::holds_alternative<accepted>(r); }
+
+// A command, then time for it to settle (150 ms of quiet after the last change).
+json command_result(remote_bench& b, page_command c) {
+  EXPECT_TRUE(is_accepted(b.remote().command(c)));
+  b.run_ms(600);
+  return b.newest_result();
+}
+
+void enable(remote_bench& b) {
+  command_result(b, page_command::shutdown);
+  command_result(b, page_command::switch_on);
+  command_result(b, page_command::enable_operation);
+  ASSERT_EQ(b.snapshot()["state"], "OPERATION_ENABLED");
+}
+
+TEST(remote_drive, set_up_reads_the_drive_and_shows_switch_on_disabled) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  b.run_ms(250);  // a heartbeat (0x1017 = 100 ms) tells the NMT state
+  const json s = b.snapshot();
+  EXPECT_EQ(s["state"], "SWITCH_ON_DISABLED");
+  EXPECT_EQ(s["remote"]["status"], "running");
+  EXPECT_EQ(s["remote"]["device_name"], "cia402 virtual drive");
+  EXPECT_EQ(s["remote"]["nmt"], "OPERATIONAL");
+  EXPECT_TRUE(s["remote"]["heartbeat_watched"].get<bool>());
+  // The option codes' defaults (semantics.md S5, S7, S9, S10), read from the node.
+  EXPECT_EQ(s["objects"]["0x605A"], 2);
+  EXPECT_EQ(s["objects"]["0x605E"], 2);
+  EXPECT_EQ(s["objects"]["0x6007"], 1);
+  EXPECT_TRUE(s["last_transition"].is_null());
+  EXPECT_TRUE(b.remote().fault_injection_available());
+}
+
+TEST(remote_drive, shutdown_switch_on_enable_operation_reach_operation_enabled_by_inferred_2_3_4) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  const json r2 = command_result(b, page_command::shutdown);
+  EXPECT_EQ(r2["outcome"], "done") << r2;
+  EXPECT_EQ(r2["transitions"], json::array({2}));
+  EXPECT_EQ(b.snapshot()["state"], "READY_TO_SWITCH_ON");
+  EXPECT_EQ(b.snapshot()["control_word"], "0x0006");
+
+  const json r3 = command_result(b, page_command::switch_on);
+  EXPECT_EQ(r3["transitions"], json::array({3}));
+  EXPECT_EQ(b.snapshot()["state"], "SWITCHED_ON");
+
+  const json r4 = command_result(b, page_command::enable_operation);
+  EXPECT_EQ(r4["transitions"], json::array({4}));
+  EXPECT_NE(r4["text"].get<std::string>().find("inferred"), std::string::npos) << r4;
+  const json s = b.snapshot();
+  EXPECT_EQ(s["state"], "OPERATION_ENABLED");
+  EXPECT_EQ(s["control_word"], "0x000F");
+  EXPECT_EQ(s["last_transition"]["number"], 4);
+  EXPECT_EQ(s["last_transition"]["from"], "SWITCHED_ON");
+  EXPECT_TRUE(s["last_transition"]["inferred"].get<bool>());
+  // The drive itself agrees: the page showed what happened, not what it hoped for.
+  EXPECT_EQ(b.drive().view().current(), cia402::state::operation_enabled);
+}
+
+TEST(remote_drive, enable_operation_from_ready_to_switch_on_is_inferred_as_3_then_4) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  command_result(b, page_command::shutdown);
+  const json r = command_result(b, page_command::enable_operation);
+  EXPECT_EQ(r["transitions"], json::array({3, 4})) << r;
+  EXPECT_EQ(b.snapshot()["state"], "OPERATION_ENABLED");
+}
+
+TEST(remote_drive, a_vendor_profile_is_decoded_with_that_profile_and_disable_voltage_is_t9) {
+  // Seed 004_e07fd68605b3a8c6.txt (Beckhoff AX2000): fast stop on bit 4, T9 on bit 1 cleared.
+  const cia402::profile* ax = cia402::find_builtin_profile("ax2000-profibus");
+  ASSERT_NE(ax, nullptr);
+  remote_bench b(test_config(), *ax);
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  enable(b);
+  const json r = command_result(b, page_command::disable_voltage);
+  EXPECT_EQ(r["transitions"], json::array({9})) << r;
+  EXPECT_EQ(b.snapshot()["state"], "SWITCH_ON_DISABLED");
+  EXPECT_EQ(b.drive().view().current(), cia402::state::switch_on_disabled);
+}
+
+TEST(remote_drive, fault_through_0x2001_gives_fault_and_fault_reset_gives_switch_on_disabled_by_15) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  enable(b);
+  plant_change fault;
+  fault.fault = true;
+  fault.fault_code = 0x2310;
+  ASSERT_TRUE(is_accepted(b.blocking([&] { return b.remote().change_plant(fault); })));
+  b.run_ms(1000);
+  json s = b.snapshot();
+  EXPECT_EQ(s["state"], "FAULT");
+  EXPECT_EQ(s["error_code"], "0x2310");
+  EXPECT_EQ(s["fault_cause"], "0x2310");
+  EXPECT_EQ(s["results"][0]["transitions"], json::array({13, 14})) << s["results"][0];
+  EXPECT_EQ(s["last_transition"]["number"], 14);
+
+  // With the cause present a reset is used up and changes nothing (S2).
+  const json early = command_result(b, page_command::fault_reset);
+  EXPECT_EQ(early["outcome"], "refused") << early;
+  EXPECT_NE(early["text"].get<std::string>().find("0x2310"), std::string::npos) << early;
+
+  plant_change clear;
+  clear.fault = false;
+  ASSERT_TRUE(is_accepted(b.blocking([&] { return b.remote().change_plant(clear); })));
+  b.run_ms(100);
+  const json r = command_result(b, page_command::fault_reset);
+  EXPECT_EQ(r["outcome"], "done") << r;
+  EXPECT_EQ(r["transitions"], json::array({15}));
+  s = b.snapshot();
+  EXPECT_EQ(s["state"], "SWITCH_ON_DISABLED");
+  EXPECT_EQ(s["last_transition"]["number"], 15);
+  EXPECT_EQ(s["last_transition"]["from"], "FAULT");
+  // The reset edge went out and came back down: bit 7 is clear again.
+  EXPECT_EQ(std::stoi(s["control_word"].get<std::string>(), nullptr, 16) & 0x80, 0);
+}
+
+TEST(remote_drive, option_write_the_drive_refuses_carries_its_abort_code_and_changes_nothing) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  const reply no = b.blocking([&] { return b.remote().write_object(0x605A, 12); });
+  ASSERT_TRUE(std::holds_alternative<refused>(no));
+  EXPECT_EQ(std::get<refused>(no).http_status, 422);
+  // S5: a value the profile does not support is 0x06090030.
+  EXPECT_EQ(std::get<refused>(no).abort, cia402::sdo_abort::invalid_value);
+  EXPECT_NE(std::get<refused>(no).reason.find("0x06090030"), std::string::npos);
+  EXPECT_EQ(b.snapshot()["objects"]["0x605A"], 2);
+  EXPECT_EQ(b.newest_result()["outcome"], "refused");
+
+  const reply yes = b.blocking([&] { return b.remote().write_object(0x605A, 6); });
+  EXPECT_TRUE(is_accepted(yes));
+  EXPECT_EQ(b.snapshot()["objects"]["0x605A"], 6);
+  std::int64_t on_drive = 0;
+  ASSERT_EQ(b.drive().read(0x605A, 0, on_drive), cia402::sdo_abort::none);
+  EXPECT_EQ(on_drive, 6);
+}
+
+TEST(remote_drive, value_outside_the_objects_type_is_refused_before_sending) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  const reply r = b.remote().write_object(0x605A, 70000);  // INTEGER16
+  ASSERT_TRUE(std::holds_alternative<refused>(r));
+  EXPECT_EQ(std::get<refused>(r).abort, cia402::sdo_abort::value_too_high);
+  const reply unknown = b.remote().write_object(0x1234, 1);
+  ASSERT_TRUE(std::holds_alternative<refused>(unknown));
+  EXPECT_EQ(std::get<refused>(unknown).http_status, 400);
+}
+
+TEST(remote_drive, target_velocity_goes_out_by_sdo_and_actual_velocity_comes_back) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  enable(b);
+  plant_change c;
+  c.target_velocity = 300;
+  ASSERT_TRUE(is_accepted(b.blocking([&] { return b.remote().change_plant(c); })));
+  b.run_ms(2000);  // 300 rpm at the default acceleration of 1000 rpm/s
+  const json s = b.snapshot();
+  EXPECT_EQ(s["target_velocity"], 300);
+  EXPECT_EQ(s["velocity"], 300);
+  EXPECT_TRUE(s["remote"]["velocity_in_pdo"].get<bool>());
+  EXPECT_EQ(b.drive().view().target_velocity(), 300);
+}
+
+TEST(remote_drive, dc_link_and_sto_are_refused_and_the_capabilities_say_why) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  const json info = json::parse(b.remote().info_json(true, false));
+  EXPECT_EQ(info["backend"], "remote");
+  EXPECT_FALSE(info["capabilities"]["dc_link"].get<bool>());
+  EXPECT_FALSE(info["capabilities"]["sto"].get<bool>());
+  EXPECT_TRUE(info["capabilities"]["fault"].get<bool>());
+  EXPECT_EQ(info["capabilities"]["reasons"]["dc_link"], "not available on a remote drive");
+  plant_change c;
+  c.sto = true;
+  const reply r = b.remote().change_plant(c);
+  ASSERT_TRUE(std::holds_alternative<refused>(r));
+  EXPECT_EQ(std::get<refused>(r).http_status, 409);
+  EXPECT_NE(std::get<refused>(r).reason.find("not available on a remote drive"), std::string::npos);
+  EXPECT_FALSE(b.drive().view().sto());
+}
+
+TEST(remote_drive, silent_node_shows_does_not_answer_and_is_picked_up_again_when_it_returns) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  command_result(b, page_command::shutdown);
+  b.silence();
+  b.run_ms(500);  // heartbeat 100 ms, watched at 300 ms
+  EXPECT_EQ(b.remote().status(), remote_status::no_answer);
+  EXPECT_NE(b.remote().status_text().find("node 1 does not answer"), std::string::npos)
+      << b.remote().status_text();
+  const json s = b.snapshot();
+  EXPECT_EQ(s["state"], "UNKNOWN");
+  EXPECT_EQ(s["remote"]["status"], "no_answer");
+  const reply r = b.remote().command(page_command::switch_on);
+  ASSERT_TRUE(std::holds_alternative<refused>(r));
+  EXPECT_EQ(std::get<refused>(r).http_status, 503);
+  EXPECT_NE(std::get<refused>(r).reason.find("does not answer"), std::string::npos);
+
+  b.revive();
+  ASSERT_TRUE(b.run_until_running(5000)) << b.remote().status_text();
+  EXPECT_EQ(b.snapshot()["state"], "READY_TO_SWITCH_ON");
+}
+
+TEST(remote_drive, node_that_is_not_on_the_bus_does_not_answer_set_up) {
+  remote_bench b(test_config(5));  // the bench's drive is node 1
+  b.run_ms(700);
+  EXPECT_EQ(b.remote().status(), remote_status::no_answer);
+  EXPECT_NE(b.remote().status_text().find("node 5 does not answer (SDO timeout reading 0x1000:0)"),
+            std::string::npos)
+      << b.remote().status_text();
+  EXPECT_EQ(b.snapshot()["state"], "UNKNOWN");
+}
+
+}  // namespace

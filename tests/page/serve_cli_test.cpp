@@ -1,0 +1,53 @@
+// `cia402 serve --can` options through the tool's run(): what is refused before anything is served
+// (exit status 2, or 1 for a bus that cannot be reached), with a reason.
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli/app.hpp"
+
+namespace cia402::cli {
+namespace {
+
+struct result {
+  int status;
+  std::string out;
+  std::string err;
+};
+
+result run_tool(std::vector<std::string> args) {
+  std::istringstream in;
+  std::ostringstream out, err;
+  const int status = run(args, in, out, err);
+  return {status, out.str(), err.str()};
+}
+
+TEST(cli_serve_can, a_url_that_is_no_channel_is_refused_with_status_2) {
+  const result r = run_tool({"serve", "--can", "tcp://x", "--port", "0"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("is not socketcand://"), std::string::npos) << r.err;
+}
+
+TEST(cli_serve_can, can_virtual_is_refused_with_a_pointer_to_cia402_bus) {
+  const result r = run_tool({"serve", "--can", "virtual", "--port", "0"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("cia402 bus"), std::string::npos) << r.err;
+}
+
+TEST(cli_serve_can, node_without_can_or_outside_1_to_127_is_a_usage_error) {
+  EXPECT_NE(run_tool({"serve", "--node", "3", "--port", "0"}).status, 0);
+  EXPECT_NE(run_tool({"serve", "--can", "socketcand://127.0.0.1:1/can0", "--node", "128"}).status, 0);
+}
+
+TEST(cli_serve_can, a_bus_nobody_listens_on_fails_with_status_1_and_says_why) {
+  // Port 1 on loopback: nothing listens there, the connection is refused at once.
+  const result r = run_tool({"serve", "--can", "socketcand://127.0.0.1:1/can0", "--port", "0"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("cannot reach the bus socketcand://127.0.0.1:1/can0"), std::string::npos)
+      << r.err;
+}
+
+}  // namespace
+}  // namespace cia402::cli
