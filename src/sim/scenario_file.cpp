@@ -14,30 +14,22 @@
 #include "cia402/profile_file.hpp"
 #include "cia402/sim/scenario.hpp"
 #include "cia402/sim/virtual_drive.hpp"
+#include "toml_reading.hpp"
 
 static_assert(TOML_EXCEPTIONS, "the loader relies on toml::parse throwing toml::parse_error");
 
 namespace cia402::sim {
 namespace {
 
-struct refusal {
-  int line = 0;
-  int column = 0;
-  std::string reason;
-};
-
-[[noreturn]] void refuse(const toml::source_region& at, std::string reason) {
-  throw refusal{static_cast<int>(at.begin.line), static_cast<int>(at.begin.column),
-                std::move(reason)};
-}
-[[noreturn]] void refuse(const toml::node& at, std::string reason) {
-  refuse(at.source(), std::move(reason));
-}
-[[noreturn]] void refuse(const toml::key& at, std::string reason) {
-  refuse(at.source(), std::move(reason));
-}
-
-std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
+using toml_reading::get_array;
+using toml_reading::get_bool;
+using toml_reading::get_int;
+using toml_reading::get_string;
+using toml_reading::get_table;
+using toml_reading::refusal;
+using toml_reading::refuse;
+using toml_reading::refuse_type;
+using toml_reading::type_name;
 
 std::string hex(std::uint64_t v, int digits) {
   static constexpr char d[] = "0123456789ABCDEF";
@@ -46,82 +38,20 @@ std::string hex(std::uint64_t v, int digits) {
   return s;
 }
 
-const char* type_name(const toml::node& n) {
-  switch (n.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-    case toml::node_type::none: break;
-  }
-  return "nothing";
-}
-
-[[noreturn]] void refuse_type(const toml::node& n, std::string_view what,
-                              std::string_view expected) {
-  refuse(n, std::string(what) + " must be " + std::string(expected) + ", not " + type_name(n));
-}
-
+// A key of the top level written under a [table] is the usual slip: say so.
 void check_keys(const toml::table& t, std::initializer_list<std::string_view> allowed,
                 std::string_view where) {
-  for (auto&& [key, value] : t) {
-    (void)value;
-    if (std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end()) {
-      std::string list;
-      for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-      std::string hint;
-      for (std::string_view root_key : {"events", "expect", "objects", "duration", "cycle"}) {
-        if (key.str() == root_key && where != "the scenario") {
-          hint = "; a [table] lasts until the next one, so write '" + std::string(root_key) +
-                 "' before the first [table] header";
-        }
+  toml_reading::check_keys(t, allowed, where, [where](std::string_view key) {
+    for (std::string_view root_key : {"events", "expect", "objects", "duration", "cycle"}) {
+      if (key == root_key && where != "the scenario") {
+        return "; a [table] lasts until the next one, so write '" + std::string(root_key) +
+               "' before the first [table] header";
       }
-      refuse(key, "unknown key " + in_quotes(key.str()) + " in " + std::string(where) +
-                      " (allowed: " + list + ")" + hint);
     }
-  }
+    return std::string();
+  });
 }
 
-std::int64_t get_int(const toml::node& n, std::string_view what, std::int64_t lo,
-                     std::int64_t hi) {
-  const auto* v = n.as_integer();
-  if (v == nullptr) refuse_type(n, what, "an integer");
-  const std::int64_t x = v->get();
-  if (x < lo || x > hi) {
-    refuse(n, std::string(what) + " " + std::to_string(x) + " is outside " + std::to_string(lo) +
-                  ".." + std::to_string(hi));
-  }
-  return x;
-}
-
-std::string_view get_string(const toml::node& n, std::string_view what) {
-  const auto* v = n.as_string();
-  if (v == nullptr) refuse_type(n, what, "a string");
-  return v->get();
-}
-
-bool get_bool(const toml::node& n, std::string_view what) {
-  const auto* v = n.as_boolean();
-  if (v == nullptr) refuse_type(n, what, "true or false");
-  return v->get();
-}
-
-const toml::table& get_table(const toml::node& n, std::string_view what) {
-  const auto* v = n.as_table();
-  if (v == nullptr) refuse_type(n, what, "a table");
-  return *v;
-}
-
-const toml::array& get_array(const toml::node& n, std::string_view what) {
-  const auto* v = n.as_array();
-  if (v == nullptr) refuse_type(n, what, "an array");
-  return *v;
-}
 
 // A decimal or 0x-hexadecimal integer written as a key ("0x605A").
 bool parse_index(std::string_view text, std::uint16_t& out) {
@@ -157,7 +87,7 @@ std::uint64_t get_time_us(const toml::node& n, std::string_view what) {
   std::uint64_t fraction = 0;
   std::uint64_t scale = 1;  // 10^(fraction digits)
   auto bad = [&]() {
-    refuse(n, std::string(what) + " " + in_quotes(text) +
+    refuse(n, std::string(what) + " " + toml_reading::quoted(text) +
                   " is not a time: write a number and a unit (s, ms, us), e.g. \"1.5s\"");
   };
   const std::size_t digits_start = i;
@@ -186,7 +116,7 @@ std::uint64_t get_time_us(const toml::node& n, std::string_view what) {
   else if (unit == "us") us_per_unit = 1;
   else bad();
   if ((fraction * us_per_unit) % scale != 0) {
-    refuse(n, std::string(what) + " " + in_quotes(text) + " is finer than a microsecond");
+    refuse(n, std::string(what) + " " + toml_reading::quoted(text) + " is finer than a microsecond");
   }
   return whole * us_per_unit + fraction * us_per_unit / scale;
 }
@@ -273,7 +203,7 @@ struct loader {
         list += (i ? ", " : "") + std::string(builtin_profile(i).name);
       }
       refuse(by_name ? *by_name : static_cast<const toml::node&>(root),
-             "unknown profile " + in_quotes(name) + " (built-in: " + list + ")");
+             "unknown profile " + toml_reading::quoted(name) + " (built-in: " + list + ")");
     }
     s.drive_profile = custom_profile(*p);
   }
@@ -340,7 +270,7 @@ struct loader {
                    "' before [objects], or as objects.0x605A = ... dotted keys)";
           }
         }
-        refuse(key, "object key " + in_quotes(key.str()) + " is not an index such as 0x605A" + hint);
+        refuse(key, "object key " + toml_reading::quoted(key.str()) + " is not an index such as 0x605A" + hint);
       }
       const std::int64_t v = get_int(value, "object " + hex(index, 4),
                                      std::numeric_limits<std::int64_t>::min(),
@@ -379,7 +309,7 @@ struct loader {
       for (auto&& [key, value] : get_table(*n, "'write'")) {
         std::uint16_t index = 0;
         if (!parse_index(key.str(), index)) {
-          refuse(key, "object key " + in_quotes(key.str()) + " is not an index such as 0x605A");
+          refuse(key, "object key " + toml_reading::quoted(key.str()) + " is not an index such as 0x605A");
         }
         add_write(index, value, "object " + hex(index, 4));
       }
@@ -472,7 +402,7 @@ struct loader {
         }
       }
       if (!found) {
-        refuse(*always, "unknown rule " + in_quotes(name) +
+        refuse(*always, "unknown rule " + toml_reading::quoted(name) +
                             " (brake_engaged_before_torque_off, motion_waits_for_brake_release, "
                             "coast_removes_torque_at_once)");
       }
@@ -507,7 +437,7 @@ struct loader {
       e.what = expectation::kind::state;
       const std::string_view name = get_string(*n, "state");
       if (!parse_state(name, e.expected_state) || e.expected_state == state::start) {
-        refuse(*n, "unknown state " + in_quotes(name) + " (e.g. OPERATION_ENABLED)");
+        refuse(*n, "unknown state " + toml_reading::quoted(name) + " (e.g. OPERATION_ENABLED)");
       }
       s.expectations.push_back(e);
     }

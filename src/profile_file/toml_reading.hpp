@@ -1,0 +1,45 @@
+// Reading TOML for the project's own file formats (profile files, simulator scenarios): typed
+// getters that refuse with the line, the column and a reason, and a check that refuses unknown
+// keys so a typo never passes as "not given". Internal to the tools layer: refusals travel as the
+// exception `refusal` inside a loader, which returns them as values.
+#pragma once
+
+#include <toml++/toml.h>
+
+#include <cstdint>
+#include <functional>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+
+namespace cia402::toml_reading {
+
+struct refusal {
+  int line = 0;
+  int column = 0;
+  std::string reason;
+};
+
+[[noreturn]] void refuse(const toml::source_region& at, std::string reason);
+[[noreturn]] void refuse(const toml::node& at, std::string reason);
+[[noreturn]] void refuse(const toml::key& at, std::string reason);
+[[noreturn]] void refuse_type(const toml::node& n, std::string_view what, std::string_view expected);
+
+/// "'text'".
+std::string quoted(std::string_view s);
+/// "an integer", "a table", ... for messages.
+const char* type_name(const toml::node& n);
+
+/// Refuses the first key of `t` not in `allowed`; `hint`, when given, may add to the reason.
+void check_keys(const toml::table& t, std::initializer_list<std::string_view> allowed,
+                std::string_view where,
+                const std::function<std::string(std::string_view key)>& hint = {});
+
+const toml::node& require(const toml::table& t, std::string_view key, std::string_view where);
+std::int64_t get_int(const toml::node& n, std::string_view what, std::int64_t lo, std::int64_t hi);
+std::string_view get_string(const toml::node& n, std::string_view what);
+bool get_bool(const toml::node& n, std::string_view what);
+const toml::array& get_array(const toml::node& n, std::string_view what);
+const toml::table& get_table(const toml::node& n, std::string_view what);
+
+}  // namespace cia402::toml_reading
