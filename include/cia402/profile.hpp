@@ -144,6 +144,18 @@ constexpr std::uint16_t option_index(option o) noexcept {
   constexpr std::uint16_t indices[option_count] = {0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007};
   return indices[static_cast<int>(o)];
 }
+/// The values the standard defines for an option-code object (cia402-reference.md §3): 0x605A
+/// 0..8, 0x605B and 0x605C 0..1, 0x605D 1..4, 0x605E 0..4, 0x6007 0..3. A profile may support
+/// fewer, never others.
+struct option_range {
+  std::int8_t lo;
+  std::int8_t hi;
+};
+constexpr option_range standard_option_range(option o) noexcept {
+  constexpr option_range ranges[option_count] = {{0, 8}, {0, 1}, {0, 1}, {1, 4}, {0, 4}, {0, 3}};
+  return ranges[static_cast<int>(o)];
+}
+
 /// Maps 0x605A..0x605E and 0x6007 to their option; false for any other index.
 bool option_of_index(std::uint16_t index, option& out) noexcept;
 

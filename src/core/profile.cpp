@@ -76,10 +76,17 @@ const char* check_profile(const profile& p, int& row) noexcept {
     }
   }
   row = -1;
+  // The drive has no meaning for a value the standard does not define.
   for (int o = 0; o < option_count; ++o) {
     const option_spec& s = p.options[o];
+    const option_range range = standard_option_range(static_cast<option>(o));
+    const auto standard_values = static_cast<std::uint16_t>(((1u << (range.hi + 1)) - 1u) &
+                                                            ~((1u << range.lo) - 1u));
     if (s.exists() && !s.allows(s.default_value)) return "an option code's default is not supported";
-    if (!s.exists() && (s.default_value < 0 || s.default_value > 15)) {
+    if ((s.supported & ~standard_values) != 0) {
+      return "an option code supports a value the standard does not define";
+    }
+    if (!s.exists() && (s.default_value < range.lo || s.default_value > range.hi)) {
       return "an option code's fixed value is out of range";
     }
   }

@@ -320,11 +320,12 @@ void load_options(const toml::node& node, profile& p, bool complete) {
     const toml::table& t = get_table(value, where);
     check_keys(t, {"supported", "default"}, where);
     option_spec spec = p.options[oi];
+    const option_range range = standard_option_range(o);
     const toml::node* supported = find(t, "supported");
     if (supported != nullptr) {
       spec.supported = 0;
       for (const toml::node& item : get_array(*supported, "supported")) {
-        const std::int64_t v = get_int(item, "supported value", 0, 15);
+        const std::int64_t v = get_int(item, "supported value of " + where, range.lo, range.hi);
         if (spec.supported & (1u << v)) {
           refuse(item, "value " + std::to_string(v) + " is listed twice in supported");
         }
@@ -335,7 +336,8 @@ void load_options(const toml::node& node, profile& p, bool complete) {
     }
     const toml::node* def = find(t, "default");
     if (def != nullptr) {
-      spec.default_value = static_cast<std::int8_t>(get_int(*def, "default", 0, 15));
+      spec.default_value =
+          static_cast<std::int8_t>(get_int(*def, "default of " + where, range.lo, range.hi));
       if (spec.exists() && !spec.allows(spec.default_value)) {
         refuse(*def, "default " + std::to_string(spec.default_value) +
                          " is not a supported value of " + where);

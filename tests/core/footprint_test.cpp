@@ -175,6 +175,21 @@ const malformation malformations[] = {
        c.settings().options[static_cast<int>(option::halt)] = {0, 40};
        c.finalize();
      }},
+    {"halt code 0, which the standard reserves", "does not define", -1,
+     [](custom_profile& c) {
+       c.settings().options[static_cast<int>(option::halt)] = {0x0003, 1};
+       c.finalize();
+     }},
+    {"quick stop code 9", "does not define", -1,
+     [](custom_profile& c) {
+       c.settings().options[static_cast<int>(option::quick_stop)] = {0x0204, 2};
+       c.finalize();
+     }},
+    {"fixed fault reaction 7", "out of range", -1,
+     [](custom_profile& c) {
+       c.settings().options[static_cast<int>(option::fault_reaction)] = {0, 7};
+       c.finalize();
+     }},
     {"status pattern with bit 4", "status pattern", -1,
      [](custom_profile& c) {
        c.settings().states[static_cast<int>(state::switched_on)].status_pattern = 0x33;

@@ -274,13 +274,20 @@ TEST(profile_file_errors, supported_list_without_the_inherited_default_is_refuse
                  "inherited default 2");
 }
 
-TEST(profile_file_errors, option_value_above_15_is_refused) {
-  expect_refused("base = \"cia402\"\n[options.0x605A]\nsupported = [2, 16]\n", 3, 17,
-                 "outside 0..15");
+TEST(profile_file_errors, quick_stop_value_the_standard_does_not_define_is_refused) {
+  // 0x605A is 0..8 (cia402-reference.md section 3).
+  expect_refused("base = \"cia402\"\n[options.0x605A]\nsupported = [2, 9]\n", 3, 17,
+                 "outside 0..8");
+}
+
+TEST(profile_file_errors, halt_code_0_is_refused_as_reserved) {
+  // 0x605D is 1..4; 0 is reserved.
+  expect_refused("base = \"cia402\"\n[options.0x605D]\nsupported = [0, 1]\n", 3, 14,
+                 "outside 1..4");
 }
 
 TEST(profile_file_errors, negative_option_default_is_refused) {
-  expect_refused("base = \"cia402\"\n[options.0x605A]\ndefault = -1\n", 3, 11, "outside 0..15");
+  expect_refused("base = \"cia402\"\n[options.0x605A]\ndefault = -1\n", 3, 11, "outside 0..8");
 }
 
 TEST(profile_file_errors, supported_value_listed_twice_is_refused) {
