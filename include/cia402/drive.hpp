@@ -14,8 +14,7 @@ namespace cia402 {
 /// Everything the drive reads in one cycle. The defaults are an ideal plant: DC link on, no STO, at
 /// standstill with no holding brake to wait for, remote control.
 struct drive_inputs {
-  // What a quiet cycle must find as it is by default (no fault, voltage, no STO, remote,
-  // connection, no local request) comes first.
+  // A quiet cycle (detail/quiet_step.hpp) finds these first seven as they are by default.
   std::uint16_t fault_code = 0;     ///< error code of the present fault cause (0x603F); 0 = none
   bool dc_link = true;              ///< DC-link (main) voltage present (S13)
   bool sto = false;                 ///< safe torque off active (S14)
