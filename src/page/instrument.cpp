@@ -2,46 +2,40 @@
 
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
-#include <cstdio>
+#include <deque>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
 
 #include "cia402/drive.hpp"
 #include "cia402/master.hpp"
 #include "cia402/words.hpp"
+#include "action_log.hpp"
 #include "page_json.hpp"
 #include "page_names.hpp"
+#include "snapshot_board.hpp"
+#include "word_change.hpp"
 
 namespace cia402::page {
 namespace {
 
 using json = nlohmann::ordered_json;
 using detail::abort_text;
-using detail::command_entry;
-using detail::core_command_of;
-using detail::entry_of;
 using detail::hex;
-using detail::result_entry;
 
 constexpr std::uint16_t bit7 = control_bit::fault_reset;
-constexpr std::uint16_t bit8 = control_bit::halt;
 constexpr std::uint8_t no_pending_row = 0xFF;
-
-// An action waiting for the drive to settle, so the page learns whether it led anywhere.
-struct tracked_action {
-  std::uint64_t id = 0;
-  std::string action;
-  state before = state::start;
-  std::uint64_t start_cycle = 0;
-  std::uint64_t busy_until = 0;  // last cycle with a transition or a stop running
-  std::vector<int> transitions;
-  bool refused_without_transition = true;  // commands: yes; plant inputs: a plain report
-};
 
 }  // namespace
 
 struct instrument::impl {
-  impl(const profile& p, const instrument_config& c) : table(p), config(c), drive(p, c.plant) {
+  impl(const profile& p, const instrument_config& c)
+      : table(p),
+        config(c),
+        drive(p, c.plant),
+        log({c.results_kept, c.settle_quiet, c.settle_limit,
+             "still busy when the instrument stopped waiting", ""},
+            [this] { return how_it_stands(); }) {
     if (config.publish_every == 0) config.publish_every = 1;
   }
 
@@ -50,15 +44,11 @@ struct instrument::impl {
   // mutable: views for reading are taken in const snapshots; reads change nothing.
   mutable sim::virtual_drive drive;
 
-  mutable std::mutex mutex;
-  std::condition_variable updated;
-  bool is_closed = false;
+  mutable std::mutex mutex;  // guards all here but the board, which has a lock of its own
 
   std::uint16_t control_word = 0;
   std::deque<std::uint16_t> scripted;  // words for the next cycles, one each (a fault-reset edge)
-  std::optional<tracked_action> pending;
-  std::deque<result_entry> results;
-  std::uint64_t next_id = 1;
+  detail::action_log log;
 
   struct transition_seen {
     int number = 0;
@@ -67,16 +57,9 @@ struct instrument::impl {
   };
   std::optional<transition_seen> last_transition;
 
-  std::string published_body;  // the last published snapshot without its time fields
-  published newest;
+  detail::snapshot_board board;
 
   // --- under the lock ------------------------------------------------------------------------
-
-  std::uint64_t new_id() { return next_id++; }
-
-  void push_result(result_entry r) {
-    detail::push_result(results, std::move(r), config.results_kept);
-  }
 
   void apply_word(std::uint16_t word) {
     control_word = word;
@@ -84,11 +67,25 @@ struct instrument::impl {
     drive.write(sim::object::control_word, 0, word);
   }
 
-  // A new action takes over: the one still waiting is reported as it stands.
-  void finish_pending(const char* why_unsettled) {
-    if (!pending) return;
-    finish(*pending, why_unsettled);
-    pending.reset();
+  // Logs a command or bit toggle and gives its word to the drive from the next cycle on.
+  std::uint64_t change_word(const detail::word_change& w) {
+    const std::uint64_t id =
+        w.tracked ? track(w.action, true) : log.report_now(w.action, "done", w.text);
+    scripted.clear();
+    if (w.fault_reset_edge) {
+      // Bit 7 set for one cycle after a cycle with it clear (S2), then cleared again.
+      if ((control_word & bit7) != 0) scripted.push_back(w.word);
+      scripted.push_back(static_cast<std::uint16_t>(w.word | bit7));
+      scripted.push_back(w.word);
+    } else {
+      apply_word(w.word);
+    }
+    return id;
+  }
+
+  std::uint64_t track(std::string action, bool refuse_without_transition) {
+    return log.track(std::move(action), refuse_without_transition, drive.view().current(),
+                     drive.cycle());
   }
 
   std::string blocking_conditions() {
@@ -102,56 +99,9 @@ struct instrument::impl {
     return s;
   }
 
-  void finish(const tracked_action& a, const char* why_unsettled) {
-    result_entry r;
-    r.id = a.id;
-    r.action = a.action;
-    r.transitions = a.transitions;
+  detail::action_log::standing how_it_stands() {
     const state now = drive.view().current();
-    if (!a.transitions.empty()) {
-      r.outcome = "done";
-      r.text = detail::transitions_text(a.transitions, now);
-    } else if (a.refused_without_transition) {
-      r.outcome = "refused";
-      r.text = std::string("refused: no transition from ") + state_name(a.before) + " for " +
-               a.action + blocking_conditions();
-    } else {
-      r.outcome = "done";
-      r.text = std::string("done: no transition, still ") + state_name(now);
-    }
-    if (why_unsettled != nullptr) r.text += std::string(" (") + why_unsettled + ")";
-    push_result(std::move(r));
-  }
-
-  std::uint64_t track(std::string action, bool refuse_without_transition) {
-    finish_pending("superseded before it settled");
-    tracked_action a;
-    a.id = new_id();
-    a.action = std::move(action);
-    a.before = drive.view().current();
-    a.start_cycle = drive.cycle();
-    a.busy_until = drive.cycle();
-    a.refused_without_transition = refuse_without_transition;
-    result_entry r;
-    r.id = a.id;
-    r.action = a.action;
-    r.outcome = "pending";
-    r.text = "pending";
-    push_result(std::move(r));
-    pending = std::move(a);
-    return pending->id;
-  }
-
-  std::uint64_t report_now(std::string action, std::string outcome, std::string text) {
-    finish_pending("superseded before it settled");
-    result_entry r;
-    r.id = new_id();
-    r.action = std::move(action);
-    r.outcome = std::move(outcome);
-    r.text = std::move(text);
-    const std::uint64_t id = r.id;
-    push_result(std::move(r));
-    return id;
+    return {now, state_name(now), blocking_conditions()};
   }
 
   void step_locked() {
@@ -164,10 +114,12 @@ struct instrument::impl {
     const std::uint64_t now = drive.cycle();
     if (out.transition != no_transition) {
       last_transition = transition_seen{out.transition, before, out.current};
-      if (pending) pending->transitions.push_back(out.transition);
+      if (auto* a = log.pending()) a->transitions.push_back(out.transition);
     }
-    if (pending) settle(out, now);
-    if (now % config.publish_every == 0) publish();
+    if (log.pending()) settle(out, now);
+    if (now % config.publish_every == 0) {
+      board.publish([this](bool with_time) { return snapshot(with_time); });
+    }
   }
 
   // Settled: no scripted word left, no transition and no stop running for settle_quiet cycles.
@@ -180,14 +132,7 @@ struct instrument::impl {
                               ((act == state_activity::quick_stop ||
                                 act == state_activity::fault_reaction) &&
                                !v.inputs().standstill);
-    if (out.transition != no_transition || stop_running || !scripted.empty()) {
-      pending->busy_until = now;
-    }
-    if (now - pending->busy_until >= config.settle_quiet) {
-      finish_pending(nullptr);
-    } else if (now - pending->start_cycle >= config.settle_limit) {
-      finish_pending("still busy when the instrument stopped waiting");
-    }
+    log.settle(now, out.transition != no_transition || stop_running || !scripted.empty());
   }
 
   json snapshot(bool with_time) const {
@@ -224,23 +169,12 @@ struct instrument::impl {
       if (v.read(o.index, 0, value) == sdo_abort::none) objects[hex(o.index, 4)] = value;
     }
     j["objects"] = std::move(objects);
-    j["results"] = detail::results_json(results);
+    j["results"] = log.results_json();
     if (with_time) {
       j["cycle"] = drive.cycle();
       j["time_ms"] = drive.time_us() / 1000;
     }
     return j;
-  }
-
-  void publish() {
-    std::string body = snapshot(false).dump();
-    if (body == published_body && newest.version != 0) return;
-    published_body = std::move(body);
-    json j = snapshot(true);
-    j["version"] = newest.version + 1;
-    newest.version += 1;
-    newest.json = j.dump();
-    updated.notify_all();
   }
 };
 
@@ -261,67 +195,15 @@ std::uint64_t instrument::cycle() const {
 
 reply instrument::command(page_command c) {
   std::lock_guard lock(impl_->mutex);
-  impl& m = *impl_;
-  const command_entry& e = entry_of(c);
-  if (c == page_command::halt) {
-    const std::uint16_t word = static_cast<std::uint16_t>(m.control_word ^ bit8);
-    const bool on = (word & bit8) != 0;
-    std::string text = std::string("done: halt bit 8 = ") + (on ? "1" : "0");
-    if (!m.table.spec(option::halt).exists()) text += " (this profile has no halt: bit 8 is ignored)";
-    const std::uint64_t id = m.report_now(e.action, "done", std::move(text));
-    m.scripted.clear();
-    m.apply_word(word);
-    return accepted{id};
-  }
-  if (c == page_command::fault_reset) {
-    // An edge of bit 7 (S2): set for one cycle after a cycle with it clear, then cleared again.
-    const std::uint16_t low = static_cast<std::uint16_t>(m.control_word & ~bit7);
-    const std::uint16_t high = static_cast<std::uint16_t>(m.control_word | bit7);
-    const std::uint64_t id = m.track(e.action, true);
-    m.scripted.clear();
-    if ((m.control_word & bit7) != 0) m.scripted.push_back(low);
-    m.scripted.push_back(high);
-    m.scripted.push_back(low);
-    return accepted{id};
-  }
-  cia402::command core_command{};
-  core_command_of(c, core_command);
-  std::uint16_t word = 0;
-  if (!encode_command(m.table, core_command, m.control_word, word)) {
-    return refused{409, std::string("profile ") + m.table.name + " has no control word for " +
-                            e.action};
-  }
-  const std::uint64_t id = m.track(e.action, true);
-  m.scripted.clear();
-  m.apply_word(word);
-  return accepted{id};
+  const auto change = detail::press_button(impl_->table, c, impl_->control_word);
+  if (const refused* no = std::get_if<refused>(&change)) return *no;
+  return accepted{impl_->change_word(std::get<detail::word_change>(change))};
 }
 
 reply instrument::toggle_control_bit(int bit) {
   if (bit < 0 || bit > 15) return refused{400, "bit must be 0..15"};
   std::lock_guard lock(impl_->mutex);
-  impl& m = *impl_;
-  m.scripted.clear();
-  const std::uint16_t old_word = m.control_word;
-  const std::uint16_t word = static_cast<std::uint16_t>(old_word ^ (1u << bit));
-  const bool value = ((word >> bit) & 1u) != 0;
-  const cia402::command was = m.table.decode(old_word);
-  const cia402::command now = m.table.decode(word);
-  const bool reset_edge = bit == 7 && value;
-  std::string action = "BIT_" + std::to_string(bit) + "=" + (value ? "1" : "0");
-  std::uint64_t id = 0;
-  if (was != now || reset_edge) {
-    action += std::string(" (") + (reset_edge ? "FAULT_RESET edge" : command_name(now)) + ")";
-    id = m.track(std::move(action), true);
-  } else {
-    const bool owned = ((owned_control_bits(m.table) >> bit) & 1u) != 0;
-    id = m.report_now(action, "done",
-                      owned ? std::string("done: still decodes to ") + command_name(now)
-                            : std::string("done: the state machine does not read bit ") +
-                                  std::to_string(bit));
-  }
-  m.apply_word(word);
-  return accepted{id};
+  return accepted{impl_->change_word(detail::flip_bit(impl_->table, impl_->control_word, bit))};
 }
 
 reply instrument::write_object(std::uint16_t index, std::int64_t value) {
@@ -334,10 +216,10 @@ reply instrument::write_object(std::uint16_t index, std::int64_t value) {
   const sdo_abort r = m.drive.write(index, 0, value);
   if (r != sdo_abort::none) {
     const std::string text = "refused: " + abort_text(r);
-    m.report_now(action, "refused", text);
+    m.log.report_now(action, "refused", text);
     return refused{422, action + ": " + text, r};
   }
-  return accepted{m.report_now(action, "done", "done")};
+  return accepted{m.log.report_now(action, "done", "done")};
 }
 
 reply instrument::change_plant(const plant_change& change) {
@@ -354,7 +236,7 @@ reply instrument::change_plant(const plant_change& change) {
     const sdo_abort r = v.write(sim::object::target_velocity, 0, *change.target_velocity);
     if (r != sdo_abort::none) {
       const std::string what = "WRITE 0x60FF = " + std::to_string(*change.target_velocity);
-      m.report_now(what, "refused", "refused: " + abort_text(r));
+      m.log.report_now(what, "refused", "refused: " + abort_text(r));
       return refused{422, what + ": " + abort_text(r), r};
     }
     add("TARGET_VELOCITY=" + std::to_string(*change.target_velocity));
@@ -398,36 +280,18 @@ std::string instrument::info_json(bool control, bool token_required) const {
 
 std::string instrument::snapshot_json() const {
   std::lock_guard lock(impl_->mutex);
-  json j = impl_->snapshot(true);
-  j["version"] = impl_->newest.version;
-  return j.dump();
+  return impl_->board.present_json(impl_->snapshot(true));
 }
 
 std::optional<published> instrument::wait_for_update(std::uint64_t seen,
                                                      std::chrono::milliseconds timeout) {
-  std::unique_lock lock(impl_->mutex);
-  impl_->updated.wait_for(lock, timeout,
-                          [&] { return impl_->is_closed || impl_->newest.version > seen; });
-  if (impl_->newest.version > seen) return impl_->newest;
-  return std::nullopt;
+  return impl_->board.wait_for_update(seen, timeout);
 }
 
-published instrument::latest() const {
-  std::lock_guard lock(impl_->mutex);
-  return impl_->newest;
-}
+published instrument::latest() const { return impl_->board.latest(); }
 
-void instrument::close() {
-  {
-    std::lock_guard lock(impl_->mutex);
-    impl_->is_closed = true;
-  }
-  impl_->updated.notify_all();
-}
+void instrument::close() { impl_->board.close(); }
 
-bool instrument::closed() const {
-  std::lock_guard lock(impl_->mutex);
-  return impl_->is_closed;
-}
+bool instrument::closed() const { return impl_->board.closed(); }
 
 }  // namespace cia402::page

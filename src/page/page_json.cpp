@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <tuple>
+#include <vector>
 
 #include "cia402/master.hpp"
 #include "page_names.hpp"
@@ -55,37 +56,6 @@ bool core_command_of(page_command c, command& out) noexcept {
     case page_command::halt: return false;
   }
   return false;
-}
-
-void push_result(std::deque<result_entry>& results, result_entry r, std::size_t kept) {
-  for (result_entry& e : results) {
-    if (e.id == r.id) {
-      e = std::move(r);
-      return;
-    }
-  }
-  results.push_front(std::move(r));
-  while (results.size() > kept) results.pop_back();
-}
-
-json results_json(const std::deque<result_entry>& results) {
-  json rs = json::array();
-  for (const result_entry& r : results) {
-    rs.push_back({{"id", r.id},
-                  {"action", r.action},
-                  {"outcome", r.outcome},
-                  {"text", r.text},
-                  {"transitions", r.transitions}});
-  }
-  return rs;
-}
-
-std::string transitions_text(const std::vector<int>& transitions, state now) {
-  std::string text = "done: ";
-  for (std::size_t i = 0; i < transitions.size(); ++i) {
-    text += (i ? ", T" : "T") + std::to_string(transitions[i]);
-  }
-  return text + " -> " + state_name(now);
 }
 
 json profile_info(const profile& p) {

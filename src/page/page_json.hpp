@@ -1,14 +1,14 @@
 // What both backends of the page (instrument.cpp, remote_drive.cpp) share: the command buttons'
-// table, the result list, and the profile part of /api/info. One source, so the page draws the
-// same buttons, rows and bit names whichever drive it shows.
+// table and the profile part of /api/info. One source, so the page draws the same buttons, rows and
+// bit names whichever drive it shows. What else they share has a file of its own: the results
+// (action_log.hpp), publishing snapshots (snapshot_board.hpp), the buttons' control words
+// (word_change.hpp).
 #pragma once
 
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
-#include <deque>
 #include <string>
-#include <vector>
 
 #include "cia402/page/backend.hpp"
 #include "cia402/profile.hpp"
@@ -33,21 +33,6 @@ const command_entry& entry_of(page_command c) noexcept;
 /// The core's command for a button that is a plain command word; false for the two bit actions
 /// (fault reset, halt).
 bool core_command_of(page_command c, command& out) noexcept;
-
-struct result_entry {
-  std::uint64_t id = 0;
-  std::string action;
-  std::string outcome;  // "pending", "done", "refused"
-  std::string text;
-  std::vector<int> transitions;
-};
-
-/// Results for the page, newest first, at most `kept`; an entry with a known id is replaced.
-void push_result(std::deque<result_entry>& results, result_entry r, std::size_t kept);
-json results_json(const std::deque<result_entry>& results);
-
-/// "done: T2, T3 -> SWITCHED_ON" for the transitions an action led to.
-std::string transitions_text(const std::vector<int>& transitions, state now);
 
 /// The profile's part of /api/info: name, states, rows, bit names, commands, objects.
 json profile_info(const profile& p);

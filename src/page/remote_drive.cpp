@@ -18,8 +18,11 @@
 #include "cia402/master.hpp"
 #include "cia402/page/transition_inference.hpp"
 #include "cia402/words.hpp"
+#include "action_log.hpp"
 #include "page_json.hpp"
 #include "page_names.hpp"
+#include "snapshot_board.hpp"
+#include "word_change.hpp"
 
 namespace cia402::page {
 namespace {
@@ -28,10 +31,8 @@ namespace co = cia402::canopen;
 using json = nlohmann::ordered_json;
 using detail::abort_text;
 using detail::hex;
-using detail::result_entry;
 
 constexpr std::uint16_t bit7 = control_bit::fault_reset;
-constexpr std::uint16_t bit8 = control_bit::halt;
 constexpr const char* not_remote = "not available on a remote drive";
 
 // The sizes of the objects the page writes on a remote drive; the CANopen download needs them, and
@@ -91,16 +92,6 @@ struct sdo_job {
   bool nmt_start = false;  // not a transfer: NMT start, then running
 };
 
-struct tracked_action {
-  std::uint64_t id = 0;
-  std::string action;
-  std::optional<state> before;
-  std::uint64_t start_us = 0;
-  std::uint64_t busy_until_us = 0;
-  std::vector<int> transitions;
-  bool refused_without_transition = true;
-};
-
 struct transition_seen {
   std::optional<int> number;  // none: no chain of rows connects the two states
   state from = state::start;
@@ -124,7 +115,13 @@ const char* remote_status_name(remote_status s) noexcept {
 
 struct remote_drive::impl {
   impl(const profile& p, co::channel& b, const remote_config& c)
-      : table(p), bus(b), config(c), sdo(b, c.node_id, c.sdo_timeout_us) {
+      : table(p),
+        bus(b),
+        config(c),
+        sdo(b, c.node_id, c.sdo_timeout_us),
+        log({c.results_kept, c.settle_quiet_us, c.settle_limit_us,
+             "still busy when the page stopped waiting", " (numbers inferred)"},
+            [this] { return how_it_stands(); }) {
     if (config.cycle_us == 0) config.cycle_us = 1000;
     if (config.publish_us == 0) config.publish_us = config.cycle_us;
     consumer.on_change = [this](std::uint8_t, bool lost) {
@@ -138,10 +135,8 @@ struct remote_drive::impl {
   co::channel& bus;
   remote_config config;
 
-  mutable std::mutex mutex;
-  std::condition_variable updated;
+  mutable std::mutex mutex;  // guards all here but the board, which has a lock of its own
   std::condition_variable job_done;
-  bool is_closed = false;
 
   co::sdo_client sdo;
   std::optional<sdo_job> current;
@@ -188,12 +183,8 @@ struct remote_drive::impl {
   bool reset_sent_since_change = false;
   std::deque<std::pair<std::uint16_t, std::uint64_t>> outbox;  // word, not before (us)
 
-  std::optional<tracked_action> pending;
-  std::deque<result_entry> results;
-  std::uint64_t next_id = 1;
-
-  std::string published_body;
-  published newest;
+  detail::action_log log;
+  detail::snapshot_board board;
 
   // --- set-up ---------------------------------------------------------------------------------
 
@@ -218,6 +209,13 @@ struct remote_drive::impl {
     j.group = group;
     j.optional = group != 0;
     return j;
+  }
+
+  // A `then` for an optional step of set-up: whether it worked decides what comes later.
+  static std::function<void(const co::sdo_client&)> note_done(bool& worked) {
+    return [&worked](const co::sdo_client& c) {
+      worked = c.state() == co::sdo_client::status::done;
+    };
   }
 
   void build_setup() {
@@ -275,9 +273,7 @@ struct remote_drive::impl {
 
     if (config.heartbeat_ms != 0) {
       sdo_job hb = write(0x1017, 0, config.heartbeat_ms, 2, 1);
-      hb.then = [this](const co::sdo_client& c) {
-        heartbeat_watched = c.state() == co::sdo_client::status::done;
-      };
+      hb.then = note_done(heartbeat_watched);
       setup.push_back(hb);
     }
 
@@ -288,9 +284,7 @@ struct remote_drive::impl {
     setup.push_back(write(0x1A00, 1, 0x60410010, 4));
     sdo_job err_entry = write(0x1A00, 2, 0x603F0010, 4);
     err_entry.optional = true;
-    err_entry.then = [this](const co::sdo_client& c) {
-      error_mapped = c.state() == co::sdo_client::status::done;
-    };
+    err_entry.then = note_done(error_mapped);
     setup.push_back(err_entry);
     sdo_job count = write(0x1A00, 0, 0, 1);
     count.value = [this] { return std::int64_t{error_mapped ? 2 : 1}; };
@@ -309,9 +303,7 @@ struct remote_drive::impl {
     setup.push_back(write(0x1801, 2, 255, 1, velocity_group));
     setup.push_back(write(0x1801, 3, config.velocity_inhibit_100us, 2, velocity_group));
     sdo_job enable2 = write(0x1801, 1, tpdo2, 4, velocity_group);
-    enable2.then = [this](const co::sdo_client& c) {
-      velocity_mapped = c.state() == co::sdo_client::status::done;
-    };
+    enable2.then = note_done(velocity_mapped);
     setup.push_back(enable2);
 
     // RPDO1: the control word, acting on receipt.
@@ -398,7 +390,7 @@ struct remote_drive::impl {
     outbox.clear();
     consumer.configure({});
     hb_event = heartbeat_event::none;
-    if (pending) finish_pending(status_text.c_str());
+    log.finish_pending(status_text.c_str());
   }
 
   void lose(std::string why) { stop_link(remote_status::no_answer, std::move(why)); }
@@ -552,9 +544,9 @@ struct remote_drive::impl {
         seen.from = chain.back().from;
       }
       last_transition = seen;
-      if (pending) {
-        for (const inferred_transition& t : chain) pending->transitions.push_back(t.number);
-        pending->busy_until_us = now_us;
+      if (auto* a = log.pending()) {
+        for (const inferred_transition& t : chain) a->transitions.push_back(t.number);
+        a->busy_until = now_us;
       }
       reset_sent_since_change = false;
     }
@@ -563,7 +555,7 @@ struct remote_drive::impl {
   }
 
   void on_velocity(std::int32_t v) {
-    if (velocity && *velocity != v && pending) pending->busy_until_us = now_us;
+    if (velocity && *velocity != v && log.pending()) log.pending()->busy_until = now_us;
     velocity = v;
   }
 
@@ -648,20 +640,14 @@ struct remote_drive::impl {
         }
       }
     }
-    if (pending) settle();
+    if (log.pending()) settle();
     if (now_us >= next_publish_us) {
       next_publish_us = now_us + config.publish_us;
-      publish();
+      board.publish([this](bool with_time) { return snapshot(with_time); });
     }
   }
 
   // --- actions and results --------------------------------------------------------------------
-
-  std::uint64_t new_id() { return next_id++; }
-
-  void push_result(result_entry r) {
-    detail::push_result(results, std::move(r), config.results_kept);
-  }
 
   std::string shown_state() const {
     return state_known ? state_name(observed) : "UNKNOWN";
@@ -681,63 +667,13 @@ struct remote_drive::impl {
     return s;
   }
 
-  void finish(const tracked_action& a, const char* why_unsettled) {
-    result_entry r;
-    r.id = a.id;
-    r.action = a.action;
-    r.transitions = a.transitions;
-    if (!a.transitions.empty()) {
-      r.outcome = "done";
-      r.text = detail::transitions_text(a.transitions, observed) + " (numbers inferred)";
-    } else if (a.refused_without_transition) {
-      r.outcome = "refused";
-      r.text = "refused: no transition from " +
-               (a.before ? std::string(state_name(*a.before)) : std::string("UNKNOWN")) +
-               " for " + a.action + conditions();
-    } else {
-      r.outcome = "done";
-      r.text = "done: no transition, still " + shown_state();
-    }
-    if (why_unsettled != nullptr) r.text += std::string(" (") + why_unsettled + ")";
-    push_result(std::move(r));
-  }
-
-  void finish_pending(const char* why_unsettled) {
-    if (!pending) return;
-    const tracked_action a = std::move(*pending);
-    pending.reset();
-    finish(a, why_unsettled);
+  detail::action_log::standing how_it_stands() const {
+    return {observed, shown_state(), conditions()};
   }
 
   std::uint64_t track(std::string action, bool refuse_without_transition) {
-    finish_pending("superseded before it settled");
-    tracked_action a;
-    a.id = new_id();
-    a.action = std::move(action);
-    if (state_known) a.before = observed;
-    a.start_us = now_us;
-    a.busy_until_us = now_us;
-    a.refused_without_transition = refuse_without_transition;
-    result_entry r;
-    r.id = a.id;
-    r.action = a.action;
-    r.outcome = "pending";
-    r.text = "pending";
-    push_result(std::move(r));
-    pending = std::move(a);
-    return pending->id;
-  }
-
-  std::uint64_t report_now(std::string action, std::string outcome, std::string text) {
-    finish_pending("superseded before it settled");
-    result_entry r;
-    r.id = new_id();
-    r.action = std::move(action);
-    r.outcome = std::move(outcome);
-    r.text = std::move(text);
-    const std::uint64_t id = r.id;
-    push_result(std::move(r));
-    return id;
+    return log.track(std::move(action), refuse_without_transition,
+                     state_known ? std::optional<state>(observed) : std::nullopt, now_us);
   }
 
   // Settled: nothing left to send, no transition and no change of velocity for settle_quiet. A
@@ -748,12 +684,28 @@ struct remote_drive::impl {
         state_known && velocity && *velocity != 0 &&
         (table.info(observed).activity == state_activity::quick_stop ||
          table.info(observed).activity == state_activity::fault_reaction);
-    if (!outbox.empty() || stopping || (current && current->waiter)) pending->busy_until_us = now_us;
-    if (now_us - pending->busy_until_us >= config.settle_quiet_us) {
-      finish_pending(nullptr);
-    } else if (now_us - pending->start_us >= config.settle_limit_us) {
-      finish_pending("still busy when the page stopped waiting");
+    log.settle(now_us, !outbox.empty() || stopping || (current && current->waiter));
+  }
+
+  // Logs a command or bit toggle and queues its word for RPDO1.
+  std::uint64_t change_word(const detail::word_change& w) {
+    const std::uint64_t id =
+        w.tracked ? track(w.action, true) : log.report_now(w.action, "done", w.text);
+    outbox.clear();
+    if (w.fault_reset_edge) {
+      // Each level of the edge held for reset_pulse_us, so the drive steps on both.
+      std::uint64_t at = now_us;
+      if ((last_sent & bit7) != 0) {
+        queue_word(w.word, at);
+        at += config.reset_pulse_us;
+      }
+      queue_word(static_cast<std::uint16_t>(w.word | bit7), at);
+      queue_word(w.word, at + config.reset_pulse_us);
+    } else {
+      queue_word(w.word, now_us);
     }
+    control_word = w.word;
+    return id;
   }
 
   void queue_word(std::uint16_t word, std::uint64_t at) { outbox.emplace_back(word, at); }
@@ -775,19 +727,19 @@ struct remote_drive::impl {
     j.waiter = w;
     if (on_done) j.then = [on_done](const co::sdo_client&) { on_done(); };
     user_jobs.push_back(std::move(j));
-    job_done.wait_for(lock, config.request_timeout, [&] { return w->done || is_closed; });
+    job_done.wait_for(lock, config.request_timeout, [&] { return w->done || board.closed(); });
     return w;
   }
 
   // The reply for a finished (or abandoned) download; refusals are reported to the page too.
   reply download_reply(const std::shared_ptr<user_wait>& w, const std::string& action) {
     if (!w->done) {
-      report_now(action, "refused", "refused: no answer in time");
+      log.report_now(action, "refused", "refused: no answer in time");
       return refused{504, action + ": no answer from " + node_text() + " in time"};
     }
     if (w->cancelled) {
       const std::string why = status_text.empty() ? node_text() + " does not answer" : status_text;
-      report_now(action, "refused", "refused: " + why);
+      log.report_now(action, "refused", "refused: " + why);
       return refused{503, action + ": " + why};
     }
     if (w->abort != sdo_abort::none) {
@@ -795,12 +747,12 @@ struct remote_drive::impl {
       if (w->abort == sdo_abort::sdo_protocol_timed_out) {
         text = "refused: " + node_text() + " does not answer (" + abort_text(w->abort) + ")";
       }
-      report_now(action, "refused", text);
+      log.report_now(action, "refused", text);
       return refused{w->abort == sdo_abort::sdo_protocol_timed_out ? 504 : 422,
                      action + ": " + text.substr(std::string("refused: ").size()), w->abort};
     }
     if (w->track_action) return accepted{w->id};
-    return accepted{report_now(action, "done", "done")};
+    return accepted{log.report_now(action, "done", "done")};
   }
 
   // --- snapshots ------------------------------------------------------------------------------
@@ -867,7 +819,7 @@ struct remote_drive::impl {
     json objs = json::object();
     for (const auto& [index, value] : objects) objs[hex(index, 4)] = value;
     j["objects"] = std::move(objs);
-    j["results"] = detail::results_json(results);
+    j["results"] = log.results_json();
     j["remote"] = remote_json();
     j["capabilities"] = capabilities();
     if (with_time) {
@@ -875,17 +827,6 @@ struct remote_drive::impl {
       j["time_ms"] = now_us / 1000;
     }
     return j;
-  }
-
-  void publish() {
-    std::string body = snapshot(false).dump();
-    if (body == published_body && newest.version != 0) return;
-    published_body = std::move(body);
-    json j = snapshot(true);
-    j["version"] = newest.version + 1;
-    newest.version += 1;
-    newest.json = j.dump();
-    updated.notify_all();
   }
 };
 
@@ -903,77 +844,17 @@ void remote_drive::process(std::uint32_t elapsed_us) {
 
 reply remote_drive::command(page_command c) {
   std::lock_guard lock(impl_->mutex);
-  impl& m = *impl_;
-  if (auto no = m.not_running()) return *no;
-  const detail::command_entry& e = detail::entry_of(c);
-  if (c == page_command::halt) {
-    const std::uint16_t word = static_cast<std::uint16_t>(m.control_word ^ bit8);
-    const bool on = (word & bit8) != 0;
-    std::string text = std::string("done: halt bit 8 = ") + (on ? "1" : "0");
-    if (!m.table.spec(option::halt).exists()) text += " (this profile has no halt: bit 8 is ignored)";
-    const std::uint64_t id = m.report_now(e.action, "done", std::move(text));
-    m.outbox.clear();
-    m.queue_word(word, m.now_us);
-    m.control_word = word;
-    return accepted{id};
-  }
-  if (c == page_command::fault_reset) {
-    // An edge of bit 7 (S2), each level held for reset_pulse_us so the drive steps on both.
-    const std::uint16_t low = static_cast<std::uint16_t>(m.control_word & ~bit7);
-    const std::uint16_t high = static_cast<std::uint16_t>(m.control_word | bit7);
-    const std::uint64_t id = m.track(e.action, true);
-    m.outbox.clear();
-    std::uint64_t at = m.now_us;
-    if ((m.last_sent & bit7) != 0) {
-      m.queue_word(low, at);
-      at += m.config.reset_pulse_us;
-    }
-    m.queue_word(high, at);
-    m.queue_word(low, at + m.config.reset_pulse_us);
-    m.control_word = low;
-    return accepted{id};
-  }
-  cia402::command core_command{};
-  detail::core_command_of(c, core_command);
-  std::uint16_t word = 0;
-  if (!encode_command(m.table, core_command, m.control_word, word)) {
-    return refused{409, std::string("profile ") + m.table.name + " has no control word for " +
-                            e.action};
-  }
-  const std::uint64_t id = m.track(e.action, true);
-  m.outbox.clear();
-  m.queue_word(word, m.now_us);
-  m.control_word = word;
-  return accepted{id};
+  if (auto no = impl_->not_running()) return *no;
+  const auto change = detail::press_button(impl_->table, c, impl_->control_word);
+  if (const refused* no = std::get_if<refused>(&change)) return *no;
+  return accepted{impl_->change_word(std::get<detail::word_change>(change))};
 }
 
 reply remote_drive::toggle_control_bit(int bit) {
   if (bit < 0 || bit > 15) return refused{400, "bit must be 0..15"};
   std::lock_guard lock(impl_->mutex);
-  impl& m = *impl_;
-  if (auto no = m.not_running()) return *no;
-  m.outbox.clear();
-  const std::uint16_t old_word = m.control_word;
-  const std::uint16_t word = static_cast<std::uint16_t>(old_word ^ (1u << bit));
-  const bool value = ((word >> bit) & 1u) != 0;
-  const cia402::command was = m.table.decode(old_word);
-  const cia402::command now = m.table.decode(word);
-  const bool reset_edge = bit == 7 && value;
-  std::string action = "BIT_" + std::to_string(bit) + "=" + (value ? "1" : "0");
-  std::uint64_t id = 0;
-  if (was != now || reset_edge) {
-    action += std::string(" (") + (reset_edge ? "FAULT_RESET edge" : command_name(now)) + ")";
-    id = m.track(std::move(action), true);
-  } else {
-    const bool owned = ((owned_control_bits(m.table) >> bit) & 1u) != 0;
-    id = m.report_now(action, "done",
-                      owned ? std::string("done: still decodes to ") + command_name(now)
-                            : std::string("done: the state machine does not read bit ") +
-                                  std::to_string(bit));
-  }
-  m.queue_word(word, m.now_us);
-  m.control_word = word;
-  return accepted{id};
+  if (auto no = impl_->not_running()) return *no;
+  return accepted{impl_->change_word(detail::flip_bit(impl_->table, impl_->control_word, bit))};
 }
 
 reply remote_drive::write_object(std::uint16_t index, std::int64_t value) {
@@ -991,7 +872,7 @@ reply remote_drive::write_object(std::uint16_t index, std::int64_t value) {
   impl& m = *impl_;
   if (const auto a = out_of_type(*t, value)) {
     const std::string text = "refused: " + abort_text(*a) + ", checked before sending";
-    m.report_now(action, "refused", text);
+    m.log.report_now(action, "refused", text);
     return refused{422, action + ": " + abort_text(*a), *a};
   }
   if (auto no = m.not_running()) return *no;
@@ -1019,7 +900,7 @@ reply remote_drive::change_plant(const plant_change& change) {
     const std::int64_t v = *change.target_velocity;
     const std::string action = "TARGET_VELOCITY=" + std::to_string(v);
     if (const auto a = out_of_type(*type_of(0x60FF), v)) {
-      m.report_now("WRITE 0x60FF = " + std::to_string(v), "refused", "refused: " + abort_text(*a));
+      m.log.report_now("WRITE 0x60FF = " + std::to_string(v), "refused", "refused: " + abort_text(*a));
       return refused{422, "WRITE 0x60FF = " + std::to_string(v) + ": " + abort_text(*a), *a};
     }
     if (auto no = m.not_running()) return *no;
@@ -1063,38 +944,26 @@ std::string remote_drive::info_json(bool control, bool token_required) const {
 
 std::string remote_drive::snapshot_json() const {
   std::lock_guard lock(impl_->mutex);
-  json j = impl_->snapshot(true);
-  j["version"] = impl_->newest.version;
-  return j.dump();
+  return impl_->board.present_json(impl_->snapshot(true));
 }
 
 std::optional<published> remote_drive::wait_for_update(std::uint64_t seen,
                                                        std::chrono::milliseconds timeout) {
-  std::unique_lock lock(impl_->mutex);
-  impl_->updated.wait_for(lock, timeout,
-                          [&] { return impl_->is_closed || impl_->newest.version > seen; });
-  if (impl_->newest.version > seen) return impl_->newest;
-  return std::nullopt;
+  return impl_->board.wait_for_update(seen, timeout);
 }
 
-published remote_drive::latest() const {
-  std::lock_guard lock(impl_->mutex);
-  return impl_->newest;
-}
+published remote_drive::latest() const { return impl_->board.latest(); }
 
 void remote_drive::close() {
   {
+    // Under the drive's lock, so a request waiting for its transfer cannot miss it.
     std::lock_guard lock(impl_->mutex);
-    impl_->is_closed = true;
+    impl_->board.close();
   }
-  impl_->updated.notify_all();
   impl_->job_done.notify_all();
 }
 
-bool remote_drive::closed() const {
-  std::lock_guard lock(impl_->mutex);
-  return impl_->is_closed;
-}
+bool remote_drive::closed() const { return impl_->board.closed(); }
 
 remote_status remote_drive::status() const {
   std::lock_guard lock(impl_->mutex);

@@ -24,15 +24,6 @@ namespace {
 
 constexpr int usage_error = 2;
 
-void add_profile_options(CLI::App& cmd, std::string& name, std::string& file) {
-  auto* by_name = cmd.add_option("--profile", name, "built-in profile: " + builtin_profile_names())
-                      ->type_name("NAME")
-                      ->default_str("cia402");
-  cmd.add_option("--profile-file", file, "a TOML profile file instead of a built-in")
-      ->type_name("FILE")
-      ->excludes(by_name);
-}
-
 int list_profiles(std::ostream& out) {
   std::size_t width = 4;
   for (std::size_t i = 0; i < builtin_profile_count(); ++i) {

@@ -82,12 +82,7 @@ CLI::App* add_bus_subcommand(CLI::App& app, bus_args& args) {
   cmd->add_option("--listen", args.listen, "HOST:PORT to listen on; port 0 picks a free one")
       ->default_str("127.0.0.1:29536");
   cmd->add_option("--nodes", args.nodes, "node-IDs of the drives: 1-4, 2, 1,5,9")->default_str("1-4");
-  auto* by_name = cmd->add_option("--profile", args.profile, "built-in profile: " + builtin_profile_names())
-                      ->type_name("NAME")
-                      ->default_str("cia402");
-  cmd->add_option("--profile-file", args.profile_file, "a TOML profile file instead of a built-in")
-      ->type_name("FILE")
-      ->excludes(by_name);
+  add_profile_options(*cmd, args.profile, args.profile_file);
   cmd->add_option("--bus-name", args.bus_name, "the bus name clients open")->default_str("can0");
   cmd->add_option("--heartbeat", args.heartbeat_ms, "each drive's heartbeat period in ms (0x1017), 0 = off")
       ->default_str("0");

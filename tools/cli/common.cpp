@@ -1,5 +1,6 @@
 #include "cli/common.hpp"
 
+#include <CLI/CLI.hpp>
 #include <limits>
 #include <ostream>
 #include <variant>
@@ -106,6 +107,16 @@ bool profile_choice::resolve(const std::string& name, const std::string& file, s
   }
   profile_ = p;
   return true;
+}
+
+void add_profile_options(CLI::App& cmd, std::string& name, std::string& file,
+                         const std::string& name_help) {
+  auto* by_name = cmd.add_option("--profile", name, name_help + ": " + builtin_profile_names())
+                      ->type_name("NAME")
+                      ->default_str("cia402");
+  cmd.add_option("--profile-file", file, "a TOML profile file instead of a built-in")
+      ->type_name("FILE")
+      ->excludes(by_name);
 }
 
 }  // namespace cia402::cli

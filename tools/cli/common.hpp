@@ -10,6 +10,10 @@
 
 #include "cia402/profile.hpp"
 
+namespace CLI {
+class App;
+}
+
 namespace cia402::cli {
 
 /// Parses a decimal ("15", "-1") or hexadecimal ("0x0F") integer, the whole text. Refuses anything
@@ -39,5 +43,10 @@ class profile_choice {
 
 /// "cia402, no-quick-stop, ..." for messages.
 std::string builtin_profile_names();
+
+/// The two ways a subcommand is given its profile, which exclude each other: `--profile NAME` (a
+/// built-in; `name_help` says what it is for, the names follow) or `--profile-file FILE`.
+void add_profile_options(CLI::App& cmd, std::string& name, std::string& file,
+                         const std::string& name_help = "built-in profile");
 
 }  // namespace cia402::cli

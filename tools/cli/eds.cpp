@@ -16,12 +16,7 @@ namespace cia402::cli {
 
 CLI::App* add_eds_subcommand(CLI::App& app, eds_args& args) {
   auto* cmd = app.add_subcommand("eds", "Write the CiA 306 EDS of the virtual drive (the objects `cia402 bus` serves)");
-  auto* by_name = cmd->add_option("--profile", args.profile, "built-in profile: " + builtin_profile_names())
-                      ->type_name("NAME")
-                      ->default_str("cia402");
-  cmd->add_option("--profile-file", args.profile_file, "a TOML profile file instead of a built-in")
-      ->type_name("FILE")
-      ->excludes(by_name);
+  add_profile_options(*cmd, args.profile, args.profile_file);
   cmd->add_option("--node", args.node, "node-ID whose values the EDS shows")->check(CLI::Range(1, 127))->default_str("1");
   cmd->add_option("-o,--output", args.output, "write to this file instead of standard output");
   return cmd;

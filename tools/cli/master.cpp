@@ -155,12 +155,7 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
   cmd->add_option("COMMAND", args.command, "state, enable, disable, quick-stop, reset or watch")
       ->required()
       ->check(CLI::IsMember({"state", "enable", "disable", "quick-stop", "reset", "watch"}));
-  auto* by_name = cmd->add_option("--profile", args.profile, "the drive's profile: " + builtin_profile_names())
-                      ->type_name("NAME")
-                      ->default_str("cia402");
-  cmd->add_option("--profile-file", args.profile_file, "a TOML profile file instead of a built-in")
-      ->type_name("FILE")
-      ->excludes(by_name);
+  add_profile_options(*cmd, args.profile, args.profile_file, "the drive's profile");
   cmd->add_option("--cycle", args.cycle_ms, "SYNC period in ms")->check(CLI::Range(1, 1000))->default_str("10");
   cmd->add_option("--timeout", args.timeout_ms, "give up after this many ms (watch: stop after it; 0 = never)")
       ->default_str("10000");

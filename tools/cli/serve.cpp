@@ -27,15 +27,8 @@ CLI::App* add_serve_subcommand(CLI::App& app, serve_args& args) {
       "Run a virtual drive in real time, or with --can show a drive on a CAN bus, and serve its "
       "instrument control page (control and status word bits, the state machine, the plant) on "
       "http://127.0.0.1:8402/; Ctrl-C stops");
-  auto* by_name =
-      cmd->add_option("--profile", args.profile_name,
-                      "built-in profile (with --can: the drive's, to read its words): " +
-                          builtin_profile_names())
-          ->type_name("NAME")
-          ->default_str("cia402");
-  cmd->add_option("--profile-file", args.profile_file, "a TOML profile file instead of a built-in")
-      ->type_name("FILE")
-      ->excludes(by_name);
+  add_profile_options(*cmd, args.profile_name, args.profile_file,
+                      "built-in profile (with --can: the drive's, to read its words)");
   cmd->add_option("--bind", args.bind,
                   "address to listen on; anything but loopback makes control need the token "
                   "printed at start")

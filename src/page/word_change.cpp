@@ -1,0 +1,54 @@
+#include "word_change.hpp"
+
+#include "cia402/master.hpp"
+#include "cia402/words.hpp"
+#include "page_json.hpp"
+
+namespace cia402::page::detail {
+
+std::variant<word_change, refused> press_button(const profile& p, page_command c,
+                                                std::uint16_t control_word) {
+  constexpr std::uint16_t bit7 = control_bit::fault_reset;
+  constexpr std::uint16_t bit8 = control_bit::halt;
+  word_change w;
+  w.action = entry_of(c).action;
+  if (c == page_command::halt) {
+    w.word = static_cast<std::uint16_t>(control_word ^ bit8);
+    w.tracked = false;
+    w.text = std::string("done: halt bit 8 = ") + ((w.word & bit8) != 0 ? "1" : "0");
+    if (!p.spec(option::halt).exists()) w.text += " (this profile has no halt: bit 8 is ignored)";
+    return w;
+  }
+  if (c == page_command::fault_reset) {
+    w.word = static_cast<std::uint16_t>(control_word & ~bit7);
+    w.fault_reset_edge = true;
+    return w;
+  }
+  cia402::command core_command{};
+  core_command_of(c, core_command);
+  if (!encode_command(p, core_command, control_word, w.word)) {
+    return refused{409, std::string("profile ") + p.name + " has no control word for " + w.action};
+  }
+  return w;
+}
+
+word_change flip_bit(const profile& p, std::uint16_t control_word, int bit) {
+  word_change w;
+  w.word = static_cast<std::uint16_t>(control_word ^ (1u << bit));
+  const bool value = ((w.word >> bit) & 1u) != 0;
+  const cia402::command was = p.decode(control_word);
+  const cia402::command now = p.decode(w.word);
+  const bool reset_edge = bit == 7 && value;
+  w.action = "BIT_" + std::to_string(bit) + "=" + (value ? "1" : "0");
+  if (was != now || reset_edge) {
+    w.action += std::string(" (") + (reset_edge ? "FAULT_RESET edge" : command_name(now)) + ")";
+    return w;
+  }
+  w.tracked = false;
+  const bool owned = ((owned_control_bits(p) >> bit) & 1u) != 0;
+  w.text = owned ? std::string("done: still decodes to ") + command_name(now)
+                 : std::string("done: the state machine does not read bit ") + std::to_string(bit);
+  return w;
+}
+
+}  // namespace cia402::page::detail
