@@ -79,6 +79,13 @@ struct axis {
   std::int8_t options[option_count] = {};  ///< option-code values, index by `option`
 };
 
+/// The pending-row value that means "no row's stop is running".
+inline constexpr std::uint8_t no_pending_row = 0xFF;
+
+/// True while a row's stop runs before its state change (S7: T5/T8 ramping, T17's fast stop): the
+/// status word still shows the source state. Layers above ask this, never `pending_row` itself.
+constexpr bool stop_running(const axis& a) noexcept { return a.pending_row != no_pending_row; }
+
 /// The error register 0x1001 that goes with an error code (CiA 301): bit 0 for any error, bit 1
 /// current (0x2xxx), 2 voltage (0x3xxx), 3 temperature (0x4xxx), 4 communication (0x81xx, 0x82xx),
 /// 5 device profile (0x83xx..0x8Fxx, e.g. 0x8611 following error), 7 manufacturer (0xFFxx).

@@ -24,7 +24,6 @@ using detail::abort_text;
 using detail::hex;
 
 constexpr std::uint16_t bit7 = control_bit::fault_reset;
-constexpr std::uint8_t no_pending_row = 0xFF;
 
 }  // namespace
 
@@ -128,7 +127,7 @@ struct instrument::impl {
   void settle(const drive_outputs& out, std::uint64_t now) {
     const sim::drive_view v = drive.view();
     const state_activity act = table.info(out.current).activity;
-    const bool stop_running = v.state_of_axis().core.pending_row != no_pending_row ||
+    const bool stop_running = cia402::stop_running(v.state_of_axis().core) ||
                               ((act == state_activity::quick_stop ||
                                 act == state_activity::fault_reaction) &&
                                !v.inputs().standstill);
@@ -151,7 +150,7 @@ struct instrument::impl {
     } else {
       j["last_transition"] = nullptr;
     }
-    j["stop_running"] = v.state_of_axis().core.pending_row != no_pending_row;
+    j["stop_running"] = cia402::stop_running(v.state_of_axis().core);
     j["ramp"] = stop_ramp_name(out.ramp);
     j["error_code"] = hex(out.error_code, 4);
     j["error_register"] = hex(out.error_register, 2);

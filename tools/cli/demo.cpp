@@ -56,7 +56,7 @@ class demo_run {
       const drive_outputs o = step(p_, axis_, inputs_);
       plant_.follow(o, p_);
       print(o);
-      if (o.transition == no_transition && axis_.pending_row == 0xFF && plant_ == before) break;
+      if (o.transition == no_transition && !stop_running(axis_) && plant_ == before) break;
     }
   }
 

@@ -63,7 +63,7 @@ std::string replay_session::settle() {
     last = step(*profile_, axis_, inputs_);
     if (last.transition != no_transition) {
       transitions += (transitions.empty() ? "" : ",") + std::to_string(last.transition);
-    } else if (axis_.pending_row == 0xFF) {
+    } else if (!stop_running(axis_)) {
       break;
     }
   }
