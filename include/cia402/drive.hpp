@@ -68,7 +68,7 @@ inline constexpr std::uint8_t coast_reaction = 1u << 3;    ///< the running faul
 inline constexpr std::uint8_t fault_latched = 1u << 4;     ///< class-4 error: only power-off clears
 }  // namespace axis_flag
 
-/// One axis's state between cycles: 12 bytes. The profile is passed to each call, so many axes
+/// One axis's state between cycles: 14 bytes. The profile is passed to each call, so many axes
 /// share one profile.
 struct axis {
   state current = state::start;
@@ -77,6 +77,10 @@ struct axis {
   std::uint8_t flags = 0;               ///< axis_flag bits
   std::uint16_t error_code = 0;         ///< 0x603F
   std::int8_t options[option_count] = {};  ///< option-code values, index by `option`
+  /// The option code governing the stop or reaction that runs now, as it was when that stop started
+  /// (S16): 0x605A in QUICK STOP ACTIVE, 0x605E in FAULT REACTION ACTIVE, 0x605B or 0x605C for a
+  /// pending row's stop. A write while the stop runs changes `options`, not this.
+  std::int8_t stop_code = 0;
 };
 
 /// The pending-row value that means "no row's stop is running".

@@ -52,7 +52,20 @@ struct command_path {
   std::array<path_step, max_path_length> steps{};
 };
 
+///
+/// S17: a path to any target but OPERATION ENABLED never enters OPERATION ENABLED on the way (motion
+/// is never enabled as a side effect), even where that costs a cycle.
 command_path plan_path(const profile& p, const axis& from, state target) noexcept;
+
+/// The fewest-cycles path that brings every one of `count` axes (at most 2) to the target with the
+/// same words: what a master plans when it cannot tell them apart.
+command_path plan_path(const profile& p, const axis* from, std::size_t count, state target) noexcept;
+
+/// The path a master plans from what a status word shows: the drive in state s, at rest, with the
+/// given option codes and fault-reset bit, and where the profile remembers how a state was entered
+/// (seed 001: a class-1 quick stop needs Fault Reset to leave) every way it may have been entered.
+command_path plan_path_from_status(const profile& p, const axis& options_from, state s,
+                                   bool fault_reset_bit, state target) noexcept;
 
 /// An axis at rest in state s, as a master may assume it: the profile's option codes as given by
 /// `options_from`, torque on where the state runs it, no stop pending.

@@ -84,7 +84,11 @@ enum class row_stop : std::uint8_t {
   disable_operation_option = 2,  ///< 0x605C decides: 0 immediate, 1 slow-down ramp first (T5)
   slow_down_ramp = 3,            ///< always ramp on the slow-down ramp first
   quick_stop_ramp = 4,           ///< always ramp on the quick-stop ramp first (seed 004 T17)
+  halt_ramp = 5,                 ///< always stop "with Halt" first: the ramp 0x605D picks (seed 001 T5)
+  shutdown_option_halt = 6,      ///< 0x605B decides: 0 immediate, 1 stop "with Halt" (seed 001 T8, local T9)
 };
+
+inline constexpr int row_stop_count = 7;
 
 namespace row_flag {
 /// The row may fire while another row's stop is still running (S7: T9, T11, T13 take over).

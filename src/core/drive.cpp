@@ -25,16 +25,32 @@ stop_ramp ramp_of_code(int code) noexcept {
   return static_cast<stop_ramp>(((code - 1) & 3) + 1);
 }
 
-// The ramp a row's stop runs before its state change; none means the change is immediate.
-stop_ramp ramp_of_row(const axis& a, row_stop stop) noexcept {
+// The option code a row's stop depends on, read when the stop starts (S16).
+std::int8_t stop_code_of_row(const axis& a, row_stop stop) noexcept {
   switch (stop) {
     case row_stop::shutdown_option:
-      return option_value(a, option::shutdown) == 1 ? stop_ramp::slow_down : stop_ramp::none;
+    case row_stop::shutdown_option_halt: return option_value(a, option::shutdown);
+    case row_stop::disable_operation_option: return option_value(a, option::disable_operation);
+    case row_stop::immediate:
+    case row_stop::slow_down_ramp:
+    case row_stop::quick_stop_ramp:
+    case row_stop::halt_ramp: break;
+  }
+  return 0;
+}
+
+// The ramp a row's stop runs before its state change, given the code read when it started; none
+// means the change is immediate. 0x605D acts at once (S16), so a stop "with Halt" reads it live.
+stop_ramp ramp_of_row(const axis& a, row_stop stop, int code) noexcept {
+  switch (stop) {
+    case row_stop::shutdown_option:
     case row_stop::disable_operation_option:
-      return option_value(a, option::disable_operation) == 1 ? stop_ramp::slow_down
-                                                             : stop_ramp::none;
+      return code == 1 ? stop_ramp::slow_down : stop_ramp::none;
     case row_stop::slow_down_ramp: return stop_ramp::slow_down;
     case row_stop::quick_stop_ramp: return stop_ramp::quick_stop;
+    case row_stop::halt_ramp: return ramp_of_code(option_value(a, option::halt));
+    case row_stop::shutdown_option_halt:
+      return code == 1 ? ramp_of_code(option_value(a, option::halt)) : stop_ramp::none;
     case row_stop::immediate: break;
   }
   return stop_ramp::none;
@@ -52,7 +68,7 @@ activity_now activity_of(const profile& p, const axis& a, bool halt) noexcept {
   activity_now now;
   if (a.pending_row != no_row) {
     const transition_row& r = p.rows[a.pending_row];
-    now.ramp = ramp_of_row(a, r.stop);
+    now.ramp = ramp_of_row(a, r.stop, a.stop_code);
     now.torque_wanted = true;
     // A stop into a state that holds torque (SWITCHED ON of seeds 003/004) keeps the brake open.
     now.stop_ends_torque = !p.torque_allowed(r.to);
@@ -66,7 +82,7 @@ activity_now activity_of(const profile& p, const axis& a, bool halt) noexcept {
       if (halt) now.ramp = ramp_of_code(option_value(a, option::halt));
       break;
     case state_activity::quick_stop: {
-      const int code = option_value(a, option::quick_stop);
+      const int code = a.stop_code;  // 0x605A as it was when the quick stop started (S16)
       now.ramp = ramp_of_code(code);
       now.torque_wanted = now.ramp != stop_ramp::coast;
       now.stop_ends_torque = code >= 1 && code <= 4;
@@ -75,7 +91,7 @@ activity_now activity_of(const profile& p, const axis& a, bool halt) noexcept {
     case state_activity::fault_reaction:
       now.ramp = (a.flags & axis_flag::coast_reaction)
                      ? stop_ramp::coast
-                     : ramp_of_code(option_value(a, option::fault_reaction));
+                     : ramp_of_code(a.stop_code);  // 0x605E as at T13 (S16)
       now.torque_wanted = now.ramp != stop_ramp::coast;
       now.stop_ends_torque = true;
       break;
@@ -149,9 +165,14 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   std::uint32_t f = bits(fact::automatic) |
                     (in.dc_link ? bits(fact::dc_link) : bits(fact::undervoltage)) |
                     (static_cast<std::uint32_t>(in.sto) << 13) |
-                    (static_cast<std::uint32_t>(in.local_enable) << 19) |
+                    // S15: a local enable commands only while the control word does not; a
+                    // local disable acts whatever place has control.
+                    (static_cast<std::uint32_t>(in.local_enable && !in.remote) << 19) |
                     (static_cast<std::uint32_t>(in.local_disable) << 20) |
-                    quick_stop_facts(a.options[0]) |
+                    // S16: in QUICK STOP ACTIVE the code read when the quick stop started.
+                    quick_stop_facts(p.info(a.current).activity == state_activity::quick_stop
+                                         ? a.stop_code
+                                         : a.options[static_cast<int>(option::quick_stop)]) |
                     ((static_cast<std::uint32_t>(a.flags) & axis_flag::entered_by_fault) << 16) |
                     ((static_cast<std::uint32_t>(a.flags) & axis_flag::fault_latched) << 17);
   static_assert(axis_flag::entered_by_fault << 16 == static_cast<std::uint32_t>(fact::entered_by_fault));
@@ -180,6 +201,13 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
       }
     }
   }
+  // S4: a fault that calls for a coast turns a ramped fault reaction into a coast at once, so the
+  // stop completes (T14) in this same step with torque off and the brake closed.
+  const state_activity act_before = p.info(a.current).activity;
+  if (act_before == state_activity::fault_reaction &&
+      (in.sto || !in.dc_link || (fault.code != 0 && fault.error_class >= 3))) {
+    a.flags |= axis_flag::coast_reaction;
+  }
   // Seed 001: T2 needs "< 1000 RPM", T7 fires on "> 1000 RPM"; exactly 1000 does neither.
   const std::int32_t limit = p.speed_limit_rpm;
   const std::int32_t speed = in.actual_speed_rpm;
@@ -191,7 +219,6 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   // Only a pending row, QUICK STOP ACTIVE and FAULT REACTION ACTIVE run stops that can coast or
   // end with torque off; elsewhere standstill is enough.
   const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
-  const state_activity act_before = p.info(a.current).activity;
   bool complete = in.sto || in.standstill;
   if (a.pending_row != no_row || act_before == state_activity::quick_stop ||
       act_before == state_activity::fault_reaction) {
@@ -231,10 +258,12 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
     take = match;
   }
   if (take != no_row) {
-    const bool ramp_first = torque_was_on && !in.sto &&
-                            ramp_of_row(a, p.rows[take].stop) != stop_ramp::none;
+    const row_stop stop = p.rows[take].stop;
+    const std::int8_t code = stop_code_of_row(a, stop);  // read as the stop starts (S16)
+    const bool ramp_first = torque_was_on && !in.sto && ramp_of_row(a, stop, code) != stop_ramp::none;
     if (ramp_first) {
       a.pending_row = take;
+      a.stop_code = code;
     } else {
       commit = take;
     }
@@ -250,6 +279,14 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
     const std::uint32_t why = r.any.bits() & f;
     a.current = r.to;
     a.pending_row = no_row;
+    // S16: the quick stop and the fault reaction run by the code they find as they start.
+    switch (p.info(r.to).activity) {
+      case state_activity::quick_stop: a.stop_code = option_value(a, option::quick_stop); break;
+      case state_activity::fault_reaction:
+        a.stop_code = option_value(a, option::fault_reaction);
+        break;
+      default: a.stop_code = 0; break;
+    }
     a.last_transition = r.number;
     out.transition = r.number;
     out.clear_setpoints = (r.flags & row_flag::clears_setpoints) != 0;
@@ -288,7 +325,7 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   if (info.activity == state_activity::run) {
     target = halt ? in.standstill : in.target_reached;
   } else {
-    const int qs_code = option_value(a, option::quick_stop);
+    const int qs_code = a.stop_code;
     target = info.activity == state_activity::quick_stop && qs_code >= 5 && qs_code <= 8 &&
              in.standstill;
   }

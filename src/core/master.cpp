@@ -6,7 +6,10 @@ namespace {
 int popcount(unsigned v) noexcept { return __builtin_popcount(v); }
 
 bool same_axis(const axis& a, const axis& b) noexcept {
-  if (a.current != b.current || a.pending_row != b.pending_row || a.flags != b.flags) return false;
+  if (a.current != b.current || a.pending_row != b.pending_row || a.flags != b.flags ||
+      a.stop_code != b.stop_code) {
+    return false;
+  }
   for (int i = 0; i < option_count; ++i) {
     if (a.options[i] != b.options[i]) return false;
   }
@@ -17,8 +20,27 @@ bool same_axis(const axis& a, const axis& b) noexcept {
 // pending rows times flag combinations met in practice stay far below this.
 constexpr std::size_t max_nodes = 512;
 
+// What the master believes the drive may be: every axis consistent with what it has seen. The
+// status word does not show everything the drive remembers (seed 001's "entered by a fault"), so a
+// plan must work from each of them at once.
+constexpr std::size_t max_beliefs = 2;
+
+struct belief {
+  std::array<axis, max_beliefs> at{};
+  std::uint8_t count = 1;
+  state current() const noexcept { return at[0].current; }
+};
+
+bool same_belief(const belief& a, const belief& b) noexcept {
+  if (a.count != b.count) return false;
+  for (std::size_t i = 0; i < a.count; ++i) {
+    if (!same_axis(a.at[i], b.at[i])) return false;
+  }
+  return true;
+}
+
 struct node {
-  axis at;
+  belief at;
   std::uint16_t parent;
   std::uint16_t control_word;
   std::uint8_t transition;
@@ -78,6 +100,11 @@ axis axis_at_rest(const profile& p, const axis& options_from, state s, bool faul
                       (act == state_activity::quick_stop && qs != 0);
   if (torque) a.flags |= axis_flag::torque_on;
   if (act == state_activity::fault_reaction) a.flags |= axis_flag::coast_reaction;
+  // The code the running stop started with (S16): the present one is the best guess.
+  if (act == state_activity::quick_stop) a.stop_code = a.options[static_cast<int>(option::quick_stop)];
+  if (act == state_activity::fault_reaction) {
+    a.stop_code = a.options[static_cast<int>(option::fault_reaction)];
+  }
   return a;
 }
 
@@ -97,7 +124,16 @@ bool word_holds(const profile& p, axis at, std::uint16_t word) noexcept {
   return true;
 }
 
-command_path search(const profile& p, const axis& from, state target,
+bool at_goal(const profile& p, const belief& b, state target, std::uint16_t word,
+             bool must_hold) noexcept {
+  for (std::size_t i = 0; i < b.count; ++i) {
+    if (b.at[i].current != target) return false;
+    if (must_hold && !word_holds(p, b.at[i], word)) return false;
+  }
+  return true;
+}
+
+command_path search(const profile& p, const belief& from, state target,
                     const std::uint16_t* words, std::size_t word_count, bool must_hold) noexcept {
   command_path path;
   std::array<node, max_nodes> nodes{};
@@ -109,13 +145,23 @@ command_path search(const profile& p, const axis& from, state target,
     for (std::size_t w = 0; w < word_count; ++w) {
       drive_inputs in;
       in.control_word = words[w];
-      axis next = nodes[head].at;
-      const drive_outputs out = step(p, next, in);
+      belief next = nodes[head].at;
+      drive_outputs out;
+      bool enters_operation = false;
+      for (std::size_t i = 0; i < next.count; ++i) {
+        const state before = next.at[i].current;
+        const drive_outputs o = step(p, next.at[i], in);
+        if (i == 0) out = o;
+        enters_operation |= before != state::operation_enabled &&
+                            next.at[i].current == state::operation_enabled;
+      }
+      // S17: motion is never enabled on the way to another target.
+      if (enters_operation && target != state::operation_enabled) continue;
       // The goal test comes before the seen test: whether the target holds depends on the word,
       // and an axis first reached by a word that moves on may be reached again by one that holds.
-      const bool goal = next.current == target && (!must_hold || word_holds(p, next, words[w]));
+      const bool goal = at_goal(p, next, target, words[w], must_hold);
       bool seen = false;
-      for (std::size_t k = 0; k < count && !seen && !goal; ++k) seen = same_axis(nodes[k].at, next);
+      for (std::size_t k = 0; k < count && !seen && !goal; ++k) seen = same_belief(nodes[k].at, next);
       if (seen || count == max_nodes) continue;
       nodes[count] = {next, static_cast<std::uint16_t>(head), words[w], out.transition};
       depth[count] = static_cast<std::uint8_t>(depth[head] + 1);
@@ -125,7 +171,7 @@ command_path search(const profile& p, const axis& from, state target,
         path.length = depth[count];
         for (std::size_t k = count, d = path.length; k != 0; k = nodes[k].parent) {
           --d;
-          path.steps[d] = {nodes[k].control_word, nodes[k].transition, nodes[k].at.current};
+          path.steps[d] = {nodes[k].control_word, nodes[k].transition, nodes[k].at.current()};
         }
         return path;
       }
@@ -138,9 +184,20 @@ command_path search(const profile& p, const axis& from, state target,
 }  // namespace
 
 command_path plan_path(const profile& p, const axis& from, state target) noexcept {
-  if (from.current == target) {
+  return plan_path(p, &from, 1, target);
+}
+
+command_path plan_path(const profile& p, const axis* from, std::size_t count, state target) noexcept {
+  belief start;
+  start.count = static_cast<std::uint8_t>(count < max_beliefs ? count : max_beliefs);
+  bool there = true;
+  for (std::size_t i = 0; i < start.count; ++i) {
+    start.at[i] = from[i];
+    there &= from[i].current == target;
+  }
+  if (there || start.count == 0) {
     command_path here;
-    here.reachable = true;
+    here.reachable = there;
     return here;
   }
   // The distinct control words a master may send: each command, with bit 7 clear or set. Of equally
@@ -166,9 +223,36 @@ command_path plan_path(const profile& p, const axis& from, state target) noexcep
 
   // A target the drive leaves by itself (QUICK STOP ACTIVE with 0x605A = 1..4) has no word that
   // holds it: then arriving is enough.
-  const command_path held = search(p, from, target, words.data(), word_count, true);
+  const command_path held = search(p, start, target, words.data(), word_count, true);
   if (held.reachable) return held;
-  return search(p, from, target, words.data(), word_count, false);
+  return search(p, start, target, words.data(), word_count, false);
+}
+
+namespace {
+
+bool reads_entered_by_fault(const profile& p) noexcept {
+  for (std::size_t i = 0; i < p.row_count; ++i) {
+    const transition_row& r = p.rows[i];
+    if ((r.any | r.all | r.none).has(fact::entered_by_fault)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+command_path plan_path_from_status(const profile& p, const axis& options_from, state s,
+                                   bool fault_reset_bit, state target) noexcept {
+  std::array<axis, max_beliefs> beliefs{};
+  beliefs[0] = axis_at_rest(p, options_from, s, fault_reset_bit);
+  std::size_t count = 1;
+  // Seed 001: a quick stop a class-1 error caused needs Fault Reset to leave, one the fieldbus
+  // asked for needs Enable operation, and the status word shows the same state for both.
+  if (reads_entered_by_fault(p)) {
+    beliefs[1] = beliefs[0];
+    beliefs[1].flags |= axis_flag::entered_by_fault;
+    count = 2;
+  }
+  return plan_path(p, beliefs.data(), count, target);
 }
 
 master_policy master_policy::make(const profile& p, const axis& options_from, state target) noexcept {
@@ -183,8 +267,8 @@ master_policy master_policy::make(const profile& p, const axis& options_from, st
   }
   for (int s = 0; s < state_count; ++s) {
     for (int bit = 0; bit < 2; ++bit) {
-      const axis a = axis_at_rest(p, options_from, static_cast<state>(s), bit != 0);
-      const command_path path = plan_path(p, a, target);
+      const command_path path =
+          plan_path_from_status(p, options_from, static_cast<state>(s), bit != 0, target);
       entry& e = policy.first[s][bit];
       if (!path.reachable) continue;
       e.cycles = path.length;  // at most max_path_length, below `unreachable`
@@ -202,8 +286,8 @@ master_policy master_policy::make(const profile& p, const axis& options_from, st
     for (int bit = 0; bit < 2; ++bit) {
       entry& hold = policy.first[static_cast<int>(target)][bit];
       if (hold.control_word != 0xFFFF) continue;
-      const axis a = axis_at_rest(p, options_from, static_cast<state>(s), bit != 0);
-      const command_path path = plan_path(p, a, target);
+      const command_path path =
+          plan_path_from_status(p, options_from, static_cast<state>(s), bit != 0, target);
       if (path.reachable && path.length > 0) {
         hold.control_word = static_cast<std::uint16_t>(path.steps[path.length - 1].control_word &
                                                        ~control_bit::fault_reset);

@@ -68,7 +68,7 @@ const char* check_profile(const profile& p, int& row) noexcept {
     if (r.any.empty()) return "row has no trigger";
     if (((r.any | r.all | r.none).bits() & ~all_facts) != 0) return "row uses an unknown fact";
     if ((r.all & r.none) != fact_set()) return "row requires and forbids the same fact";
-    if (static_cast<unsigned>(r.stop) > static_cast<unsigned>(row_stop::quick_stop_ramp)) {
+    if (static_cast<unsigned>(r.stop) >= static_cast<unsigned>(row_stop_count)) {
       return "row has an unknown stop";
     }
     if ((r.flags & ~(row_flag::interrupts_stop | row_flag::clears_setpoints)) != 0) {

@@ -26,9 +26,10 @@ namespace {
 // Names that only profile files spell; the core names states and facts itself.
 
 constexpr const char* row_stop_names[] = {
-    "immediate", "shutdown_option", "disable_operation_option", "slow_down_ramp", "quick_stop_ramp",
+    "immediate",       "shutdown_option", "disable_operation_option", "slow_down_ramp",
+    "quick_stop_ramp", "halt_ramp",       "shutdown_option_halt",
 };
-constexpr int row_stop_count = 5;
+static_assert(sizeof(row_stop_names) / sizeof(row_stop_names[0]) == row_stop_count);
 
 constexpr const char* activity_names[] = {"idle", "hold", "run", "quick_stop", "fault_reaction"};
 constexpr int activity_count = 5;
@@ -241,7 +242,7 @@ std::vector<toml::source_region> load_rows(const toml::node& node, custom_profil
       if (!parse_listed(name, row_stop_names, r.stop)) {
         refuse(*stop, "unknown stop " + quoted(name) +
                           " (immediate, shutdown_option, disable_operation_option, slow_down_ramp, "
-                          "quick_stop_ramp)");
+                          "quick_stop_ramp, halt_ramp, shutdown_option_halt)");
       }
     }
     if (const toml::node* f = find(t, "interrupts_stop"); f && get_bool(*f, "interrupts_stop")) {

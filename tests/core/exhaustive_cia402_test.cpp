@@ -268,6 +268,9 @@ void set_up(const profile& p, state s, bool bit7_before, const sweep_config& cfg
                       s == state::fault_reaction_active;
   if (torque) a.flags |= axis_flag::torque_on;
   if (s == state::fault_reaction_active || s == state::fault) a.error_code = earlier_error;
+  // The quick stop and the fault reaction started with the codes configured here (S16).
+  if (s == state::quick_stop_active) a.stop_code = static_cast<std::int8_t>(cfg.qs);
+  if (s == state::fault_reaction_active) a.stop_code = a.options[static_cast<int>(option::fault_reaction)];
 
   m = model{};
   m.s = s;

@@ -101,6 +101,31 @@ std::vector<row_case> common_cases() {
   return c;
 }
 
+// S14: STO acts as a local Disable voltage in READY TO SWITCH ON (T7) and, where SWITCHED ON holds
+// no torque, in SWITCHED ON (T10); SWITCH ON DISABLED is not left while it is active.
+void sto_on(bench& b) { b.in.sto = true; }
+std::vector<row_case> sto_cases(bool switched_on_is_idle) {
+  std::vector<row_case> c = {
+      {"T7: STO, with Switch on held (S14: no restart when it goes)", S::ready_to_switch_on, F::sto,
+       7, S::switch_on_disabled, nullptr,
+       [](bench& b) {
+         cw_switch_on(b);
+         sto_on(b);
+       }},
+      {"T2 refused while STO is active (S14)", S::switch_on_disabled, F::shutdown, no_transition,
+       S::switch_on_disabled, nullptr,
+       [](bench& b) {
+         cw_shutdown(b);
+         sto_on(b);
+       }},
+  };
+  if (switched_on_is_idle) {
+    c.push_back({"T10: STO (S14)", S::switched_on, F::sto, 10, S::switch_on_disabled, nullptr,
+                 sto_on});
+  }
+  return c;
+}
+
 // ---------------------------------------------------------------------------------------------
 // cia402: seed 002_522d2c0bb8f5a5f8.txt (CoE table 7.8) with semantics.md.
 std::vector<row_case> cia402_cases() {
@@ -119,12 +144,6 @@ std::vector<row_case> cia402_cases() {
        [](bench& b) {
          cw_switch_on(b);
          b.in.dc_link = false;
-       }},
-      {"T3 refused with STO active (S14)", S::ready_to_switch_on, F::switch_on, no_transition,
-       S::ready_to_switch_on, nullptr,
-       [](bench& b) {
-         cw_switch_on(b);
-         b.in.sto = true;
        }},
       {"T4: Enable operation", S::switched_on, F::enable_operation, 4, S::operation_enabled,
        nullptr, cw_enable_operation},
@@ -160,6 +179,8 @@ std::vector<row_case> cia402_cases() {
       {"605A = 6: Switch on stays in QUICK STOP ACTIVE (S6)", S::quick_stop_active, F::switch_on,
        no_transition, S::quick_stop_active, quick_stop_code_6, cw_switch_on},
   };
+  const std::vector<row_case> sto = sto_cases(true);
+  c.insert(c.end(), sto.begin(), sto.end());
   c.insert(c.end(), own.begin(), own.end());
   return c;
 }
@@ -207,6 +228,8 @@ std::vector<row_case> no_quick_stop_cases() {
       {"T10: 'Quick Stop' *)", S::switched_on, F::quick_stop, 10, S::switch_on_disabled, nullptr,
        cw_quick_stop},
   };
+  const std::vector<row_case> sto = sto_cases(true);
+  c.insert(c.end(), sto.begin(), sto.end());
   c.insert(c.end(), own.begin(), own.end());
   return c;
 }
@@ -276,11 +299,19 @@ std::vector<row_case> lexium32_cases() {
       {"T3 4->5: fieldbus Enable Operation", S::ready_to_switch_on, F::enable_operation, 3,
        S::switched_on, nullptr, cw_enable_operation},
       {"T3 4->5: request for enabling the power stage", S::ready_to_switch_on, F::local_enable, 3,
-       S::switched_on, nullptr, [](bench& b) { b.in.local_enable = true; }},
+       S::switched_on, nullptr,
+       [](bench& b) {
+         b.in.remote = false;  // S15: a local enable commands only without the fieldbus
+         b.in.local_enable = true;
+       }},
       {"T4 5->6: fieldbus Enable Operation", S::switched_on, F::enable_operation, 4,
        S::operation_enabled, nullptr, cw_enable_operation},
       {"T4 5->6: automatic after the local enable request", S::switched_on, F::local_enable, 4,
-       S::operation_enabled, nullptr, [](bench& b) { b.in.local_enable = true; }},
+       S::operation_enabled, nullptr,
+       [](bench& b) {
+         b.in.remote = false;
+         b.in.local_enable = true;
+       }},
       {"T5 6->5: fieldbus Disable Operation", S::operation_enabled, F::switch_on, 5,
        S::switched_on, nullptr, cw_switch_on},
       {"T6 5->4: fieldbus Shutdown", S::switched_on, F::shutdown, 6, S::ready_to_switch_on,
@@ -349,6 +380,8 @@ std::vector<row_case> lexium32_cases() {
        },
        S::operation_enabled, quick_stop_by_class_1},
   };
+  const std::vector<row_case> sto = sto_cases(true);
+  c.insert(c.end(), sto.begin(), sto.end());
   c.insert(c.end(), own.begin(), own.end());
   return c;
 }
@@ -377,6 +410,9 @@ std::vector<row_case> s300_cases() {
        nullptr, [](bench& b) { b.in.control_word = 0x07; }},
       {"T6: bit 0 is canceled", S::switched_on, F::shutdown, 6, S::ready_to_switch_on, nullptr,
        [](bench& b) { b.in.control_word = 0x06; }},
+      {"T7: the DC link goes ('DC-link voltage must be applied', seed line 26)",
+       S::ready_to_switch_on, F::undervoltage, 7, S::switch_on_disabled, nullptr,
+       [](bench& b) { b.in.dc_link = false; }},
       {"T7: bit 1 is canceled", S::ready_to_switch_on, F::disable_voltage, 7,
        S::switch_on_disabled, nullptr, [](bench& b) { b.in.control_word = 0x04; }},
       {"T7: bit 2 is canceled", S::ready_to_switch_on, F::quick_stop, 7, S::switch_on_disabled,
@@ -405,6 +441,8 @@ std::vector<row_case> s300_cases() {
        F::enable_operation, 16, S::operation_enabled, nullptr,
        [](bench& b) { b.in.control_word = 0x0F; }},
   };
+  const std::vector<row_case> sto = sto_cases(false);
+  c.insert(c.end(), sto.begin(), sto.end());
   c.insert(c.end(), own.begin(), own.end());
   return c;
 }
@@ -471,6 +509,8 @@ std::vector<row_case> ax2000_cases() {
       {"T17: bit 2 is canceled in QUICK STOP ACTIVE", S::quick_stop_active, F::stop_and_inhibit,
        17, S::switch_on_disabled, nullptr, [](bench& b) { b.in.control_word = 0x0B; }},
   };
+  const std::vector<row_case> sto = sto_cases(false);
+  c.insert(c.end(), sto.begin(), sto.end());
   c.insert(c.end(), own.begin(), own.end());
   return c;
 }

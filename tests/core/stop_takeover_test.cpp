@@ -284,11 +284,10 @@ TEST(fault_codes, dc_link_lost_while_torque_is_on_records_0x3220_and_error_regis
   }
 }
 
-// S14 elsewhere: STO where torque is off only raises the warning bit 7 and blocks T3; no fault, no
-// code. S11 gives the whole status word of SWITCH ON DISABLED on the ideal plant: 0x40 | bit 4 (DC
-// link) | bit 9 (remote) = 0x0250; with STO bit 7 joins it. T2 has no condition in seed
-// 002_522d2c0bb8f5a5f8.txt ("Shutdown command"), so it is taken under STO.
-TEST(fault_codes, cia402_sto_in_switch_on_disabled_sets_only_bit_7_and_blocks_t3) {
+// S14 elsewhere: STO where torque is off raises the warning bit 7; no fault, no code. S11 gives the
+// whole status word of SWITCH ON DISABLED on the ideal plant: 0x40 | bit 4 (DC link) | bit 9
+// (remote) = 0x0250; with STO bit 7 joins it. T2 waits for STO to go (S14).
+TEST(fault_codes, cia402_sto_in_switch_on_disabled_sets_only_bit_7_and_holds_the_state) {
   bench b(test::builtin("cia402"));
   ASSERT_TRUE(test::reach(b, S::switch_on_disabled));
   b.step();
@@ -301,26 +300,27 @@ TEST(fault_codes, cia402_sto_in_switch_on_disabled_sets_only_bit_7_and_blocks_t3
     EXPECT_EQ(b.out.error_code, 0);
     EXPECT_EQ(b.out.error_register, 0);
   }
-  b.in.control_word = 0x0006;  // Shutdown
-  b.step();
-  ASSERT_EQ(int(b.out.transition), 2) << test::describe(b.out);
-  for (std::uint16_t word : {std::uint16_t{0x0007}, std::uint16_t{0x000F}}) {
+  // S14: SWITCH ON DISABLED is not left while STO is active, whatever the master sends.
+  for (std::uint16_t word : {std::uint16_t{0x0006}, std::uint16_t{0x0007}, std::uint16_t{0x000F}}) {
     SCOPED_TRACE(test::hex(word));
     b.in.control_word = word;
     for (int i = 0; i < 3; ++i) {
       b.step();
-      EXPECT_EQ(b.out.transition, no_transition) << "T3 blocked by STO; " << test::describe(b.out);
-      EXPECT_EQ(b.out.current, S::ready_to_switch_on);
+      EXPECT_EQ(b.out.transition, no_transition) << "T2 blocked by STO; " << test::describe(b.out);
+      EXPECT_EQ(b.out.current, S::switch_on_disabled);
       EXPECT_TRUE(b.out.status_word & status_bit::warning);
       EXPECT_FALSE(b.out.torque);
       EXPECT_EQ(b.out.error_code, 0);
     }
   }
-  b.in.sto = false;  // released: the same Switch on now takes T3
-  b.in.control_word = 0x0007;
+  b.in.sto = false;  // released with Enable operation held: no restart
   b.step();
-  EXPECT_EQ(int(b.out.transition), 3) << test::describe(b.out);
+  EXPECT_EQ(b.out.transition, no_transition) << test::describe(b.out);
+  EXPECT_EQ(b.out.current, S::switch_on_disabled);
   EXPECT_FALSE(b.out.status_word & status_bit::warning);
+  b.in.control_word = 0x0006;  // only a Shutdown brings the drive back
+  b.step();
+  EXPECT_EQ(int(b.out.transition), 2) << test::describe(b.out);
 }
 
 // ---------------------------------------------------------------------------------------------

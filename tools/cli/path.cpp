@@ -38,7 +38,7 @@ int run_path(const profile& p, const std::vector<option_write>& writes, const st
       return 2;
     }
   }
-  const command_path path = plan_path(p, axis_at_rest(p, options, start, false), target);
+  const command_path path = plan_path_from_status(p, options, start, false, target);
   out << p.name << ": " << state_name(start) << " -> " << state_name(target);
   if (!path.reachable) {
     out << ": unreachable by any sequence of commands\n";

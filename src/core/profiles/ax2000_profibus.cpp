@@ -24,7 +24,7 @@ constexpr transition_row rows[] = {
     row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
     // T2: bits 1 and 2 set, DC bus link voltage present (seed lines 14..16).
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown),
-        facts(F::dc_link)),
+        facts(F::dc_link), facts(F::sto)),
     // T3: "Bit 0 is also set" (seed line 19), whatever bits 3 and 4 say: with bit 4 clear the word
     // decodes as fast stop, which still switches on.
     row(3, from(S::ready_to_switch_on), S::switched_on,
@@ -34,13 +34,14 @@ constexpr transition_row rows[] = {
     row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
         row_stop::slow_down_ramp),
     row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown)),
-    // T7, T10: "Bit 1 or Bit 2 is canceled" (seed lines 33, 42).
+    // T7, T10: "Bit 1 or Bit 2 is canceled" (seed lines 33, 42); S14: STO as a local Disable voltage.
     row(7, from(S::ready_to_switch_on), S::switch_on_disabled,
-        facts(F::disable_voltage, F::stop_and_inhibit)),
+        facts(F::disable_voltage, F::stop_and_inhibit, F::sto)),
     row(8, from(S::operation_enabled), S::ready_to_switch_on, facts(F::shutdown), {}, {},
         row_stop::immediate, interrupts),
     row(9, from(S::operation_enabled), S::switch_on_disabled, facts(F::disable_voltage), {}, {},
         row_stop::immediate, interrupts),
+    // No STO trigger on T10: SWITCHED ON holds torque here, so STO is a fault (S14, T13 first).
     row(10, from(S::switched_on), S::switch_on_disabled,
         facts(F::disable_voltage, F::stop_and_inhibit)),
     // T11: "Bit 4 is canceled" (seed line 45).

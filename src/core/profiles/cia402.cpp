@@ -1,5 +1,5 @@
 // Profile `cia402`: the standard, as seed 002_522d2c0bb8f5a5f8.txt (CoE table 7.8) prints it, with
-// the points it leaves open fixed by semantics.md (S1..S14). docs/profiles/cia402.md cites each row.
+// the points it leaves open fixed by docs/semantics.md (S1..S17). docs/profiles/cia402.md cites each row.
 #include "profiles/builtin.hpp"
 #include "profiles/rows.hpp"
 
@@ -13,7 +13,8 @@ constexpr transition_row rows[] = {
         row_stop::immediate, interrupts),
     row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic)),
     row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
-    row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown)),
+    // S14: SWITCH ON DISABLED is not left while STO is active.
+    row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown), {}, facts(F::sto)),
     // S3: Enable operation here runs T3, then T4 in the next step. S13/S14: voltage, no STO.
     row(3, from(S::ready_to_switch_on), S::switched_on, facts(F::switch_on, F::enable_operation),
         facts(F::dc_link), facts(F::sto)),
@@ -22,14 +23,15 @@ constexpr transition_row rows[] = {
     row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
         row_stop::disable_operation_option),
     row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown)),
+    // S14: STO acts as seed 002's "local signal" Disable voltage in T7 and T10.
     row(7, from(S::ready_to_switch_on), S::switch_on_disabled,
-        facts(F::disable_voltage, F::quick_stop)),
+        facts(F::disable_voltage, F::quick_stop, F::sto)),
     row(8, from(S::operation_enabled), S::ready_to_switch_on, facts(F::shutdown), {}, {},
         row_stop::shutdown_option),
     row(9, from(S::operation_enabled), S::switch_on_disabled, facts(F::disable_voltage), {}, {},
         row_stop::immediate, interrupts),
     row(10, from(S::switched_on), S::switch_on_disabled,
-        facts(F::disable_voltage, F::quick_stop)),
+        facts(F::disable_voltage, F::quick_stop, F::sto)),
     row(11, from(S::operation_enabled), S::quick_stop_active, facts(F::quick_stop), {}, {},
         row_stop::immediate, interrupts),
     row(12, from(S::quick_stop_active), S::switch_on_disabled, facts(F::disable_voltage)),

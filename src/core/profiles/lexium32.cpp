@@ -21,28 +21,32 @@ constexpr transition_row rows[] = {
     row(7, from(S::ready_to_switch_on), S::switch_on_disabled,
         facts(F::disable_voltage, F::undervoltage, F::sto, F::overspeed)),
     // T3: local request or Switch On or Enable Operation (seed lines 11..13).
+    // S15: a local disable request wins over any enable.
     row(3, from(S::ready_to_switch_on), S::switched_on,
-        facts(F::switch_on, F::enable_operation, F::local_enable), facts(F::dc_link), facts(F::sto)),
+        facts(F::switch_on, F::enable_operation, F::local_enable), facts(F::dc_link),
+        facts(F::sto, F::local_disable)),
     // T4: automatic after a local enable, or Enable Operation (seed lines 14..17).
     row(4, from(S::switched_on), S::operation_enabled, facts(F::enable_operation, F::local_enable),
-        facts(F::dc_link), facts(F::sto)),
-    // T5: "Movement is canceled with Halt", brake applied, power stage disabled (seed lines 18..20).
+        facts(F::dc_link), facts(F::sto, F::local_disable)),
+    // T5: "Movement is canceled with Halt", brake applied, power stage disabled (seed lines 18..20):
+    // the halt ramp (0x605D), and the cancelled movement's set-points are dropped.
     row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
-        row_stop::slow_down_ramp),
+        row_stop::halt_ramp, clears),
     row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown)),
     // T8: Halt or immediate, by DSM_ShutDownOption, here 0x605B (seed lines 27..29).
     row(8, from(S::operation_enabled), S::ready_to_switch_on, facts(F::shutdown), {}, {},
-        row_stop::shutdown_option),
+        row_stop::shutdown_option_halt, clears),
     // T9: Disable Voltage disables at once; a local request follows DSM_ShutDownOption (lines 30..36).
     row(9, from(S::operation_enabled), S::switch_on_disabled, facts(F::disable_voltage), {}, {},
-        row_stop::immediate, interrupts),
+        row_stop::immediate, interrupts | clears),
     row(9, from(S::operation_enabled), S::switch_on_disabled, facts(F::local_disable), {}, {},
-        row_stop::shutdown_option, interrupts),
+        row_stop::shutdown_option_halt, interrupts | clears),
+    // S14: STO acts as a local Disable voltage.
     row(10, from(S::switched_on), S::switch_on_disabled,
-        facts(F::disable_voltage, F::local_disable)),
+        facts(F::disable_voltage, F::local_disable, F::sto)),
     // T11: error class 1 or Quick Stop (seed lines 39..40).
     row(11, from(S::operation_enabled), S::quick_stop_active,
-        facts(F::quick_stop, F::fault_quick_stop), {}, {}, row_stop::immediate, interrupts),
+        facts(F::quick_stop, F::fault_quick_stop), {}, {}, row_stop::immediate, interrupts | clears),
     // T12: "disabled immediately, even if Quick Stop is still active" (seed lines 41..43).
     row(12, from(S::quick_stop_active), S::switch_on_disabled,
         facts(F::disable_voltage, F::local_disable)),

@@ -18,7 +18,8 @@ constexpr transition_row rows[] = {
         row_stop::immediate, interrupts),
     row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic)),
     row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
-    row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown)),
+    // S14: SWITCH ON DISABLED is not left while STO is active.
+    row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown), {}, facts(F::sto)),
     // "System checks if power supply is switched on" (seed line 49).
     row(3, from(S::ready_to_switch_on), S::switched_on, facts(F::switch_on, F::enable_operation),
         facts(F::dc_link), facts(F::sto)),
@@ -28,15 +29,16 @@ constexpr transition_row rows[] = {
     row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
         row_stop::slow_down_ramp),
     row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown)),
+    // S14: STO acts as seed 002's "local signal" Disable voltage in T7 and T10.
     row(7, from(S::ready_to_switch_on), S::switch_on_disabled,
-        facts(F::disable_voltage, F::quick_stop)),
+        facts(F::disable_voltage, F::quick_stop, F::sto)),
     row(8, from(S::operation_enabled), S::ready_to_switch_on, facts(F::shutdown), {}, {},
         row_stop::slow_down_ramp),
     // T9 coasts and closes the brake at once (seed line 109).
     row(9, from(S::operation_enabled), S::switch_on_disabled,
         facts(F::disable_voltage, F::quick_stop), {}, {}, row_stop::immediate, interrupts),
     row(10, from(S::switched_on), S::switch_on_disabled,
-        facts(F::disable_voltage, F::quick_stop)),
+        facts(F::disable_voltage, F::quick_stop, F::sto)),
     row(14, from(S::fault_reaction_active), S::fault, facts(F::automatic), facts(F::stop_complete)),
     row(15, from(S::fault), S::switch_on_disabled, facts(F::fault_reset), {}, facts(F::fault_present)),
 };

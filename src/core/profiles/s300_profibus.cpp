@@ -16,7 +16,7 @@ constexpr transition_row rows[] = {
     row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
     // T2: bits 1 and 2 set (shutdown), DC-link voltage present (seed lines 73..74).
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown),
-        facts(F::dc_link)),
+        facts(F::dc_link), facts(F::sto)),
     row(3, from(S::ready_to_switch_on), S::switched_on, facts(F::switch_on, F::enable_operation),
         facts(F::dc_link), facts(F::sto)),
     row(4, from(S::switched_on), S::operation_enabled, facts(F::enable_operation),
@@ -25,12 +25,15 @@ constexpr transition_row rows[] = {
     row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
         row_stop::slow_down_ramp),
     row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown)),
+    // T7 also when the DC link goes: "Ready for switch-on: DC-link voltage must be applied" (seed
+    // line 26). S14: STO acts as a local Disable voltage.
     row(7, from(S::ready_to_switch_on), S::switch_on_disabled,
-        facts(F::disable_voltage, F::quick_stop)),
+        facts(F::disable_voltage, F::quick_stop, F::undervoltage, F::sto)),
     row(8, from(S::operation_enabled), S::ready_to_switch_on, facts(F::shutdown), {}, {},
         row_stop::immediate, interrupts),
     row(9, from(S::operation_enabled), S::switch_on_disabled, facts(F::disable_voltage), {}, {},
         row_stop::immediate, interrupts),
+    // No STO trigger on T10: SWITCHED ON holds torque here, so STO is a fault (S14, T13 first).
     row(10, from(S::switched_on), S::switch_on_disabled,
         facts(F::disable_voltage, F::quick_stop)),
     // T11: emergency ramp, output stage stays on, set-points cancelled (seed line 169).
