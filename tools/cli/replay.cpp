@@ -1,5 +1,6 @@
 #include "cli/replay.hpp"
 
+#include <cstring>
 #include <istream>
 #include <ostream>
 
@@ -56,19 +57,45 @@ sdo_abort replay_session::write(const option_write& w) {
 
 std::string replay_session::power_up() { return settle(); }
 
+namespace {
+
+bool same_outputs(const drive_outputs& a, const drive_outputs& b) {
+  return a.current == b.current && a.status_word == b.status_word && a.ramp == b.ramp &&
+         a.torque == b.torque && a.brake_released == b.brake_released &&
+         a.clear_setpoints == b.clear_setpoints && a.error_code == b.error_code &&
+         a.error_register == b.error_register;
+}
+
+bool same_axis(const axis& a, const axis& b) {
+  return std::memcmp(&a, &b, sizeof(axis)) == 0;
+}
+
+}  // namespace
+
+// Steps with unchanged inputs until a step takes no transition and changes neither the axis nor the
+// outputs: then every further step would be the same.
 std::string replay_session::settle() {
   std::string transitions;
-  drive_outputs last;
-  for (int i = 0; i < max_settle_steps; ++i) {
-    last = step(*profile_, axis_, inputs_);
-    if (last.transition != no_transition) {
-      transitions += (transitions.empty() ? "" : ",") + std::to_string(last.transition);
-    } else if (!stop_running(axis_)) {
-      break;
+  bool settled = false;
+  for (int i = 0; i < max_settle_steps && !settled; ++i) {
+    const axis before = axis_;
+    const drive_outputs out = step(*profile_, axis_, inputs_);
+    if (out.transition != no_transition) {
+      transitions += (transitions.empty() ? "" : ",") + std::to_string(out.transition);
     }
+    settled = out.transition == no_transition && same_axis(before, axis_) && stepped_ &&
+              same_outputs(out, last_);
+    last_ = out;
+    stepped_ = true;
   }
-  return std::string("{\"state\":\"") + state_name(last.current) + "\",\"statusword\":\"" +
-         hex(last.status_word, 4) + "\",\"transitions\":[" + transitions + "]}";
+  std::string line = std::string("{\"state\":\"") + state_name(last_.current) +
+                     "\",\"statusword\":\"" + hex(last_.status_word, 4) + "\",\"transitions\":[" +
+                     transitions + "],\"torque\":" + (last_.torque ? "true" : "false") +
+                     ",\"brake\":\"" + (last_.brake_released ? "released" : "engaged") +
+                     "\",\"ramp\":\"" + stop_ramp_name(last_.ramp) + "\",\"error_code\":\"" +
+                     hex(last_.error_code, 4) + "\"";
+  if (!settled) line += ",\"settled\":false";
+  return line + "}";
 }
 
 std::string replay_session::error(std::string_view reason, int line_number) const {
@@ -103,7 +130,10 @@ std::string replay_session::handle(const std::vector<std::string_view>& words, i
     return settle();
   }
   if (event == "fault") {
-    if (args > 2) return wrong_count("at most a code and a class: fault [CODE [CLASS]]");
+    const bool class_word = args == 3 && words[2] == "class";
+    if (args > 2 && !class_word) {
+      return wrong_count("at most a code and a class: fault [CODE [class N]]");
+    }
     std::uint16_t code = error_code::generic;
     std::uint8_t error_class = drive_inputs{}.fault_class;
     if (args >= 1) {
@@ -115,7 +145,14 @@ std::string replay_session::handle(const std::vector<std::string_view>& words, i
       }
       code = static_cast<std::uint16_t>(*v);
     }
-    if (args == 2) {
+    if (class_word) {
+      // Profiles without error classes take every class as a fault (the drive ignores it).
+      const auto v = parse_number(words[3]);
+      if (!v || *v < 0 || *v > 4) {
+        return error("fault class '" + std::string(words[3]) + "' is not 0..4", line_number);
+      }
+      error_class = static_cast<std::uint8_t>(*v);
+    } else if (args == 2) {
       if (!profile_->error_classes) {
         return error(std::string("profile '") + profile_->name +
                          "' has no error classes; write 'fault CODE'",
@@ -172,7 +209,35 @@ std::string replay_session::handle(const std::vector<std::string_view>& words, i
       inputs_.sto = on;
     return settle();
   }
-  return error("unknown event '" + std::string(event) + "' (cw, fault, clear, set, voltage, sto)",
+  if (event == "moving" || event == "standstill") {
+    if (args != 0) return wrong_count("no argument: " + std::string(event));
+    inputs_.standstill = event == "standstill";
+    return settle();
+  }
+  if (event == "local") {
+    if (args != 1 || (words[1] != "enable" && words[1] != "disable" && words[1] != "off")) {
+      return wrong_count("enable, disable or off: local enable|disable|off");
+    }
+    inputs_.local_enable = words[1] == "enable";
+    inputs_.local_disable = words[1] == "disable";
+    return settle();
+  }
+  if (event == "remote") {
+    if (args != 1 || (words[1] != "on" && words[1] != "off")) {
+      return wrong_count("on or off: remote on|off");
+    }
+    inputs_.remote = words[1] == "on";
+    return settle();
+  }
+  if (event == "link") {
+    if (args != 1 || (words[1] != "lost" && words[1] != "ok")) {
+      return wrong_count("lost or ok: link lost|ok");
+    }
+    inputs_.connection_lost = words[1] == "lost";
+    return settle();
+  }
+  return error("unknown event '" + std::string(event) +
+                   "' (cw, fault, clear, set, voltage, sto, moving, standstill, local, remote, link)",
                line_number);
 }
 

@@ -1,5 +1,5 @@
-// `cia402 replay`: one drive on an ideal plant, driven by events read one a line, exactly as
-// /work/shared/spec/semantics.md ("A black-box interface every profile must offer") defines it.
+// `cia402 replay`: one drive on an ideal plant unless told otherwise, driven by events read one a
+// line, exactly as docs/semantics.md ("The replay interface") defines it.
 #pragma once
 
 #include <cstdint>
@@ -51,6 +51,8 @@ class replay_session {
   const profile* profile_;
   axis axis_;
   drive_inputs inputs_;
+  drive_outputs last_;    ///< the outputs of the latest step
+  bool stepped_ = false;  ///< a step has been taken (power-up)
   /// Fault causes present, oldest first: (error code, error class). The newest is the one the
   /// drive sees as inputs.fault_code.
   std::vector<std::pair<std::uint16_t, std::uint8_t>> faults_;
