@@ -1,7 +1,10 @@
-// Long random runs on every built-in profile: random control words, fault causes and classes, STO,
-// DC-link loss, lost connections, standstill and brake feedback, option writes and power cycles. After
-// every step the safety invariants of semantics.md S4, S11, S12, S13, S14 must hold. The runs are
-// seeded (std::mt19937), so a failure repeats exactly; the message gives profile, seed and step.
+// Long random runs on every built-in profile, beside the exhaustive model check (model_check.hpp):
+// random control words, fault causes and classes, STO, DC-link loss, lost connections, standstill
+// and brake feedback, option writes and power cycles. After every step the safety invariants of
+// docs/semantics.md S4, S11..S14 must hold, and every transition follows its seed's arrow. What the
+// model check does not cover is here: option writes and power cycles in the middle of a run. The
+// runs are seeded (std::mt19937), so a failure repeats exactly; the message gives profile, seed and
+// step.
 #include <algorithm>
 #include <array>
 #include <cstdint>

@@ -22,7 +22,8 @@ constexpr transition_row rows[] = {
         facts(F::dc_link), facts(F::sto), row_stop::immediate, clears),
     row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
         row_stop::disable_operation_option),
-    row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown)),
+    // S14: under STO, SWITCHED ON goes to SWITCH ON DISABLED (T10), whatever the command.
+    row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown), {}, facts(F::sto)),
     // S14: STO acts as seed 002's "local signal" Disable voltage in T7 and T10.
     row(7, from(S::ready_to_switch_on), S::switch_on_disabled,
         facts(F::disable_voltage, F::quick_stop, F::sto)),

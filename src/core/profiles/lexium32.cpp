@@ -32,7 +32,8 @@ constexpr transition_row rows[] = {
     // the halt ramp (0x605D), and the cancelled movement's set-points are dropped.
     row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
         row_stop::halt_ramp, clears),
-    row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown)),
+    // S14: under STO, SWITCHED ON goes to SWITCH ON DISABLED (T10), whatever the command.
+    row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown), {}, facts(F::sto)),
     // T8: Halt or immediate, by DSM_ShutDownOption, here 0x605B (seed lines 27..29).
     row(8, from(S::operation_enabled), S::ready_to_switch_on, facts(F::shutdown), {}, {},
         row_stop::shutdown_option_halt, clears),

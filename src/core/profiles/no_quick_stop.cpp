@@ -28,7 +28,8 @@ constexpr transition_row rows[] = {
     // T5, T8: ramp on 0x221E, close the brake at standstill, then power off (seed lines 69, 99).
     row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
         row_stop::slow_down_ramp),
-    row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown)),
+    // S14: under STO, SWITCHED ON goes to SWITCH ON DISABLED (T10), whatever the command.
+    row(6, from(S::switched_on), S::ready_to_switch_on, facts(F::shutdown), {}, facts(F::sto)),
     // S14: STO acts as seed 002's "local signal" Disable voltage in T7 and T10.
     row(7, from(S::ready_to_switch_on), S::switch_on_disabled,
         facts(F::disable_voltage, F::quick_stop, F::sto)),
