@@ -47,6 +47,10 @@ class ratio_reporter : public benchmark::ConsoleReporter {
     if (auto b = swap("drive_step_steady/", "baseline_step_steady"); !b.empty()) return b;
     if (auto b = swap("drive_step_mixed/", "baseline_step_mixed"); !b.empty()) return b;
     if (auto b = swap("drive_cycle_axes", "baseline_cycle_axes"); !b.empty()) return b;
+    if (auto b = swap("compiled_quiet/", "lookup_quiet"); !b.empty()) return b;
+    if (auto b = swap("compiled_transitions/", "lookup_transitions"); !b.empty()) return b;
+    if (name == "compiled_axes") return "lookup_axes";
+    if (name == "master_new_word") return "master_repeated_word";
     if (name == "master_step_steady") return "baseline_master_steady";
     if (name == "master_step_trace") return "baseline_master_trace";
     return {};

@@ -120,12 +120,16 @@ class master {
   void set_target(const master_policy& policy, std::uint64_t now, std::uint64_t timeout) noexcept;
   void clear_target() noexcept;
 
+  /// The status-word bits a master's decision reads: the state (bits 0..6) and remote (bit 9).
+  static constexpr std::uint16_t decisive_bits = 0x007F | status_bit::remote;
+
   /// One cycle: the status word the drive last reported (and 0x603F when known) in, the control
-  /// word to send out. Never blocks, never allocates. A status word like the last one, with nothing
-  /// latched and no deadline passed, gets the same command at once.
+  /// word to send out. Never blocks, never allocates. A status word that shows the same state as the
+  /// last one (other bits, such as warning or target reached, may differ), with nothing latched and
+  /// no deadline passed, gets the same command at once.
   std::uint16_t step(std::uint16_t status_word, std::uint64_t now,
                      std::uint16_t error_code = 0) noexcept {
-    if (status_word == last_status_word_ && repeatable_ &&
+    if (((status_word ^ last_status_word_) & decisive_bits) == 0 && repeatable_ &&
         (timeout_ == 0 || outcome_ == master_outcome::reached || now - since_ < timeout_)) {
       control_word_ = static_cast<std::uint16_t>(command_bits_ | (application_bits & ~owned_));
       return control_word_;

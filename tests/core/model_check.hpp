@@ -21,14 +21,13 @@
 #include <unordered_map>
 #include <vector>
 
+#include "cia402/compiled.hpp"
 #include "cia402/drive.hpp"
 #include "cia402/master.hpp"
 #include "cia402/profile.hpp"
 
 namespace cia402::model_check {
 
-/// A step to check against detail::full_step: it gets the axis and inputs, returns the outputs.
-using step_function = drive_outputs (*)(const profile&, axis&, const drive_inputs&);
 
 /// The fault code every injected fault carries; internal faults bring their own (S13, S14, S10).
 inline constexpr std::uint16_t injected_fault = 0x5530;
@@ -169,10 +168,10 @@ struct axis_key_hash {
 };
 
 /// Searches every axis reachable from power-up with the given option codes, checks every pair.
-/// `under_test`, unless null, must equal detail::full_step byte for byte (outputs and axis) on every
-/// pair, as must the quiet step wherever it takes the cycle.
+/// The compiled step of `compiled`, unless null, must equal detail::full_step byte for byte (outputs
+/// and axis) on every pair, as must the quiet step wherever it takes the cycle.
 inline report check(const profile& p, const std::array<std::int8_t, option_count>& options,
-                    step_function under_test) {
+                    const compiled_profile* compiled) {
   report r;
   const std::vector<drive_inputs> inputs = alphabet(p);
   auto violation = [&](const std::string& what, const axis& from, const drive_inputs& in) {
@@ -225,11 +224,11 @@ inline report check(const profile& p, const std::array<std::int8_t, option_count
       ++r.pairs;
       axis next = from;
       const drive_outputs out = detail::full_step(p, next, in);
-      if (under_test != nullptr) {
+      if (compiled != nullptr) {
         axis other = from;
-        const drive_outputs other_out = under_test(p, other, in);
+        const drive_outputs other_out = step(*compiled, other, in);
         if (!same_outputs(out, other_out) || std::memcmp(&next, &other, sizeof(axis)) != 0) {
-          violation("the step under test differs from full_step", from, in);
+          violation("the compiled step differs from full_step", from, in);
         }
       }
       axis quiet = from;

@@ -20,12 +20,13 @@ void check_profile(const char* name) {
   std::size_t pairs = 0;
   int deepest = 0;
   const auto sets = model_check::option_sets(*p);
+  const compiled_profile compiled(*p);
   // The option sets are independent searches: two threads, as the machines have two cores.
   std::vector<model_check::report> reports(sets.size());
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
     for (std::size_t k; (k = next++) < sets.size();) {
-      reports[k] = model_check::check(*p, sets[k], nullptr);
+      reports[k] = model_check::check(*p, sets[k], &compiled);
     }
   };
   std::thread helper(worker);
@@ -44,8 +45,9 @@ void check_profile(const char* name) {
                                 << int(options[4]) << "," << int(options[5]) << ":" << first;
   }
   std::printf("model check %s: %zu option sets, %zu reachable states, %zu (state, input) pairs, "
-              "%zu inputs, rest within %d steps\n",
-              name, sets.size(), states, pairs, model_check::alphabet(*p).size(), deepest);
+              "%zu inputs, rest within %d steps; compiled table answers %zu of %zu entries\n",
+              name, sets.size(), states, pairs, model_check::alphabet(*p).size(), deepest,
+              compiled.covered(), compiled_profile::entry_count);
   EXPECT_LE(deepest, model_check::settle_bound);
 }
 
@@ -65,7 +67,8 @@ namespace {
 std::size_t violations_of(const custom_profile& p, const char* what) {
   std::array<std::int8_t, option_count> defaults{};
   for (int o = 0; o < option_count; ++o) defaults[o] = p.get().options[o].default_value;
-  const model_check::report r = model_check::check(p.get(), defaults, nullptr);
+  const compiled_profile compiled(p.get());
+  const model_check::report r = model_check::check(p.get(), defaults, &compiled);
   std::size_t matching = 0;
   for (const auto& [kind, count] : r.kinds) {
     if (kind.find(what) != std::string::npos) matching += count;

@@ -1,0 +1,135 @@
+// The compiled step (cia402/compiled.hpp) against a bare 256-entry lookup table (lookup_table.hpp),
+// in the three scenarios of the speed targets, and the master with a status word that changes in
+// bits the state does not show against one that repeats. main.cpp prints each as a ratio to its
+// yardstick measured in the same run.
+#include <benchmark/benchmark.h>
+
+#include <random>
+#include <vector>
+
+#include "cia402/compiled.hpp"
+#include "cia402/master.hpp"
+#include "lookup_table.hpp"
+
+namespace {
+
+cia402::axis enabled_axis(const cia402::profile& p) {
+  cia402::axis a = cia402::make_axis(p);
+  cia402::drive_inputs in;
+  for (std::uint16_t w : {0x00, 0x00, 0x06, 0x0F, 0x0F}) {
+    in.control_word = w;
+    cia402::step(p, a, in);
+  }
+  return a;
+}
+
+void lookup_quiet(benchmark::State& st) {
+  const bench::lookup_table t;
+  bench::lookup_table::axis a{3};
+  for (auto _ : st) benchmark::DoNotOptimize(t.step(a, 0x0F));
+}
+
+void compiled_quiet(benchmark::State& st, const cia402::profile* p) {
+  const cia402::compiled_profile c(*p);
+  cia402::axis a = enabled_axis(*p);
+  cia402::drive_inputs in;
+  in.control_word = 0x0F;
+  for (auto _ : st) benchmark::DoNotOptimize(cia402::step(c, a, in));
+}
+
+void lookup_transitions(benchmark::State& st) {
+  const bench::lookup_table t;
+  bench::lookup_table::axis a;
+  std::uint32_t seed = 402;
+  for (auto _ : st) benchmark::DoNotOptimize(t.step(a, bench::transition_word(seed)));
+}
+
+void compiled_transitions(benchmark::State& st, const cia402::profile* p) {
+  const cia402::compiled_profile c(*p);
+  cia402::axis a = enabled_axis(*p);
+  cia402::drive_inputs in;
+  std::uint32_t seed = 402;
+  for (auto _ : st) {
+    in.control_word = bench::transition_word(seed);
+    benchmark::DoNotOptimize(cia402::step(c, a, in));
+  }
+}
+
+constexpr std::size_t axes = 10000;
+
+void lookup_axes(benchmark::State& st) {
+  const bench::lookup_table t;
+  std::vector<bench::lookup_table::axis> a(axes);
+  std::vector<std::uint16_t> status(axes);
+  std::uint32_t seed = 403;
+  for (auto _ : st) {
+    for (std::size_t k = 0; k < axes; ++k) status[k] = t.step(a[k], bench::transition_word(seed));
+    benchmark::DoNotOptimize(status.data());
+  }
+  st.SetItemsProcessed(static_cast<std::int64_t>(st.iterations() * axes));
+}
+
+void compiled_axes(benchmark::State& st) {
+  const cia402::compiled_profile c(cia402::standard_profile());
+  std::vector<cia402::axis> a(axes, cia402::make_axis(cia402::standard_profile()));
+  std::vector<std::uint16_t> status(axes);
+  std::uint32_t seed = 403;
+  for (auto _ : st) {
+    for (std::size_t k = 0; k < axes; ++k) {
+      cia402::drive_inputs in;
+      in.control_word = bench::transition_word(seed);
+      status[k] = cia402::step(c, a[k], in).status_word;
+    }
+    benchmark::DoNotOptimize(status.data());
+  }
+  st.SetItemsProcessed(static_cast<std::int64_t>(st.iterations() * axes));
+}
+
+void master_repeated_word(benchmark::State& st) {
+  const cia402::profile& p = cia402::standard_profile();
+  const auto policy =
+      cia402::master_policy::make(p, cia402::make_axis(p), cia402::state::operation_enabled);
+  cia402::master m;
+  m.set_target(policy, 0, 0);
+  std::uint64_t now = 0;
+  std::uint16_t word = 0x0237;
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(m.step(word, ++now));
+    word ^= 0;  // the same work as the changing word's toggle
+    benchmark::DoNotOptimize(word);
+  }
+}
+
+// OPERATION ENABLED throughout, with the warning bit 7 toggling every cycle: a new word each time.
+void master_new_word(benchmark::State& st) {
+  const cia402::profile& p = cia402::standard_profile();
+  const auto policy =
+      cia402::master_policy::make(p, cia402::make_axis(p), cia402::state::operation_enabled);
+  cia402::master m;
+  m.set_target(policy, 0, 0);
+  std::uint64_t now = 0;
+  std::uint16_t word = 0x0237;
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(m.step(word, ++now));
+    word ^= cia402::status_bit::warning;
+    benchmark::DoNotOptimize(word);
+  }
+}
+
+const bool registered = [] {
+  benchmark::RegisterBenchmark("lookup_quiet", lookup_quiet);
+  benchmark::RegisterBenchmark("lookup_transitions", lookup_transitions);
+  for (std::size_t i = 0; i < cia402::builtin_profile_count(); ++i) {
+    const cia402::profile* p = &cia402::builtin_profile(i);
+    benchmark::RegisterBenchmark((std::string("compiled_quiet/") + p->name).c_str(), compiled_quiet, p);
+    benchmark::RegisterBenchmark((std::string("compiled_transitions/") + p->name).c_str(),
+                                 compiled_transitions, p);
+  }
+  benchmark::RegisterBenchmark("lookup_axes", lookup_axes);
+  benchmark::RegisterBenchmark("compiled_axes", compiled_axes);
+  benchmark::RegisterBenchmark("master_repeated_word", master_repeated_word);
+  benchmark::RegisterBenchmark("master_new_word", master_new_word);
+  return true;
+}();
+
+}  // namespace

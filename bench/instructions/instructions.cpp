@@ -1,0 +1,109 @@
+// Steps the core and the bare lookup table through the scenarios of the speed targets, each in a
+// function of its own, so callgrind (instructions.sh) can count the instructions of each and divide
+// by the steps. Instruction counts do not depend on the machine's load, unlike nanoseconds.
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "cia402/compiled.hpp"
+#include "cia402/drive.hpp"
+#include "cia402/master.hpp"
+#include "lookup_table.hpp"
+
+namespace {
+
+constexpr std::uint32_t steps = 1u << 20;
+volatile std::uint16_t sink;
+
+cia402::axis enabled_axis(const cia402::profile& p) {
+  cia402::axis a = cia402::make_axis(p);
+  cia402::drive_inputs in;
+  for (std::uint16_t w : {0x00, 0x00, 0x06, 0x0F, 0x0F}) {
+    in.control_word = w;
+    cia402::step(p, a, in);
+  }
+  return a;
+}
+
+__attribute__((noinline)) void core_quiet(const cia402::profile& p, cia402::axis& a) {
+  cia402::drive_inputs in;
+  in.control_word = 0x0F;
+  for (std::uint32_t i = 0; i < steps; ++i) sink = cia402::step(p, a, in).status_word;
+}
+
+__attribute__((noinline)) void compiled_quiet(const cia402::compiled_profile& c, cia402::axis& a) {
+  cia402::drive_inputs in;
+  in.control_word = 0x0F;
+  for (std::uint32_t i = 0; i < steps; ++i) sink = cia402::step(c, a, in).status_word;
+}
+
+__attribute__((noinline)) void compiled_transitions(const cia402::compiled_profile& c, cia402::axis& a) {
+  cia402::drive_inputs in;
+  std::uint32_t seed = 402;
+  for (std::uint32_t i = 0; i < steps; ++i) {
+    in.control_word = bench::transition_word(seed);
+    sink = cia402::step(c, a, in).status_word;
+  }
+}
+
+__attribute__((noinline)) void table_quiet(const bench::lookup_table& t, bench::lookup_table::axis& a) {
+  for (std::uint32_t i = 0; i < steps; ++i) sink = t.step(a, 0x0F);
+}
+
+__attribute__((noinline)) void core_transitions(const cia402::profile& p, cia402::axis& a) {
+  cia402::drive_inputs in;
+  std::uint32_t seed = 402;
+  for (std::uint32_t i = 0; i < steps; ++i) {
+    in.control_word = bench::transition_word(seed);
+    sink = cia402::step(p, a, in).status_word;
+  }
+}
+
+__attribute__((noinline)) void table_transitions(const bench::lookup_table& t, bench::lookup_table::axis& a) {
+  std::uint32_t seed = 402;
+  for (std::uint32_t i = 0; i < steps; ++i) sink = t.step(a, bench::transition_word(seed));
+}
+
+__attribute__((noinline)) void master_repeated(const cia402::master_policy& policy) {
+  cia402::master m;
+  m.set_target(policy, 0, 0);
+  for (std::uint32_t i = 0; i < steps; ++i) sink = m.step(0x0237, i);
+}
+
+
+__attribute__((noinline)) void master_changing(const cia402::master_policy& policy) {
+  cia402::master m;
+  m.set_target(policy, 0, 0);
+  for (std::uint32_t i = 0; i < steps; ++i) {
+    sink = m.step(static_cast<std::uint16_t>(0x0237 | ((i & 1u) << 7)), i);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const char* which = argc > 1 ? argv[1] : "";
+  const char* name = argc > 2 ? argv[2] : "cia402";
+  const cia402::profile* p = cia402::find_builtin_profile(name);
+  if (p == nullptr) return 2;
+  const bench::lookup_table table;
+  bench::lookup_table::axis ta;
+  cia402::axis a = enabled_axis(*p);
+  const cia402::compiled_profile compiled(*p);
+  if (std::strcmp(which, "core_quiet") == 0) core_quiet(*p, a);
+  else if (std::strcmp(which, "compiled_quiet") == 0) compiled_quiet(compiled, a);
+  else if (std::strcmp(which, "compiled_transitions") == 0) compiled_transitions(compiled, a);
+  else if (std::strcmp(which, "table_quiet") == 0) { ta.state = 3; table_quiet(table, ta); }
+  else if (std::strcmp(which, "core_transitions") == 0) core_transitions(*p, a);
+  else if (std::strcmp(which, "table_transitions") == 0) table_transitions(table, ta);
+  else if (std::strcmp(which, "master_repeated") == 0 || std::strcmp(which, "master_changing") == 0) {
+    const cia402::master_policy policy = cia402::master_policy::make(*p, a, cia402::state::operation_enabled);
+    if (which[7] == 'r') master_repeated(policy); else master_changing(policy);
+  } else {
+    std::fprintf(stderr, "usage: instructions SCENARIO [PROFILE]\n");
+    return 2;
+  }
+  std::printf("%u steps\n", steps);
+  return 0;
+}
