@@ -4,6 +4,7 @@
 #include "cli/replay.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <sstream>
@@ -441,4 +442,30 @@ TEST(replay_cli, help_exits_zero_and_names_every_subcommand) {
 }
 
 }  // namespace
+}  // namespace cia402
+
+namespace cia402 {
+
+// Every line replay prints is valid JSON, whatever bytes it is fed: bytes that are not UTF-8 are
+// echoed as U+FFFD in the error, never raw.
+TEST(replay, every_line_is_valid_json_whatever_the_input_bytes) {
+  const std::string inputs[] = {
+      std::string("\xcf\n"),        std::string("cw \xff\xfe\n"),
+      std::string("\xd0\xb9 on\n"), std::string("fault \xc3\x28\n"),
+      std::string("set 0x605A \xe2\x82\n"), std::string("bogus\x01\x1f\x7f\n"),
+      std::string("cw 6\0x\n", 7),
+  };
+  for (const std::string& input : inputs) {
+    const auto r = test::run_tool({"replay", "--profile", "cia402"}, input);
+    EXPECT_EQ(r.exit_code, 0);
+    const auto lines = test::whole_lines(r);
+    ASSERT_EQ(lines.size(), 2u) << r.out;
+    for (const std::string& line : lines) {
+      const auto parsed = nlohmann::json::parse(line, nullptr, false);
+      EXPECT_FALSE(parsed.is_discarded()) << "not JSON: " << line;
+    }
+    EXPECT_NE(lines[1].find("\"error\""), std::string::npos) << lines[1];
+  }
+}
+
 }  // namespace cia402

@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <istream>
+#include <nlohmann/json.hpp>
 #include <ostream>
 
 #include "cli/common.hpp"
@@ -98,8 +99,11 @@ std::string replay_session::settle() {
   return line + "}";
 }
 
+// The reason may echo bytes of the input that are not UTF-8: they become U+FFFD, so every line
+// replay prints is valid JSON whatever it was fed.
 std::string replay_session::error(std::string_view reason, int line_number) const {
-  return "{\"error\":\"" + json_escape(reason) + "\",\"line\":" + std::to_string(line_number) + "}";
+  const nlohmann::ordered_json line = {{"error", std::string(reason)}, {"line", line_number}};
+  return line.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 std::string replay_session::feed(std::string_view line, int line_number) {
