@@ -30,9 +30,13 @@ constexpr std::uint16_t state_bit(state s) noexcept {
 /// The standard's name in upper snake case: "OPERATION_ENABLED". Never null.
 const char* state_name(state s) noexcept;
 
-/// Parses an upper or lower snake-case name ("operation_enabled", "QUICK_STOP_ACTIVE").
-/// Returns false and leaves `out` untouched when the name is unknown.
+/// Parses an upper or lower snake-case name ("operation_enabled", "QUICK_STOP_ACTIVE") or its
+/// abbreviation ("OE", "qsa"; state_abbreviation). Returns false and leaves `out` untouched when the
+/// name is unknown.
 bool parse_state(std::string_view name, state& out) noexcept;
+
+/// "NRTSO", "SOD", "RTSO", "SO", "OE", "QSA", "FRA", "F" ("START" for the power-on pseudo state).
+const char* state_abbreviation(state s) noexcept;
 
 /// The transition number reported when no transition was taken.
 inline constexpr std::uint8_t no_transition = 0xFF;

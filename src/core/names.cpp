@@ -54,14 +54,24 @@ const char* state_name(state s) noexcept {
   return i < state_count ? state_names[i] : "UNKNOWN";
 }
 
+// The short forms the docs and masters' logs use, by state.
+constexpr const char* state_abbreviations[state_count] = {
+    "START", "NRTSO", "SOD", "RTSO", "SO", "OE", "QSA", "FRA", "F",
+};
+
 bool parse_state(std::string_view name, state& out) noexcept {
   for (int i = 0; i < state_count; ++i) {
-    if (same_name(name, state_names[i])) {
+    if (same_name(name, state_names[i]) || same_name(name, state_abbreviations[i])) {
       out = static_cast<state>(i);
       return true;
     }
   }
   return false;
+}
+
+const char* state_abbreviation(state s) noexcept {
+  const auto i = static_cast<unsigned>(s);
+  return i < static_cast<unsigned>(state_count) ? state_abbreviations[i] : "?";
 }
 
 const char* command_name(command c) noexcept {

@@ -21,6 +21,26 @@ TEST(path_cli, switch_on_disabled_to_operation_enabled_takes_shutdown_then_enabl
   EXPECT_NE(r.lines[3].find("-> OPERATION_ENABLED"), std::string::npos);
 }
 
+TEST(path_cli, abbreviations_name_the_same_states_as_the_full_names) {
+  const auto full = run_tool({"path", "SWITCH_ON_DISABLED", "OPERATION_ENABLED"});
+  const auto short_names = run_tool({"path", "SOD", "OE"});
+  ASSERT_EQ(short_names.exit_code, 0) << short_names.err;
+  EXPECT_EQ(short_names.out, full.out);
+  EXPECT_EQ(run_tool({"path", "qsa", "so", "--set", "0x605A=6"}).out,
+            run_tool({"path", "QUICK_STOP_ACTIVE", "SWITCHED_ON", "--set", "0x605A=6"}).out);
+}
+
+TEST(path_cli, an_unknown_state_is_refused_with_every_valid_name) {
+  const auto r = run_tool({"path", "SODD", "OE"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("unknown state 'SODD'"), std::string::npos) << r.err;
+  for (const char* name : {"NOT_READY_TO_SWITCH_ON (NRTSO)", "SWITCH_ON_DISABLED (SOD)",
+                           "READY_TO_SWITCH_ON (RTSO)", "SWITCHED_ON (SO)", "OPERATION_ENABLED (OE)",
+                           "QUICK_STOP_ACTIVE (QSA)", "FAULT_REACTION_ACTIVE (FRA)", "FAULT (F)"}) {
+    EXPECT_NE(r.err.find(name), std::string::npos) << name << " missing from: " << r.err;
+  }
+}
+
 TEST(path_cli, from_fault_starts_with_the_reset_edge) {
   const auto r = run_tool({"path", "fault", "switch_on_disabled"});
   ASSERT_EQ(r.exit_code, 0) << r.err;

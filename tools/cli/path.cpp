@@ -21,14 +21,17 @@ int run_path(const profile& p, const std::vector<option_write>& writes, const st
              const std::string& to, std::ostream& out, std::ostream& err) {
   state start;
   state target;
-  if (!parse_state(from, start) || start == state::start) {
-    err << "cia402 path: unknown state '" << from << "'\n";
+  const auto unknown = [&](const std::string& name) {
+    err << "cia402 path: unknown state '" << name << "'; the states are";
+    for (int i = 1; i < state_count; ++i) {
+      const auto s = static_cast<state>(i);
+      err << (i == 1 ? " " : ", ") << state_name(s) << " (" << state_abbreviation(s) << ")";
+    }
+    err << "\n";
     return 2;
-  }
-  if (!parse_state(to, target) || target == state::start) {
-    err << "cia402 path: unknown state '" << to << "'\n";
-    return 2;
-  }
+  };
+  if (!parse_state(from, start) || start == state::start) return unknown(std::string(from));
+  if (!parse_state(to, target) || target == state::start) return unknown(std::string(to));
   axis options = make_axis(p);
   for (const option_write& w : writes) {
     const sdo_abort abort = write_option(p, options, w.index, w.value);
