@@ -121,6 +121,11 @@ fault_now fault_of(const profile& p, const axis& a, const drive_inputs& in) noex
   return {};
 }
 
+bool raised_by_drive(std::uint16_t code) noexcept {
+  return code == error_code::safe_torque_off || code == error_code::dc_link_undervoltage ||
+         code == error_code::heartbeat;
+}
+
 void set_flag(axis& a, std::uint8_t flag, bool on) noexcept {
   a.flags = static_cast<std::uint8_t>(on ? (a.flags | flag) : (a.flags & ~flag));
 }
@@ -268,9 +273,12 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
       commit = take;
     }
   }
-  // S4: in FAULT REACTION ACTIVE and FAULT a new fault is recorded, whatever else happens.
+  // S4: in FAULT REACTION ACTIVE and FAULT a new fault is recorded, whatever else happens. A fault
+  // the drive raised itself (STO or undervoltage under torque, a lost link) came after the outside
+  // cause that is still present, so that cause does not write over it.
   if ((f & bits(fact::fault)) &&
-      (a.current == state::fault_reaction_active || a.current == state::fault)) {
+      (a.current == state::fault_reaction_active || a.current == state::fault) &&
+      (fault.internal || !raised_by_drive(a.error_code))) {
     a.error_code = fault.code;
   }
 
