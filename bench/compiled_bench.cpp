@@ -55,6 +55,17 @@ void compiled_transitions(benchmark::State& st, const cia402::profile* p) {
   }
 }
 
+// The interpreting step on the same sequence: what the table replaces.
+void profile_transitions(benchmark::State& st, const cia402::profile* p) {
+  cia402::axis a = enabled_axis(*p);
+  cia402::drive_inputs in;
+  std::uint32_t seed = 402;
+  for (auto _ : st) {
+    in.control_word = bench::transition_word(seed);
+    benchmark::DoNotOptimize(cia402::step(*p, a, in));
+  }
+}
+
 constexpr std::size_t axes = 10000;
 
 void lookup_axes(benchmark::State& st) {
@@ -124,6 +135,8 @@ const bool registered = [] {
     benchmark::RegisterBenchmark((std::string("compiled_quiet/") + p->name).c_str(), compiled_quiet, p);
     benchmark::RegisterBenchmark((std::string("compiled_transitions/") + p->name).c_str(),
                                  compiled_transitions, p);
+    benchmark::RegisterBenchmark((std::string("profile_transitions/") + p->name).c_str(),
+                                 profile_transitions, p);
   }
   benchmark::RegisterBenchmark("lookup_axes", lookup_axes);
   benchmark::RegisterBenchmark("compiled_axes", compiled_axes);

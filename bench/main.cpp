@@ -49,6 +49,7 @@ class ratio_reporter : public benchmark::ConsoleReporter {
     if (auto b = swap("drive_cycle_axes", "baseline_cycle_axes"); !b.empty()) return b;
     if (auto b = swap("compiled_quiet/", "lookup_quiet"); !b.empty()) return b;
     if (auto b = swap("compiled_transitions/", "lookup_transitions"); !b.empty()) return b;
+    if (auto b = swap("profile_transitions/", "lookup_transitions"); !b.empty()) return b;
     if (name == "compiled_axes") return "lookup_axes";
     if (name == "master_new_word") return "master_repeated_word";
     if (name == "master_step_steady") return "baseline_master_steady";

@@ -87,9 +87,6 @@ constexpr unsigned actions = shift(offsetof(drive_outputs, current) + 1, 1);  //
 constexpr unsigned status_word = shift(offsetof(drive_outputs, status_word), 2);
 constexpr unsigned transition = shift(offsetof(drive_outputs, transition), 1);
 constexpr unsigned ramp = shift(offsetof(drive_outputs, ramp), 1);
-constexpr unsigned clear_setpoints = shift(offsetof(drive_outputs, clear_setpoints), 1);
-constexpr unsigned error_code = shift(offsetof(drive_outputs, error_code), 2);
-constexpr unsigned error_register = shift(offsetof(drive_outputs, error_register), 1);
 static_assert(offsetof(drive_outputs, status_word) == 2, "a padding byte follows `current`");
 }  // namespace outputs_layout
 
@@ -117,7 +114,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   if (actions & compiled_profile::fallback) return detail::full_step(p, a, in);
 
   unsigned keep = ~static_cast<unsigned>(axis_flag::fault_reset_bit | axis_flag::torque_on);
-  std::uint64_t hi = 0;
+  bool clear_setpoints = false;
   if (actions & compiled_profile::commit) {
     a.current = static_cast<state>((lo >> at::current) & 0xFFu);
     a.last_transition = static_cast<std::uint8_t>((lo >> at::transition) & 0xFFu);
@@ -127,32 +124,33 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
       keep &= ~static_cast<unsigned>(axis_flag::coast_reaction);
       a.error_code = 0;
     }
-    hi = static_cast<std::uint64_t>((actions >> 3) & 1u) << at::clear_setpoints;
+    clear_setpoints = (actions & compiled_profile::clears) != 0;
   }
   // Torque is on exactly where the entry's brake is released (a resting state, S12).
   const unsigned torque = static_cast<unsigned>(lo >> at::shift(offsetof(drive_outputs, torque), 1)) & 1u;
   a.flags = static_cast<std::uint8_t>((flags & keep) | bit7 | (torque << 1));
-  unsigned status = (static_cast<unsigned>(in.warning) << 7) |
-                    (static_cast<unsigned>(in.internal_limit) << 11) |
-                    (in.mode_status_bits & status_bit::mode_specific);
+  unsigned status = static_cast<unsigned>(lo >> at::status_word) & 0xFFFFu;
+  status |= (static_cast<unsigned>(in.warning) << 7) | (static_cast<unsigned>(in.internal_limit) << 11) |
+            (in.mode_status_bits & status_bit::mode_specific);
+  // Field by field, not one copy of the entry: the caller reads the outputs back in registers, and
+  // a load that spans several narrower stores waits for all of them (store forwarding).
+  drive_outputs out;
+  out.ramp = stop_ramp::none;
   if (actions & compiled_profile::run) {
     const bool halt = ((cw >> 8) & 1u) & c.has_halt_;
     // 0x605D: 1 slow-down, 2 quick-stop, 3 current limit, 4 voltage limit (stop_ramp's values, S8).
-    if (halt) {
-      lo |= static_cast<std::uint64_t>(static_cast<std::uint8_t>(a.options[static_cast<int>(option::halt)]))
-            << at::ramp;
-    }
+    if (halt) out.ramp = static_cast<stop_ramp>(a.options[static_cast<int>(option::halt)]);
     status |= static_cast<unsigned>(halt ? in.standstill : in.target_reached) << 10;
   }
-  lo = (lo & ~(std::uint64_t{0xFF} << at::actions)) | (static_cast<std::uint64_t>(status) << at::status_word);
+  out.current = static_cast<state>((lo >> at::current) & 0xFFu);
+  out.status_word = static_cast<std::uint16_t>(status);
+  out.transition = static_cast<std::uint8_t>((lo >> at::transition) & 0xFFu);
+  out.torque = torque != 0;
+  out.brake_released = torque != 0;
+  out.clear_setpoints = clear_setpoints;
   const std::uint16_t code = a.error_code;
-  if (code != 0) {
-    hi |= (static_cast<std::uint64_t>(code) << at::error_code) |
-          (static_cast<std::uint64_t>(error_register_of(code)) << at::error_register);
-  }
-  drive_outputs out;
-  std::memcpy(static_cast<void*>(&out), &lo, 8);
-  std::memcpy(static_cast<unsigned char*>(static_cast<void*>(&out)) + 8, &hi, sizeof(drive_outputs) - 8);
+  out.error_code = code;
+  out.error_register = code ? error_register_of(code) : std::uint8_t{0};
   return out;
 }
 
