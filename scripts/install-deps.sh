@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfmt-dev libcpp-httplib-dev
-  graphviz
+  graphviz valgrind
   gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib
   chromium python3-can python3-pytest
 )

@@ -3,7 +3,8 @@
 # it installs what it needs first. Exits non-zero at the first failure.
 #   dev preset: build + ctest; asan-ubsan preset: build + ctest; no-exceptions preset: build the core
 #   alone as C++17 without exceptions or RTTI; release preset: benchmarks (a short run, ratios to the
-#   baseline), the Cortex-M4 flash and RAM, the state diagrams against docs/diagrams; then
+#   baseline), instructions per step (callgrind), the Cortex-M4 flash and RAM, the state diagrams
+#   against docs/diagrams; then
 #   scripts/test-consumer.sh.
 set -euo pipefail
 
@@ -58,6 +59,7 @@ banner release
 cmake --preset release
 cmake --build --preset release
 build/release/bench/cia402_bench --benchmark_min_time=0.05
+bash bench/instructions/instructions.sh build/release/bench/cia402_instructions
 bash bench/cortex_m4/size.sh build/cortex-m4
 bash scripts/diagrams.sh build/release/tools/cia402 --check
 done_steps+=("release: bench, cortex-m4 size, diagrams")
