@@ -47,7 +47,7 @@ class compiled_profile {
 
   const profile* profile_;
   std::array<std::uint64_t, entry_count> table_{};
-  std::uint32_t speed_span_ = 0;  ///< 2 * limit - 2: |speed| < limit is (speed + limit - 1) <= this
+  std::uint64_t speed_span_ = 0;  ///< 2 * limit - 2: |speed| < limit is (speed + limit - 1) <= this
   bool has_speed_limit_ = false;
   bool has_halt_ = false;         ///< 0x605D exists: control-word bit 8 halts
 };
@@ -97,8 +97,9 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   const profile& p = *c.profile_;
   std::uint64_t head;
   std::memcpy(&head, &in, 8);
+  // |speed| < limit as one unsigned compare, in 64 bits so no limit or speed can overflow it.
   const bool slow = c.has_speed_limit_ &&
-                    static_cast<std::uint32_t>(in.actual_speed_rpm + p.speed_limit_rpm - 1) >
+                    static_cast<std::uint64_t>(std::int64_t{in.actual_speed_rpm} + p.speed_limit_rpm - 1) >
                         c.speed_span_;
   if ((head != detail::ordinary_head()) | (a.pending_row != no_pending_row) | slow) {
     return detail::full_step(p, a, in);

@@ -73,7 +73,7 @@ bool resting(const profile& p, state s) noexcept {
 
 compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
   has_speed_limit_ = p.speed_limit_rpm > 0;
-  speed_span_ = has_speed_limit_ ? static_cast<std::uint32_t>(2 * p.speed_limit_rpm - 2) : 0u;
+  speed_span_ = has_speed_limit_ ? static_cast<std::uint64_t>(2 * std::int64_t{p.speed_limit_rpm} - 2) : 0u;
   has_halt_ = p.spec(option::halt).exists();
   const std::array<std::uint8_t, 8> words = word_of_command(p);
   // Every fact an ordinary cycle does not fix, both ways: where the full step does not care, the

@@ -127,3 +127,33 @@ TEST(model_check, reports_each_broken_invariant) {
 
 }  // namespace
 }  // namespace cia402
+
+namespace cia402 {
+namespace {
+
+// The compiled step's speed test must not overflow for any limit or speed a profile file can hold.
+TEST(compiled_step, extreme_speed_limits_and_speeds_agree_with_the_full_step) {
+  for (const std::int32_t limit : {1, 1000, 0x3FFFFFFF, INT32_MAX}) {
+    custom_profile c(*find_builtin_profile("lexium32"));
+    c.settings().speed_limit_rpm = limit;
+    c.finalize();
+    const compiled_profile compiled(c.get());
+    for (const std::int32_t speed : {INT32_MIN, INT32_MIN + 1, -limit, -limit + 1, -1, 0, 1,
+                                     limit - 1, limit, INT32_MAX}) {
+      axis a = make_axis(c.get());
+      axis b = a;
+      drive_inputs in;
+      in.actual_speed_rpm = speed;
+      for (const std::uint16_t cw : {0x00, 0x00, 0x06, 0x0F, 0x0F, 0x07, 0x0F}) {
+        in.control_word = cw;
+        const drive_outputs x = detail::full_step(c.get(), a, in);
+        const drive_outputs y = step(compiled, b, in);
+        EXPECT_TRUE(model_check::same_outputs(x, y)) << "limit " << limit << " speed " << speed;
+        EXPECT_EQ(std::memcmp(&a, &b, sizeof(axis)), 0) << "limit " << limit << " speed " << speed;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace cia402
