@@ -13,15 +13,7 @@
 
 namespace {
 
-cia402::axis enabled_axis(const cia402::profile& p) {
-  cia402::axis a = cia402::make_axis(p);
-  cia402::drive_inputs in;
-  for (std::uint16_t w : {0x00, 0x00, 0x06, 0x0F, 0x0F}) {
-    in.control_word = w;
-    cia402::step(p, a, in);
-  }
-  return a;
-}
+using bench::enabled_axis;
 
 void lookup_quiet(benchmark::State& st) {
   const bench::lookup_table t;
@@ -96,7 +88,9 @@ void compiled_axes(benchmark::State& st) {
   st.SetItemsProcessed(static_cast<std::int64_t>(st.iterations() * axes));
 }
 
-void master_repeated_word(benchmark::State& st) {
+// The master in OPERATION ENABLED, its status word XORed with `toggle` every cycle: 0 repeats the
+// word, the warning bit 7 gives a new word in the same state each time.
+void master_words(benchmark::State& st, std::uint16_t toggle) {
   const cia402::profile& p = cia402::standard_profile();
   const auto policy =
       cia402::master_policy::make(p, cia402::make_axis(p), cia402::state::operation_enabled);
@@ -106,26 +100,13 @@ void master_repeated_word(benchmark::State& st) {
   std::uint16_t word = 0x0237;
   for (auto _ : st) {
     benchmark::DoNotOptimize(m.step(word, ++now));
-    word ^= 0;  // the same work as the changing word's toggle
+    word ^= toggle;
     benchmark::DoNotOptimize(word);
   }
 }
 
-// OPERATION ENABLED throughout, with the warning bit 7 toggling every cycle: a new word each time.
-void master_new_word(benchmark::State& st) {
-  const cia402::profile& p = cia402::standard_profile();
-  const auto policy =
-      cia402::master_policy::make(p, cia402::make_axis(p), cia402::state::operation_enabled);
-  cia402::master m;
-  m.set_target(policy, 0, 0);
-  std::uint64_t now = 0;
-  std::uint16_t word = 0x0237;
-  for (auto _ : st) {
-    benchmark::DoNotOptimize(m.step(word, ++now));
-    word ^= cia402::status_bit::warning;
-    benchmark::DoNotOptimize(word);
-  }
-}
+void master_repeated_word(benchmark::State& st) { master_words(st, 0); }
+void master_new_word(benchmark::State& st) { master_words(st, cia402::status_bit::warning); }
 
 const bool registered = [] {
   benchmark::RegisterBenchmark("lookup_quiet", lookup_quiet);

@@ -1,10 +1,12 @@
-// The yardstick of the speed targets: a bare 256-entry lookup table, the fastest a drive state
+// The yardstick of the speed targets, and the scenarios measured against it: a bare 256-entry lookup table, the fastest a drive state
 // machine can be. Indexed by the state (3 bits) and control-word bits 0..4; it knows the standard's
 // commands and status patterns and nothing else (no faults, options, stops, brake or plant).
 #pragma once
 
 #include <array>
 #include <cstdint>
+
+#include "cia402/drive.hpp"
 
 namespace bench {
 
@@ -44,6 +46,17 @@ struct lookup_table {
 /// The sequence of the "a transition nearly every cycle" figure: a fixed pseudo-random choice among
 /// Disable voltage, Shutdown, Switch on, Enable operation, Quick stop and the same with bit 7 set.
 inline constexpr std::uint16_t transition_words[8] = {0x00, 0x06, 0x07, 0x0F, 0x0B, 0x80, 0x86, 0x8F};
+
+/// An axis of the profile in OPERATION ENABLED, brought there by real steps.
+inline cia402::axis enabled_axis(const cia402::profile& p) {
+  cia402::axis a = cia402::make_axis(p);
+  cia402::drive_inputs in;
+  for (std::uint16_t w : {0x00, 0x00, 0x06, 0x0F, 0x0F}) {
+    in.control_word = w;
+    cia402::step(p, a, in);
+  }
+  return a;
+}
 
 inline std::uint16_t transition_word(std::uint32_t& seed) noexcept {
   seed = seed * 1664525u + 1013904223u;  // a fixed LCG: the same sequence in every run

@@ -16,15 +16,7 @@ namespace {
 constexpr std::uint32_t steps = 1u << 20;
 volatile std::uint16_t sink;
 
-cia402::axis enabled_axis(const cia402::profile& p) {
-  cia402::axis a = cia402::make_axis(p);
-  cia402::drive_inputs in;
-  for (std::uint16_t w : {0x00, 0x00, 0x06, 0x0F, 0x0F}) {
-    in.control_word = w;
-    cia402::step(p, a, in);
-  }
-  return a;
-}
+using bench::enabled_axis;
 
 __attribute__((noinline)) void core_quiet(const cia402::profile& p, cia402::axis& a) {
   cia402::drive_inputs in;

@@ -1,7 +1,10 @@
 #include "page_names.hpp"
 
+#include <cctype>
+#include <string>
 #include <string_view>
 
+#include "cia402/objects.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 
 namespace cia402::page {
@@ -106,20 +109,23 @@ bit_names bit_names_for(const profile& p) {
   return {"controlword 0x6040", "statusword 0x6041", cia402_control, cia402_status};
 }
 
+// The objects the page lists for writing: the option codes the profile has and the ramps, named
+// from the one object table ("Quick stop option code" -> "quick stop option code (rpm/s)").
 std::vector<object_name> object_names(const profile& p) {
-  constexpr object_name options[] = {
-      {0x605A, "quick stop option code"},   {0x605B, "shutdown option code"},
-      {0x605C, "disable operation option code"}, {0x605D, "halt option code"},
-      {0x605E, "fault reaction option code"}, {0x6007, "abort connection option code"},
-  };
+  constexpr std::uint16_t listed[] = {0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007,
+                                      object_index::profile_acceleration, object_index::profile_deceleration,
+                                      object_index::quick_stop_deceleration};
   std::vector<object_name> out;
-  for (const object_name& o : options) {
+  for (const std::uint16_t index : listed) {
     option opt{};
-    if (option_of_index(o.index, opt) && p.spec(opt).exists()) out.push_back(o);
+    if (option_of_index(index, opt) && !p.spec(opt).exists()) continue;
+    const object_description* o = find_drive_object(index);
+    if (o == nullptr) continue;
+    std::string name = o->name;
+    if (!name.empty()) name[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(name[0])));
+    if (o->unit[0] != '\0') name += std::string(" (") + o->unit + ")";
+    out.push_back({index, std::move(name)});
   }
-  out.push_back({sim::object::profile_acceleration, "profile acceleration (rpm/s)"});
-  out.push_back({sim::object::profile_deceleration, "profile deceleration (rpm/s)"});
-  out.push_back({sim::object::quick_stop_deceleration, "quick stop deceleration (rpm/s)"});
   return out;
 }
 

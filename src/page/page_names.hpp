@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "cia402/profile.hpp"
@@ -23,7 +24,7 @@ bit_names bit_names_for(const profile& p);
 
 struct object_name {
   std::uint16_t index = 0;
-  const char* name = "";
+  std::string name;
 };
 
 /// The objects the page offers to write: the profile's option codes, then the ramps.

@@ -16,6 +16,7 @@
 #include "cia402/canopen/sdo_client.hpp"
 #include "cia402/canopen/timing.hpp"
 #include "cia402/master.hpp"
+#include "cia402/objects.hpp"
 #include "cia402/page/transition_inference.hpp"
 #include "cia402/words.hpp"
 #include "action_log.hpp"
@@ -35,34 +36,19 @@ using detail::hex;
 constexpr std::uint16_t bit7 = control_bit::fault_reset;
 constexpr const char* not_remote = "not available on a remote drive";
 
-// The sizes of the objects the page writes on a remote drive; the CANopen download needs them, and
+// The objects the page writes on a remote drive: the writable ones of the one object table, but
+// the control word, which commands and bit toggles set. The CANopen download needs their sizes, and
 // a value outside the type is refused here rather than cut to fit.
-struct object_type {
-  std::uint16_t index;
-  unsigned bytes;
-  bool is_signed;
-};
-constexpr object_type writable_objects[] = {
-    {0x605A, 2, true}, {0x605B, 2, true}, {0x605C, 2, true}, {0x605D, 2, true},
-    {0x605E, 2, true}, {0x6007, 2, true}, {0x6060, 1, true}, {0x6083, 4, false},
-    {0x6084, 4, false}, {0x6085, 4, false}, {0x60FF, 4, true},
-};
-
-const object_type* type_of(std::uint16_t index) {
-  for (const object_type& t : writable_objects) {
-    if (t.index == index) return &t;
-  }
-  return nullptr;
+const object_description* type_of(std::uint16_t index) {
+  const object_description* o = find_drive_object(index);
+  if (o == nullptr || o->access != object_access::read_write || index == 0x6040) return nullptr;
+  return o;
 }
 
 // Nothing if the value fits the object's type, else the abort code the drive would give.
-std::optional<sdo_abort> out_of_type(const object_type& t, std::int64_t v) {
-  const unsigned bits = 8 * t.bytes;
-  const std::int64_t low = t.is_signed ? -(std::int64_t{1} << (bits - 1)) : 0;
-  const std::int64_t high =
-      t.is_signed ? (std::int64_t{1} << (bits - 1)) - 1 : (std::int64_t{1} << bits) - 1;
-  if (v < low) return sdo_abort::value_too_low;
-  if (v > high) return sdo_abort::value_too_high;
+std::optional<sdo_abort> out_of_type(const object_description& t, std::int64_t v) {
+  if (v < type_low(t.type)) return sdo_abort::value_too_low;
+  if (v > type_high(t.type)) return sdo_abort::value_too_high;
   return std::nullopt;
 }
 
@@ -249,13 +235,13 @@ struct remote_drive::impl {
     setup.push_back(probe);
 
     for (const object_name& o : object_names(table)) {
-      const object_type* t = type_of(o.index);
-      sdo_job j = read(o.index, 0, true, t != nullptr && t->is_signed);
+      const object_description* t = find_drive_object(o.index);
+      sdo_job j = read(o.index, 0, true, t != nullptr && type_signed(t->type));
       const std::uint16_t index = o.index;
       j.then = [this, index](const co::sdo_client& c) {
         if (c.state() == co::sdo_client::status::done) {
-          const object_type* ty = type_of(index);
-          objects[index] = c.value(ty != nullptr && ty->is_signed);
+          const object_description* ty = find_drive_object(index);
+          objects[index] = c.value(ty != nullptr && type_signed(ty->type));
         } else {
           objects.erase(index);
         }
@@ -861,7 +847,7 @@ reply remote_drive::write_object(std::uint16_t index, std::int64_t value) {
   if (index == 0x6040) {
     return refused{400, "the control word is set by commands and bit toggles, not written here"};
   }
-  const object_type* t = type_of(index);
+  const object_description* t = type_of(index);
   if (t == nullptr) {
     return refused{400, "object " + hex(index, 4) +
                             " is not one the page writes on a remote drive (option codes, "
@@ -876,7 +862,7 @@ reply remote_drive::write_object(std::uint16_t index, std::int64_t value) {
     return refused{422, action + ": " + abort_text(*a), *a};
   }
   if (auto no = m.not_running()) return *no;
-  const auto w = m.download(lock, index, value, t->bytes, [&m, index, value] {
+  const auto w = m.download(lock, index, value, static_cast<unsigned>(type_size(t->type)), [&m, index, value] {
     m.objects[index] = value;
     if (index == 0x60FF) m.target_velocity = static_cast<std::int32_t>(value);
   });

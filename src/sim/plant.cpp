@@ -112,39 +112,6 @@ void remove_fault_at(axis_state& a, int i) noexcept {
   a.fault_classes[max_fault_causes - 1] = 0;
 }
 
-sdo_abort check_range(std::int64_t value, std::int64_t lo, std::int64_t hi) noexcept {
-  if (value < lo) return sdo_abort::value_too_low;
-  if (value > hi) return sdo_abort::value_too_high;
-  return sdo_abort::none;
-}
-
-bool read_only(std::uint16_t index) noexcept {
-  switch (index) {
-    case object::status_word:
-    case object::velocity_actual:
-    case object::error_code:
-    case object::error_register:
-    case object::modes_of_operation_display:
-      return true;
-    default:
-      return false;
-  }
-}
-
-bool writable(std::uint16_t index) noexcept {
-  switch (index) {
-    case object::control_word:
-    case object::target_velocity:
-    case object::profile_acceleration:
-    case object::profile_deceleration:
-    case object::quick_stop_deceleration:
-    case object::modes_of_operation:
-      return true;
-    default:
-      return false;
-  }
-}
-
 }  // namespace
 
 const char* check_plant_config(const plant_config& c) noexcept {
@@ -245,85 +212,82 @@ const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_
   return a.last;
 }
 
+namespace {
+
+// The object at index/sub as this drive has it: from the one object table, an option code only
+// where the profile has it. Existence, sub-index, access and range are checked here for every
+// object alike; what a value means is the switch's below.
+sdo_abort describe(const profile& p, std::uint16_t index, std::uint8_t sub,
+                   const object_description*& out) noexcept {
+  out = find_drive_object(index, 0);
+  option o;
+  if (out == nullptr || (option_of_index(index, o) && !p.spec(o).exists())) {
+    return sdo_abort::object_does_not_exist;
+  }
+  if (sub != 0) return sdo_abort::sub_index_does_not_exist;
+  return sdo_abort::none;
+}
+
+}  // namespace
+
 sdo_abort write_object(const profile& p, axis_state& a, std::uint16_t index, std::uint8_t sub,
                        std::int64_t value) noexcept {
-  option o;
-  if (option_of_index(index, o)) {
-    if (!p.spec(o).exists()) return sdo_abort::object_does_not_exist;
-    if (sub != 0) return sdo_abort::sub_index_does_not_exist;
-    if (const sdo_abort r = check_range(value, std::numeric_limits<std::int16_t>::min(),
-                                        std::numeric_limits<std::int16_t>::max());
-        r != sdo_abort::none) {
-      return r;
-    }
-    return write_option(p, a.core, index, static_cast<std::int32_t>(value));
+  if (index == object::error_register) {
+    return sub != 0 ? sdo_abort::sub_index_does_not_exist : sdo_abort::read_only_object;
   }
-  if (!read_only(index) && !writable(index)) return sdo_abort::object_does_not_exist;
-  if (sub != 0) return sdo_abort::sub_index_does_not_exist;
-  if (read_only(index)) return sdo_abort::read_only_object;
-
-  constexpr std::int64_t u32_max = std::numeric_limits<std::uint32_t>::max();
-  sdo_abort r = sdo_abort::none;
+  const object_description* o = nullptr;
+  if (const sdo_abort r = describe(p, index, sub, o); r != sdo_abort::none) return r;
+  if (const sdo_abort r = check_write(*o, value); r != sdo_abort::none) return r;
+  option opt;
+  if (option_of_index(index, opt)) return write_option(p, a.core, index, static_cast<std::int32_t>(value));
   switch (index) {
-    case object::control_word:
-      r = check_range(value, 0, 0xFFFF);
-      if (r == sdo_abort::none) a.control_word = static_cast<std::uint16_t>(value);
-      break;
+    case object::control_word: a.control_word = static_cast<std::uint16_t>(value); break;
     case object::target_velocity:
-      r = check_range(value, std::numeric_limits<std::int32_t>::min(),
-                      std::numeric_limits<std::int32_t>::max());
-      if (r == sdo_abort::none) {
-        a.target_velocity = static_cast<std::int32_t>(value);
-        set_flag(a, sim_flag::setpoints_cleared, false);
-      }
+      a.target_velocity = static_cast<std::int32_t>(value);
+      set_flag(a, sim_flag::setpoints_cleared, false);
       break;
-    case object::profile_acceleration:
-    case object::profile_deceleration:
-    case object::quick_stop_deceleration: {
-      r = check_range(value, 1, u32_max);
-      if (r != sdo_abort::none) break;
-      const auto v = static_cast<std::uint32_t>(value);
-      if (index == object::profile_acceleration) a.acceleration = v;
-      if (index == object::profile_deceleration) a.deceleration = v;
-      if (index == object::quick_stop_deceleration) a.quick_stop_deceleration = v;
+    case object::profile_acceleration: a.acceleration = static_cast<std::uint32_t>(value); break;
+    case object::profile_deceleration: a.deceleration = static_cast<std::uint32_t>(value); break;
+    case object::quick_stop_deceleration:
+      a.quick_stop_deceleration = static_cast<std::uint32_t>(value);
       break;
-    }
     case object::modes_of_operation:
-      r = check_range(value, std::numeric_limits<std::int8_t>::min(),
-                      std::numeric_limits<std::int8_t>::max());
-      if (r == sdo_abort::none && value != profile_velocity_mode) r = sdo_abort::invalid_value;
+      if (value != profile_velocity_mode) return sdo_abort::invalid_value;
       break;
-    default:
-      r = sdo_abort::object_does_not_exist;
+    default: return sdo_abort::object_does_not_exist;
   }
-  return r;
+  return sdo_abort::none;
 }
 
 sdo_abort read_object(const profile& p, const axis_state& a, std::uint16_t index, std::uint8_t sub,
                       std::int64_t& value) noexcept {
-  option o;
-  if (option_of_index(index, o)) {
-    if (!p.spec(o).exists()) return sdo_abort::object_does_not_exist;
+  if (index == object::error_register) {
     if (sub != 0) return sdo_abort::sub_index_does_not_exist;
+    value = error_register_of(a.core.error_code);
+    return sdo_abort::none;
+  }
+  const object_description* o = nullptr;
+  if (const sdo_abort r = describe(p, index, sub, o); r != sdo_abort::none) return r;
+  if (o->access == object_access::write_only) return sdo_abort::write_only_object;
+  option opt;
+  if (option_of_index(index, opt)) {
     std::int32_t v = 0;
     const sdo_abort r = read_option(p, a.core, index, v);
     if (r == sdo_abort::none) value = v;
     return r;
   }
-  if (!read_only(index) && !writable(index)) return sdo_abort::object_does_not_exist;
-  if (sub != 0) return sdo_abort::sub_index_does_not_exist;
   switch (index) {
     case object::control_word: value = a.control_word; break;
     case object::status_word: value = a.last.status_word; break;
     case object::target_velocity: value = a.target_velocity; break;
-    case object::velocity_actual: value = velocity_rpm(a); break;
+    case object::velocity_actual_value: value = velocity_rpm(a); break;
     case object::profile_acceleration: value = a.acceleration; break;
     case object::profile_deceleration: value = a.deceleration; break;
     case object::quick_stop_deceleration: value = a.quick_stop_deceleration; break;
     case object::error_code: value = a.core.error_code; break;
-    case object::error_register: value = error_register_of(a.core.error_code); break;
     case object::modes_of_operation:
     case object::modes_of_operation_display: value = profile_velocity_mode; break;
+    case object::supported_drive_modes: value = o->default_value; break;
     default: return sdo_abort::object_does_not_exist;
   }
   return sdo_abort::none;

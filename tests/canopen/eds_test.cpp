@@ -7,7 +7,11 @@
 #include <sstream>
 #include <string>
 
+#include <algorithm>
+
+#include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/eds.hpp"
+#include "cia402/objects.hpp"
 #include "cia402/canopen/sim_device.hpp"
 #include "cia402/canopen/virtual_bus.hpp"
 
@@ -118,3 +122,33 @@ TEST(eds, option_code_the_profile_lacks_is_left_out) {
 
 }  // namespace
 }  // namespace cia402::canopen
+
+namespace {
+
+// The CANopen dictionary takes the drive profile's objects from the one table: same type, access,
+// PDO mapping and limits, and their values are the device's.
+TEST(eds, the_dictionary_holds_every_object_of_the_one_table_as_it_describes_it) {
+  const std::vector<cia402::canopen::object_entry> od = cia402::canopen::drive_objects();
+  for (std::size_t i = 0; i < cia402::drive_object_count(); ++i) {
+    const cia402::object_description& d = cia402::drive_object(i);
+    SCOPED_TRACE(d.name);
+    const auto it = std::find_if(od.begin(), od.end(), [&](const auto& e) { return e.index == d.index; });
+    ASSERT_NE(it, od.end());
+    ASSERT_EQ(it->subs.size(), 1u);
+    const cia402::canopen::sub_entry& e = it->subs[0];
+    EXPECT_EQ(static_cast<unsigned>(e.type), static_cast<unsigned>(d.type));
+    EXPECT_EQ(e.name, d.name);
+    EXPECT_EQ(e.pdo_mappable, d.pdo_mappable);
+    EXPECT_EQ(e.acc == cia402::canopen::access::ro, d.access == cia402::object_access::read_only);
+    EXPECT_EQ(e.where, cia402::canopen::backing::device);
+    if (e.has_limits) {
+      EXPECT_EQ(e.low, d.low);
+      EXPECT_EQ(e.high, d.high);
+    } else {
+      EXPECT_EQ(d.low, cia402::type_low(d.type));
+      EXPECT_EQ(d.high, cia402::type_high(d.type));
+    }
+  }
+}
+
+}  // namespace

@@ -25,6 +25,7 @@
 #include "cia402/drive.hpp"
 #include "cia402/master.hpp"
 #include "cia402/profile.hpp"
+#include "test_support.hpp"
 
 namespace cia402::model_check {
 
@@ -147,12 +148,7 @@ inline std::string describe(const axis& a) {
   return os.str();
 }
 
-inline bool same_outputs(const drive_outputs& a, const drive_outputs& b) {
-  return a.current == b.current && a.status_word == b.status_word && a.transition == b.transition &&
-         a.ramp == b.ramp && a.torque == b.torque && a.brake_released == b.brake_released &&
-         a.clear_setpoints == b.clear_setpoints && a.error_code == b.error_code &&
-         a.error_register == b.error_register;
-}
+using test::same_outputs;
 
 struct axis_key {
   std::array<std::uint8_t, sizeof(axis)> bytes{};

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "cia402/objects.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 #include "sim_support.hpp"
 
@@ -159,6 +160,36 @@ TEST(objects, a_control_word_write_acts_in_the_next_cycle) {
   ASSERT_EQ(d.write(0x6040, 0, 0x0006), sdo_abort::none);
   EXPECT_EQ(d.view().current(), state::switch_on_disabled);
   EXPECT_EQ(d.step().transition, 2);
+}
+
+}  // namespace
+
+namespace {
+
+// Every object of the one table (cia402/objects.hpp) is the virtual drive's: readable where the
+// table says so, refused as read-only where it says so, and writable at its limits.
+TEST(objects, the_virtual_drive_answers_every_object_of_the_one_table) {
+  virtual_drive d(standard_profile());
+  for (std::size_t i = 0; i < cia402::drive_object_count(); ++i) {
+    const cia402::object_description& o = cia402::drive_object(i);
+    SCOPED_TRACE(o.name);
+    std::int64_t value = 0;
+    ASSERT_EQ(d.read(o.index, o.sub, value), sdo_abort::none);
+    EXPECT_GE(value, cia402::type_low(o.type));
+    EXPECT_LE(value, cia402::type_high(o.type));
+    if (o.access == cia402::object_access::read_only) {
+      EXPECT_EQ(d.write(o.index, o.sub, value), sdo_abort::read_only_object);
+      continue;
+    }
+    if (o.index == 0x6060 || (o.index >= 0x605A && o.index <= 0x605E) || o.index == 0x6007) {
+      continue;  // which values these take is the profile's (S5..S10) and the mode's
+    }
+    EXPECT_EQ(d.write(o.index, o.sub, o.low - 1), sdo_abort::value_too_low);
+    EXPECT_EQ(d.write(o.index, o.sub, o.high + 1), sdo_abort::value_too_high);
+    EXPECT_EQ(d.write(o.index, o.sub, o.high), sdo_abort::none);
+    ASSERT_EQ(d.read(o.index, o.sub, value), sdo_abort::none);
+    EXPECT_EQ(value, o.high);
+  }
 }
 
 }  // namespace

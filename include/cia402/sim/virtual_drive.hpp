@@ -6,26 +6,19 @@
 #include <cstdint>
 
 #include "cia402/drive.hpp"
+#include "cia402/objects.hpp"
 #include "cia402/profile.hpp"
 #include "cia402/sdo_abort.hpp"
 #include "cia402/sim/plant.hpp"
 
 namespace cia402::sim {
 
-/// Objects of the virtual drive's dictionary (all sub-index 0).
+/// The virtual drive's objects: the drive profile's, described once in cia402/objects.hpp (index,
+/// type, access, limits, name), and the CiA 301 error register beside them.
 namespace object {
-inline constexpr std::uint16_t error_register = 0x1001;    ///< UINT8, read-only
-inline constexpr std::uint16_t error_code = 0x603F;        ///< UINT16, read-only
-inline constexpr std::uint16_t control_word = 0x6040;      ///< UINT16
-inline constexpr std::uint16_t status_word = 0x6041;       ///< UINT16, read-only
-inline constexpr std::uint16_t modes_of_operation = 0x6060;          ///< INT8, only 3 (pv)
-inline constexpr std::uint16_t modes_of_operation_display = 0x6061;  ///< INT8, read-only: 3
-inline constexpr std::uint16_t velocity_actual = 0x606C;   ///< INT32 rpm, read-only
-inline constexpr std::uint16_t profile_acceleration = 0x6083;       ///< UINT32 rpm/s, >= 1
-inline constexpr std::uint16_t profile_deceleration = 0x6084;       ///< UINT32 rpm/s, >= 1
-inline constexpr std::uint16_t quick_stop_deceleration = 0x6085;    ///< UINT32 rpm/s, >= 1
-inline constexpr std::uint16_t target_velocity = 0x60FF;   ///< INT32 rpm
-/// Option codes 0x605A..0x605E and 0x6007 (INT16) go to cia402::write_option / read_option.
+using namespace cia402::object_index;
+inline constexpr std::uint16_t error_register = 0x1001;  ///< UINT8, read-only (CiA 301)
+/// Option codes 0x605A..0x605E and 0x6007 go to cia402::write_option / read_option.
 }  // namespace object
 
 /// The profile velocity mode, the only mode the plant runs (0x6060 / 0x6061).

@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "cia402/objects.hpp"
+
 namespace cia402::canopen {
 namespace {
 
@@ -179,39 +181,21 @@ std::vector<object_entry> drive_objects() {
   t.push_back(single(fault_injection_index, manufacturer,
                      var(0, "Fault injection", data_type::unsigned16, access::wo)));
 
-  const auto option_code = [](const char* name) {
-    return on_device(var(0, name, data_type::integer16, access::rw));
-  };
-  t.push_back(single(0x6007, optional, option_code("Abort connection option code")));
-  t.push_back(single(0x603F, optional,
-                     mappable(on_device(var(0, "Error code", data_type::unsigned16, access::ro)))));
-  t.push_back(single(0x6040, mandatory,
-                     mappable(on_device(var(0, "Controlword", data_type::unsigned16, access::rw)))));
-  t.push_back(single(0x6041, mandatory,
-                     mappable(on_device(var(0, "Statusword", data_type::unsigned16, access::ro)))));
-  t.push_back(single(0x605A, optional, option_code("Quick stop option code")));
-  t.push_back(single(0x605B, optional, option_code("Shutdown option code")));
-  t.push_back(single(0x605C, optional, option_code("Disable operation option code")));
-  t.push_back(single(0x605D, optional, option_code("Halt option code")));
-  t.push_back(single(0x605E, optional, option_code("Fault reaction option code")));
-  t.push_back(single(0x6060, optional, mappable(on_device(var(0, "Modes of operation",
-                                                              data_type::integer8, access::rw)))));
-  t.push_back(single(0x6061, optional, mappable(on_device(var(0, "Modes of operation display",
-                                                              data_type::integer8, access::ro)))));
-  t.push_back(single(0x606C, optional, mappable(on_device(var(0, "Velocity actual value",
-                                                              data_type::integer32, access::ro)))));
-  const auto ramp = [](const char* name) {
-    // A ramp of 0 would never end (the simulator refuses it too): the EDS says so as LowLimit.
-    return limited(mappable(on_device(var(0, name, data_type::unsigned32, access::rw))), 1,
-                   type_max(data_type::unsigned32));
-  };
-  t.push_back(single(0x6083, optional, ramp("Profile acceleration")));
-  t.push_back(single(0x6084, optional, ramp("Profile deceleration")));
-  t.push_back(single(0x6085, optional, ramp("Quick stop deceleration")));
-  t.push_back(single(0x60FF, optional, mappable(on_device(var(0, "Target velocity",
-                                                              data_type::integer32, access::rw)))));
-  t.push_back(single(0x6502, optional,
-                     var(0, "Supported drive modes", data_type::unsigned32, access::ro, 1u << 2)));
+  // The drive profile's objects, from the one table the whole project reads (cia402/objects.hpp);
+  // their values are the device's.
+  for (std::size_t i = 0; i < drive_object_count(); ++i) {
+    const object_description& d = drive_object(i);
+    const access acc = d.access == object_access::read_only    ? access::ro
+                       : d.access == object_access::write_only ? access::wo
+                                                               : access::rw;
+    sub_entry e = on_device(var(d.sub, d.name, static_cast<data_type>(d.type), acc, d.default_value));
+    e.pdo_mappable = d.pdo_mappable;
+    // The limits a write must keep, where they are narrower than the type (a ramp of 0 would never
+    // end): the EDS says so as LowLimit / HighLimit.
+    if (d.low != type_low(d.type) || d.high != type_high(d.type)) e = limited(std::move(e), d.low, d.high);
+    const bool mandatory_object = d.index == 0x6040 || d.index == 0x6041;
+    t.push_back(single(d.index, mandatory_object ? mandatory : optional, std::move(e)));
+  }
   return t;
 }
 

@@ -1,0 +1,74 @@
+// The one CiA 402 object table (include/cia402/objects.hpp): its entries as CiA 402 and CiA 301
+// give them, and the write check every layer uses.
+#include <gtest/gtest.h>
+
+#include "cia402/objects.hpp"
+#include "cia402/profile.hpp"
+
+namespace cia402 {
+namespace {
+
+TEST(objects, every_option_code_is_an_integer16_the_profile_decides_the_values_of) {
+  for (int i = 0; i < option_count; ++i) {
+    const std::uint16_t index = option_index(static_cast<option>(i));
+    const object_description* o = find_drive_object(index);
+    ASSERT_NE(o, nullptr) << std::hex << index;
+    EXPECT_EQ(o->type, object_type::integer16);
+    EXPECT_EQ(o->access, object_access::read_write);
+    EXPECT_FALSE(o->pdo_mappable);
+  }
+}
+
+TEST(objects, the_table_holds_the_drive_objects_with_their_types_and_access) {
+  struct expected {
+    std::uint16_t index;
+    object_type type;
+    object_access access;
+  };
+  // CiA 402-2: controlword UNSIGNED16 rw, statusword UNSIGNED16 ro, error code UNSIGNED16 ro,
+  // modes INTEGER8, velocity actual and target velocity INTEGER32, ramps UNSIGNED32.
+  const expected table[] = {
+      {0x603F, object_type::unsigned16, object_access::read_only},
+      {0x6040, object_type::unsigned16, object_access::read_write},
+      {0x6041, object_type::unsigned16, object_access::read_only},
+      {0x6060, object_type::integer8, object_access::read_write},
+      {0x6061, object_type::integer8, object_access::read_only},
+      {0x606C, object_type::integer32, object_access::read_only},
+      {0x6083, object_type::unsigned32, object_access::read_write},
+      {0x6084, object_type::unsigned32, object_access::read_write},
+      {0x6085, object_type::unsigned32, object_access::read_write},
+      {0x60FF, object_type::integer32, object_access::read_write},
+      {0x6502, object_type::unsigned32, object_access::read_only},
+  };
+  for (const expected& e : table) {
+    const object_description* o = find_drive_object(e.index);
+    ASSERT_NE(o, nullptr) << std::hex << e.index;
+    EXPECT_EQ(o->type, e.type) << std::hex << e.index;
+    EXPECT_EQ(o->access, e.access) << std::hex << e.index;
+    EXPECT_GE(o->low, type_low(o->type));
+    EXPECT_LE(o->high, type_high(o->type));
+    EXPECT_GE(o->default_value, o->low);
+    EXPECT_LE(o->default_value, o->high);
+    EXPECT_NE(o->name[0], '\0');
+  }
+  EXPECT_EQ(find_drive_object(0x6040, 1), nullptr) << "sub-index 1 does not exist";
+  EXPECT_EQ(find_drive_object(0x6000), nullptr);
+  for (std::size_t i = 1; i < drive_object_count(); ++i) {
+    EXPECT_LT(drive_object(i - 1).index, drive_object(i).index) << "kept in index order";
+  }
+}
+
+TEST(objects, a_write_is_checked_against_access_type_and_limits) {
+  const object_description& ramp = *find_drive_object(0x6083);
+  EXPECT_EQ(check_write(ramp, 0), sdo_abort::value_too_low) << "a ramp of 0 would never end";
+  EXPECT_EQ(check_write(ramp, 1), sdo_abort::none);
+  EXPECT_EQ(check_write(ramp, 4294967295LL), sdo_abort::none);
+  EXPECT_EQ(check_write(ramp, 4294967296LL), sdo_abort::value_too_high);
+  EXPECT_EQ(check_write(*find_drive_object(0x6041), 0), sdo_abort::read_only_object);
+  EXPECT_EQ(check_write(*find_drive_object(0x60FF), -2147483648LL), sdo_abort::none);
+  EXPECT_EQ(check_write(*find_drive_object(0x60FF), -2147483649LL), sdo_abort::value_too_low);
+  EXPECT_EQ(check_write(*find_drive_object(0x605A), 32768), sdo_abort::value_too_high);
+}
+
+}  // namespace
+}  // namespace cia402
