@@ -1,0 +1,150 @@
+#!/usr/bin/env python3
+"""Checks the link rules between the project's layers by reading every #include line.
+
+Each file of src/, include/ and tools/ belongs to one layer (LAYERS, by path). A layer may include
+its own files and the public headers of the layers it is allowed to see (ALLOWED); never a layer
+above it, and never another layer's private files (src/<layer>/...). docs/architecture.md draws the
+same rules. Known breaches that the restructuring still has to remove are listed in
+scripts/layer_exceptions.txt, each with its reason: a new breach fails, and so does a listed one
+that is gone (the list must stay true). Exit 0 when every include keeps the rules.
+
+    python3 scripts/check_layers.py [ROOT]
+"""
+import os
+import re
+import sys
+
+# (layer, path prefix) in the order they are matched: the first prefix that fits wins.
+LAYERS = [
+    ("core", "include/cia402/detail/"),
+    ("motion", "include/cia402/motion/"),
+    ("motion", "src/motion/"),
+    ("sim", "include/cia402/sim/"),
+    ("sim", "src/sim/"),
+    ("canopen/402", "include/cia402/canopen/drive_objects.hpp"),
+    ("canopen/402", "include/cia402/canopen/drive_master.hpp"),
+    ("canopen/402", "include/cia402/canopen/sim_device.hpp"),
+    ("canopen/402", "src/canopen/402/"),
+    ("canopen/306", "include/cia402/canopen/eds.hpp"),
+    ("canopen/306", "src/canopen/306/"),
+    ("canopen/can", "include/cia402/canopen/channel.hpp"),
+    ("canopen/can", "include/cia402/canopen/frame.hpp"),
+    ("canopen/transport", "include/cia402/canopen/channel_url.hpp"),
+    ("canopen/transport", "include/cia402/canopen/socketcan.hpp"),
+    ("canopen/transport", "include/cia402/canopen/socketcand.hpp"),
+    ("canopen/transport", "include/cia402/canopen/virtual_bus.hpp"),
+    ("canopen/transport", "src/canopen/transport/"),
+    ("canopen/301", "include/cia402/canopen/"),
+    ("canopen/301", "src/canopen/301/"),
+    ("page", "src/page/"),
+    ("profile_file", "include/cia402/profile_file.hpp"),
+    ("profile_file", "src/profile_file/"),
+    ("diagram", "include/cia402/diagram.hpp"),
+    ("diagram", "src/diagram/"),
+    ("core", "include/cia402/"),
+    ("core", "src/core/"),
+    ("tools", "tools/"),
+]
+
+# What each layer may include besides itself. Dependencies point downward only.
+ALLOWED = {
+    "core": set(),
+    "motion": set(),
+    "profile_file": {"core"},
+    "diagram": {"core"},
+    "sim": {"core", "profile_file", "motion"},
+    "canopen/can": {"core"},
+    "canopen/301": {"core", "canopen/can"},
+    "canopen/306": {"core", "canopen/can", "canopen/301"},
+    "canopen/transport": {"core", "canopen/can"},
+    "canopen/402": {"core", "canopen/can", "canopen/301", "canopen/306", "sim"},
+    "page": {"core", "motion", "profile_file", "diagram", "sim", "canopen/can", "canopen/301",
+             "canopen/306", "canopen/transport", "canopen/402"},
+    "tools": {"core", "motion", "profile_file", "diagram", "sim", "canopen/can", "canopen/301",
+              "canopen/306", "canopen/transport", "canopen/402", "page"},
+}
+
+# Where a quoted include is looked for, after the including file's own folder.
+INCLUDE_ROOTS = ["include", "src/page/include", "src/core", "src/profile_file", "tools"]
+
+INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
+
+
+def layer_of(path):
+    for layer, prefix in LAYERS:
+        if path.startswith(prefix):
+            return layer
+    return None
+
+
+def public(path):
+    """A header other layers may include: under include/ or a layer's own include/ folder."""
+    return path.startswith("include/") or "/include/" in path
+
+
+def resolve(root, including, name):
+    candidates = [os.path.join(os.path.dirname(including), name)]
+    candidates += [os.path.join(r, name) for r in INCLUDE_ROOTS]
+    for c in candidates:
+        full = os.path.normpath(os.path.join(root, c))
+        if os.path.isfile(full):
+            return os.path.relpath(full, root)
+    return None
+
+
+def breaches(root):
+    found = []
+    for top in ("include", "src", "tools"):
+        for folder, _, files in os.walk(os.path.join(root, top)):
+            for f in sorted(files):
+                if not f.endswith((".hpp", ".cpp", ".h")):
+                    continue
+                path = os.path.relpath(os.path.join(folder, f), root)
+                mine = layer_of(path)
+                if mine is None:
+                    continue
+                with open(os.path.join(root, path), encoding="utf-8") as text:
+                    for line in text:
+                        m = INCLUDE.match(line)
+                        if not m:
+                            continue
+                        target = resolve(root, path, m.group(1))
+                        theirs = layer_of(target) if target else None
+                        if theirs is None or theirs == mine:
+                            continue
+                        if theirs not in ALLOWED[mine]:
+                            found.append((path, target, f"{mine} may not include {theirs}"))
+                        elif not public(target):
+                            found.append((path, target, f"a private file of {theirs}"))
+    return found
+
+
+def main():
+    root = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), ".."))
+    listed = {}
+    with open(os.path.join(root, "scripts", "layer_exceptions.txt"), encoding="utf-8") as f:
+        for line in f:
+            line = line.split("#", 1)[0].strip()
+            if line:
+                source, _, target = line.partition(" -> ")
+                listed[(source.strip(), target.strip())] = True
+    failed = False
+    seen = set()
+    for source, target, why in breaches(root):
+        seen.add((source, target))
+        if (source, target) not in listed:
+            print(f"{source} includes {target}: {why}")
+            failed = True
+    for pair in listed:
+        if pair not in seen:
+            print(f"{pair[0]} -> {pair[1]} is listed in layer_exceptions.txt but keeps the rules now: "
+                  "remove it from the list")
+            failed = True
+    layers = sorted(ALLOWED)
+    print(f"layers: {len(layers)}; known breaches still listed: {len(listed)}; "
+          + ("FAILED" if failed else "every other include keeps the rules"))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
