@@ -12,7 +12,8 @@ set(cia402_exported_targets cia402_core)
 # finds that too (CIA402_EXPORTS_PROFILE_FILE is substituted into cia402Config.cmake).
 set(CIA402_EXPORTS_PROFILE_FILE OFF)
 if(TARGET cia402_profile_file)
-  list(APPEND cia402_exported_targets cia402_profile_file)
+  # The static profile-file library links the internal support library, so the export carries it.
+  list(APPEND cia402_exported_targets cia402_support cia402_profile_file)
   set(CIA402_EXPORTS_PROFILE_FILE ON)
 endif()
 

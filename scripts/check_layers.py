@@ -37,6 +37,7 @@ LAYERS = [
     ("canopen/301", "include/cia402/canopen/"),
     ("canopen/301", "src/canopen/301/"),
     ("page", "src/page/"),
+    ("support", "src/support/"),
     ("profile_file", "include/cia402/profile_file.hpp"),
     ("profile_file", "src/profile_file/"),
     ("diagram", "include/cia402/diagram.hpp"),
@@ -50,22 +51,23 @@ LAYERS = [
 ALLOWED = {
     "core": set(),
     "motion": set(),
-    "profile_file": {"core"},
+    "support": set(),
+    "profile_file": {"core", "support"},
     "diagram": {"core"},
-    "sim": {"core", "profile_file", "motion"},
+    "sim": {"core", "profile_file", "motion", "support"},
     "canopen/can": {"core"},
     "canopen/301": {"core", "canopen/can"},
     "canopen/306": {"core", "canopen/can", "canopen/301"},
     "canopen/transport": {"core", "canopen/can"},
     "canopen/402": {"core", "canopen/can", "canopen/301", "canopen/306", "sim"},
-    "page": {"core", "motion", "profile_file", "diagram", "sim", "canopen/can", "canopen/301",
-             "canopen/306", "canopen/transport", "canopen/402"},
-    "tools": {"core", "motion", "profile_file", "diagram", "sim", "canopen/can", "canopen/301",
-              "canopen/306", "canopen/transport", "canopen/402", "page"},
+    "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
+             "canopen/301", "canopen/306", "canopen/transport", "canopen/402"},
+    "tools": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
+              "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "page"},
 }
 
 # Where a quoted include is looked for, after the including file's own folder.
-INCLUDE_ROOTS = ["include", "src/page/include", "src/core", "src/profile_file", "tools"]
+INCLUDE_ROOTS = ["include", "src/page/include", "src/support/include", "src/core", "tools"]
 
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 

@@ -37,13 +37,13 @@ def main():
     code, out = run(upward)
     checks.append(("core including sim fails", code == 1 and "core may not include sim" in out))
     private = dict(sound)
-    private["src/profile_file/toml_reading.hpp"] = "#pragma once\n"
-    private["src/sim/scenario_file.cpp"] = '#include "toml_reading.hpp"\n'
+    private["src/core/profiles/rows.hpp"] = "#pragma once\n"
+    private["src/sim/scenario_file.cpp"] = '#include "profiles/rows.hpp"\n'
     code, out = run(private)
     checks.append(("a private header of another layer fails", code == 1 and "private" in out))
-    code, out = run(private, "src/sim/scenario_file.cpp -> src/profile_file/toml_reading.hpp  # why\n")
+    code, out = run(private, "src/sim/scenario_file.cpp -> src/core/profiles/rows.hpp  # why\n")
     checks.append(("a listed breach passes", code == 0))
-    code, out = run(sound, "src/sim/scenario_file.cpp -> src/profile_file/toml_reading.hpp  # why\n")
+    code, out = run(sound, "src/sim/scenario_file.cpp -> src/core/profiles/rows.hpp  # why\n")
     checks.append(("a listed breach that is gone fails", code == 1 and "remove it" in out))
     failed = [name for name, ok in checks if not ok]
     for name, ok in checks:

@@ -3,7 +3,7 @@
 // so a caller sees a complete profile or an error, never a half-loaded one.
 #include "cia402/profile_file.hpp"
 
-#include "toml_reading.hpp"
+#include "cia402/support/toml_reading.hpp"
 
 #include <toml++/toml.h>
 

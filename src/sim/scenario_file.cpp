@@ -14,7 +14,7 @@
 #include "cia402/profile_file.hpp"
 #include "cia402/sim/scenario.hpp"
 #include "cia402/sim/virtual_drive.hpp"
-#include "toml_reading.hpp"
+#include "cia402/support/toml_reading.hpp"
 
 static_assert(TOML_EXCEPTIONS, "the loader relies on toml::parse throwing toml::parse_error");
 

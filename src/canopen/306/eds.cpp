@@ -4,7 +4,6 @@
 #include <ostream>
 #include <vector>
 
-#include "cia402/canopen/drive_objects.hpp"
 
 namespace cia402::canopen {
 namespace {
@@ -74,6 +73,13 @@ void write_eds(slave& node, const eds_info& info, std::ostream& out) {
     if (default_text(node, o, o.subs.front(), ignored)) present.push_back(&o);
   }
 
+  // The PDOs the node has: its communication parameter objects (RPDO 0x1400.., TPDO 0x1800..).
+  int rpdos = 0, tpdos = 0;
+  for (const object_entry& o : node.dictionary().table()) {
+    if (o.index >= 0x1400 && o.index <= 0x15FF) ++rpdos;
+    if (o.index >= 0x1800 && o.index <= 0x19FF) ++tpdos;
+  }
+
   std::int64_t vendor = 0, product = 0, revision = 0;
   (void)node.read(0x1018, 1, vendor);
   (void)node.read(0x1018, 2, product);
@@ -96,7 +102,7 @@ void write_eds(slave& node, const eds_info& info, std::ostream& out) {
       << "OrderCode=\n";
   for (int rate : {10, 20, 50, 125, 250, 500, 800, 1000}) out << "BaudRate_" << rate << "=1\n";
   out << "SimpleBootUpMaster=0\nSimpleBootUpSlave=1\nGranularity=8\nDynamicChannelsSupported=0\n"
-      << "GroupMessaging=0\nNrOfRxPDO=" << pdo_count << "\nNrOfTxPDO=" << pdo_count
+      << "GroupMessaging=0\nNrOfRxPDO=" << rpdos << "\nNrOfTxPDO=" << tpdos
       << "\nLSS_Supported=0\n\n";
   out << "[DummyUsage]\n";
   for (int i = 1; i <= 7; ++i) out << "Dummy000" << i << "=0\n";

@@ -1,4 +1,4 @@
-#include "toml_reading.hpp"
+#include "cia402/support/toml_reading.hpp"
 
 #include <algorithm>
 #include <utility>
