@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/nmt.hpp"
 #include "cia402/canopen/sim_device.hpp"
 #include "cia402/canopen/slave.hpp"
@@ -40,6 +41,7 @@ void bm_bus_64_drives_1ms_sync(benchmark::State& state) {
     n.dev = std::make_unique<sim_device>(p);
     n.ch = bus.attach();
     slave_config c;
+    c.objects = drive_objects();
     c.node_id = static_cast<std::uint8_t>(i + 1);
     n.sl = std::make_unique<slave>(*n.dev, *n.ch, c);
     n.sl->write(0x1800, 2, 1);  // TPDO1 on every SYNC

@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/drive_master.hpp"
 #include "cia402/canopen/sim_device.hpp"
 #include "cia402/canopen/slave.hpp"
@@ -37,6 +38,7 @@ class bench {
     n.dev = std::make_unique<sim_device>(standard_profile());
     n.ch = bus_.attach();
     slave_config c;
+    c.objects = drive_objects();
     c.node_id = id;
     n.sl = std::make_unique<slave>(*n.dev, *n.ch, c);
     drives_.push_back(std::move(n));
@@ -115,7 +117,7 @@ TEST(drive_master, two_drives_on_one_bus_each_follow_their_own_master) {
     drive_node n;
     n.dev = std::make_unique<sim_device>(standard_profile());
     n.ch = bus.attach();
-    n.sl = std::make_unique<slave>(*n.dev, *n.ch, slave_config{id, 1000000, 0});
+    n.sl = std::make_unique<slave>(*n.dev, *n.ch, drive_node_config(id));
     nodes.push_back(std::move(n));
     chs.push_back(bus.attach());
     drive_master_config c;

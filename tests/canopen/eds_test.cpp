@@ -44,7 +44,7 @@ std::string eds_of(const profile& p) {
   virtual_bus bus;
   auto ch = bus.attach();
   sim_device dev(p);
-  slave node(dev, *ch, slave_config{});
+  slave node(dev, *ch, drive_node_config(1));
   std::ostringstream out;
   write_eds(node, eds_info{}, out);
   return out.str();

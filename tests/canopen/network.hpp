@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/nmt.hpp"
 #include "cia402/canopen/slave.hpp"
 #include "cia402/canopen/virtual_bus.hpp"
@@ -33,6 +34,7 @@ class network {
     n.dev = dev ? std::move(dev) : std::make_unique<test_device>();
     n.ch = bus_.attach();
     slave_config c;
+    c.objects = drive_objects();
     c.node_id = id;
     c.heartbeat_ms = heartbeat_ms;
     c.sdo_timeout_us = sdo_timeout_us;

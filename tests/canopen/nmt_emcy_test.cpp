@@ -143,7 +143,7 @@ TEST_F(nmt_test, no_emcy_while_stopped) {
   net.add(id);
   net.send(nmt_frame(nmt_command::stop, id));
   net.settle();
-  net.device_at(0).inject_fault(0x2310);
+  net.device_at(0).write(0x2001, 0, 0x2310);  // fault injection
   net.received.clear();
   net.run(5000, 1000);
   EXPECT_TRUE(net.with_id(0x87).empty());

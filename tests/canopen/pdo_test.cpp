@@ -217,7 +217,7 @@ TEST_F(pdo_test, remapped_tpdo_carries_the_new_objects_in_mapping_order) {
   ASSERT_EQ(write(0x1A00, 0, 3, 1), 0u);
   ASSERT_EQ(write(0x1800, 1, 0x183, 4), 0u);
   EXPECT_EQ(node().tpdo(0).length, 5);
-  dev().inject_fault(0x2310);
+  dev().write(0x2001, 0, 0x2310);  // fault injection
   start();
   net.run(5000, 1000);
   const auto sent = net.with_id(0x183);

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/drive_master.hpp"
 #include "cia402/canopen/sim_device.hpp"
 #include "cia402/canopen/slave.hpp"
@@ -139,7 +140,7 @@ class socketcand_server_test : public ::testing::Test {
     drive_on_bus d;
     d.dev = std::make_unique<sim_device>(standard_profile());
     d.ch = bus.attach();
-    d.sl = std::make_unique<slave>(*d.dev, *d.ch, slave_config{id, 1000000, 0});
+    d.sl = std::make_unique<slave>(*d.dev, *d.ch, drive_node_config(id));
     drives.push_back(std::move(d));
   }
   /// One cycle of the server loop: sockets, time, nodes, output.

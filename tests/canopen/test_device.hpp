@@ -49,6 +49,10 @@ class test_device final : public device {
         return sdo_abort::none;
       case 0x1001: case 0x603F: case 0x6041: case 0x6061: case 0x606C:
         return sdo_abort::read_only_object;
+      case 0x2001:  // fault injection: a cause with this code, 0 clears it
+        if (v < 0 || v > 0xFFFF) return sdo_abort::value_too_high;
+        fault_ = static_cast<std::uint16_t>(v);
+        return sdo_abort::none;
       default: return drive_.write(index, static_cast<std::int32_t>(v));
     }
   }
@@ -68,10 +72,6 @@ class test_device final : public device {
   }
 
   void set_connection_lost(bool lost) noexcept override { connection_lost = lost; }
-  sdo_abort inject_fault(std::uint16_t code) noexcept override {
-    fault_ = code;
-    return sdo_abort::none;
-  }
   void reset() noexcept override {
     drive_ = cia402::drive(*profile_);
     out_ = {};

@@ -13,6 +13,7 @@
 #include <memory>
 #include <thread>
 
+#include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/sim_device.hpp"
 #include "cia402/canopen/slave.hpp"
 #include "cia402/canopen/virtual_bus.hpp"
@@ -49,6 +50,7 @@ class remote_bench {
                         const cia402::profile& p = cia402::standard_profile())
       : dev_(std::make_unique<co::sim_device>(p)), drive_ch_(bus_.attach()) {
     co::slave_config sc;
+    sc.objects = co::drive_objects();
     sc.node_id = 1;
     node_ = std::make_unique<co::slave>(*dev_, *drive_ch_, sc);
     for (int i = 0; i < 10; ++i) node_->poll(*drive_ch_, 1000);  // power-up: T0, T1

@@ -6,6 +6,7 @@
 #include <memory>
 #include <ostream>
 
+#include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/sim_device.hpp"
 #include "cia402/canopen/slave.hpp"
 #include "cia402/canopen/socketcand.hpp"
@@ -112,6 +113,7 @@ int run_bus(const bus_args& args, std::ostream& out, std::ostream& err) {
     n.dev = std::make_unique<canopen::sim_device>(choice.get());
     n.ch = bus.attach();
     canopen::slave_config sc;
+    sc.objects = canopen::drive_objects();
     sc.node_id = id;
     sc.heartbeat_ms = args.heartbeat_ms;
     n.sl = std::make_unique<canopen::slave>(*n.dev, *n.ch, sc);

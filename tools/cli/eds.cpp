@@ -6,6 +6,7 @@
 #include <fstream>
 #include <ostream>
 
+#include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/eds.hpp"
 #include "cia402/canopen/sim_device.hpp"
 #include "cia402/canopen/slave.hpp"
@@ -28,7 +29,7 @@ int run_eds(const eds_args& args, std::ostream& out, std::ostream& err) {
   canopen::virtual_bus bus;
   auto ch = bus.attach();
   canopen::sim_device dev(choice.get());
-  canopen::slave node(dev, *ch, canopen::slave_config{static_cast<std::uint8_t>(args.node), 1000000, 0});
+  canopen::slave node(dev, *ch, canopen::drive_node_config(static_cast<std::uint8_t>(args.node)));
 
   canopen::eds_info info;
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());

@@ -8,6 +8,7 @@
 #include <memory>
 #include <ostream>
 
+#include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/channel_url.hpp"
 #include "cia402/canopen/drive_master.hpp"
 #include "cia402/canopen/sdo_client.hpp"
@@ -40,6 +41,7 @@ class bus_session {
       dev_ = std::make_unique<canopen::sim_device>(p);
       drive_ch_ = bus_.attach();
       canopen::slave_config sc;
+      sc.objects = canopen::drive_objects();
       sc.node_id = static_cast<std::uint8_t>(a.node);
       slave_ = std::make_unique<canopen::slave>(*dev_, *drive_ch_, sc);
       master_ch_ = bus_.attach();

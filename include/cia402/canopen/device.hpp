@@ -23,9 +23,6 @@ class device {
   virtual std::uint32_t step(std::uint32_t elapsed_us) noexcept = 0;
   /// The fieldbus connection was lost (heartbeat consumer timeout) or is back: 0x6007 applies (S10).
   virtual void set_connection_lost(bool lost) noexcept = 0;
-  /// Raises a fault cause with this error code (0x603F), or clears every cause with 0. Reached over
-  /// the bus through the manufacturer object 0x2001, so tests and benches can fault a virtual drive.
-  virtual sdo_abort inject_fault(std::uint16_t code) noexcept = 0;
   /// Reset application (NMT reset node): the device starts again as at power-on.
   virtual void reset() noexcept = 0;
 };

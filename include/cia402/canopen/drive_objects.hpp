@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "cia402/canopen/object_dictionary.hpp"
+#include "cia402/canopen/slave.hpp"
 
 namespace cia402::canopen {
 
@@ -32,11 +33,12 @@ inline constexpr const char* virtual_drive_device_name = "cia402 virtual drive";
 inline constexpr std::uint16_t fault_injection_index = 0x2001;
 inline constexpr std::uint16_t device_label_index = 0x2000;
 inline constexpr std::size_t device_label_capacity = 64;
-inline constexpr int pdo_count = 4;             ///< RPDOs and TPDOs each
-inline constexpr int max_mapped_objects = 8;    ///< entries per mapping object
-inline constexpr int heartbeat_consumers = 4;   ///< sub-indices 1..4 of 0x1016
 
-/// The table; 0x6xxx objects are backed by the device.
+/// The table; 0x6xxx objects and 0x2001 are backed by the device.
 std::vector<object_entry> drive_objects();
+
+/// A node configuration that serves the drive's table: what a CiA 402 node is built with.
+slave_config drive_node_config(std::uint8_t node_id, std::uint32_t sdo_timeout_us = 1000000,
+                               std::uint16_t heartbeat_ms = 0);
 
 }  // namespace cia402::canopen

@@ -23,12 +23,11 @@ class sim_device final : public device {
   sdo_abort read(std::uint16_t index, std::uint8_t sub, std::int64_t& value) noexcept override {
     return drive_->read(index, sub, value);
   }
-  sdo_abort write(std::uint16_t index, std::uint8_t sub, std::int64_t value) noexcept override {
-    return drive_->write(index, sub, value);
-  }
+  /// The drive's objects, and 0x2001 (fault injection): an error code raises a fault cause in the
+  /// virtual drive, 0 clears every cause.
+  sdo_abort write(std::uint16_t index, std::uint8_t sub, std::int64_t value) noexcept override;
   std::uint32_t step(std::uint32_t elapsed_us) noexcept override;
   void set_connection_lost(bool lost) noexcept override { drive_->view().set_connection_lost(lost); }
-  sdo_abort inject_fault(std::uint16_t code) noexcept override;
   void reset() noexcept override;
 
   sim::virtual_drive& drive() noexcept { return *drive_; }

@@ -48,11 +48,19 @@
 
 namespace cia402::canopen {
 
+/// The communication objects the node has room for (CiA 301): its PDOs and heartbeat consumers.
+inline constexpr int pdo_count = 4;             ///< RPDOs and TPDOs each
+inline constexpr int max_mapped_objects = 8;    ///< entries per mapping object
+inline constexpr int heartbeat_consumers = 4;   ///< sub-indices 1..4 of 0x1016
+
 struct slave_config {
   std::uint8_t node_id = 1;
   std::uint32_t sdo_timeout_us = 1000000;
   /// Default of 0x1017 (also after a reset); 0 = no heartbeat until a master asks for one.
   std::uint16_t heartbeat_ms = 0;
+  /// The dictionary the node serves, given by the layer above (a CiA 402 drive: drive_objects(),
+  /// or drive_node_config() in canopen/402), so this CiA 301 node knows no device profile.
+  std::vector<object_entry> objects;
 };
 
 /// Error codes the node raises itself (not the drive).

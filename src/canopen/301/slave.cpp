@@ -2,13 +2,12 @@
 
 #include <algorithm>
 
-#include "cia402/canopen/drive_objects.hpp"
 
 namespace cia402::canopen {
 namespace {
 
 std::vector<object_entry> table_for(const slave_config& c) {
-  std::vector<object_entry> t = drive_objects();
+  std::vector<object_entry> t = c.objects;
   for (object_entry& o : t) {
     if (o.index == 0x1017) o.subs[0].default_value = c.heartbeat_ms;
   }
@@ -390,8 +389,6 @@ sdo_abort slave::write_checked(object_dictionary::slot& s, std::int64_t v) {
       s.number = v;
       producer_.configure(static_cast<std::uint16_t>(u));
       return sdo_abort::none;
-    case fault_injection_index:
-      return device_->inject_fault(static_cast<std::uint16_t>(u));
     default:
       s.number = v;
       return sdo_abort::none;

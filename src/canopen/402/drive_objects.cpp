@@ -179,14 +179,14 @@ std::vector<object_entry> drive_objects() {
   t.push_back(single(device_label_index, manufacturer,
                      text(0, "Device label", access::rw, "", device_label_capacity)));
   t.push_back(single(fault_injection_index, manufacturer,
-                     var(0, "Fault injection", data_type::unsigned16, access::wo)));
+                     on_device(var(0, "Fault injection", data_type::unsigned16, access::wo))));
 
   // The drive profile's objects, from the one table the whole project reads (cia402/objects.hpp);
   // their values are the device's.
   for (std::size_t i = 0; i < drive_object_count(); ++i) {
     const object_description& d = drive_object(i);
-    const access acc = d.access == object_access::read_only    ? access::ro
-                       : d.access == object_access::write_only ? access::wo
+    const access acc = d.access == cia402::object_access::read_only    ? access::ro
+                       : d.access == cia402::object_access::write_only ? access::wo
                                                                : access::rw;
     sub_entry e = on_device(var(d.sub, d.name, static_cast<data_type>(d.type), acc, d.default_value));
     e.pdo_mappable = d.pdo_mappable;
@@ -197,6 +197,16 @@ std::vector<object_entry> drive_objects() {
     t.push_back(single(d.index, mandatory_object ? mandatory : optional, std::move(e)));
   }
   return t;
+}
+
+slave_config drive_node_config(std::uint8_t node_id, std::uint32_t sdo_timeout_us,
+                               std::uint16_t heartbeat_ms) {
+  slave_config c;
+  c.node_id = node_id;
+  c.sdo_timeout_us = sdo_timeout_us;
+  c.heartbeat_ms = heartbeat_ms;
+  c.objects = drive_objects();
+  return c;
 }
 
 }  // namespace cia402::canopen

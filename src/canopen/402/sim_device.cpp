@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "cia402/canopen/drive_objects.hpp"
+
 namespace cia402::canopen {
 
 sim_device::sim_device(const profile& p, const sim::plant_config& config)
@@ -19,11 +21,15 @@ std::uint32_t sim_device::step(std::uint32_t elapsed_us) noexcept {
   return cycle - pending_us_;
 }
 
-sdo_abort sim_device::inject_fault(std::uint16_t code) noexcept {
-  if (code == 0) {
+sdo_abort sim_device::write(std::uint16_t index, std::uint8_t sub, std::int64_t value) noexcept {
+  if (index != fault_injection_index) return drive_->write(index, sub, value);
+  if (sub != 0) return sdo_abort::sub_index_does_not_exist;
+  if (value < 0) return sdo_abort::value_too_low;
+  if (value > 0xFFFF) return sdo_abort::value_too_high;
+  if (value == 0) {
     drive_->view().clear_faults();
   } else {
-    (void)drive_->view().inject_fault(code);
+    (void)drive_->view().inject_fault(static_cast<std::uint16_t>(value));
   }
   return sdo_abort::none;
 }
