@@ -132,6 +132,10 @@ struct state_info {
   state_activity activity = state_activity::idle;
 };
 
+/// Which names a profile's manuals give the bits of the control and status word: CiA 402's, or
+/// DRIVECOM's STW / ZSW of the PROFIBUS drives (seeds 003 and 004: bit 8 is jog there, not halt).
+enum class word_names : std::uint8_t { cia402 = 0, drivecom = 1 };
+
 /// The option-code objects of the drive-side machine.
 enum class option : std::uint8_t {
   quick_stop = 0,         ///< 0x605A
@@ -195,6 +199,8 @@ struct profile {
   std::int32_t speed_limit_rpm = 0;
   /// Error classes 0..4 of seed 001 are honoured; without them every fault cause calls for T13.
   bool error_classes = false;
+  /// The names of the control- and status-word bits (bit_names_of()).
+  word_names words = word_names::cia402;
 
   // Derived by finalize(): the decoder as a table over control-word bits 0..4, and per state the
   // rows that leave it (bit i = rows[i]), so a step that can fire nothing costs one AND.
@@ -297,6 +303,19 @@ class custom_profile {
   std::array<transition_row, max_rows> rows_{};
   profile view_{};
 };
+
+/// The 16 bits of the control and status word by name, as the profile's manuals call them, and the
+/// words' own names ("controlword 0x6040", "control word STW (0x6040)").
+struct word_bit_names {
+  const char* control_word;
+  const char* status_word;
+  const char* control[16];
+  const char* status[16];
+};
+const word_bit_names& bit_names_of(const profile& p) noexcept;
+/// "cia402" / "drivecom", as profile files spell them; parse_word_names refuses anything else.
+const char* word_names_name(word_names w) noexcept;
+bool parse_word_names(std::string_view name, word_names& out) noexcept;
 
 /// The built-in profiles: cia402, no-quick-stop, lexium32, s300-profibus, ax2000-profibus.
 std::size_t builtin_profile_count() noexcept;

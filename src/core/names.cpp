@@ -131,4 +131,60 @@ const char* sdo_abort_text(sdo_abort code) noexcept {
   return "unknown abort code";
 }
 
+namespace {
+
+// CiA 402 (the standard's names of 0x6040 and 0x6041).
+constexpr word_bit_names cia402_bit_names = {
+    "controlword 0x6040",
+    "statusword 0x6041",
+    {"Switch on", "Enable voltage", "Quick stop (active low)", "Enable operation",
+     "Operation mode specific", "Operation mode specific", "Operation mode specific",
+     "Fault reset (0->1 edge)", "Halt", "Operation mode specific", "Reserved",
+     "Manufacturer specific", "Manufacturer specific", "Manufacturer specific",
+     "Manufacturer specific", "Manufacturer specific"},
+    {"Ready to switch on", "Switched on", "Operation enabled", "Fault", "Voltage enabled",
+     "Quick stop (active low)", "Switch on disabled", "Warning", "Manufacturer specific", "Remote",
+     "Target reached", "Internal limit active", "Operation mode specific",
+     "Operation mode specific", "Manufacturer specific", "Manufacturer specific"},
+};
+
+// DRIVECOM's STW and ZSW, as the Kollmorgen S300 and Beckhoff AX2000 PROFIBUS manuals name them.
+// Bit 4 of the ZSW: the core sets it when DC-link voltage is present, as CiA 402 does; the name
+// says what it shows (docs/profiles/s300-profibus.md keeps the manuals' "voltage inhibited" as an
+// open point).
+constexpr word_bit_names drivecom_bit_names = {
+    "control word STW (0x6040)",
+    "status word ZSW (0x6041)",
+    {"Switch on", "Inhibit voltage (active low)", "Fast stop, switch-on inhibited (active low)",
+     "Operation enabled", "Fast stop / inhibit ramp function generator", "Pause",
+     "Setpoint enable", "Reset fault", "Jog", "Reserved", "PZD enable", "Start homing (edge)",
+     "Reset position", "Acknowledge warnings", "Manufacturer specific", "Manufacturer specific"},
+    {"Ready for switch-on", "Switched on", "Operation enabled", "Error",
+     "Voltage present (DC link)", "Fast stop (active low)", "Switch-on inhibit", "Warning",
+     "Following error", "Remote", "In position", "Limit", "Mode specific", "Mode specific",
+     "Manufacturer specific", "Manufacturer specific"},
+};
+
+}  // namespace
+
+const word_bit_names& bit_names_of(const profile& p) noexcept {
+  return p.words == word_names::drivecom ? drivecom_bit_names : cia402_bit_names;
+}
+
+const char* word_names_name(word_names w) noexcept {
+  return w == word_names::drivecom ? "drivecom" : "cia402";
+}
+
+bool parse_word_names(std::string_view name, word_names& out) noexcept {
+  if (name == "cia402") {
+    out = word_names::cia402;
+    return true;
+  }
+  if (name == "drivecom") {
+    out = word_names::drivecom;
+    return true;
+  }
+  return false;
+}
+
 }  // namespace cia402

@@ -90,6 +90,7 @@ const char* check_profile(const profile& p, int& row) noexcept {
       return "an option code's fixed value is out of range";
     }
   }
+  if (p.words != word_names::cia402 && p.words != word_names::drivecom) return "unknown word names";
   for (int s = 0; s < state_count; ++s) {
     if ((p.states[s].status_pattern & ~0x6Fu) != 0) return "a status pattern uses bits other than 0..3, 5, 6";
     if (static_cast<unsigned>(p.states[s].activity) > static_cast<unsigned>(state_activity::fault_reaction)) {

@@ -18,8 +18,8 @@ struct bit_names {
   std::array<const char*, 16> status{};
 };
 
-/// CiA 402 names (cia402-reference.md §1.2, §2.1), or the DRIVECOM STW / ZSW names (§6.1) for the
-/// PROFIBUS profiles of seeds 003 and 004 (s300-profibus, ax2000-profibus).
+/// The profile's names of the bits (cia402::bit_names_of: CiA 402's, or DRIVECOM's STW / ZSW on the
+/// PROFIBUS profiles).
 bit_names bit_names_for(const profile& p);
 
 struct object_name {

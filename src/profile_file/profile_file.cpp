@@ -363,8 +363,8 @@ void load_options(const toml::node& node, profile& p, bool complete) {
 
 custom_profile load(const toml::table& root) {
   check_keys(root,
-             {"base", "name", "seed", "title", "speed_limit_rpm", "error_classes", "decoder",
-              "rows", "states", "options"},
+             {"base", "name", "seed", "title", "speed_limit_rpm", "error_classes", "word_names",
+              "decoder", "rows", "states", "options"},
              "the profile");
 
   custom_profile out;
@@ -402,6 +402,12 @@ custom_profile load(const toml::table& root) {
   }
   if (const toml::node* n = find(root, "error_classes")) {
     p.error_classes = get_bool(*n, "error_classes");
+  }
+  if (const toml::node* n = find(root, "word_names")) {
+    const std::string_view name = get_string(*n, "word_names");
+    if (!parse_word_names(name, p.words)) {
+      refuse(*n, "unknown word_names " + quoted(name) + " (cia402, drivecom)");
+    }
   }
 
   if (const toml::node* n = find(root, "decoder")) {
@@ -543,6 +549,8 @@ std::string dump_profile_toml(const profile& p) {
   o << "title = " << toml_string(p.title) << "\n";
   o << "speed_limit_rpm = " << p.speed_limit_rpm << "\n";
   o << "error_classes = " << (p.error_classes ? "true" : "false") << "\n";
+  o << "# The names of the control- and status-word bits: cia402, or drivecom (PROFIBUS STW/ZSW).\n"
+    << "word_names = \"" << word_names_name(p.words) << "\"\n";
 
   o << "\n# Control-word decoder over bits 0..4: the first rule whose (word & mask) == value\n"
     << "# wins; a word no rule matches is enable_operation.\n";

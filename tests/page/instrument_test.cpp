@@ -245,7 +245,9 @@ TEST(instrument, ax2000_enable_operation_word_sets_fast_stop_bit_4) {
 TEST(instrument, drivecom_profiles_name_bits_as_stw_and_zsw) {
   instrument s300(by_name("s300-profibus"));
   const json info = json::parse(s300.info_json(true, false));
-  EXPECT_EQ(info["control_bits"][1]["name"], "Inhibit voltage");  // §6.1 STW
+  // STW bits 1 and 2 act when cleared: their names say so, as the standard's do.
+  EXPECT_EQ(info["control_bits"][1]["name"], "Inhibit voltage (active low)");  // §6.1 STW
+  EXPECT_EQ(info["control_bits"][2]["name"], "Fast stop, switch-on inhibited (active low)");
   EXPECT_EQ(info["control_bits"][8]["name"], "Jog");
   EXPECT_EQ(info["status_bits"][6]["name"], "Switch-on inhibit");  // §6.1 ZSW
   instrument standard(cia402::standard_profile());

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <variant>
+
+#include <string>
 
 #include "cia402/profile_file.hpp"
 #include "helpers.hpp"
@@ -54,6 +57,20 @@ TEST(profile_file_errors, table_given_twice_is_refused_at_the_second_header) {
 }
 
 // --- keys --------------------------------------------------------------------------------------
+
+TEST(profile_file_errors, unknown_word_names_are_refused_with_the_known_ones) {
+  expect_refused("base = \"cia402\"\nname = \"x\"\nword_names = \"profinet\"\n", 3, 14,
+                 "unknown word_names 'profinet' (cia402, drivecom)");
+}
+
+TEST(profile_file_errors, word_names_pick_the_bit_names_and_a_base_passes_them_on) {
+  const auto drivecom = load_profile_toml("base = \"cia402\"\nname = \"x\"\nword_names = \"drivecom\"\n", "t.toml");
+  ASSERT_TRUE(std::holds_alternative<custom_profile>(drivecom));
+  EXPECT_EQ(std::string(bit_names_of(std::get<custom_profile>(drivecom).get()).control[8]), "Jog");
+  const auto inherited = load_profile_toml("base = \"s300-profibus\"\nname = \"y\"\n", "t.toml");
+  ASSERT_TRUE(std::holds_alternative<custom_profile>(inherited));
+  EXPECT_EQ(std::get<custom_profile>(inherited).get().words, word_names::drivecom);
+}
 
 TEST(profile_file_errors, unknown_top_level_key_is_refused_at_the_key) {
   expect_refused("base = \"cia402\"\n\nnmae = \"x\"\n", 3, 1, "unknown key 'nmae'");

@@ -45,6 +45,7 @@ void expect_same_tables(const profile& a, const profile& b) {
   }
   EXPECT_EQ(a.speed_limit_rpm, b.speed_limit_rpm);
   EXPECT_EQ(a.error_classes, b.error_classes);
+  EXPECT_EQ(a.words, b.words) << "the bit names (word_names)";
   EXPECT_EQ(a.command_of_bits, b.command_of_bits);
   EXPECT_EQ(a.rows_from, b.rows_from);
   EXPECT_EQ(a.busy_from, b.busy_from);

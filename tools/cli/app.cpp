@@ -17,7 +17,7 @@
 #include "cli/replay.hpp"
 #include "cli/serve.hpp"
 #include "cli/simulate.hpp"
-#include "cli/words.hpp"
+#include "cli/decode.hpp"
 
 namespace cia402::cli {
 namespace {

@@ -68,11 +68,17 @@ constexpr std::array<option_spec, option_count> options = {{
     {0, 1},  // a lost connection is a fault
 }};
 
-}  // namespace
-
-const profile ax2000_profibus_profile = make_profile(
+constexpr profile make() noexcept {
+  profile p = make_profile(
     "ax2000-profibus", "004_e07fd68605b3a8c6.txt",
     "Beckhoff AX2000 PROFIBUS DP: fast stop on bit 4, T17 on bit 2", decoder, rows,
     standard_states(state_activity::hold), options);
+  p.words = word_names::drivecom;  // STW / ZSW: bit 8 is jog, not halt
+  return p;
+}
+
+}  // namespace
+
+const profile ax2000_profibus_profile = make();
 
 }  // namespace cia402::detail
