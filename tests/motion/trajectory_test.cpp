@@ -23,6 +23,15 @@ double trapezoid_seconds(double distance_rev, double v_rpm, double a_rpm_s, doub
   return peak / a + peak / d;
 }
 
+pp_parameters profile_of(std::uint32_t velocity_rpm, std::uint32_t acceleration_rpm_s,
+                         std::uint32_t deceleration_rpm_s) {
+  pp_parameters par;
+  par.profile_velocity_rpm = velocity_rpm;
+  par.acceleration_rpm_s = acceleration_rpm_s;
+  par.deceleration_rpm_s = deceleration_rpm_s;
+  return par;
+}
+
 struct run_result {
   int cycles_to_reach = -1;     // first cycle whose status shows target reached
   int cycles_to_ack = -1;
@@ -68,10 +77,7 @@ TEST(profile_position, a_move_takes_the_time_the_trapezoid_says_within_one_cycle
   for (const case_t& c : cases) {
     SCOPED_TRACE(::testing::Message() << c.distance << " inc at " << c.v << " rpm, a " << c.a
                                       << ", d " << c.d);
-    pp_parameters par;
-    par.profile_velocity_rpm = c.v;
-    par.acceleration_rpm_s = c.a;
-    par.deceleration_rpm_s = c.d;
+    const pp_parameters par = profile_of(c.v, c.a, c.d);
     profile_position pp;
     pp.reset(0);
     const run_result r = move(pp, par, c.distance);
@@ -87,10 +93,7 @@ TEST(profile_position, a_move_takes_the_time_the_trapezoid_says_within_one_cycle
 }
 
 TEST(profile_position, bit_12_follows_the_handshake_and_bit_10_waits_for_the_window_time) {
-  pp_parameters par;
-  par.profile_velocity_rpm = 600;
-  par.acceleration_rpm_s = 6000;
-  par.deceleration_rpm_s = 6000;
+  pp_parameters par = profile_of(600, 6000, 6000);
   par.position_window_time_ms = 5;
   profile_position pp;
   pp.reset(0);
@@ -114,10 +117,7 @@ TEST(profile_position, bit_12_follows_the_handshake_and_bit_10_waits_for_the_win
 }
 
 TEST(profile_position, a_relative_move_adds_to_the_previous_target) {
-  pp_parameters par;
-  par.profile_velocity_rpm = 1200;
-  par.acceleration_rpm_s = 10000;
-  par.deceleration_rpm_s = 10000;
+  pp_parameters par = profile_of(1200, 10000, 10000);
   profile_position pp;
   pp.reset(500);
   EXPECT_EQ(move(pp, par, 20000).final_position, 20000);
@@ -128,10 +128,7 @@ TEST(profile_position, a_relative_move_adds_to_the_previous_target) {
 // Bit 5 = 0: the second set-point waits in the queue until the first is reached; bit 12 stays set
 // while it waits. Bit 5 = 1: it replaces the running one at once.
 TEST(profile_position, the_queue_and_change_immediately) {
-  pp_parameters par;
-  par.profile_velocity_rpm = 600;
-  par.acceleration_rpm_s = 6000;
-  par.deceleration_rpm_s = 6000;
+  pp_parameters par = profile_of(600, 6000, 6000);
   profile_position pp;
   pp.reset(0);
   pp_command cmd;
@@ -178,10 +175,7 @@ TEST(profile_position, the_queue_and_change_immediately) {
 
 // Bit 9: the running set-point is passed at speed into the queued one, not stopped at.
 TEST(profile_position, change_on_setpoint_blends_into_the_next_target) {
-  pp_parameters par;
-  par.profile_velocity_rpm = 600;
-  par.acceleration_rpm_s = 6000;
-  par.deceleration_rpm_s = 6000;
+  pp_parameters par = profile_of(600, 6000, 6000);
   profile_position pp;
   pp.reset(0);
   pp_command cmd;
@@ -208,10 +202,7 @@ TEST(profile_position, change_on_setpoint_blends_into_the_next_target) {
 }
 
 TEST(profile_position, halt_stops_on_the_deceleration_ramp_and_clearing_it_resumes) {
-  pp_parameters par;
-  par.profile_velocity_rpm = 600;
-  par.acceleration_rpm_s = 6000;
-  par.deceleration_rpm_s = 3000;
+  pp_parameters par = profile_of(600, 6000, 3000);
   profile_position pp;
   pp.reset(0);
   pp_command cmd;
