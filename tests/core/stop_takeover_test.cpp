@@ -1,7 +1,7 @@
 // Behaviour no other core test pins: a stop that takes over a running T5 stop, T5 into a SWITCHED
 // ON that holds torque, the ways out of a Lexium quick stop, the codes STO and undervoltage record,
 // status bits passed through from the motion side, and a lost connection beside a Lexium warning.
-// Every expectation is written from the seed a test cites, semantics.md (S1..S14) or the project's
+// Every expectation is written from the seed a test cites, docs/semantics.md (S1..S17) or the project's
 // documented choices in docs/semantics.md; the profiles' rows are never read.
 #include <cstdint>
 #include <string>

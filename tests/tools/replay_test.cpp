@@ -1,5 +1,5 @@
 // `cia402 replay` on the standard profile: the interface and the behaviour semantics.md defines.
-// Expected lines are written from semantics.md (S1..S14) and the status-word table, not from
+// Expected lines are written from docs/semantics.md (S1..S17) and the status-word table, not from
 // output.
 #include "cli/replay.hpp"
 

@@ -57,7 +57,8 @@ constexpr std::array<option_spec, option_count> options = {{
 
 const profile cia402_profile = make_profile(
     "cia402", "002_522d2c0bb8f5a5f8.txt",
-    "CiA 402 standard (CoE table 7.8) with semantics.md S1..S14", standard_decoder, rows,
+    "CiA 402 standard (CoE table 7.8)",
+    standard_decoder, rows,
     standard_states(state_activity::idle), options);
 
 }  // namespace cia402::detail
