@@ -23,13 +23,13 @@ struct drive_inputs {
   bool local_enable = false;        ///< local request to enable the power stage (seed 001)
   bool local_disable = false;       ///< local request to disable the power stage (seed 001)
   std::uint16_t control_word = 0;   ///< 0x6040
+  /// Status-word bits the motion side reports, each in its own place (status_bit::reported): 7
+  /// warning, 10 target reached (shown in a running state), 11 internal limit active, 8 and 12..15
+  /// mode specific. The bits the drive owns (state, voltage, remote) are ignored here.
+  std::uint16_t status_bits = 0;
   std::uint8_t fault_class = 2;     ///< error class 0..4, read by profiles with error classes
   bool standstill = true;           ///< the motion side is at standstill / its ramp has finished
   bool brake_engaged = true;        ///< the holding brake has engaged (true if none is fitted)
-  bool warning = false;             ///< a warning from elsewhere (status bit 7)
-  bool target_reached = false;      ///< the operation mode's target reached (status bit 10)
-  bool internal_limit = false;      ///< an internal limit is active (status bit 11)
-  std::uint16_t mode_status_bits = 0;   ///< status bits 8 and 12..15, passed through
   std::int32_t actual_speed_rpm = 0;    ///< read by profiles with a speed limit (seed 001 T2/T7)
 };
 
@@ -72,9 +72,9 @@ inline constexpr std::uint8_t fault_latched = 1u << 4;     ///< class-4 error: o
 /// share one profile.
 struct axis {
   state current = state::start;
+  std::uint8_t flags = 0;               ///< axis_flag bits (next to `current`: compiled.hpp reads both)
   std::uint8_t pending_row = 0xFF;      ///< row whose stop is running (S7), 0xFF = none
   std::uint8_t last_transition = no_transition;  ///< the last transition taken, ever
-  std::uint8_t flags = 0;               ///< axis_flag bits
   std::uint16_t error_code = 0;         ///< 0x603F
   std::int8_t options[option_count] = {};  ///< option-code values, index by `option`
   /// The option code governing the stop or reaction that runs now, as it was when that stop started
@@ -93,7 +93,16 @@ constexpr bool stop_running(const axis& a) noexcept { return a.pending_row != no
 /// The error register 0x1001 that goes with an error code (CiA 301): bit 0 for any error, bit 1
 /// current (0x2xxx), 2 voltage (0x3xxx), 3 temperature (0x4xxx), 4 communication (0x81xx, 0x82xx),
 /// 5 device profile (0x83xx..0x8Fxx, e.g. 0x8611 following error), 7 manufacturer (0xFFxx).
-std::uint8_t error_register_of(std::uint16_t error_code) noexcept;
+/// Inline, so a step whose caller ignores the register does not compute it.
+constexpr std::uint8_t error_register_of(std::uint16_t error_code) noexcept {
+  const unsigned group = error_code >> 12;
+  const unsigned high = error_code >> 8;
+  return static_cast<std::uint8_t>(
+      error_code == 0 ? 0u
+                      : 0x01u | (group == 0x2 ? 0x02u : 0u) | (group == 0x3 ? 0x04u : 0u) |
+                            (group == 0x4 ? 0x08u : 0u) | (high == 0x81 || high == 0x82 ? 0x10u : 0u) |
+                            (group == 0x8 && high >= 0x83 ? 0x20u : 0u) | (high == 0xFF ? 0x80u : 0u));
+}
 
 /// Error codes the drive raises itself.
 namespace error_code {

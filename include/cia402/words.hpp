@@ -30,6 +30,9 @@ inline constexpr std::uint16_t internal_limit_active = 1u << 11;
 inline constexpr std::uint16_t state_bits = 0x006F;
 /// Bits the drive passes through from the motion side unchanged: 8 and 12..15.
 inline constexpr std::uint16_t mode_specific = 0xF100;
+/// Bits the motion side reports through drive_inputs::status_bits: warning, target reached,
+/// internal limit and the mode-specific bits.
+inline constexpr std::uint16_t reported = warning | target_reached | internal_limit_active | mode_specific;
 }  // namespace status_bit
 
 /// Commands of the control word, as a profile's decoder yields them (cia402-reference.md §2.2).

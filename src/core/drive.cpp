@@ -132,20 +132,6 @@ void set_flag(axis& a, std::uint8_t flag, bool on) noexcept {
 
 }  // namespace
 
-std::uint8_t error_register_of(std::uint16_t code) noexcept {
-  if (code == 0) return 0;
-  std::uint8_t reg = 0x01;
-  const unsigned group = code >> 12;
-  const unsigned high = code >> 8;
-  if (group == 0x2) reg |= 0x02;
-  if (group == 0x3) reg |= 0x04;
-  if (group == 0x4) reg |= 0x08;
-  if (high == 0x81 || high == 0x82) reg |= 0x10;
-  if (group == 0x8 && high >= 0x83) reg |= 0x20;
-  if (high == 0xFF) reg |= 0x80;
-  return reg;
-}
-
 axis make_axis(const profile& p) noexcept {
   axis a;
   for (int i = 0; i < option_count; ++i) a.options[i] = p.options[i].default_value;
@@ -324,14 +310,13 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
 
   const state_info info = p.info(s);
   std::uint32_t sw = info.status_pattern | (static_cast<std::uint32_t>(in.dc_link) << 4) |
-                     (static_cast<std::uint32_t>(in.warning | in.sto) << 7) |
+                     (static_cast<std::uint32_t>(in.sto) << 7) |
                      (static_cast<std::uint32_t>(in.remote) << 9) |
-                     (static_cast<std::uint32_t>(in.internal_limit) << 11) |
-                     (in.mode_status_bits & status_bit::mode_specific);
+                     (in.status_bits & (status_bit::reported & ~status_bit::target_reached));
   if (p.error_classes && in.fault_code != 0 && in.fault_class <= 1) sw |= status_bit::warning;
   bool target;
   if (info.activity == state_activity::run) {
-    target = halt ? in.standstill : in.target_reached;
+    target = halt ? in.standstill : (in.status_bits & status_bit::target_reached) != 0;
   } else {
     const int qs_code = a.stop_code;
     target = info.activity == state_activity::quick_stop && qs_code >= 5 && qs_code <= 8 &&

@@ -178,12 +178,14 @@ inline drive_inputs inputs_of(const plant_constants& k, const axis_state& a) noe
   const bool standstill = magnitude(a.velocity) <= k.standstill_window;
   in.standstill = standstill;
   in.brake_engaged = brake_engaged(k, a);
-  in.target_reached =
+  const bool target_reached =
       magnitude(a.velocity - std::int64_t{effective_target(a)} * micro) <= k.target_window;
   // Status bit 11 while a stop at the current or voltage limit is still braking.
-  in.internal_limit = !standstill && (a.last.ramp == stop_ramp::current_limit ||
-                                      a.last.ramp == stop_ramp::voltage_limit);
-  in.mode_status_bits = standstill ? std::uint16_t{0x1000} : std::uint16_t{0};  // pv: speed = 0
+  const bool internal_limit = !standstill && (a.last.ramp == stop_ramp::current_limit ||
+                                              a.last.ramp == stop_ramp::voltage_limit);
+  in.status_bits = static_cast<std::uint16_t>((target_reached ? status_bit::target_reached : 0u) |
+                                              (internal_limit ? status_bit::internal_limit_active : 0u) |
+                                              (standstill ? 0x1000u : 0u));  // pv: speed = 0
   in.actual_speed_rpm = velocity_rpm(a);
   return in;
 }

@@ -7,8 +7,8 @@
 // set or clear, no fault or a fault of each class (0..4 where the profile has error classes, else one
 // class), DC link on/off, STO on/off, standstill or moving, brake engaged or not, remote on/off, the
 // fieldbus link lost or not, and where the profile's rows read them, local enable/disable requests
-// and the actual speed below or above its limit. Inputs that only pass through to the status word
-// (warning, target reached, internal limit, mode bits) are held at their defaults.
+// and the actual speed below or above its limit. The status bits the motion side reports are held
+// clear; the compiled step is compared once more with every one of them set.
 #pragma once
 
 #include <algorithm>
@@ -197,6 +197,12 @@ inline report check(const profile& p, const std::array<std::int8_t, option_count
 
   for (std::size_t head = 0; head < states.size(); ++head) {
     const axis from = states[head];
+    // S16: a stop code is latched only while its stop runs (the compiled step relies on it).
+    const state_activity resting = p.info(from.current).activity;
+    if (from.stop_code != 0 && !stop_running(from) && resting != state_activity::quick_stop &&
+        resting != state_activity::fault_reaction) {
+      violation("a stop code is latched outside a stop", from, drive_inputs{});
+    }
     // Writes of every option code, supported or not: a refused one changes nothing; an accepted
     // one changes its value only, never the stop that runs (S16).
     for (int o = 0; o < option_count; ++o) {
@@ -225,6 +231,17 @@ inline report check(const profile& p, const std::array<std::int8_t, option_count
         const drive_outputs other_out = step(*compiled, other, in);
         if (!same_outputs(out, other_out) || std::memcmp(&next, &other, sizeof(axis)) != 0) {
           violation("the compiled step differs from full_step", from, in);
+        }
+        // The reported status bits pass differently by state: every one set, the drive's own too.
+        drive_inputs reporting = in;
+        reporting.status_bits = 0xFFFF;
+        axis full_axis = from, compiled_axis = from;
+        const drive_outputs full_out = detail::full_step(p, full_axis, reporting);
+        const drive_outputs compiled_out = step(*compiled, compiled_axis, reporting);
+        if (!same_outputs(full_out, compiled_out) ||
+            std::memcmp(&full_axis, &compiled_axis, sizeof(axis)) != 0) {
+          violation("the compiled step differs from full_step with every status bit reported", from,
+                    reporting);
         }
       }
       axis quiet = from;

@@ -84,11 +84,14 @@ std::vector<std::string> broken_invariants(const profile& p, const step_facts& f
         "status bit 4 is not the DC-link voltage (S11)");
   check(static_cast<bool>(out.status_word & status_bit::remote) == in.remote,
         "status bit 9 is not remote (S11)");
-  check(!(in.warning || in.sto) || (out.status_word & status_bit::warning),
+  check(!((in.status_bits & status_bit::warning) || in.sto) || (out.status_word & status_bit::warning),
         "a warning (or STO, S14) without status bit 7");
   check((out.status_word & status_bit::mode_specific) ==
-            (in.mode_status_bits & status_bit::mode_specific),
+            (in.status_bits & status_bit::mode_specific),
         "status bits 8, 12..15 not passed through");
+  check(static_cast<bool>(out.status_word & status_bit::internal_limit_active) ==
+            static_cast<bool>(in.status_bits & status_bit::internal_limit_active),
+        "status bit 11 not passed through");
   check(!(f.fault && from != S::start && from != S::fault_reaction_active && from != S::fault) ||
             (s == S::fault_reaction_active && out.transition == 13),
         "a fault cause did not take T13 to FAULT REACTION ACTIVE (faults win, S4)");
@@ -197,10 +200,12 @@ struct random_run {
     }
     if (chance(10)) in.local_enable = !in.local_enable;
     if (chance(10)) in.local_disable = !in.local_disable;
-    in.warning = chance(20);
-    in.target_reached = chance(300);
-    in.internal_limit = chance(20);
-    in.mode_status_bits = static_cast<std::uint16_t>(rng());
+    const bool warning = chance(20), target_reached = chance(300), internal_limit = chance(20);
+    // The mode bits random, the drive's own bits too: they must not reach the status word.
+    in.status_bits = static_cast<std::uint16_t>(
+        (rng() & ~unsigned{status_bit::reported & ~status_bit::mode_specific}) |
+        (warning ? status_bit::warning : 0u) | (target_reached ? status_bit::target_reached : 0u) |
+        (internal_limit ? status_bit::internal_limit_active : 0u));
   }
 
   void maybe_write_option() {

@@ -328,7 +328,7 @@ TEST(fault_codes, cia402_sto_in_switch_on_disabled_sets_only_bit_7_and_holds_the
 
 // S11: bit 11 = internal limit active; bits 8 and 12..15 (manufacturer / operation-mode specific,
 // cia402-reference.md §1.2) pass through unchanged, whatever the state, and no other bit of
-// `mode_status_bits` reaches the status word. Checked where the drive `b` stands; it must stay
+// `status_bits` reaches the status word. Checked where the drive `b` stands; it must stay
 // there.
 void check_pass_through(bench& b) {
   const state s = b.a.current;
@@ -336,21 +336,18 @@ void check_pass_through(bench& b) {
   for (std::uint16_t bits : passed) {
     for (bool limit : {false, true}) {
       SCOPED_TRACE(test::hex(bits) + (limit ? " with internal limit" : ""));
-      b.in.mode_status_bits = bits;
-      b.in.internal_limit = limit;
+      b.in.status_bits = static_cast<std::uint16_t>(bits | (limit ? status_bit::internal_limit_active : 0));
       b.step();
       ASSERT_EQ(b.out.current, s) << test::describe(b.out);
       const std::uint16_t want = static_cast<std::uint16_t>(bits | (limit ? 0x0800 : 0));
       EXPECT_EQ(b.out.status_word & 0xF900, want) << test::describe(b.out);
     }
   }
-  // Bits 0..7, 9, 10 and 11 have meanings of their own: set in mode_status_bits, they change
-  // nothing.
-  b.in.internal_limit = false;
-  b.in.mode_status_bits = 0xF100;
+  // Bits 0..6 and 9 are the drive's own: set in status_bits, they change nothing.
+  b.in.status_bits = 0xF100;
   b.step();
   const std::uint16_t clean = b.out.status_word;
-  b.in.mode_status_bits = 0xFFFF;
+  b.in.status_bits = static_cast<std::uint16_t>(0xF100 | 0x027F);
   b.step();
   EXPECT_EQ(b.out.status_word, clean) << test::describe(b.out);
 }
@@ -422,7 +419,7 @@ TEST(status_word, bit_10_stays_clear_while_a_t5_or_t8_stop_runs_also_with_halt) 
     SCOPED_TRACE(std::string(c.profile) + " control word " + test::hex(c.word));
     bench b(test::builtin(c.profile));
     ASSERT_TRUE(test::reach(b, S::operation_enabled));
-    b.in.target_reached = true;
+    b.in.status_bits = status_bit::target_reached;
     b.in.standstill = false;
     b.in.brake_engaged = false;
     b.in.control_word = c.word;
@@ -443,10 +440,10 @@ TEST(status_word, bit_10_stays_clear_while_a_t5_or_t8_stop_runs_also_with_halt) 
   // halt at standstill (S8).
   bench b(test::builtin("cia402"));
   ASSERT_TRUE(test::reach(b, S::operation_enabled));
-  b.in.target_reached = true;
+  b.in.status_bits = status_bit::target_reached;
   b.step();
   EXPECT_TRUE(b.out.status_word & status_bit::target_reached) << test::describe(b.out);
-  b.in.target_reached = false;
+  b.in.status_bits = 0;
   b.in.control_word = 0x010F;  // halt
   b.step();
   EXPECT_TRUE(b.out.status_word & status_bit::target_reached) << test::describe(b.out);

@@ -52,11 +52,12 @@ inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_
   out.torque = torque;
   out.brake_released = torque;
   out.clear_setpoints = false;
-  const bool target = run && (halt ? in.standstill : in.target_reached);
+  const bool target =
+      run && (halt ? in.standstill : (in.status_bits & status_bit::target_reached) != 0);
   out.status_word = static_cast<std::uint16_t>(
       info.status_pattern | 0x0210u /* voltage enabled, remote */ |
-      (static_cast<unsigned>(in.warning) << 7) | (static_cast<unsigned>(target) << 10) |
-      (static_cast<unsigned>(in.internal_limit) << 11) | (in.mode_status_bits & 0xF100u));
+      (in.status_bits & (status_bit::reported & ~status_bit::target_reached)) |
+      (static_cast<unsigned>(target) << 10));
   out.error_code = a.error_code;
   out.error_register = a.error_code ? error_register_of(a.error_code) : std::uint8_t{0};
   return true;
