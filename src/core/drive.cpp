@@ -1,6 +1,7 @@
 #include "cia402/drive.hpp"
 
 #include "cia402/words.hpp"
+#include "bits.hpp"
 
 namespace cia402 {
 namespace {
@@ -224,7 +225,7 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   std::uint8_t match = no_row;
   if (p.busy_from[from] & f) {
     for (std::uint32_t rows = p.rows_from[from]; rows != 0; rows &= rows - 1) {
-      const std::uint8_t i = static_cast<std::uint8_t>(__builtin_ctz(rows));
+      const std::uint8_t i = static_cast<std::uint8_t>(detail::lowest_bit(rows));
       const transition_row& r = p.rows[i];
       if ((r.any.bits() & f) && (r.all.bits() & f) == r.all.bits() && !(r.none.bits() & f)) {
         match = i;

@@ -1,9 +1,11 @@
 #include "cia402/master.hpp"
 
+#include "bits.hpp"
+
 namespace cia402 {
 namespace {
 
-int popcount(unsigned v) noexcept { return __builtin_popcount(v); }
+int popcount(unsigned v) noexcept { return detail::set_bits(v); }
 
 bool same_axis(const axis& a, const axis& b) noexcept {
   if (a.current != b.current || a.pending_row != b.pending_row || a.flags != b.flags ||
