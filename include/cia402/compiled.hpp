@@ -144,7 +144,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   // load does not wait for this one's store.
   // The choice is of an address, not a branch: a command that changes at random costs no
   // mispredicted jump.
-  std::memcpy(&a, &after, 4);
+  std::memcpy(static_cast<void*>(&a), &after, 4);
   out.current = e.next;
   out.status_word = static_cast<std::uint16_t>(status);
   out.transition = e.transition;
