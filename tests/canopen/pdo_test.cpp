@@ -86,6 +86,59 @@ TEST_F(pdo_test, event_rpdo_acts_at_once_and_event_tpdo_sends_each_new_status_wo
   EXPECT_EQ(status.back().len, 2);
 }
 
+// CANopenNode's OD_requestTPDO: the node samples an event TPDO when the device reports a change
+// of an object it maps (or the node wrote one), not every time it runs.
+TEST_F(pdo_test, a_drive_at_rest_is_not_read_and_sends_nothing) {
+  start();
+  net.run(5000, 1000);  // SWITCH ON DISABLED, every event TPDO sent once
+  net.received.clear();
+  const int reads_before = dev().reads;
+  net.run(50000, 100);  // 500 calls of process(), nothing changes
+  EXPECT_EQ(dev().reads, reads_before) << "the node polled the device";
+  EXPECT_TRUE(net.received.empty());
+}
+
+TEST_F(pdo_test, a_reported_change_is_sampled_and_sent_once) {
+  start();
+  net.run(5000, 1000);
+  net.received.clear();
+  const int reads_before = dev().reads;
+  net.send(make_frame(0x203, {0x06, 0x00}));  // Shutdown: the status word changes at the next step
+  net.run(5000, 100);
+  const auto status = net.with_id(0x183);
+  ASSERT_EQ(status.size(), 1u);
+  EXPECT_EQ(get_le(status[0].data.data(), 2) & 0x6F, 0x21u);  // READY TO SWITCH ON
+  // Each TPDO that maps the status word is sampled once for the change (TPDO1, 2 and 4: 1 + 2 + 2
+  // objects), none after.
+  int mapped = 0;
+  for (int n = 0; n < pdo_count; ++n) {
+    const pdo_config& t = node().tpdo(n);
+    bool maps_status = false;
+    for (std::uint8_t i = 0; i < t.count; ++i) maps_status |= t.map[i].index == 0x6041;
+    if (t.valid && maps_status) mapped += t.count;
+  }
+  EXPECT_EQ(mapped, 5);
+  EXPECT_EQ(dev().reads - reads_before, mapped);
+}
+
+TEST_F(pdo_test, a_velocity_the_node_writes_goes_out_in_the_tpdo_that_maps_it) {
+  // TPDO4 maps 0x6041 and 0x606C; the test device's 0x606C follows 0x60FF while torque is on, so
+  // the change is reported by the device's write, not by a step.
+  start();
+  net.run(3000, 1000);
+  for (const std::uint8_t cw : {0x06, 0x0F}) {
+    net.send(make_frame(0x203, {cw, 0x00}));
+    net.run(3000, 1000);
+  }
+  ASSERT_EQ(dev().current(), state::operation_enabled);
+  net.received.clear();
+  net.send(make_frame(0x503, {0x0F, 0x00, 0xE8, 0x03, 0x00, 0x00}));  // RPDO4: 0x6040, 0x60FF = 1000
+  net.settle();
+  const auto velocity = net.with_id(0x483);
+  ASSERT_FALSE(velocity.empty());
+  EXPECT_EQ(get_le(velocity.back().data.data() + 2, 4), 1000u);
+}
+
 TEST_F(pdo_test, entering_operational_sends_every_event_tpdo_once) {
   net.run(3000, 1000);
   net.received.clear();

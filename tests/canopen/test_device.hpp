@@ -3,6 +3,7 @@
 // of it, so tests can see the node's calls, and it does not depend on the simulator.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "cia402/canopen/device.hpp"
@@ -42,7 +43,10 @@ class test_device final : public device {
     switch (index) {
       case 0x6040: control_word_ = static_cast<std::uint16_t>(v); return sdo_abort::none;
       case 0x6060: return v == 3 ? sdo_abort::none : sdo_abort::invalid_value;
-      case 0x60FF: target_velocity_ = static_cast<std::int32_t>(v); return sdo_abort::none;
+      case 0x60FF:
+        target_velocity_ = static_cast<std::int32_t>(v);
+        report_changes();  // 0x606C follows it at once
+        return sdo_abort::none;
       case 0x6083: case 0x6084: case 0x6085:
         if (v < 1) return sdo_abort::value_too_low;
         ramps_[index - 0x6083] = static_cast<std::uint32_t>(v);
@@ -68,7 +72,13 @@ class test_device final : public device {
       out_ = drive_.step(in);
       ++steps;
     }
+    report_changes();
     return cycle_us - pending_us_;
+  }
+
+  std::array<std::uint8_t, 5> manufacturer_error_field() const noexcept override {
+    return {static_cast<std::uint8_t>(out_.status_word), static_cast<std::uint8_t>(out_.status_word >> 8),
+            0, 0, 0};
   }
 
   void set_connection_lost(bool lost) noexcept override { connection_lost = lost; }
@@ -77,6 +87,7 @@ class test_device final : public device {
     out_ = {};
     control_word_ = 0;
     ++resets;
+    report_changes();
   }
 
   state current() const noexcept { return drive_.current(); }
@@ -92,6 +103,28 @@ class test_device final : public device {
   int resets = 0;
 
  private:
+  // Tells the node what changed by the device's own doing, as a device must (device.hpp).
+  void report_changes() noexcept {
+    const std::int64_t velocity = out_.torque ? target_velocity_ : 0;
+    if (out_.status_word != reported_status_) {
+      reported_status_ = out_.status_word;
+      changed(0x6041, 0);
+    }
+    if (out_.error_code != reported_error_) {
+      reported_error_ = out_.error_code;
+      changed(0x603F, 0);
+      changed(0x1001, 0);
+      error_changed(out_.error_code);
+    }
+    if (velocity != reported_velocity_) {
+      reported_velocity_ = velocity;
+      changed(0x606C, 0);
+    }
+  }
+
+  std::uint16_t reported_status_ = 0;
+  std::uint16_t reported_error_ = 0;
+  std::int64_t reported_velocity_ = 0;
   const profile* profile_;
   cia402::drive drive_;
   drive_outputs out_{};

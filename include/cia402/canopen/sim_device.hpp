@@ -2,6 +2,7 @@
 // the core state machine and a plant, stepped once per plant cycle of the time the node passes in.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 
@@ -29,14 +30,23 @@ class sim_device final : public device {
   std::uint32_t step(std::uint32_t elapsed_us) noexcept override;
   void set_connection_lost(bool lost) noexcept override { drive_->view().set_connection_lost(lost); }
   void reset() noexcept override;
+  /// The status word, then zeros.
+  std::array<std::uint8_t, 5> manufacturer_error_field() const noexcept override;
 
   sim::virtual_drive& drive() noexcept { return *drive_; }
 
  private:
   const profile* profile_;
   sim::plant_config config_;
+  // Reports to the node what the drive changed by itself since the last report.
+  void report_changes() noexcept;
+
   std::unique_ptr<sim::virtual_drive> drive_;
   std::uint32_t pending_us_ = 0;
+  // What the node was last told: the objects the drive changes by itself.
+  std::uint16_t status_word_ = 0;
+  std::uint16_t error_code_ = 0;
+  std::int32_t velocity_rpm_ = 0;
 };
 
 }  // namespace cia402::canopen

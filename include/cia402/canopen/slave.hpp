@@ -13,9 +13,9 @@
 //   resets 0x1000..0x1FFF. Both send the boot-up message and enter PRE-OPERATIONAL.
 // - A heartbeat consumer timeout (0x1016) tells the device the connection is lost, so 0x6007 acts
 //   (S10), and sends EMCY 0x8130; the next heartbeat from that node clears it.
-// - EMCY (0x80 + node-ID) on every new drive fault (0x603F becomes non-zero or changes): bytes 0..1
-//   the error code, byte 2 the error register 0x1001, bytes 3..4 the status word 0x6041 at that
-//   moment, bytes 5..7 zero. Node errors (heartbeat lost 0x8130, RPDO too short 0x8210) send their
+// - EMCY (0x80 + node-ID) on every new device error (device::error_changed, device.hpp): bytes 0..1
+//   the error code, byte 2 the error register 0x1001, bytes 3..7 the device's
+//   manufacturer_error_field() at that moment (a CiA 402 drive: its status word, then zeros). Node errors (heartbeat lost 0x8130, RPDO too short 0x8210) send their
 //   own EMCY. When the last error is gone, EMCY 0x0000 ("error reset").
 // - 0x1001 reads as the drive's register, plus bits 0 and 4 (communication) while a node error is
 //   active.
@@ -28,7 +28,10 @@
 //   valid.
 // - A synchronous RPDO's data acts at the next SYNC; an event RPDO's at once. A synchronous TPDO
 //   (1..240) is sampled and sent on every n-th SYNC; type 0 on a SYNC if its data changed; 254/255
-//   when its data changes (after the inhibit time) and every event-timer period.
+//   when its data changes (after the inhibit time) and every event-timer period. An event TPDO is
+//   sampled only when the device reported a change of an object it maps, the node wrote one, its
+//   event timer ran out or it has not been sent since it was (re)configured: no device reads while
+//   nothing changes.
 #pragma once
 
 #include <array>
@@ -69,10 +72,12 @@ inline constexpr std::uint16_t heartbeat_lost = 0x8130;   ///< life guard / hear
 inline constexpr std::uint16_t pdo_length = 0x8210;       ///< PDO not processed: length error
 }  // namespace node_error
 
-class slave final : private object_access {
+class slave final : private object_access, private device_events {
  public:
-  /// Sends the boot-up message and enters PRE-OPERATIONAL. Device and channel must outlive it.
+  /// Sends the boot-up message and enters PRE-OPERATIONAL. Device and channel must outlive it; the
+  /// node attaches itself to the device's reports until it is destroyed.
   slave(device& d, channel& out, const slave_config& config);
+  ~slave();
   slave(const slave&) = delete;
   slave& operator=(const slave&) = delete;
 
@@ -114,6 +119,7 @@ class slave final : private object_access {
     std::uint32_t inhibit_left_us = 0;
     std::uint32_t event_left_us = 0;
     bool event_pending = false;
+    bool requested = false;  // an object it maps changed: sample it
   };
 
   // object_access (the SDO server's view)
@@ -123,6 +129,10 @@ class slave final : private object_access {
                      bool size_indicated) noexcept override;
   sdo_abort upload(std::uint16_t index, std::uint8_t sub,
                    std::vector<std::uint8_t>& data) noexcept override;
+
+  // device_events (the device's reports)
+  void object_changed(std::uint16_t index, std::uint8_t sub) noexcept override;
+  void error_changed(std::uint16_t code) noexcept override;
 
   sdo_abort write_checked(object_dictionary::slot& s, std::int64_t v);
   sdo_abort write_pdo_parameter(object_dictionary::slot& s, std::int64_t v);
@@ -140,7 +150,6 @@ class slave final : private object_access {
   bool sample(const tpdo_state& t, std::array<std::uint8_t, 8>& out);
   void send_tpdo(tpdo_state& t, const std::array<std::uint8_t, 8>& data);
   std::uint32_t process_tpdo_events(std::uint32_t elapsed_us);
-  void check_errors();
   void set_node_error(std::uint16_t code, bool active);
   void send_emcy(std::uint16_t code);
 
@@ -155,7 +164,7 @@ class slave final : private object_access {
   std::array<rpdo_state, 4> rpdo_{};
   std::array<tpdo_state, 4> tpdo_{};
   std::uint32_t sync_id_ = cob::sync;
-  std::uint16_t drive_error_ = 0;      // the drive's 0x603F as last reported by EMCY
+  std::uint16_t drive_error_ = 0;      // the device's error as last reported
   bool heartbeat_error_ = false;
   bool pdo_length_error_ = false;
   bool any_error_reported_ = false;    // an EMCY other than 0x0000 went out since the last reset one

@@ -31,6 +31,7 @@ slave::slave(device& d, channel& out, const slave_config& config)
       config_(config),
       od_(table_for(config), config.node_id),
       sdo_(*this, out, config.node_id, config.sdo_timeout_us) {
+  device_->attach(this);
   consumer_.on_change = [this](std::uint8_t, bool) {
     const bool lost = consumer_.any_lost();
     device_->set_connection_lost(lost);
@@ -38,6 +39,8 @@ slave::slave(device& d, channel& out, const slave_config& config)
   };
   boot();
 }
+
+slave::~slave() { device_->attach(nullptr); }
 
 // ---- NMT ------------------------------------------------------------------------------------
 
@@ -127,7 +130,6 @@ std::uint32_t slave::poll(channel& in, std::uint32_t elapsed_us) {
 
 std::uint32_t slave::process(std::uint32_t elapsed_us) {
   std::uint32_t next = device_->step(elapsed_us);
-  check_errors();
   next = earliest(next, producer_.process(elapsed_us, *out_, config_.node_id, state_));
   next = earliest(next, consumer_.process(elapsed_us));
   if (state_ != nmt_state::stopped) next = earliest(next, sdo_.process(elapsed_us));
@@ -205,6 +207,11 @@ std::uint32_t slave::process_tpdo_events(std::uint32_t elapsed_us) {
       if (t.event_left_us == 0) t.event_pending = true;
     }
     std::array<std::uint8_t, 8> data{};
+    if (!t.requested && !t.event_pending && t.sent) {  // nothing it maps changed
+      if (t.cfg.event_timer_ms != 0) next = earliest(next, t.event_left_us);
+      continue;
+    }
+    t.requested = false;
     if (!sample(t, data)) continue;
     if (!t.sent || data != t.last) t.event_pending = true;
     if (t.event_pending && t.inhibit_left_us == 0) send_tpdo(t, data);
@@ -357,7 +364,11 @@ sdo_abort slave::read_value(const object_dictionary::slot& s, std::int64_t& v) {
 sdo_abort slave::write_checked(object_dictionary::slot& s, std::int64_t v) {
   const std::uint16_t index = s.object->index;
   const std::uint8_t sub = s.entry->sub;
-  if (s.entry->where == backing::device) return device_->write(index, sub, v);
+  if (s.entry->where == backing::device) {
+    const sdo_abort a = device_->write(index, sub, v);
+    if (a == sdo_abort::none) object_changed(index, sub);  // a TPDO mapping it sends it
+    return a;
+  }
   if (is_pdo_parameter(index)) return write_pdo_parameter(s, v);
   const auto u = static_cast<std::uint32_t>(v);
   switch (index) {
@@ -478,14 +489,20 @@ sdo_abort slave::upload(std::uint16_t index, std::uint8_t sub,
 
 // ---- EMCY -------------------------------------------------------------------------------------
 
-void slave::check_errors() {
-  std::int64_t code = 0;
-  if (device_->read(0x603F, 0, code) != sdo_abort::none) return;
-  const auto c = static_cast<std::uint16_t>(code);
-  if (c == drive_error_) return;
-  drive_error_ = c;
-  if (c != 0) {
-    send_emcy(c);
+void slave::object_changed(std::uint16_t index, std::uint8_t sub) noexcept {
+  for (tpdo_state& t : tpdo_) {
+    if (!t.cfg.valid || !event_type(t.cfg.transmission_type)) continue;
+    for (std::uint8_t i = 0; i < t.cfg.count; ++i) {
+      if (t.cfg.map[i].index == index && t.cfg.map[i].sub == sub) t.requested = true;
+    }
+  }
+}
+
+void slave::error_changed(std::uint16_t code) noexcept {
+  if (code == drive_error_) return;
+  drive_error_ = code;
+  if (code != 0) {
+    send_emcy(code);
   } else if (!heartbeat_error_ && !pdo_length_error_) {
     send_emcy(0);
   }
@@ -507,17 +524,17 @@ void slave::send_emcy(std::uint16_t code) {
   if (code == 0 && !any_error_reported_) return;  // nothing to reset
   any_error_reported_ = code != 0;
   std::int64_t reg = 0;
-  std::int64_t status = 0;
+  std::array<std::uint8_t, 5> field{};
   if (code != 0) {
     (void)read(0x1001, 0, reg);
-    (void)device_->read(0x6041, 0, status);
+    field = device_->manufacturer_error_field();
   }
   frame f;
   f.id = static_cast<std::uint32_t>(od_.number(0x1014, 0)) & max_base_id;
   f.len = 8;
   put_le(&f.data[0], code, 2);
   f.data[2] = static_cast<std::uint8_t>(reg);
-  put_le(&f.data[3], static_cast<std::uint64_t>(status), 2);
+  for (std::size_t i = 0; i < field.size(); ++i) f.data[3 + i] = field[i];
   (void)out_->send(f);
 }
 

@@ -18,7 +18,34 @@ std::uint32_t sim_device::step(std::uint32_t elapsed_us) noexcept {
     drive_->step();
     pending_us_ -= cycle;
   }
+  report_changes();
   return cycle - pending_us_;
+}
+
+void sim_device::report_changes() noexcept {
+  const sim::drive_view v = drive_->view();
+  const std::uint16_t status = v.outputs().status_word;
+  const std::uint16_t error = v.outputs().error_code;
+  const std::int32_t velocity = v.velocity_rpm();
+  if (status != status_word_) {
+    status_word_ = status;
+    changed(object_index::status_word, 0);
+  }
+  if (error != error_code_) {
+    error_code_ = error;
+    changed(object_index::error_code, 0);
+    changed(sim::object::error_register, 0);
+    error_changed(error);
+  }
+  if (velocity != velocity_rpm_) {
+    velocity_rpm_ = velocity;
+    changed(object_index::velocity_actual_value, 0);
+  }
+}
+
+std::array<std::uint8_t, 5> sim_device::manufacturer_error_field() const noexcept {
+  const std::uint16_t status = drive_->view().outputs().status_word;
+  return {static_cast<std::uint8_t>(status), static_cast<std::uint8_t>(status >> 8), 0, 0, 0};
 }
 
 sdo_abort sim_device::write(std::uint16_t index, std::uint8_t sub, std::int64_t value) noexcept {
@@ -40,6 +67,7 @@ void sim_device::reset() noexcept {
   drive_ = std::make_unique<sim::virtual_drive>(*profile_, config_);
   drive_->view().set_connection_lost(lost);
   pending_us_ = 0;
+  report_changes();
 }
 
 }  // namespace cia402::canopen
