@@ -57,7 +57,7 @@ ALLOWED = {
     "sim": {"core", "profile_file", "motion", "support"},
     "canopen/can": {"core"},
     "canopen/301": {"core", "canopen/can"},
-    "canopen/306": {"core", "canopen/can", "canopen/301"},
+    "canopen/306": {"core", "support", "canopen/can", "canopen/301"},
     "canopen/transport": {"core", "canopen/can"},
     "canopen/402": {"core", "canopen/can", "canopen/301", "canopen/306", "sim"},
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",

@@ -25,12 +25,6 @@ constexpr command_entry commands[] = {
 
 }  // namespace
 
-std::string hex(std::uint32_t value, int digits) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%0*X", digits, value);
-  return buf;
-}
-
 std::string abort_text(sdo_abort code) {
   return "SDO abort " + hex(static_cast<std::uint32_t>(code), 8) + " (" + sdo_abort_text(code) +
          ")";

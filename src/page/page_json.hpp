@@ -13,13 +13,14 @@
 #include "cia402/page/backend.hpp"
 #include "cia402/profile.hpp"
 #include "cia402/sdo_abort.hpp"
+#include "cia402/support/text.hpp"
 
 namespace cia402::page::detail {
 
 using json = nlohmann::ordered_json;
 
-/// "0x605A" with `digits` hex digits.
-std::string hex(std::uint32_t value, int digits);
+using support::hex;  // "0x605A" with `digits` hex digits
+
 /// "SDO abort 0x06090030 (value range of parameter exceeded)".
 std::string abort_text(sdo_abort code);
 

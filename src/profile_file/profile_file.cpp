@@ -3,6 +3,7 @@
 // so a caller sees a complete profile or an error, never a half-loaded one.
 #include "cia402/profile_file.hpp"
 
+#include "cia402/support/text.hpp"
 #include "cia402/support/toml_reading.hpp"
 
 #include <toml++/toml.h>
@@ -74,17 +75,11 @@ bool parse_listed(std::string_view name, const char* const (&names)[N], Enum& ou
   return false;
 }
 
-std::string hex(unsigned v, int digits) {
-  static constexpr char d[] = "0123456789ABCDEF";
-  std::string s = "0x";
-  for (int i = digits - 1; i >= 0; --i) s += d[(v >> (4 * i)) & 0xFu];
-  return s;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Refusals travel as an exception inside this file only (toml_reading.hpp); the public API returns
 // them as values.
 
+using support::hex;
 using toml_reading::check_keys;
 using toml_reading::get_array;
 using toml_reading::get_bool;

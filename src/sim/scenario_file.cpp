@@ -14,6 +14,7 @@
 #include "cia402/profile_file.hpp"
 #include "cia402/sim/scenario.hpp"
 #include "cia402/sim/virtual_drive.hpp"
+#include "cia402/support/text.hpp"
 #include "cia402/support/toml_reading.hpp"
 
 static_assert(TOML_EXCEPTIONS, "the loader relies on toml::parse throwing toml::parse_error");
@@ -21,6 +22,7 @@ static_assert(TOML_EXCEPTIONS, "the loader relies on toml::parse throwing toml::
 namespace cia402::sim {
 namespace {
 
+using support::hex;
 using toml_reading::get_array;
 using toml_reading::get_bool;
 using toml_reading::get_int;
@@ -30,13 +32,6 @@ using toml_reading::refusal;
 using toml_reading::refuse;
 using toml_reading::refuse_type;
 using toml_reading::type_name;
-
-std::string hex(std::uint64_t v, int digits) {
-  static constexpr char d[] = "0123456789ABCDEF";
-  std::string s = "0x";
-  for (int i = digits - 1; i >= 0; --i) s += d[(v >> (4 * i)) & 0xFu];
-  return s;
-}
 
 // A key of the top level written under a [table] is the usual slip: say so.
 void check_keys(const toml::table& t, std::initializer_list<std::string_view> allowed,
@@ -55,24 +50,9 @@ void check_keys(const toml::table& t, std::initializer_list<std::string_view> al
 
 // A decimal or 0x-hexadecimal integer written as a key ("0x605A").
 bool parse_index(std::string_view text, std::uint16_t& out) {
-  unsigned base = 10;
-  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
-    base = 16;
-    text.remove_prefix(2);
-  }
-  if (text.empty()) return false;
-  std::uint32_t v = 0;
-  for (char c : text) {
-    unsigned d;
-    if (c >= '0' && c <= '9') d = static_cast<unsigned>(c - '0');
-    else if (base == 16 && c >= 'a' && c <= 'f') d = static_cast<unsigned>(c - 'a' + 10);
-    else if (base == 16 && c >= 'A' && c <= 'F') d = static_cast<unsigned>(c - 'A' + 10);
-    else return false;
-    v = v * base + d;
-    if (v > 0xFFFF) return false;
-  }
-  out = static_cast<std::uint16_t>(v);
-  return true;
+  const std::optional<std::int64_t> v = support::parse_integer(text, 0, 0xFFFF);
+  if (v) out = static_cast<std::uint16_t>(*v);
+  return v.has_value();
 }
 
 // "10ms", "1.5s", "250us", "2 s": an exact number of microseconds.

@@ -4,17 +4,13 @@
 
 #include "cia402/sim/scenario.hpp"
 #include "cia402/sim/virtual_drive.hpp"
+#include "cia402/support/text.hpp"
 #include "cia402/words.hpp"
 
 namespace cia402::sim {
 namespace {
 
-std::string hex(std::uint32_t v, int digits) {
-  static constexpr char d[] = "0123456789ABCDEF";
-  std::string s = "0x";
-  for (int i = digits - 1; i >= 0; --i) s += d[(v >> (4 * i)) & 0xFu];
-  return s;
-}
+using support::hex;
 
 std::string short_seconds(std::uint64_t us) {
   const std::string full = format_seconds(us);  // "1.250000"

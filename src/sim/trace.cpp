@@ -4,15 +4,12 @@
 #include <ostream>
 #include <string>
 
+#include "cia402/support/text.hpp"
+
 namespace cia402::sim {
 namespace {
 
-std::string hex4(std::uint32_t v) {
-  static constexpr char d[] = "0123456789ABCDEF";
-  std::string s = "0x";
-  for (int i = 3; i >= 0; --i) s += d[(v >> (4 * i)) & 0xFu];
-  return s;
-}
+using support::hex;
 
 std::string binary(std::uint32_t v, int bits) {
   std::string s;
@@ -126,12 +123,12 @@ void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_
          "brake_released,brake_engaged,ramp,error_code,fault_cause,dc_link,sto\n";
   for (std::size_t i : kept_rows(rows, every)) {
     const trace_row& r = rows[i];
-    out << r.time_us << ',' << hex4(r.control_word) << ',' << hex4(r.status_word) << ','
+    out << r.time_us << ',' << hex(r.control_word, 4) << ',' << hex(r.status_word, 4) << ','
         << state_name(r.current) << ','
         << (r.transition == no_transition ? std::string() : std::to_string(r.transition)) << ','
         << format_rpm(r.velocity) << ',' << r.target_velocity << ',' << int{r.torque} << ','
         << int{r.brake_released} << ',' << int{r.brake_engaged} << ',' << stop_ramp_name(r.ramp)
-        << ',' << hex4(r.error_code) << ',' << hex4(r.fault_cause) << ',' << int{r.dc_link} << ','
+        << ',' << hex(r.error_code, 4) << ',' << hex(r.fault_cause, 4) << ',' << int{r.dc_link} << ','
         << int{r.sto} << '\n';
   }
 }
@@ -140,16 +137,16 @@ void write_jsonl(std::ostream& out, const std::vector<trace_row>& rows, std::siz
   auto b = [](bool v) { return v ? "true" : "false"; };
   for (std::size_t i : kept_rows(rows, every)) {
     const trace_row& r = rows[i];
-    out << "{\"time_us\":" << r.time_us << ",\"controlword\":\"" << hex4(r.control_word)
-        << "\",\"statusword\":\"" << hex4(r.status_word) << "\",\"state\":\""
+    out << "{\"time_us\":" << r.time_us << ",\"controlword\":\"" << hex(r.control_word, 4)
+        << "\",\"statusword\":\"" << hex(r.status_word, 4) << "\",\"state\":\""
         << state_name(r.current) << "\",\"transition\":"
         << (r.transition == no_transition ? std::string("null") : std::to_string(r.transition))
         << ",\"velocity_rpm\":" << format_rpm(r.velocity) << ",\"target_rpm\":"
         << r.target_velocity << ",\"torque\":" << b(r.torque)
         << ",\"brake_released\":" << b(r.brake_released)
         << ",\"brake_engaged\":" << b(r.brake_engaged) << ",\"ramp\":\""
-        << stop_ramp_name(r.ramp) << "\",\"error_code\":\"" << hex4(r.error_code)
-        << "\",\"fault_cause\":\"" << hex4(r.fault_cause) << "\",\"dc_link\":" << b(r.dc_link)
+        << stop_ramp_name(r.ramp) << "\",\"error_code\":\"" << hex(r.error_code, 4)
+        << "\",\"fault_cause\":\"" << hex(r.fault_cause, 4) << "\",\"dc_link\":" << b(r.dc_link)
         << ",\"sto\":" << b(r.sto) << "}\n";
   }
 }

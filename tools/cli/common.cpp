@@ -10,44 +10,8 @@
 namespace cia402::cli {
 
 std::optional<std::int64_t> parse_number(std::string_view text) {
-  bool negative = false;
-  if (!text.empty() && (text[0] == '-' || text[0] == '+')) {
-    negative = text[0] == '-';
-    text.remove_prefix(1);
-  }
-  unsigned base = 10;
-  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
-    base = 16;
-    text.remove_prefix(2);
-  }
-  if (text.empty()) return std::nullopt;
-  std::int64_t value = 0;
-  for (char c : text) {
-    unsigned digit = 0;
-    if (c >= '0' && c <= '9')
-      digit = static_cast<unsigned>(c - '0');
-    else if (base == 16 && c >= 'a' && c <= 'f')
-      digit = static_cast<unsigned>(c - 'a' + 10);
-    else if (base == 16 && c >= 'A' && c <= 'F')
-      digit = static_cast<unsigned>(c - 'A' + 10);
-    else
-      return std::nullopt;
-    if (digit >= base) return std::nullopt;
-    value = value * base + digit;
-    if (value > std::int64_t{std::numeric_limits<std::uint32_t>::max()}) return std::nullopt;
-  }
-  if (negative) {
-    value = -value;
-    if (value < std::numeric_limits<std::int32_t>::min()) return std::nullopt;
-  }
-  return value;
-}
-
-std::string hex(std::uint32_t value, int digits) {
-  static constexpr char d[] = "0123456789ABCDEF";
-  std::string s = "0x";
-  for (int i = digits - 1; i >= 0; --i) s += d[(value >> (4 * i)) & 0xFu];
-  return s;
+  return support::parse_integer(text, std::numeric_limits<std::int32_t>::min(),
+                                std::numeric_limits<std::uint32_t>::max());
 }
 
 std::string json_escape(std::string_view text) {

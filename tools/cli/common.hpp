@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "cia402/profile.hpp"
+#include "cia402/support/text.hpp"
 
 namespace CLI {
 class App;
@@ -21,7 +22,7 @@ namespace cia402::cli {
 std::optional<std::int64_t> parse_number(std::string_view text);
 
 /// "0x0237": 0x and `digits` upper-case hex digits.
-std::string hex(std::uint32_t value, int digits);
+using support::hex;
 
 /// The text as the body of a JSON string (quotes, backslashes and control characters escaped).
 std::string json_escape(std::string_view text);

@@ -4,15 +4,12 @@
 #include <ostream>
 #include <vector>
 
+#include "cia402/support/text.hpp"
 
 namespace cia402::canopen {
 namespace {
 
-std::string hex(std::uint64_t v, int digits) {
-  char buf[24];
-  std::snprintf(buf, sizeof buf, "0x%0*llX", digits, static_cast<unsigned long long>(v));
-  return buf;
-}
+using support::hex;
 
 std::string section_name(std::uint16_t index) {
   char buf[8];

@@ -1,0 +1,21 @@
+// Text helpers the layers above the core share: one way to write a number in hexadecimal and one
+// way to read an integer a person typed (decimal or 0x-hexadecimal), so every file format, message
+// and command line agrees.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace cia402::support {
+
+/// "0x" and `digits` upper-case hexadecimal digits (more if the value needs them): hex(0x6041, 4)
+/// is "0x6041".
+std::string hex(std::uint64_t value, int digits);
+
+/// A decimal or 0x-hexadecimal integer with an optional sign, the whole text and nothing else,
+/// within [min, max]; nothing otherwise.
+std::optional<std::int64_t> parse_integer(std::string_view text, std::int64_t min, std::int64_t max);
+
+}  // namespace cia402::support
