@@ -67,6 +67,17 @@ TEST(cli_eds, eds_starts_with_file_info_and_names_the_profile) {
   EXPECT_NE(r.out.find("[MandatoryObjects]"), std::string::npos);
 }
 
+// An EDS describes every node alike ($NODEID); --node names the node the file is written for, in
+// CiA 306's commissioning section, so `--node 5` is not the file of node 1.
+TEST(cli_eds, node_option_writes_the_commissioning_section) {
+  const result plain = run_tool({"eds"});
+  const result five = run_tool({"eds", "--node", "5"});
+  ASSERT_EQ(five.status, 0) << five.err;
+  EXPECT_EQ(plain.out.find("[DeviceComissioning]"), std::string::npos);
+  EXPECT_NE(five.out.find("[DeviceComissioning]\nNodeID=5\n"), std::string::npos) << five.out;
+  EXPECT_EQ(run_tool({"eds", "--node", "0"}).status, 2);
+}
+
 TEST(cli_bus, bad_options_are_refused_before_listening) {
   EXPECT_EQ(run_tool({"bus", "--nodes", "0-3"}).status, 2);
   EXPECT_EQ(run_tool({"bus", "--nodes", "1,1"}).status, 2);

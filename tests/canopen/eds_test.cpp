@@ -69,7 +69,7 @@ TEST(eds, object_lists_count_and_name_every_object_section) {
       EXPECT_TRUE(listed.insert(name).second) << name << " listed twice";
     }
   }
-  EXPECT_EQ(counts["MandatoryObjects"], 5u);    // 1000, 1001, 1018, 6040, 6041
+  EXPECT_EQ(counts["MandatoryObjects"], 3u);    // 1000, 1001, 1018 (CiA 306)
   EXPECT_EQ(counts["ManufacturerObjects"], 2u); // 2000, 2001
   for (const auto& [section, keys] : eds) {
     if (section.size() == 4 && section.find_first_not_of("0123456789ABCDEF") == std::string::npos) {
@@ -108,8 +108,29 @@ TEST(eds, entries_carry_type_access_default_and_mapping_of_the_dictionary) {
   EXPECT_EQ(eds.at("1A01sub2").at("DefaultValue"), "0x60610008");
   EXPECT_EQ(eds.at("1802sub1").at("DefaultValue"), "$NODEID+0x80000380") << "TPDO3 starts invalid";
   EXPECT_EQ(eds.at("1800").at("SubNumber"), "0x5") << "sub 4 is reserved";
-  EXPECT_EQ(eds.at("DeviceInfo").at("NrOfRxPDO"), "4");
+  // Spelled as CiA 306 spells them: parsers read the keys case-sensitively.
+  EXPECT_EQ(eds.at("DeviceInfo").at("NrOfRXPDO"), "4");
+  EXPECT_EQ(eds.at("DeviceInfo").at("NrOfTXPDO"), "4");
+  EXPECT_EQ(eds.at("DeviceInfo").count("NrOfRxPDO"), 0u);
   EXPECT_EQ(eds.at("FileInfo").at("EDSVersion"), "4.0");
+}
+
+// CiA 306 keeps [MandatoryObjects] for CiA 301's 0x1000, 0x1001 and 0x1018; the drive's 0x6040 and
+// 0x6041 are optional objects there, 0x2000..0x5FFF the manufacturer's.
+TEST(eds, mandatory_objects_are_the_three_of_cia_301) {
+  const ini eds = parse_ini(eds_of(standard_profile()));
+  const auto& mandatory = eds.at("MandatoryObjects");
+  EXPECT_EQ(mandatory.at("SupportedObjects"), "3");
+  EXPECT_EQ(mandatory.at("1"), "0x1000");
+  EXPECT_EQ(mandatory.at("2"), "0x1001");
+  EXPECT_EQ(mandatory.at("3"), "0x1018");
+  std::set<std::string> optional, manufacturer;
+  for (const auto& [key, value] : eds.at("OptionalObjects")) optional.insert(value);
+  for (const auto& [key, value] : eds.at("ManufacturerObjects")) manufacturer.insert(value);
+  EXPECT_TRUE(optional.count("0x6040"));
+  EXPECT_TRUE(optional.count("0x6041"));
+  EXPECT_TRUE(manufacturer.count("0x2001"));
+  EXPECT_FALSE(optional.count("0x1000"));
 }
 
 TEST(eds, option_code_the_profile_lacks_is_left_out) {

@@ -42,7 +42,8 @@ int list_profiles(std::ostream& out) {
 int run(const std::vector<std::string>& args, std::istream& in, std::ostream& out,
         std::ostream& err) {
   CLI::App app{"Tools for the CiA 402 drive state machine.", "cia402"};
-  app.require_subcommand(1);
+  app.require_subcommand(0, 1);
+  app.set_version_flag("--version", std::string("cia402 ") + CIA402_VERSION);
 
   std::string profile_name = "cia402";
   std::string profile_file;
@@ -109,11 +110,23 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   eds_args eds_options;
   auto* eds = add_eds_subcommand(app, eds_options);
 
+  // A word that is not a command gets the list of commands, not CLI11's "subcommand required".
+  const std::string first = args.empty() ? std::string() : args.front();
+  const auto known = app.get_subcommands([&first](CLI::App* c) { return c->check_name(first); });
+  if (!first.empty() && first.front() != '-' && known.empty()) {
+    err << "cia402: unknown command '" << first << "'\n\n" << app.help();
+    return usage_error;
+  }
   try {
     std::vector<std::string> reversed(args.rbegin(), args.rend());
     app.parse(reversed);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e, out, err);
+    // --help and --version exit 0; every refused argument exits 2, as the tool's own refusals do.
+    return app.exit(e, out, err) == 0 ? 0 : usage_error;
+  }
+  if (app.get_subcommands().empty()) {
+    err << app.help();
+    return usage_error;
   }
 
   if (simulate->parsed()) return run_simulate(simulate_options, out, err);

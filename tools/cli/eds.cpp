@@ -18,7 +18,11 @@ namespace cia402::cli {
 CLI::App* add_eds_subcommand(CLI::App& app, eds_args& args) {
   auto* cmd = app.add_subcommand("eds", "Write the CiA 306 EDS of the virtual drive (the objects `cia402 bus` serves)");
   add_profile_options(*cmd, args.profile, args.profile_file);
-  cmd->add_option("--node", args.node, "node-ID whose values the EDS shows")->check(CLI::Range(1, 127))->default_str("1");
+  cmd->add_option("--node", args.node,
+                  "node-ID the file is written for: its values, and a [DeviceComissioning] section")
+      ->check(CLI::Range(1, 127))
+      ->default_str("1")
+      ->each([&args](const std::string&) { args.node_given = true; });
   cmd->add_option("-o,--output", args.output, "write to this file instead of standard output");
   return cmd;
 }
@@ -42,6 +46,7 @@ int run_eds(const eds_args& args, std::ostream& out, std::ostream& err) {
   info.date = date;
   info.time = time;
   info.description += std::string(", profile ") + choice.get().name;
+  if (args.node_given) info.node_id = static_cast<std::uint8_t>(args.node);
   if (args.output.empty()) {
     canopen::write_eds(node, info, out);
     return 0;

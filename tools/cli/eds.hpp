@@ -15,6 +15,7 @@ struct eds_args {
   std::string profile = "cia402";
   std::string profile_file;
   int node = 1;
+  bool node_given = false;  ///< --node was given: the file names its node
   std::string output;  ///< file, or standard output when empty
 };
 

@@ -5,6 +5,7 @@
 // Node-dependent defaults are written "$NODEID+0x180" as CiA 306 allows.
 #pragma once
 
+#include <cstdint>
 #include <iosfwd>
 #include <string>
 
@@ -20,6 +21,8 @@ struct eds_info {
   std::string time = "12:00PM";     ///< hh:mm(AM|PM)
   std::string vendor_name = "cia402 project";
   std::string product_name = "cia402 virtual drive";
+  /// Non-zero: the node-ID the file is written for, in a [DeviceComissioning] section (CiA 306).
+  std::uint8_t node_id = 0;
 };
 
 /// Writes the EDS of `node` (a freshly started node: its values are the defaults).

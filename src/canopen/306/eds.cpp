@@ -11,6 +11,15 @@ namespace {
 
 using support::hex;
 
+// CiA 306 lists objects by what CiA 301 says of them, not by the device profile: 0x1000, 0x1001
+// and 0x1018 are mandatory, 0x2000..0x5FFF are the manufacturer's, the rest optional (a CiA 402
+// drive's 0x6040 and 0x6041 included).
+int eds_list_of(std::uint16_t index) {
+  if (index == 0x1000 || index == 0x1001 || index == 0x1018) return 0;
+  if (index >= 0x2000 && index <= 0x5FFF) return 2;
+  return 1;
+}
+
 std::string section_name(std::uint16_t index) {
   char buf[8];
   std::snprintf(buf, sizeof buf, "%04X", index);
@@ -99,19 +108,22 @@ void write_eds(slave& node, const eds_info& info, std::ostream& out) {
       << "OrderCode=\n";
   for (int rate : {10, 20, 50, 125, 250, 500, 800, 1000}) out << "BaudRate_" << rate << "=1\n";
   out << "SimpleBootUpMaster=0\nSimpleBootUpSlave=1\nGranularity=8\nDynamicChannelsSupported=0\n"
-      << "GroupMessaging=0\nNrOfRxPDO=" << rpdos << "\nNrOfTxPDO=" << tpdos
+      << "GroupMessaging=0\nNrOfRXPDO=" << rpdos << "\nNrOfTXPDO=" << tpdos
       << "\nLSS_Supported=0\n\n";
   out << "[DummyUsage]\n";
   for (int i = 1; i <= 7; ++i) out << "Dummy000" << i << "=0\n";
   out << "\n[Comments]\nLines=1\nLine1=Generated from the node's object dictionary (cia402 eds).\n\n";
+  if (info.node_id != 0) {
+    // CiA 306's commissioning section (as a DCF has it): the node this file was written for.
+    out << "[DeviceComissioning]\nNodeID=" << int{info.node_id} << "\nNodeName=" << info.product_name
+        << " " << int{info.node_id} << "\nBaudrate=1000\n\n";
+  }
 
-  const object_category categories[3] = {object_category::mandatory, object_category::optional,
-                                         object_category::manufacturer};
   const char* list_names[3] = {"MandatoryObjects", "OptionalObjects", "ManufacturerObjects"};
   for (int c = 0; c < 3; ++c) {
     std::vector<const object_entry*> in;
     for (const object_entry* o : present) {
-      if (o->category == categories[c]) in.push_back(o);
+      if (eds_list_of(o->index) == c) in.push_back(o);
     }
     out << "[" << list_names[c] << "]\nSupportedObjects=" << in.size() << "\n";
     for (std::size_t i = 0; i < in.size(); ++i) out << i + 1 << "=" << hex(in[i]->index, 4) << "\n";
