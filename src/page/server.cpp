@@ -271,6 +271,13 @@ struct server::impl {
   }
 
   void routes() {
+    // cpp-httplib's default sets SO_REUSEPORT, so a second `cia402 serve` on the same port would
+    // listen too and the two would answer in turn. SO_REUSEADDR alone still allows a restart while
+    // old connections linger, and makes the second bind fail.
+    http.set_socket_options([](socket_t sock) {
+      const int yes = 1;
+      ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
     http.set_payload_max_length(options.max_body);
     // Event streams hold a thread each while open; leave room for ordinary requests.
     const auto threads = static_cast<std::size_t>(options.max_event_streams) + 8;

@@ -79,6 +79,19 @@ class page_server : public ::testing::Test {
   std::unique_ptr<httplib::Client> client;
 };
 
+// Two servers on one port would answer in turn, so the page could show one drive while its
+// commands go to the other: the second bind is refused with a message that says why.
+TEST_F(page_server, a_second_server_on_the_same_port_is_refused) {
+  start(false);
+  instrument other{cia402::standard_profile()};
+  server_options o;
+  o.bind = "127.0.0.1";
+  o.port = http->bound_port();
+  server second(other, o);
+  EXPECT_FALSE(second.bind());
+  EXPECT_NE(second.error().find("address in use"), std::string::npos) << second.error();
+}
+
 TEST_F(page_server, page_and_its_files_are_served_from_the_binary) {
   start(false);
   const auto page = client->Get("/");
