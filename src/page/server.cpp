@@ -130,6 +130,7 @@ struct server::impl {
   httplib::Server http;
   std::thread thread;
   std::atomic<bool> stopping{false};
+  std::atomic<bool> listen_returned{false};  // the listening thread is done (or never listened)
   std::atomic<int> streams{0};
   int port = -1;
   std::string error;
@@ -421,11 +422,21 @@ const server_options& server::options() const { return impl_->options; }
 
 void server::start() {
   if (impl_->port < 0 || impl_->thread.joinable()) return;
-  impl_->thread = std::thread([this] { impl_->http.listen_after_bind(); });
+  impl_->thread = std::thread([this] {
+    impl_->http.listen_after_bind();
+    impl_->listen_returned = true;
+  });
 }
 
 void server::stop() {
   impl_->stopping = true;
+  // A stop before the thread has begun to listen would be lost and the join below would wait for
+  // ever: wait until it listens (or has given up) first.
+  if (impl_->thread.joinable()) {
+    while (!impl_->http.is_running() && !impl_->listen_returned) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
   impl_->http.stop();
   if (impl_->thread.joinable()) impl_->thread.join();
 }

@@ -90,7 +90,7 @@ TEST_F(pdo_test, event_rpdo_acts_at_once_and_event_tpdo_sends_each_new_status_wo
 // of an object it maps (or the node wrote one), not every time it runs.
 TEST_F(pdo_test, a_drive_at_rest_is_not_read_and_sends_nothing) {
   start();
-  net.run(5000, 1000);  // SWITCH ON DISABLED, every event TPDO sent once
+  net.run(20000, 1000);  // SWITCH ON DISABLED; every TPDO sent, TPDO4 after its inhibit time
   net.received.clear();
   const int reads_before = dev().reads;
   net.run(50000, 100);  // 500 calls of process(), nothing changes
@@ -100,11 +100,11 @@ TEST_F(pdo_test, a_drive_at_rest_is_not_read_and_sends_nothing) {
 
 TEST_F(pdo_test, a_reported_change_is_sampled_and_sent_once) {
   start();
-  net.run(5000, 1000);
+  net.run(20000, 1000);
   net.received.clear();
   const int reads_before = dev().reads;
   net.send(make_frame(0x203, {0x06, 0x00}));  // Shutdown: the status word changes at the next step
-  net.run(5000, 100);
+  net.run(15000, 100);  // beyond TPDO4's inhibit time of 10 ms
   const auto status = net.with_id(0x183);
   ASSERT_EQ(status.size(), 1u);
   EXPECT_EQ(get_le(status[0].data.data(), 2) & 0x6F, 0x21u);  // READY TO SWITCH ON
@@ -133,7 +133,7 @@ TEST_F(pdo_test, a_velocity_the_node_writes_goes_out_in_the_tpdo_that_maps_it) {
   ASSERT_EQ(dev().current(), state::operation_enabled);
   net.received.clear();
   net.send(make_frame(0x503, {0x0F, 0x00, 0xE8, 0x03, 0x00, 0x00}));  // RPDO4: 0x6040, 0x60FF = 1000
-  net.settle();
+  net.run(15000, 1000);  // TPDO4 waits out its inhibit time
   const auto velocity = net.with_id(0x483);
   ASSERT_FALSE(velocity.empty());
   EXPECT_EQ(get_le(velocity.back().data.data() + 2, 4), 1000u);

@@ -80,16 +80,19 @@ std::uint32_t slave::process_tpdo_events(std::uint32_t elapsed_us) {
       t.event_left_us = saturating_sub(t.event_left_us, elapsed_us);
       if (t.event_left_us == 0) t.event_pending = true;
     }
-    std::array<std::uint8_t, 8> data{};
-    if (!t.requested && !t.event_pending && t.sent) {  // nothing it maps changed
-      if (t.cfg.event_timer_ms != 0) next = earliest(next, t.event_left_us);
+    if (t.cfg.event_timer_ms != 0) next = earliest(next, t.event_left_us);
+    const bool may_send = t.requested || t.event_pending || !t.sent;
+    if (!may_send) continue;  // nothing it maps changed
+    // Within the inhibit time nothing is read: the data is sampled when it may go, so the latest
+    // values go out once.
+    if (t.inhibit_left_us != 0) {
+      next = earliest(next, t.inhibit_left_us);
       continue;
     }
     t.requested = false;
+    std::array<std::uint8_t, 8> data{};
     if (!sample(t, data)) continue;
-    if (!t.sent || data != t.last) t.event_pending = true;
-    if (t.event_pending && t.inhibit_left_us == 0) send_tpdo(t, data);
-    if (t.event_pending) next = earliest(next, t.inhibit_left_us);
+    if (t.event_pending || !t.sent || data != t.last) send_tpdo(t, data);
     if (t.cfg.event_timer_ms != 0) next = earliest(next, t.event_left_us);
   }
   return next;

@@ -140,6 +140,12 @@ std::vector<object_entry> drive_objects() {
       {map_entry(0x6040, 0, 16), map_entry(0x6060, 0, 8)},
       {},
       {map_entry(0x6040, 0, 16), map_entry(0x60FF, 0, 32)}};
+  // A master can rely on each TPDO at least every second (event timer), and the one that carries the
+  // velocity sends at most every 10 ms while the drive ramps (inhibit time): without them a ramping
+  // drive sent about 850 frames/s. The status word alone (TPDO1) has no inhibit time, so every
+  // state change arrives.
+  const std::uint16_t tpdo_inhibit_100us[pdo_count] = {0, 0, 0, 100};
+  constexpr std::uint16_t tpdo_event_timer_ms = 1000;
   const std::vector<std::uint32_t> tpdo_maps[pdo_count] = {
       {map_entry(0x6041, 0, 16)},
       {map_entry(0x6041, 0, 16), map_entry(0x6061, 0, 8)},
@@ -170,8 +176,8 @@ std::vector<object_entry> drive_objects() {
          plus_node(var(1, "COB-ID used by TPDO", data_type::unsigned32, access::rw,
                        invalid + 0x180 + off)),
          var(2, "Transmission type", data_type::unsigned8, access::rw, 255),
-         var(3, "Inhibit time", data_type::unsigned16, access::rw, 0),
-         var(5, "Event timer", data_type::unsigned16, access::rw, 0)}));
+         var(3, "Inhibit time", data_type::unsigned16, access::rw, tpdo_inhibit_100us[n]),
+         var(5, "Event timer", data_type::unsigned16, access::rw, tpdo_event_timer_ms)}));
     t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1A00 + n), "TPDO" + num + " mapping parameter",
                             tpdo_maps[n]));
   }
