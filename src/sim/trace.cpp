@@ -161,6 +161,7 @@ void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trac
     int width;
     std::string (*value)(const trace_row&, int bit);
     int bit;
+    std::uint32_t (*code)(const trace_row&) = nullptr;  // a string's integer code (vcd_standard)
   };
   using value_fn = std::string (*)(const trace_row&, int);
   const value_fn cw_bit = [](const trace_row& r, int bit) {
@@ -175,7 +176,8 @@ void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trac
       {"", "statusword", type::vector, 16,
        [](const trace_row& r, int) { return binary(r.status_word, 16); }, 0},
       {"", "state", type::string, 1,
-       [](const trace_row& r, int) { return std::string(state_name(r.current)); }, 0},
+       [](const trace_row& r, int) { return std::string(state_name(r.current)); }, 0,
+       [](const trace_row& r) { return static_cast<std::uint32_t>(r.current); }},
       {"", "last_transition", type::integer, 8, nullptr, 0},  // filled in below: it is sticky
       {"", "transition_taken", type::wire, 1,
        [](const trace_row& r, int) { return std::string(r.transition != no_transition ? "1" : "0"); },
@@ -185,7 +187,8 @@ void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trac
       {"", "target_rpm", type::real, 64,
        [](const trace_row& r, int) { return std::to_string(r.target_velocity); }, 0},
       {"", "ramp", type::string, 1,
-       [](const trace_row& r, int) { return std::string(stop_ramp_name(r.ramp)); }, 0},
+       [](const trace_row& r, int) { return std::string(stop_ramp_name(r.ramp)); }, 0,
+       [](const trace_row& r) { return static_cast<std::uint32_t>(r.ramp); }},
       {"", "torque", type::wire, 1,
        [](const trace_row& r, int) { return std::string(r.torque ? "1" : "0"); }, 0},
       {"", "brake_released", type::wire, 1,
@@ -203,12 +206,30 @@ void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trac
   };
   for (int b = 0; b < 16; ++b) signals.push_back({"cw", control_bit_names[b], type::wire, 1, cw_bit, b});
   for (int b = 0; b < 16; ++b) signals.push_back({"sw", status_bit_names[b], type::wire, 1, sw_bit, b});
+  if (info.vcd_standard) {
+    // IEEE 1364 has no string variables: the names become codes, and the header says which.
+    for (signal& s : signals) {
+      if (s.t != type::string) continue;
+      s.t = type::integer;
+      s.width = 8;
+      s.value = nullptr;
+    }
+  }
 
   out << "$comment cia402 simulate: " << without_dollar_end(info.title) << " (profile "
       << without_dollar_end(info.profile_name) << ", cycle " << info.cycle_us << " us) $end\n"
       << "$version cia402 simulator $end\n"
-      << "$timescale 1us $end\n"
-      << "$scope module drive $end\n";
+      << "$timescale 1us $end\n";
+  if (info.vcd_standard) {
+    out << "$comment state codes:";
+    for (int i = 0; i < state_count; ++i) out << ' ' << i << '=' << state_name(static_cast<state>(i));
+    out << "; ramp codes:";
+    for (int i = 0; i <= static_cast<int>(stop_ramp::coast); ++i) {
+      out << ' ' << i << '=' << stop_ramp_name(static_cast<stop_ramp>(i));
+    }
+    out << " $end\n";
+  }
+  out << "$scope module drive $end\n";
   std::string open_scope;
   for (std::size_t i = 0; i < signals.size(); ++i) {
     const signal& s = signals[i];
@@ -246,7 +267,9 @@ void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trac
     std::string changes;
     for (std::size_t i = 0; i < signals.size(); ++i) {
       const signal& s = signals[i];
-      const std::string v = s.value ? s.value(r, s.bit) : binary(static_cast<std::uint32_t>(last_transition), 8);
+      const std::string v = s.value  ? s.value(r, s.bit)
+                            : s.code ? binary(s.code(r), 8)
+                                     : binary(static_cast<std::uint32_t>(last_transition), 8);
       if (first || v != last[i]) {
         changes += format(s, v, i) + "\n";
         last[i] = v;

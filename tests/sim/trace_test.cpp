@@ -199,6 +199,29 @@ TEST(vcd, signals_are_named_per_bit_and_their_values_follow_the_trace) {
   EXPECT_EQ(v.value_at("drive.last_transition", 800000), "00001100");  // T12
 }
 
+// The standard form keeps to IEEE 1364: no `$var string` (GTKWave's extension), the state and the
+// ramp as integer codes that the header names; every other signal as before.
+TEST(vcd, the_standard_form_has_no_string_variables_and_names_its_codes) {
+  const scenario s = load_example("quick-stop-2.toml");
+  const run_result r = run_scenario(s);
+  trace_info info{s.name, "cia402", 1000, true};
+  info.vcd_standard = true;
+  std::ostringstream out;
+  write_vcd(out, r.trace, info);
+  EXPECT_EQ(out.str().find("$var string"), std::string::npos);
+  EXPECT_NE(out.str().find("5=OPERATION_ENABLED"), std::string::npos) << "the codes are named";
+  const vcd_file v = read_vcd(out.str());
+  EXPECT_EQ(v.type_of.at("drive.state"), "integer");
+  EXPECT_EQ(v.type_of.at("drive.ramp"), "integer");
+  EXPECT_EQ(v.type_of.size(), 15u + 16u + 16u);
+  for (const trace_row& row : r.trace) {
+    const std::uint64_t t = row.time_us;
+    ASSERT_EQ(std::stoul(v.value_at("drive.state", t), nullptr, 2), static_cast<unsigned>(row.current)) << t;
+    ASSERT_EQ(std::stoul(v.value_at("drive.ramp", t), nullptr, 2), static_cast<unsigned>(row.ramp)) << t;
+    ASSERT_EQ(v.value_at("drive.velocity_rpm", t), format_rpm(row.velocity)) << t;
+  }
+}
+
 TEST(svg, the_plot_names_states_marks_transitions_and_labels_its_axes) {
   const scenario s = load_example("quick-stop-2.toml");
   const run_result r = run_scenario(s);

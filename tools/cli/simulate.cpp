@@ -43,6 +43,8 @@ CLI::App* add_simulate_subcommand(CLI::App& app, simulate_args& args) {
       ->type_name("N")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--quiet", args.quiet, "print only failures and the summary");
+  cmd->add_flag("--vcd-standard", args.vcd_standard,
+                "VCD: state and ramp as integer codes (IEEE 1364) instead of GTKWave's strings");
   return cmd;
 }
 
@@ -104,6 +106,7 @@ int run_simulate(const simulate_args& args, std::ostream& out, std::ostream& err
   info.profile_name = s.drive_profile.get().name;
   info.cycle_us = s.plant.cycle_us;
   info.brake_fitted = s.plant.brake_fitted;
+  info.vcd_standard = args.vcd_standard;
   switch (format) {
     case trace_format::csv: write_csv(trace_file, r.trace, args.every); break;
     case trace_format::jsonl: write_jsonl(trace_file, r.trace, args.every); break;

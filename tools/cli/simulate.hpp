@@ -18,6 +18,7 @@ struct simulate_args {
   std::string plot;   ///< out.svg
   std::size_t every = 1;  ///< keep every n-th row of a CSV/JSONL trace (changes always kept)
   bool quiet = false;
+  bool vcd_standard = false;  ///< VCD without GTKWave's string variables
 };
 
 /// Registers the subcommand on `app`, filling `args` when it is parsed.

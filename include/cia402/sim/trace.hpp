@@ -55,6 +55,9 @@ struct trace_info {
   std::string profile_name;
   std::uint32_t cycle_us = 1000;
   bool brake_fitted = true;  ///< without a brake the plot's brake lane says so
+  /// VCD: state and ramp as 8-bit integer codes (named in a $comment) instead of GTKWave's
+  /// `$var string`, so viewers that keep to IEEE 1364 read the file.
+  bool vcd_standard = false;
 };
 
 /// CSV with a header line: time_us, controlword, statusword, state, transition, velocity_rpm,
@@ -63,7 +66,8 @@ void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_
 /// One JSON object per line with the same fields (transition null when none was taken).
 void write_jsonl(std::ostream& out, const std::vector<trace_row>& rows, std::size_t every = 1);
 /// Value change dump, timescale 1 us, for GTKWave: scope `drive` with controlword, statusword,
-/// velocity_rpm and target_rpm (real), state and ramp (GTKWave's string type: `$var string`),
+/// velocity_rpm and target_rpm (real), state and ramp (GTKWave's string type: `$var string`, or
+/// with info.vcd_standard 8-bit integer codes the header's $comment names),
 /// last_transition (integer) with a transition_taken pulse in the cycle one is taken, torque,
 /// brake_released, brake_engaged, dc_link, sto (wires), error_code;
 /// sub-scopes `cw` and `sw` with one wire per control-word and status-word bit, named by number and
