@@ -43,8 +43,8 @@ class compiled_profile {
  public:
   /// The key of an entry: bits 0..3 the state, 4..6 the decoded command, 7 control-word bit 7, 8
   /// and 9 the axis flags fault_reset_bit (bit 7 before) and torque_on. So the state and the flags,
-  /// adjacent in `axis`, come with one 16-bit load and one mask, and bits 0..7 of the control word
-  /// with one byte load and one lookup. 9 of 16 state slots are used.
+  /// adjacent in `axis`, come with the one load of the axis's first word and one mask, and bits
+  /// 0..7 of the control word with one byte load and one lookup. 9 of 16 state slots are used.
   static constexpr std::size_t entry_count = 1024;
 
   explicit compiled_profile(const profile& p) noexcept;
@@ -140,10 +140,8 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   // A committed row's stop code needs no clearing: outside a stop it is 0 (S16; the model check
   // holds every reachable axis to it).
   const std::uint32_t after = (word & e.keep) | e.set;
-  // Stored only when it changes: a held command then leaves the axis alone, and the next cycle's
-  // load does not wait for this one's store.
-  // The choice is of an address, not a branch: a command that changes at random costs no
-  // mispredicted jump.
+  // Stored every cycle, whole: a store only on a change would be a branch that a command changing
+  // at random mispredicts, and the next cycle's load of the same word is forwarded from this store.
   std::memcpy(static_cast<void*>(&a), &after, 4);
   out.current = e.next;
   out.status_word = static_cast<std::uint16_t>(status);
