@@ -59,7 +59,7 @@ ALLOWED = {
     "canopen/301": {"core", "canopen/can"},
     "canopen/306": {"core", "support", "canopen/can", "canopen/301"},
     "canopen/transport": {"core", "canopen/can"},
-    "canopen/402": {"core", "canopen/can", "canopen/301", "canopen/306", "sim"},
+    "canopen/402": {"core", "support", "canopen/can", "canopen/301", "canopen/306", "sim"},
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
              "canopen/301", "canopen/306", "canopen/transport", "canopen/402"},
     "tools": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",

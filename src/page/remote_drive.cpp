@@ -1,21 +1,15 @@
 #include "cia402/page/remote_drive.hpp"
 
-#include <algorithm>
 #include <condition_variable>
-#include <deque>
 #include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
 #include <vector>
 
+#include "cia402/canopen/drive_master.hpp"
 #include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/frame.hpp"
 #include "cia402/canopen/nmt.hpp"
-#include "cia402/canopen/pdo.hpp"
-#include "cia402/canopen/sdo_client.hpp"
-#include "cia402/canopen/timing.hpp"
-#include "cia402/master.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/page/transition_inference.hpp"
 #include "cia402/words.hpp"
@@ -63,28 +57,33 @@ struct user_wait {
   std::uint64_t id = 0;
 };
 
-struct sdo_job {
-  bool write = false;
-  std::uint16_t index = 0;
-  std::uint8_t sub = 0;
-  std::function<std::int64_t()> value;  // evaluated when the transfer starts
-  unsigned bytes = 0;
-  bool is_signed = false;
-  bool optional = false;  // set-up: a refusal does not end it (a timeout does)
-  int group = 0;          // set-up: a refusal skips the rest of the group
-  std::function<bool()> wanted;  // set-up: the job runs only if this says so
-  std::function<void(const co::sdo_client&)> then;  // after a done transfer (or an optional abort)
-  std::shared_ptr<user_wait> waiter;
-  bool nmt_start = false;  // not a transfer: NMT start, then running
-};
-
 struct transition_seen {
   std::optional<int> number;  // none: no chain of rows connects the two states
   state from = state::start;
   state to = state::start;
 };
 
-enum class heartbeat_event : std::uint8_t { none, lost, back };
+// The CANopen 402 master's settings for the page: PDOs on change (every state the drive reports
+// arrives), the velocity mapped, the heartbeat watched where the drive takes it, the page's objects
+// read at set-up.
+co::drive_master_config master_config(const profile& p, const remote_config& c) {
+  co::drive_master_config m;
+  m.node_id = c.node_id;
+  m.cycle_us = c.cycle_us;
+  m.drive_heartbeat_ms = c.heartbeat_ms;
+  m.heartbeat_required = false;
+  m.sdo_timeout_us = c.sdo_timeout_us;
+  m.drive_profile = &p;
+  m.timing = co::pdo_timing::on_change;
+  m.map_velocity = true;
+  m.velocity_inhibit_100us = c.velocity_inhibit_100us;
+  for (const object_name& o : object_names(p)) m.read_at_start.push_back(o.index);
+  m.read_at_start.push_back(0x60FF);
+  m.poll_us = c.poll_us;
+  m.retry_us = c.retry_us;
+  m.reset_pulse_us = c.reset_pulse_us;
+  return m;
+}
 
 }  // namespace
 
@@ -104,17 +103,21 @@ struct remote_drive::impl {
       : table(p),
         bus(b),
         config(c),
-        sdo(b, c.node_id, c.sdo_timeout_us),
+        remote(b, master_config(p, c)),
         log({c.results_kept, c.settle_quiet_us, c.settle_limit_us,
              "still busy when the page stopped waiting", " (numbers inferred)"},
             [this] { return how_it_stands(); }) {
     if (config.cycle_us == 0) config.cycle_us = 1000;
     if (config.publish_us == 0) config.publish_us = config.cycle_us;
-    consumer.on_change = [this](std::uint8_t, bool lost) {
-      hb_event = lost ? heartbeat_event::lost : heartbeat_event::back;
+    remote.on_status = [this](std::uint16_t sw) { on_status(sw); };
+    remote.on_velocity = [this](std::int32_t v) { on_velocity(v); };
+    remote.on_sent = [this](std::uint16_t w) {
+      if ((w & bit7) != 0 && (sent_before & bit7) == 0) reset_sent_since_change = true;
+      sent_before = w;
     };
-    build_setup();
-    restart_setup("configuring node " + node_text());
+    remote.on_phase = [this](co::master_phase phase, co::phase_reason why) {
+      on_phase(phase, why);
+    };
   }
 
   const profile& table;
@@ -124,396 +127,78 @@ struct remote_drive::impl {
   mutable std::mutex mutex;  // guards all here but the board, which has a lock of its own
   std::condition_variable job_done;
 
-  co::sdo_client sdo;
-  std::optional<sdo_job> current;
-  std::vector<sdo_job> setup;
-  std::size_t setup_step = 0;
-  int skipped_group = 0;
-  std::deque<sdo_job> user_jobs;
-  co::heartbeat_consumer consumer;
-  heartbeat_event hb_event = heartbeat_event::none;
-
-  remote_status status = remote_status::configuring;
-  std::string status_text;
+  // The one CANopen 402 master: set-up, PDOs, SDO requests, polling, heartbeat, retry.
+  co::drive_master remote;
   std::uint64_t now_us = 0;
-  std::uint64_t retry_at_us = 0;
-  std::uint64_t next_poll_us = 0;
-  std::size_t poll_index = 0;
   std::uint64_t next_publish_us = 0;
 
-  // What set-up found out.
-  std::string device_name;
-  bool fault_injection = false;
-  bool error_mapped = false;
-  bool velocity_mapped = false;
-  bool heartbeat_watched = false;
-  std::optional<std::uint8_t> nmt_seen;
-
-  // What the drive reports.
-  bool status_known = false;
-  std::uint16_t status_word = 0;
+  // What the drive reports, as the page shows it.
   bool state_known = false;
   state observed = state::start;
-  std::uint16_t error_code = 0;
-  std::uint8_t error_register = 0;
   std::optional<std::int32_t> velocity;
   std::int32_t target_velocity = 0;
-  std::optional<std::uint16_t> last_emcy;
   std::uint16_t injected_fault = 0;  // what the page wrote to 0x2001 (0: none)
   std::map<std::uint16_t, std::int64_t> objects;
   std::optional<transition_seen> last_transition;
 
   // What the page sends.
   std::uint16_t control_word = 0;
-  std::uint16_t last_sent = 0;
+  std::uint16_t sent_before = 0;
   bool reset_sent_since_change = false;
-  std::deque<std::pair<std::uint16_t, std::uint64_t>> outbox;  // word, not before (us)
 
   detail::action_log log;
   detail::snapshot_board board;
 
-  // --- set-up ---------------------------------------------------------------------------------
-
   std::string node_text() const { return "node " + std::to_string(config.node_id); }
 
-  static sdo_job read(std::uint16_t index, std::uint8_t sub, bool optional, bool is_signed = false) {
-    sdo_job j;
-    j.index = index;
-    j.sub = sub;
-    j.optional = optional;
-    j.is_signed = is_signed;
-    return j;
-  }
-  static sdo_job write(std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes,
-                       int group = 0) {
-    sdo_job j;
-    j.write = true;
-    j.index = index;
-    j.sub = sub;
-    j.value = [value] { return value; };
-    j.bytes = bytes;
-    j.group = group;
-    j.optional = group != 0;
-    return j;
+  remote_status status() const {
+    switch (remote.phase()) {
+      case co::master_phase::configuring: return remote_status::configuring;
+      case co::master_phase::running: return remote_status::running;
+      case co::master_phase::failed: break;
+    }
+    switch (remote.failure()) {
+      case co::master_failure::bus_failed: return remote_status::bus_failed;
+      case co::master_failure::sdo_refused:
+      case co::master_failure::not_a_drive: return remote_status::refused;
+      default: return remote_status::no_answer;
+    }
   }
 
-  // A `then` for an optional step of set-up: whether it worked decides what comes later.
-  static std::function<void(const co::sdo_client&)> note_done(bool& worked) {
-    return [&worked](const co::sdo_client& c) {
-      worked = c.state() == co::sdo_client::status::done;
-    };
-  }
-
-  void build_setup() {
-    const std::uint8_t node = config.node_id;
-    sdo_job type = read(0x1000, 0, false);
-    type.then = [this](const co::sdo_client& c) {
-      if ((c.value() & 0xFFFF) != 0x0192) {
-        refuse_setup(node_text() + " is not a CiA 402 drive (0x1000 = " +
-                     hex(static_cast<std::uint32_t>(c.value()), 8) +
-                     ", low word not 0x0192)");
-      }
-    };
-    setup.push_back(type);
-
-    sdo_job name = read(0x1008, 0, true);
-    name.then = [this](const co::sdo_client& c) {
-      if (c.state() == co::sdo_client::status::done) {
-        device_name.assign(c.data().begin(), c.data().end());
-        while (!device_name.empty() && device_name.back() == '\0') device_name.pop_back();
-      }
-    };
-    setup.push_back(name);
-
-    // 0x2001 exists on a `cia402 bus` node as write-only: reading it says so and changes nothing.
-    sdo_job probe = read(co::fault_injection_index, 0, true);
-    probe.wanted = [this] { return device_name == co::virtual_drive_device_name; };
-    probe.then = [this](const co::sdo_client& c) {
-      fault_injection = c.state() == co::sdo_client::status::aborted &&
-                        c.abort_code() == sdo_abort::write_only_object;
-    };
-    setup.push_back(probe);
-
-    for (const object_name& o : object_names(table)) {
-      const object_description* t = find_drive_object(o.index);
-      sdo_job j = read(o.index, 0, true, t != nullptr && type_signed(t->type));
-      const std::uint16_t index = o.index;
-      j.then = [this, index](const co::sdo_client& c) {
-        if (c.state() == co::sdo_client::status::done) {
-          const object_description* ty = find_drive_object(index);
-          objects[index] = c.value(ty != nullptr && type_signed(ty->type));
-        } else {
-          objects.erase(index);
+  void on_phase(co::master_phase phase, co::phase_reason why) {
+    switch (why) {
+      case co::phase_reason::node_restarted:
+        injected_fault = 0;
+        state_known = false;
+        break;
+      case co::phase_reason::failed:
+        // The node went silent (or its set-up failed): nothing is known until set-up ran again.
+        state_known = false;
+        log.finish_pending(remote.phase_text().c_str());
+        break;
+      case co::phase_reason::running: {
+        // Start from the drive's present values, so connecting changes nothing.
+        objects.clear();
+        for (const object_name& o : object_names(table)) {
+          const auto v = remote.start_values().find(o.index);
+          if (v != remote.start_values().end()) objects[o.index] = v->second;
         }
-      };
-      setup.push_back(j);
-    }
-
-    sdo_job cw = read(0x6040, 0, true);
-    cw.then = [this](const co::sdo_client& c) {
-      if (c.state() != co::sdo_client::status::done) return;
-      control_word = static_cast<std::uint16_t>(c.value());
-      last_sent = control_word;
-    };
-    setup.push_back(cw);
-
-    if (config.heartbeat_ms != 0) {
-      sdo_job hb = write(0x1017, 0, config.heartbeat_ms, 2, 1);
-      hb.then = note_done(heartbeat_watched);
-      setup.push_back(hb);
-    }
-
-    // TPDO1: status word (+ error code), on every change.
-    const std::int64_t tpdo1 = co::cob::tpdo1 + node;
-    setup.push_back(write(0x1800, 1, co::pdo_cob_invalid | tpdo1, 4));
-    setup.push_back(write(0x1A00, 0, 0, 1));
-    setup.push_back(write(0x1A00, 1, 0x60410010, 4));
-    sdo_job err_entry = write(0x1A00, 2, 0x603F0010, 4);
-    err_entry.optional = true;
-    err_entry.then = note_done(error_mapped);
-    setup.push_back(err_entry);
-    sdo_job count = write(0x1A00, 0, 0, 1);
-    count.value = [this] { return std::int64_t{error_mapped ? 2 : 1}; };
-    setup.push_back(count);
-    setup.push_back(write(0x1800, 2, 255, 1));
-    setup.push_back(write(0x1800, 3, 0, 2, 2));  // no inhibit time: every state arrives
-    setup.push_back(write(0x1800, 1, tpdo1, 4));
-
-    // TPDO2: actual velocity, on change, at most every velocity_inhibit. Optional as a whole.
-    const std::int64_t tpdo2 = co::cob::tpdo1 + 0x100 + node;
-    constexpr int velocity_group = 3;
-    setup.push_back(write(0x1801, 1, co::pdo_cob_invalid | tpdo2, 4, velocity_group));
-    setup.push_back(write(0x1A01, 0, 0, 1, velocity_group));
-    setup.push_back(write(0x1A01, 1, 0x606C0020, 4, velocity_group));
-    setup.push_back(write(0x1A01, 0, 1, 1, velocity_group));
-    setup.push_back(write(0x1801, 2, 255, 1, velocity_group));
-    setup.push_back(write(0x1801, 3, config.velocity_inhibit_100us, 2, velocity_group));
-    sdo_job enable2 = write(0x1801, 1, tpdo2, 4, velocity_group);
-    enable2.then = note_done(velocity_mapped);
-    setup.push_back(enable2);
-
-    // RPDO1: the control word, acting on receipt.
-    const std::int64_t rpdo1 = co::cob::rpdo1 + node;
-    setup.push_back(write(0x1400, 1, co::pdo_cob_invalid | rpdo1, 4));
-    setup.push_back(write(0x1600, 0, 0, 1));
-    setup.push_back(write(0x1600, 1, 0x60400010, 4));
-    setup.push_back(write(0x1600, 0, 1, 1));
-    setup.push_back(write(0x1400, 2, 255, 1));
-    setup.push_back(write(0x1400, 1, rpdo1, 4));
-
-    // The drive's present values last, just before NMT start, so the page starts from them.
-    sdo_job target = read(0x60FF, 0, true, true);
-    target.then = [this](const co::sdo_client& c) {
-      if (c.state() == co::sdo_client::status::done) {
-        target_velocity = static_cast<std::int32_t>(c.value(true));
-      }
-    };
-    setup.push_back(target);
-
-    sdo_job sw = read(0x6041, 0, false);
-    sw.then = [this](const co::sdo_client& c) { on_status(static_cast<std::uint16_t>(c.value())); };
-    setup.push_back(sw);
-
-    sdo_job err = read(0x603F, 0, true);
-    err.then = [this](const co::sdo_client& c) {
-      if (c.state() == co::sdo_client::status::done) {
-        error_code = static_cast<std::uint16_t>(c.value());
-      }
-    };
-    setup.push_back(err);
-
-    sdo_job vel = read(0x606C, 0, true, true);
-    vel.then = [this](const co::sdo_client& c) {
-      if (c.state() == co::sdo_client::status::done) {
-        on_velocity(static_cast<std::int32_t>(c.value(true)));
-      }
-    };
-    setup.push_back(vel);
-
-    sdo_job start;
-    start.nmt_start = true;
-    setup.push_back(start);
-  }
-
-  // Drops the transfer in flight and every queued request, as when the link goes.
-  void drop_jobs() {
-    if (current) {
-      if (sdo.state() == co::sdo_client::status::busy) sdo.cancel();
-      if (current->waiter) current->waiter->cancelled = current->waiter->done = true;
-      current.reset();
-    }
-    sdo.clear();
-    for (sdo_job& j : user_jobs) {
-      if (j.waiter) j.waiter->cancelled = j.waiter->done = true;
-    }
-    user_jobs.clear();
-    job_done.notify_all();
-  }
-
-  void restart_setup(std::string why) {
-    drop_jobs();
-    status = remote_status::configuring;
-    status_text = std::move(why);
-    setup_step = 0;
-    skipped_group = 0;
-    device_name.clear();
-    fault_injection = false;
-    error_mapped = false;
-    velocity_mapped = false;
-    heartbeat_watched = false;
-    consumer.configure({});
-    hb_event = heartbeat_event::none;
-    outbox.clear();
-  }
-
-  // The node went silent (or its set-up failed): nothing is known about it until set-up ran again.
-  void stop_link(remote_status s, std::string why) {
-    drop_jobs();
-    status = s;
-    status_text = std::move(why);
-    retry_at_us = now_us + config.retry_us;
-    state_known = false;
-    outbox.clear();
-    consumer.configure({});
-    hb_event = heartbeat_event::none;
-    log.finish_pending(status_text.c_str());
-  }
-
-  void lose(std::string why) { stop_link(remote_status::no_answer, std::move(why)); }
-  void refuse_setup(std::string why) { stop_link(remote_status::refused, std::move(why)); }
-
-  void go_running() {
-    status = remote_status::running;
-    status_text.clear();
-    if (heartbeat_watched) {
-      consumer.configure({{config.node_id, static_cast<std::uint16_t>(std::min<std::uint32_t>(
-                                               3u * config.heartbeat_ms, 0xFFFF))}});
-    }
-    next_poll_us = now_us + config.poll_us;
-  }
-
-  std::string object_text(const sdo_job& j) const {
-    return hex(j.index, 4) + ":" + std::to_string(j.sub);
-  }
-
-  // --- SDO jobs -------------------------------------------------------------------------------
-
-  void start_transfer(const sdo_job& j) {
-    sdo.clear();
-    if (j.write) {
-      (void)sdo.start_download(j.index, j.sub, j.value(), j.bytes);
-    } else {
-      (void)sdo.start_upload(j.index, j.sub);
-    }
-  }
-
-  std::optional<sdo_job> next_poll() {
-    // What no PDO carries, one object per poll period in turn.
-    std::vector<std::uint16_t> list{0x1001};
-    if (!velocity_mapped) list.push_back(0x606C);
-    if (!error_mapped) list.push_back(0x603F);
-    if (!heartbeat_watched) list.push_back(0x6041);
-    const std::uint16_t index = list[poll_index++ % list.size()];
-    sdo_job j = read(index, 0, true, index == 0x606C);
-    j.then = [this, index](const co::sdo_client& c) {
-      if (c.state() != co::sdo_client::status::done) return;
-      switch (index) {
-        case 0x1001: error_register = static_cast<std::uint8_t>(c.value()); break;
-        case 0x606C: on_velocity(static_cast<std::int32_t>(c.value(true))); break;
-        case 0x603F: error_code = static_cast<std::uint16_t>(c.value()); break;
-        case 0x6041: on_status(static_cast<std::uint16_t>(c.value())); break;
-        default: break;
-      }
-    };
-    return j;
-  }
-
-  bool start_next_job() {
-    if (status == remote_status::configuring) {
-      while (status == remote_status::configuring && setup_step < setup.size()) {
-        const sdo_job& j = setup[setup_step];
-        if ((j.group != 0 && j.group == skipped_group) || (j.wanted && !j.wanted())) {
-          ++setup_step;
-          continue;
+        const auto target = remote.start_values().find(0x60FF);
+        if (target != remote.start_values().end()) {
+          target_velocity = static_cast<std::int32_t>(target->second);
         }
-        if (j.nmt_start) {
-          ++setup_step;
-          (void)bus.send(co::nmt_frame(co::nmt_command::start, config.node_id));
-          go_running();
-          return false;
-        }
-        current = j;
-        start_transfer(*current);
-        return true;
+        control_word = remote.last_sent();
+        sent_before = control_word;
+        break;
       }
-      return false;
+      default: break;
     }
-    if (status != remote_status::running) return false;
-    if (!user_jobs.empty()) {
-      current = std::move(user_jobs.front());
-      user_jobs.pop_front();
-      start_transfer(*current);
-      return true;
-    }
-    if (now_us >= next_poll_us) {
-      next_poll_us = now_us + config.poll_us;
-      current = next_poll();
-      start_transfer(*current);
-      return true;
-    }
-    return false;
-  }
-
-  void complete_current() {
-    sdo_job job = std::move(*current);
-    current.reset();
-    const bool ok = sdo.state() == co::sdo_client::status::done;
-    const sdo_abort abort = ok ? sdo_abort::none : sdo.abort_code();
-    const bool timed_out = abort == sdo_abort::sdo_protocol_timed_out;
-    const std::string what = std::string(job.write ? "writing " : "reading ") + object_text(job);
-
-    if (job.waiter) {
-      job.waiter->done = true;
-      job.waiter->abort = abort;
-      if (ok && job.then) job.then(sdo);
-      if (ok && job.waiter->track_action) job.waiter->id = track(*job.waiter->track_action, false);
-      job_done.notify_all();
-      // A node that lets an SDO request time out is silent, whatever its heartbeat did last.
-      if (timed_out) lose(node_text() + " does not answer (SDO timeout " + what + ")");
-      return;
-    }
-    if (status == remote_status::running) {  // a poll
-      if (job.then) job.then(sdo);
-      if (timed_out) lose(node_text() + " does not answer (SDO timeout " + what + ")");
-      return;
-    }
-    if (status != remote_status::configuring) return;
-    if (timed_out) {
-      lose(node_text() + " does not answer (SDO timeout " + what + ")");
-      return;
-    }
-    if (!ok && !job.optional) {
-      refuse_setup(node_text() + " refused " + what + ": " + abort_text(abort));
-      return;
-    }
-    if (!ok && job.group != 0) skipped_group = job.group;
-    if (job.then) job.then(sdo);
-    ++setup_step;
-  }
-
-  void drive_jobs() {
-    for (int guard = 0; guard < 64; ++guard) {
-      if (!current && !start_next_job()) return;
-      if (!current || !sdo.finished()) return;
-      complete_current();
-    }
+    (void)phase;
   }
 
   // --- what the drive reports -------------------------------------------------------------------
 
   void on_status(std::uint16_t sw) {
-    status_known = true;
-    status_word = sw;
     state s = state::start;
     if (!decode_status(table, sw, s)) {
       state_known = false;
@@ -521,7 +206,7 @@ struct remote_drive::impl {
     }
     if (state_known && s != observed) {
       const std::vector<inferred_transition> chain = infer_transitions(
-          table, observed, s, observer_facts(table, last_sent, reset_sent_since_change));
+          table, observed, s, observer_facts(table, remote.last_sent(), reset_sent_since_change));
       transition_seen seen;
       seen.from = observed;
       seen.to = s;
@@ -545,87 +230,9 @@ struct remote_drive::impl {
     velocity = v;
   }
 
-  void on_frame(const co::frame& f) {
-    if (f.extended || f.rtr) return;
-    if (sdo.on_frame(f)) return;
-    const std::uint8_t node = config.node_id;
-    if (f.id == co::cob::heartbeat + node && f.len >= 1) {
-      nmt_seen = f.data[0];
-      if (f.data[0] == static_cast<std::uint8_t>(co::nmt_state::initialising)) {
-        // Boot-up: the node starts afresh with its default PDOs; set it up again.
-        injected_fault = 0;
-        state_known = false;
-        restart_setup(node_text() + " restarted (boot-up message): configuring it again");
-        return;
-      }
-      consumer.on_frame(f);
-      return;
-    }
-    if (status != remote_status::running) return;
-    if (f.id == co::cob::emcy + node && f.len >= 3) {
-      const auto code = static_cast<std::uint16_t>(co::get_le(f.data.data(), 2));
-      last_emcy = code;
-      error_register = f.data[2];
-      if (!error_mapped) error_code = code;
-      return;
-    }
-    if (f.id == co::cob::tpdo1 + node && f.len >= 2) {
-      if (error_mapped && f.len >= 4) {
-        error_code = static_cast<std::uint16_t>(co::get_le(f.data.data() + 2, 2));
-      }
-      on_status(static_cast<std::uint16_t>(co::get_le(f.data.data(), 2)));
-      return;
-    }
-    if (velocity_mapped && f.id == co::cob::tpdo1 + 0x100 + node && f.len >= 4) {
-      on_velocity(static_cast<std::int32_t>(static_cast<std::uint32_t>(co::get_le(f.data.data(), 4))));
-    }
-  }
-
-  void send_word(std::uint16_t w) {
-    co::frame f;
-    f.id = co::cob::rpdo1 + config.node_id;
-    f.len = 2;
-    co::put_le(f.data.data(), w, 2);
-    if ((w & bit7) != 0 && (last_sent & bit7) == 0) reset_sent_since_change = true;
-    last_sent = w;
-    (void)bus.send(f);
-  }
-
   void process(std::uint32_t elapsed_us) {
     now_us += elapsed_us;
-    if (status != remote_status::bus_failed) {
-      if (const std::error_code ec = bus.failure()) {
-        stop_link(remote_status::bus_failed, "the bus connection failed: " + ec.message());
-      }
-    }
-    if (status != remote_status::bus_failed) {
-      // One frame at a time: an SDO answer ends its transfer before the next frame (a TPDO the
-      // write caused) is looked at.
-      co::frame f;
-      for (int n = 0; n < 4096 && bus.receive(f); ++n) {
-        on_frame(f);
-        if (current && sdo.finished()) drive_jobs();
-      }
-      (void)consumer.process(elapsed_us);
-      if (hb_event == heartbeat_event::lost && status == remote_status::running) {
-        lose(node_text() + " does not answer (no heartbeat for " +
-             std::to_string(3u * config.heartbeat_ms) + " ms)");
-      }
-      hb_event = heartbeat_event::none;
-      if (current) (void)sdo.process(elapsed_us);
-      drive_jobs();
-      if ((status == remote_status::no_answer || status == remote_status::refused) &&
-          now_us >= retry_at_us) {
-        restart_setup(status_text + "; trying again");
-        drive_jobs();
-      }
-      if (status == remote_status::running) {
-        while (!outbox.empty() && outbox.front().second <= now_us) {
-          send_word(outbox.front().first);
-          outbox.pop_front();
-        }
-      }
-    }
+    (void)remote.poll(bus, elapsed_us);
     if (log.pending()) settle();
     if (now_us >= next_publish_us) {
       next_publish_us = now_us + config.publish_us;
@@ -642,11 +249,13 @@ struct remote_drive::impl {
   std::string conditions() const {
     std::string s;
     auto add = [&s](const std::string& what) { s += (s.empty() ? " (" : ", ") + what; };
+    const std::uint16_t error_code = remote.error_code();
+    const std::uint16_t status_word = remote.status_word();
     if (error_code != 0) add("the drive reports error code " + hex(error_code, 4));
-    if (status_known && (status_word & status_bit::voltage_enabled) == 0) {
+    if (remote.status_known() && (status_word & status_bit::voltage_enabled) == 0) {
       add("no DC-link voltage: status bit 4 is 0");
     }
-    if (status_known && (status_word & status_bit::remote) == 0) {
+    if (remote.status_known() && (status_word & status_bit::remote) == 0) {
       add("status bit 9 (remote) is 0: the drive does not process the control word");
     }
     if (!s.empty()) s += ")";
@@ -670,35 +279,21 @@ struct remote_drive::impl {
         state_known && velocity && *velocity != 0 &&
         (table.info(observed).activity == state_activity::quick_stop ||
          table.info(observed).activity == state_activity::fault_reaction);
-    log.settle(now_us, !outbox.empty() || stopping || (current && current->waiter));
+    log.settle(now_us, remote.words_queued() || stopping || remote.request_pending());
   }
 
   // Logs a command or bit toggle and queues its word for RPDO1.
   std::uint64_t change_word(const detail::word_change& w) {
     const std::uint64_t id =
         w.tracked ? track(w.action, true) : log.report_now(w.action, "done", w.text);
-    outbox.clear();
-    if (w.fault_reset_edge) {
-      // Each level of the edge held for reset_pulse_us, so the drive steps on both.
-      std::uint64_t at = now_us;
-      if ((last_sent & bit7) != 0) {
-        queue_word(w.word, at);
-        at += config.reset_pulse_us;
-      }
-      queue_word(static_cast<std::uint16_t>(w.word | bit7), at);
-      queue_word(w.word, at + config.reset_pulse_us);
-    } else {
-      queue_word(w.word, now_us);
-    }
+    remote.send_control_word(w.word, w.fault_reset_edge);
     control_word = w.word;
     return id;
   }
 
-  void queue_word(std::uint16_t word, std::uint64_t at) { outbox.emplace_back(word, at); }
-
   std::optional<refused> not_running() const {
-    if (status == remote_status::running) return std::nullopt;
-    std::string why = status_text.empty() ? node_text() + " is not ready" : status_text;
+    if (remote.phase() == co::master_phase::running) return std::nullopt;
+    std::string why = remote.phase_text().empty() ? node_text() + " is not ready" : remote.phase_text();
     return refused{503, why};
   }
 
@@ -709,10 +304,17 @@ struct remote_drive::impl {
                                       std::optional<std::string> track_action = std::nullopt) {
     auto w = std::make_shared<user_wait>();
     w->track_action = std::move(track_action);
-    sdo_job j = write(index, 0, value, bytes);
-    j.waiter = w;
-    if (on_done) j.then = [on_done](const co::sdo_client&) { on_done(); };
-    user_jobs.push_back(std::move(j));
+    const bool queued = remote.write(index, 0, value, bytes, [this, w, on_done](const co::sdo_result& r) {
+      w->done = true;
+      w->cancelled = r.cancelled;
+      w->abort = r.abort;
+      if (r.ok()) {
+        if (on_done) on_done();
+        if (w->track_action) w->id = track(*w->track_action, false);
+      }
+      job_done.notify_all();
+    });
+    if (!queued) w->done = w->cancelled = true;
     job_done.wait_for(lock, config.request_timeout, [&] { return w->done || board.closed(); });
     return w;
   }
@@ -724,7 +326,8 @@ struct remote_drive::impl {
       return refused{504, action + ": no answer from " + node_text() + " in time"};
     }
     if (w->cancelled) {
-      const std::string why = status_text.empty() ? node_text() + " does not answer" : status_text;
+      const std::string why =
+          remote.phase_text().empty() ? node_text() + " does not answer" : remote.phase_text();
       log.report_now(action, "refused", "refused: " + why);
       return refused{503, action + ": " + why};
     }
@@ -745,6 +348,7 @@ struct remote_drive::impl {
 
   json capabilities() const {
     json reasons = json::object();
+    const bool fault_injection = remote.fault_injection();
     if (!fault_injection) {
       reasons["fault"] = std::string(not_remote) +
                          " (only a cia402 bus node offers fault injection, object 0x2001)";
@@ -758,21 +362,25 @@ struct remote_drive::impl {
     json r;
     r["node"] = config.node_id;
     r["bus"] = config.bus_name;
-    r["status"] = remote_status_name(status);
-    r["text"] = status_text;
+    r["status"] = remote_status_name(status());
+    r["text"] = remote.phase_text();
+    const auto nmt_seen = remote.nmt_seen();
     r["nmt"] = nmt_seen ? json(co::nmt_state_name(static_cast<co::nmt_state>(*nmt_seen)))
                         : json(nullptr);
-    r["device_name"] = device_name;
-    r["heartbeat_watched"] = heartbeat_watched;
-    r["error_code_in_pdo"] = error_mapped;
-    r["velocity_in_pdo"] = velocity_mapped;
+    r["device_name"] = remote.device_name();
+    r["heartbeat_watched"] = remote.heartbeat_watched();
+    r["error_code_in_pdo"] = remote.error_code_mapped();
+    r["velocity_in_pdo"] = remote.velocity_mapped();
+    const auto last_emcy = remote.last_emcy();
     r["last_emcy"] = last_emcy ? json(hex(*last_emcy, 4)) : json(nullptr);
     return r;
   }
 
   json snapshot(bool with_time) const {
     json j;
-    const bool live = status == remote_status::running || status == remote_status::configuring;
+    const bool live = remote.phase() != co::master_phase::failed;
+    const bool status_known = remote.status_known();
+    const std::uint16_t status_word = remote.status_word();
     j["state"] = live ? shown_state() : "UNKNOWN";
     j["status_word"] = hex(status_word, 4);
     j["control_word"] = hex(control_word, 4);
@@ -789,8 +397,8 @@ struct remote_drive::impl {
     // Not visible from the bus: the page shows them as unknown.
     j["stop_running"] = nullptr;
     j["ramp"] = nullptr;
-    j["error_code"] = hex(error_code, 4);
-    j["error_register"] = hex(error_register, 2);
+    j["error_code"] = hex(remote.error_code(), 4);
+    j["error_register"] = hex(remote.error_register(), 2);
     // A silent node's last values are history: what is shown live says "unknown" instead.
     j["velocity"] = live && velocity ? json(*velocity) : json(nullptr);
     j["target_velocity"] = target_velocity;
@@ -801,7 +409,7 @@ struct remote_drive::impl {
     j["dc_link"] = live && status_known ? json((status_word & status_bit::voltage_enabled) != 0)
                                         : json(nullptr);
     j["sto"] = nullptr;
-    j["fault_cause"] = fault_injection ? json(hex(injected_fault, 4)) : json(nullptr);
+    j["fault_cause"] = remote.fault_injection() ? json(hex(injected_fault, 4)) : json(nullptr);
     json objs = json::object();
     for (const auto& [index, value] : objects) objs[hex(index, 4)] = value;
     j["objects"] = std::move(objs);
@@ -899,7 +507,7 @@ reply remote_drive::change_plant(const plant_change& change) {
         action);
     return m.download_reply(w, action);
   }
-  if (!m.fault_injection) {
+  if (!m.remote.fault_injection()) {
     return refused{409, std::string("fault injection is ") + not_remote + " (" + m.node_text() +
                             " has no fault-injection object 0x2001 of cia402 bus)"};
   }
@@ -953,17 +561,17 @@ bool remote_drive::closed() const { return impl_->board.closed(); }
 
 remote_status remote_drive::status() const {
   std::lock_guard lock(impl_->mutex);
-  return impl_->status;
+  return impl_->status();
 }
 
 std::string remote_drive::status_text() const {
   std::lock_guard lock(impl_->mutex);
-  return impl_->status_text;
+  return impl_->remote.phase_text();
 }
 
 bool remote_drive::fault_injection_available() const {
   std::lock_guard lock(impl_->mutex);
-  return impl_->fault_injection;
+  return impl_->remote.fault_injection();
 }
 
 }  // namespace cia402::page

@@ -28,6 +28,7 @@ class bench {
   explicit bench(drive_master_config mc = {}, std::vector<std::uint8_t> ids = {1}) {
     for (std::uint8_t id : ids) add_drive(id);
     master_ch_ = bus_.attach();
+    sniffer_ = bus_.attach();
     master_ = std::make_unique<drive_master>(*master_ch_, mc);
     master_->on_emcy = [this](std::uint16_t code, std::uint8_t, const std::uint8_t*) {
       emcy.push_back(code);
@@ -71,6 +72,14 @@ class bench {
   slave& node(std::size_t i = 0) { return *drives_[i].sl; }
   sim::virtual_drive& drive(std::size_t i = 0) { return drives_[i].dev->drive(); }
   void remove_drives() { drives_.clear(); }
+  virtual_bus& bus() { return bus_; }
+  /// Every frame sent on the bus since the last call, in order.
+  std::vector<frame> sent() {
+    std::vector<frame> out;
+    frame f;
+    while (sniffer_->receive(f)) out.push_back(f);
+    return out;
+  }
 
   std::vector<std::uint16_t> emcy;
 
@@ -78,8 +87,37 @@ class bench {
   virtual_bus bus_;
   std::vector<drive_node> drives_;
   std::unique_ptr<virtual_channel> master_ch_;
+  std::unique_ptr<virtual_channel> sniffer_;
   std::unique_ptr<drive_master> master_;
 };
+
+// The settings `serve --can` gives the master: PDOs on change, words of its own, polling, retry.
+drive_master_config on_change_config() {
+  drive_master_config mc;
+  mc.timing = pdo_timing::on_change;
+  mc.map_velocity = true;
+  mc.heartbeat_required = false;
+  mc.poll_us = 100000;
+  mc.retry_us = 200000;
+  mc.read_at_start = {0x6083, 0x60FF};
+  return mc;
+}
+
+bool run_until_running(bench& b, int ms) {
+  for (int i = 0; i < ms; ++i) {
+    b.run_ms(1);
+    if (b.master().phase() == master_phase::running) return true;
+  }
+  return false;
+}
+
+std::vector<std::uint16_t> words_in(const std::vector<frame>& frames, std::uint16_t id) {
+  std::vector<std::uint16_t> words;
+  for (const frame& f : frames) {
+    if (f.id == id) words.push_back(static_cast<std::uint16_t>(get_le(f.data.data(), 2)));
+  }
+  return words;
+}
 
 TEST(drive_master, enable_configures_the_drive_and_reaches_operation_enabled) {
   bench b;
@@ -253,6 +291,155 @@ TEST(drive_master, watching_sends_no_control_word) {
   EXPECT_TRUE(b.master().status_known());
   EXPECT_EQ(b.master().observed(), state::switch_on_disabled);
   EXPECT_EQ(b.drive().view().control_word(), 0);
+}
+
+TEST(drive_master, on_change_sends_no_sync_and_starts_from_the_drives_present_values) {
+  bench b(on_change_config());
+  ASSERT_EQ(b.node().write(0x60FF, 0, 1234), sdo_abort::none);
+  ASSERT_TRUE(run_until_running(b, 2000)) << b.master().failure_text();
+  b.run_ms(50);
+  const std::vector<frame> frames = b.sent();
+  for (const frame& f : frames) EXPECT_NE(f.id, cob::sync) << "no SYNC with PDOs on change";
+  EXPECT_TRUE(words_in(frames, cob::rpdo1 + 1).empty()) << "watching commands nothing";
+  EXPECT_EQ(b.node().tpdo(0).transmission_type, 255);
+  EXPECT_EQ(b.node().tpdo(1).transmission_type, 255);
+  EXPECT_TRUE(b.master().velocity_mapped());
+  EXPECT_TRUE(b.master().heartbeat_watched());
+  EXPECT_EQ(b.master().device_name(), virtual_drive_device_name);
+  EXPECT_TRUE(b.master().fault_injection()) << "a cia402 bus node's 0x2001 answers write-only";
+  EXPECT_TRUE(b.master().status_known()) << "read before NMT start: no TPDO says it until it changes";
+  EXPECT_EQ(b.master().observed(), state::switch_on_disabled);
+  ASSERT_EQ(b.master().start_values().count(0x60FF), 1u);
+  EXPECT_EQ(b.master().start_values().at(0x60FF), 1234);
+  EXPECT_EQ(b.master().start_values().count(0x605A), 1u) << "the option codes are read too";
+}
+
+TEST(drive_master, words_of_its_own_go_out_at_once_and_a_state_change_arrives_unasked) {
+  bench b(on_change_config());
+  ASSERT_TRUE(run_until_running(b, 2000));
+  (void)b.sent();
+  b.master().send_control_word(0x0006);
+  b.run_ms(20);
+  b.master().send_control_word(0x000F);
+  b.run_ms(20);
+  EXPECT_EQ(b.master().observed(), state::operation_enabled);
+  EXPECT_EQ(b.master().last_sent(), 0x000F);
+  EXPECT_EQ(words_in(b.sent(), cob::rpdo1 + 1), (std::vector<std::uint16_t>{0x0006, 0x000F}));
+}
+
+TEST(drive_master, a_fault_reset_edge_holds_each_level_for_the_pulse_time) {
+  drive_master_config mc = on_change_config();
+  mc.reset_pulse_us = 20000;
+  bench b(mc);
+  ASSERT_TRUE(run_until_running(b, 2000));
+  b.drive().view().inject_fault(0x2310);
+  b.run_ms(50);
+  ASSERT_EQ(b.master().observed(), state::fault);
+  b.drive().view().clear_faults();
+  (void)b.sent();
+  b.master().send_control_word(0x0000, true);
+  b.run_ms(10);
+  EXPECT_EQ(words_in(b.sent(), cob::rpdo1 + 1), (std::vector<std::uint16_t>{0x0080}));
+  EXPECT_TRUE(b.master().words_queued()) << "bit 7 is held for the pulse time";
+  b.run_ms(15);
+  EXPECT_EQ(words_in(b.sent(), cob::rpdo1 + 1), (std::vector<std::uint16_t>{0x0000}));
+  EXPECT_FALSE(b.master().words_queued());
+  EXPECT_EQ(b.master().observed(), state::switch_on_disabled) << "T15 on the rising edge";
+  // With bit 7 still high from before, the edge starts with it low.
+  b.master().send_control_word(0x0080);
+  b.run_ms(5);
+  (void)b.sent();
+  b.master().send_control_word(0x0000, true);
+  b.run_ms(60);
+  EXPECT_EQ(words_in(b.sent(), cob::rpdo1 + 1), (std::vector<std::uint16_t>{0x0000, 0x0080, 0x0000}));
+}
+
+TEST(drive_master, requests_carry_the_drives_answer_and_are_refused_before_running) {
+  bench b(on_change_config());
+  int calls = 0;
+  EXPECT_FALSE(b.master().read(0x6041, 0, false, [&](const sdo_result&) { ++calls; }))
+      << "nothing is queued before set-up ended";
+  ASSERT_TRUE(run_until_running(b, 2000));
+  sdo_result wrote, read_back, refused;
+  ASSERT_TRUE(b.master().write(0x60FF, 0, -500, 4, [&](const sdo_result& r) { wrote = r; ++calls; }));
+  ASSERT_TRUE(b.master().read(0x60FF, 0, true, [&](const sdo_result& r) { read_back = r; ++calls; }));
+  ASSERT_TRUE(b.master().read(0x6FFF, 0, false, [&](const sdo_result& r) { refused = r; ++calls; }));
+  EXPECT_TRUE(b.master().request_pending());
+  b.run_ms(20);
+  EXPECT_EQ(calls, 3);
+  EXPECT_FALSE(b.master().request_pending());
+  EXPECT_TRUE(wrote.ok());
+  EXPECT_TRUE(read_back.ok());
+  EXPECT_EQ(read_back.value, -500) << "sign-extended as asked";
+  EXPECT_FALSE(refused.ok());
+  EXPECT_FALSE(refused.cancelled);
+  EXPECT_EQ(refused.abort, sdo_abort::object_does_not_exist);
+  EXPECT_EQ(b.master().phase(), master_phase::running) << "a refusal is an answer, not a lost node";
+}
+
+TEST(drive_master, a_lost_node_cancels_waiting_requests_and_set_up_retries_until_it_is_back) {
+  bench b(on_change_config());
+  ASSERT_TRUE(run_until_running(b, 2000));
+  b.remove_drives();
+  std::vector<sdo_result> results;
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_TRUE(b.master().read(0x6041, 0, false, [&](const sdo_result& r) { results.push_back(r); }));
+  }
+  b.run_ms(600);
+  ASSERT_EQ(results.size(), 2u) << "each request ends once";
+  EXPECT_FALSE(results[0].ok());
+  EXPECT_TRUE(results[1].cancelled);
+  EXPECT_NE(b.master().phase(), master_phase::running);
+  EXPECT_NE(b.master().phase_text().find("node 1 does not answer"), std::string::npos)
+      << b.master().phase_text();
+  b.add_drive(1);
+  ASSERT_TRUE(run_until_running(b, 3000)) << b.master().phase_text();
+  EXPECT_EQ(b.master().phase_text(), "");
+}
+
+TEST(drive_master, a_boot_up_message_sets_the_drive_up_again) {
+  bench b(on_change_config());
+  ASSERT_TRUE(run_until_running(b, 2000));
+  std::vector<phase_reason> why;
+  b.master().on_phase = [&](master_phase, phase_reason r) { why.push_back(r); };
+  auto other = b.bus().attach();
+  (void)other->send(make_frame(cob::heartbeat + 1, {0x00}));
+  b.run_ms(1);
+  ASSERT_FALSE(why.empty());
+  EXPECT_EQ(why.front(), phase_reason::node_restarted);
+  EXPECT_NE(b.master().phase_text().find("boot-up"), std::string::npos);
+  ASSERT_TRUE(run_until_running(b, 2000));
+  EXPECT_EQ(why.back(), phase_reason::running);
+}
+
+// A channel that fails on demand, as a socketcand connection whose server went away.
+class failing_channel final : public channel {
+ public:
+  explicit failing_channel(channel& inner) : inner_(&inner) {}
+  std::error_code send(const frame& f) noexcept override { return inner_->send(f); }
+  bool receive(frame& f) noexcept override { return inner_->receive(f); }
+  std::error_code failure() const noexcept override {
+    return failed ? std::make_error_code(std::errc::connection_reset) : std::error_code{};
+  }
+  bool failed = false;
+
+ private:
+  channel* inner_;
+};
+
+TEST(drive_master, a_failed_channel_ends_the_master_for_good) {
+  virtual_bus bus;
+  auto ch = bus.attach();
+  failing_channel out(*ch);
+  drive_master m(out, on_change_config());
+  (void)m.process(1000);
+  out.failed = true;
+  (void)m.process(1000);
+  EXPECT_EQ(m.phase(), master_phase::failed);
+  EXPECT_EQ(m.failure(), master_failure::bus_failed);
+  EXPECT_NE(m.phase_text().find("the bus connection failed"), std::string::npos);
+  for (int i = 0; i < 1000; ++i) (void)m.process(1000);
+  EXPECT_EQ(m.phase(), master_phase::failed) << "no retry on a dead channel";
 }
 
 }  // namespace

@@ -1,11 +1,22 @@
 #include "cia402/canopen/drive_master.hpp"
 
 #include <algorithm>
-#include <cstdio>
 
 #include "cia402/canopen/pdo.hpp"
+#include "cia402/support/text.hpp"
+#include "cia402/words.hpp"
 
 namespace cia402::canopen {
+namespace {
+
+using support::hex;
+
+constexpr std::uint16_t bit7 = control_bit::fault_reset;
+std::string abort_text(sdo_abort code) {
+  return "SDO abort " + hex(static_cast<std::uint32_t>(code), 8) + " (" + sdo_abort_text(code) + ")";
+}
+
+}  // namespace
 
 const char* master_failure_name(master_failure f) noexcept {
   switch (f) {
@@ -14,6 +25,7 @@ const char* master_failure_name(master_failure f) noexcept {
     case master_failure::sdo_refused: return "sdo_refused";
     case master_failure::not_a_drive: return "not_a_drive";
     case master_failure::heartbeat_lost: return "heartbeat_lost";
+    case master_failure::bus_failed: return "bus_failed";
   }
   return "unknown";
 }
@@ -24,155 +36,252 @@ drive_master::drive_master(channel& out, const drive_master_config& config)
       profile_(config.drive_profile != nullptr ? config.drive_profile : &standard_profile()),
       sdo_(out, config.node_id, config.sdo_timeout_us),
       options_(make_axis(*profile_)) {
-  consumer_.on_change = [this](std::uint8_t, bool lost) {
-    if (lost && phase_ == master_phase::running) {
-      fail(master_failure::heartbeat_lost, sdo_abort::none, 0, 0);
-    }
-  };
+  if (config_.cycle_us == 0) config_.cycle_us = 1000;
+  consumer_.on_change = [this](std::uint8_t, bool lost) { heartbeat_lost_ = lost; };
   producer_.configure(config_.master_heartbeat_ms);
+  text_ = "configuring " + node_text();
   build_script();
 }
 
-void drive_master::build_script() {
-  const std::uint8_t node = config_.node_id;
-  const auto fixed = [](std::int64_t v) { return [v] { return v; }; };
-  const auto write = [&](std::uint16_t index, std::uint8_t sub, std::int64_t v, unsigned bytes) {
-    sdo_step s;
-    s.write = true;
-    s.index = index;
-    s.sub = sub;
-    s.value = fixed(v);
-    s.bytes = bytes;
-    return s;
-  };
+std::string drive_master::node_text() const { return "node " + std::to_string(config_.node_id); }
 
-  sdo_step type;
-  type.index = 0x1000;
-  type.then = [this](const sdo_client& c) {
-    if ((c.value() & 0xFFFF) != 0x0192) fail(master_failure::not_a_drive, sdo_abort::none, 0x1000, 0);
-  };
-  script_.push_back(type);
-  for (std::uint16_t index : std::initializer_list<std::uint16_t>{0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007}) {
-    sdo_step s;
-    s.index = index;
-    s.optional = true;
-    s.then = [this, index](const sdo_client& c) {
-      if (c.state() == sdo_client::status::done) {
-        (void)write_option(*profile_, options_, index, static_cast<std::int32_t>(c.value(true)));
-      }
-    };
-    script_.push_back(s);
-  }
-  if (config_.drive_heartbeat_ms != 0) {
-    script_.push_back(write(0x1017, 0, config_.drive_heartbeat_ms, 2));
-  }
-  if (config_.master_heartbeat_ms != 0) {
-    const std::uint32_t watch = std::min<std::uint32_t>(3u * config_.master_heartbeat_ms, 0xFFFF);
-    script_.push_back(write(0x1016, 1, (static_cast<std::int64_t>(config_.master_node_id) << 16) | watch, 4));
-  }
-  // TPDO1: status word (+ error code), on every SYNC.
-  const std::int64_t tpdo_id = cob::tpdo1 + node;
-  script_.push_back(write(0x1800, 1, pdo_cob_invalid | tpdo_id, 4));
-  script_.push_back(write(0x1A00, 0, 0, 1));
-  script_.push_back(write(0x1A00, 1, 0x60410010, 4));
-  sdo_step error_entry = write(0x1A00, 2, 0x603F0010, 4);
-  error_entry.optional = true;
-  error_entry.then = [this](const sdo_client& c) {
-    error_code_mapped_ = c.state() == sdo_client::status::done;
-  };
-  script_.push_back(error_entry);
-  sdo_step count = write(0x1A00, 0, 0, 1);
-  count.value = [this] { return std::int64_t{error_code_mapped_ ? 2 : 1}; };
-  script_.push_back(count);
-  script_.push_back(write(0x1800, 2, 1, 1));
-  script_.push_back(write(0x1800, 1, tpdo_id, 4));
-  // RPDO1: control word, acting on receipt.
-  const std::int64_t rpdo_id = cob::rpdo1 + node;
-  script_.push_back(write(0x1400, 1, pdo_cob_invalid | rpdo_id, 4));
-  script_.push_back(write(0x1600, 0, 0, 1));
-  script_.push_back(write(0x1600, 1, 0x60400010, 4));
-  script_.push_back(write(0x1600, 0, 1, 1));
-  script_.push_back(write(0x1400, 2, 255, 1));
-  script_.push_back(write(0x1400, 1, rpdo_id, 4));
+void drive_master::set_phase(master_phase p, phase_reason why) {
+  phase_ = p;
+  if (on_phase) on_phase(p, why);
 }
 
-void drive_master::start_step() {
-  step_started_ = true;
-  const sdo_step& s = script_[step_];
-  sdo_.clear();
-  if (s.write) {
-    (void)sdo_.start_download(s.index, s.sub, s.value(), s.bytes);
-  } else {
-    (void)sdo_.start_upload(s.index, s.sub);
-  }
+void drive_master::restart(phase_reason why, std::string text) {
+  drop_requests();
+  failure_ = master_failure::none;
+  failed_abort_ = sdo_abort::none;
+  failed_index_ = 0;
+  failed_sub_ = 0;
+  text_ = std::move(text);
+  step_ = 0;
+  skipped_group_ = 0;
+  device_name_.clear();
+  fault_injection_ = false;
+  heartbeat_watched_ = false;
+  error_code_mapped_ = false;
+  velocity_mapped_ = false;
+  consumer_.configure({});
+  heartbeat_lost_ = false;
+  outbox_.clear();
+  set_phase(master_phase::configuring, why);
 }
 
-void drive_master::fail(master_failure f, sdo_abort a, std::uint16_t index, std::uint8_t sub) {
+void drive_master::go_running() {
+  text_.clear();
+  if (heartbeat_watched_) {
+    consumer_.configure({{config_.node_id, static_cast<std::uint16_t>(std::min<std::uint32_t>(
+                                               3u * config_.drive_heartbeat_ms, 0xFFFF))}});
+  }
+  next_poll_us_ = now_us_ + config_.poll_us;
+  set_phase(master_phase::running, phase_reason::running);
+  if (config_.timing == pdo_timing::sync) {
+    sync_timer_.start(config_.cycle_us);
+    (void)out_->send(make_frame(cob::sync, {}));
+  }
+  if (mode_ == mode::target) master_.set_target(policy_, now_us_, config_.transition_timeout_us);
+}
+
+void drive_master::fail(master_failure f, sdo_abort a, std::uint16_t index, std::uint8_t sub,
+                        std::string text) {
   if (phase_ == master_phase::failed) return;
-  phase_ = master_phase::failed;
+  drop_requests();
   failure_ = f;
   failed_abort_ = a;
   failed_index_ = index;
   failed_sub_ = sub;
+  text_ = std::move(text);
+  retry_at_us_ = now_us_ + config_.retry_us;
+  outbox_.clear();
+  consumer_.configure({});
+  heartbeat_lost_ = false;
+  set_phase(master_phase::failed, phase_reason::failed);
 }
 
-std::string drive_master::failure_text() const {
-  char buf[160];
-  switch (failure_) {
-    case master_failure::none: return "no failure";
-    case master_failure::no_answer:
-      std::snprintf(buf, sizeof buf, "node %u does not answer (SDO timeout reading/writing 0x%04X:%u)",
-                    config_.node_id, failed_index_, failed_sub_);
-      return buf;
-    case master_failure::sdo_refused:
-      std::snprintf(buf, sizeof buf, "node %u refused 0x%04X:%u: SDO abort 0x%08X (%s)", config_.node_id,
-                    failed_index_, failed_sub_, static_cast<unsigned>(failed_abort_),
-                    sdo_abort_text(failed_abort_));
-      return buf;
-    case master_failure::not_a_drive:
-      std::snprintf(buf, sizeof buf, "node %u is not a CiA 402 drive (0x1000 low word is not 0x0192)",
-                    config_.node_id);
-      return buf;
-    case master_failure::heartbeat_lost:
-      std::snprintf(buf, sizeof buf, "node %u: heartbeat lost (none for %u ms)", config_.node_id,
-                    3u * config_.drive_heartbeat_ms);
-      return buf;
+// --- SDO transfers ------------------------------------------------------------------------------
+
+void drive_master::drop_requests() {
+  std::vector<std::function<void(const sdo_result&)>> cancelled;
+  if (current_) {
+    if (sdo_.state() == sdo_client::status::busy) sdo_.cancel();
+    if (current_->done) cancelled.push_back(std::move(current_->done));
+    current_.reset();
   }
-  return "unknown failure";
+  sdo_.clear();
+  for (sdo_job& j : requests_) {
+    if (j.done) cancelled.push_back(std::move(j.done));
+  }
+  requests_.clear();
+  sdo_result r;
+  r.cancelled = true;
+  for (auto& done : cancelled) done(r);
 }
 
-void drive_master::set_target(state target) {
-  mode_ = mode::target;
-  pending_target_ = target;
-  policy_ = master_policy::make(*profile_, options_, target);
-  master_.set_target(policy_, now_us_, config_.transition_timeout_us);
+bool drive_master::read(std::uint16_t index, std::uint8_t sub, bool is_signed,
+                        std::function<void(const sdo_result&)> done) {
+  if (phase_ != master_phase::running) return false;
+  sdo_job j;
+  j.index = index;
+  j.sub = sub;
+  j.is_signed = is_signed;
+  j.done = std::move(done);
+  requests_.push_back(std::move(j));
+  return true;
 }
 
-void drive_master::set_command(command c) {
-  mode_ = mode::command;
-  command_ = c;
-  master_.clear_target();
+bool drive_master::write(std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes,
+                         std::function<void(const sdo_result&)> done) {
+  if (phase_ != master_phase::running) return false;
+  sdo_job j;
+  j.write = true;
+  j.index = index;
+  j.sub = sub;
+  j.value = [value] { return value; };
+  j.bytes = bytes;
+  j.done = std::move(done);
+  requests_.push_back(std::move(j));
+  return true;
 }
 
-void drive_master::clear_target() {
-  mode_ = mode::idle;
-  master_.clear_target();
+bool drive_master::request_pending() const noexcept {
+  return !requests_.empty() || (current_ && current_->done);
 }
 
-void drive_master::send_control_word(std::uint16_t cw) {
-  frame f;
-  f.id = cob::rpdo1 + config_.node_id;
-  f.len = 2;
-  put_le(f.data.data(), cw, 2);
-  (void)out_->send(f);
+void drive_master::start_transfer(const sdo_job& j) {
+  sdo_.clear();
+  if (j.write) {
+    (void)sdo_.start_download(j.index, j.sub, j.value(), j.bytes);
+  } else {
+    (void)sdo_.start_upload(j.index, j.sub);
+  }
 }
 
-void drive_master::on_status(std::uint16_t sw, std::uint16_t err) {
+drive_master::sdo_job drive_master::next_poll() {
+  // What no PDO carries, one object per poll period in turn.
+  std::vector<std::uint16_t> list{0x1001};
+  if (!velocity_mapped_) list.push_back(0x606C);
+  if (!error_code_mapped_) list.push_back(0x603F);
+  if (!heartbeat_watched_) list.push_back(0x6041);
+  const std::uint16_t index = list[poll_index_++ % list.size()];
+  sdo_job j;
+  j.index = index;
+  j.optional = true;
+  j.is_signed = index == 0x606C;
+  j.then = [this, index](const sdo_client& c) {
+    if (c.state() != sdo_client::status::done) return;
+    switch (index) {
+      case 0x1001: error_register_ = static_cast<std::uint8_t>(c.value()); break;
+      case 0x606C: note_velocity(static_cast<std::int32_t>(c.value(true))); break;
+      case 0x603F: error_code_ = static_cast<std::uint16_t>(c.value()); break;
+      case 0x6041: note_status(static_cast<std::uint16_t>(c.value())); break;
+      default: break;
+    }
+  };
+  return j;
+}
+
+bool drive_master::start_next_job() {
+  if (phase_ == master_phase::configuring) {
+    while (phase_ == master_phase::configuring && step_ < script_.size()) {
+      const sdo_job& j = script_[step_];
+      if ((j.group != 0 && j.group == skipped_group_) || (j.wanted && !j.wanted())) {
+        ++step_;
+        continue;
+      }
+      if (j.nmt_start) {
+        ++step_;
+        (void)out_->send(nmt_frame(nmt_command::start, config_.node_id));
+        go_running();
+        return false;
+      }
+      current_ = j;
+      start_transfer(*current_);
+      return true;
+    }
+    return false;
+  }
+  if (phase_ != master_phase::running) return false;
+  if (!requests_.empty()) {
+    current_ = std::move(requests_.front());
+    requests_.pop_front();
+    start_transfer(*current_);
+    return true;
+  }
+  if (config_.poll_us != 0 && now_us_ >= next_poll_us_) {
+    next_poll_us_ = now_us_ + config_.poll_us;
+    current_ = next_poll();
+    start_transfer(*current_);
+    return true;
+  }
+  return false;
+}
+
+void drive_master::complete_current() {
+  sdo_job job = std::move(*current_);
+  current_.reset();
+  const bool ok = sdo_.state() == sdo_client::status::done;
+  const sdo_abort abort = ok ? sdo_abort::none : sdo_.abort_code();
+  const bool timed_out = abort == sdo_abort::sdo_protocol_timed_out;
+  const std::string what = std::string(job.write ? "writing " : "reading ") +
+                           hex(job.index, 4) + ":" + std::to_string(job.sub);
+  const auto lose = [&] {
+    fail(master_failure::no_answer, abort, job.index, job.sub,
+         node_text() + " does not answer (SDO timeout " + what + ")");
+  };
+
+  if (job.done) {  // a request
+    sdo_result r;
+    r.abort = abort;
+    if (ok) r.value = sdo_.value(job.is_signed);
+    job.done(r);
+    // A node that lets an SDO request time out is silent, whatever its heartbeat did last.
+    if (timed_out) lose();
+    return;
+  }
+  if (phase_ == master_phase::running) {  // a poll
+    if (job.then) job.then(sdo_);
+    if (timed_out) lose();
+    return;
+  }
+  if (phase_ != master_phase::configuring) return;
+  if (timed_out) {
+    lose();
+    return;
+  }
+  if (!ok && !job.optional) {
+    fail(master_failure::sdo_refused, abort, job.index, job.sub,
+         node_text() + " refused " + what + ": " + abort_text(abort));
+    return;
+  }
+  if (!ok && job.group != 0) skipped_group_ = job.group;
+  if (job.then) job.then(sdo_);
+  ++step_;
+}
+
+void drive_master::drive_jobs() {
+  for (int guard = 0; guard < 64; ++guard) {
+    if (!current_ && !start_next_job()) return;
+    if (!current_ || !sdo_.finished()) return;
+    complete_current();
+  }
+}
+
+// --- what the drive reports ---------------------------------------------------------------------
+
+void drive_master::note_velocity(std::int32_t v) {
+  velocity_ = v;
+  if (on_velocity) on_velocity(v);
+}
+
+void drive_master::note_status(std::uint16_t sw) {
   status_known_ = true;
   status_word_ = sw;
-  error_code_ = err;
   state s = state::start;
   if (!decode_status(*profile_, sw, s)) s = state::start;
+  if (on_status) on_status(sw);
   if (s != observed_) {
     const state before = observed_;
     observed_ = s;
@@ -180,11 +289,12 @@ void drive_master::on_status(std::uint16_t sw, std::uint16_t err) {
   }
   if (phase_ != master_phase::running) return;
   switch (mode_) {
-    case mode::idle: break;
-    case mode::target: send_control_word(master_.step(sw, now_us_, err)); break;
+    case mode::idle:
+    case mode::word: break;
+    case mode::target: send_word(master_.step(sw, now_us_, error_code_)); break;
     case mode::command: {
       std::uint16_t cw = 0;
-      if (encode_command(*profile_, command_, 0, cw)) send_control_word(cw);
+      if (encode_command(*profile_, command_, 0, cw)) send_word(cw);
       break;
     }
   }
@@ -192,74 +302,157 @@ void drive_master::on_status(std::uint16_t sw, std::uint16_t err) {
 
 void drive_master::on_frame(const frame& f) {
   if (f.extended || f.rtr) return;
+  if (phase_ == master_phase::failed && failure_ == master_failure::bus_failed) return;
   const std::uint8_t node = config_.node_id;
-  if (sdo_.on_frame(f)) return;
-  if (consumer_.on_frame(f)) return;
-  if (f.id == cob::emcy + node && f.len == 8) {
-    if (on_emcy) on_emcy(static_cast<std::uint16_t>(get_le(f.data.data(), 2)), f.data[2], f.data.data() + 3);
+  if (sdo_.on_frame(f)) {
+    // The answer ends its transfer before the next frame (a TPDO the write caused) is looked at.
+    if (current_ && sdo_.finished()) drive_jobs();
+    return;
+  }
+  if (f.id == cob::heartbeat + node && f.len >= 1) {
+    nmt_seen_ = f.data[0];
+    if (f.data[0] == static_cast<std::uint8_t>(nmt_state::initialising) &&
+        (phase_ != master_phase::failed || config_.retry_us != 0)) {
+      // Boot-up: the node starts afresh with its default PDOs; set it up again.
+      restart(phase_reason::node_restarted,
+              node_text() + " restarted (boot-up message): configuring it again");
+      drive_jobs();
+      return;
+    }
+    (void)consumer_.on_frame(f);
+    return;
+  }
+  if (phase_ == master_phase::failed) return;
+  if (f.id == cob::emcy + node && f.len >= 3) {
+    const auto code = static_cast<std::uint16_t>(get_le(f.data.data(), 2));
+    last_emcy_ = code;
+    error_register_ = f.data[2];
+    if (!error_code_mapped_) error_code_ = code;
+    if (on_emcy) on_emcy(code, f.data[2], f.data.data() + 3);
     return;
   }
   if (f.id == cob::tpdo1 + node && f.len >= 2) {
-    const auto sw = static_cast<std::uint16_t>(get_le(f.data.data(), 2));
-    const auto err = f.len >= 4 && error_code_mapped_ ? static_cast<std::uint16_t>(get_le(f.data.data() + 2, 2))
-                                                      : std::uint16_t{0};
-    on_status(sw, err);
+    if (error_code_mapped_ && f.len >= 4) {
+      error_code_ = static_cast<std::uint16_t>(get_le(f.data.data() + 2, 2));
+    }
+    note_status(static_cast<std::uint16_t>(get_le(f.data.data(), 2)));
+    return;
+  }
+  if (velocity_mapped_ && f.id == cob::tpdo1 + 0x100 + node && f.len >= 4) {
+    note_velocity(static_cast<std::int32_t>(static_cast<std::uint32_t>(get_le(f.data.data(), 4))));
   }
 }
 
+// --- commanding ---------------------------------------------------------------------------------
+
+void drive_master::set_target(state target) {
+  mode_ = mode::target;
+  outbox_.clear();
+  policy_ = master_policy::make(*profile_, options_, target);
+  master_.set_target(policy_, now_us_, config_.transition_timeout_us);
+}
+
+void drive_master::set_command(command c) {
+  mode_ = mode::command;
+  outbox_.clear();
+  command_ = c;
+  master_.clear_target();
+}
+
+void drive_master::clear_target() {
+  mode_ = mode::idle;
+  outbox_.clear();
+  master_.clear_target();
+}
+
+void drive_master::send_control_word(std::uint16_t word, bool fault_reset_edge) {
+  if (mode_ != mode::word) master_.clear_target();
+  mode_ = mode::word;
+  outbox_.clear();
+  if (!fault_reset_edge) {
+    outbox_.emplace_back(word, now_us_);
+    return;
+  }
+  // Each level of the edge held for reset_pulse_us, so the drive steps on both.
+  std::uint64_t at = now_us_;
+  if ((last_sent_ & bit7) != 0) {
+    outbox_.emplace_back(word, at);
+    at += config_.reset_pulse_us;
+  }
+  outbox_.emplace_back(static_cast<std::uint16_t>(word | bit7), at);
+  outbox_.emplace_back(word, at + config_.reset_pulse_us);
+}
+
+void drive_master::send_word(std::uint16_t cw) {
+  frame f;
+  f.id = cob::rpdo1 + config_.node_id;
+  f.len = 2;
+  put_le(f.data.data(), cw, 2);
+  last_sent_ = cw;
+  (void)out_->send(f);
+  if (on_sent) on_sent(cw);
+}
+
+// --- time ---------------------------------------------------------------------------------------
+
 std::uint32_t drive_master::process(std::uint32_t elapsed_us) {
   now_us_ += elapsed_us;
+  if (failure_ == master_failure::bus_failed) return no_deadline;
+  if (const std::error_code ec = out_->failure()) {
+    fail(master_failure::bus_failed, sdo_abort::none, 0, 0,
+         "the bus connection failed: " + ec.message());
+    return no_deadline;
+  }
+  if (!started_) {
+    started_ = true;
+    set_phase(master_phase::configuring, phase_reason::started);
+  }
   std::uint32_t next = producer_.process(elapsed_us, *out_, config_.master_node_id,
                                          nmt_state::operational);
   next = earliest(next, consumer_.process(elapsed_us));
-  if (phase_ == master_phase::configuring) {
-    if (!step_started_) start_step();
-    next = earliest(next, sdo_.process(elapsed_us));
-    while (phase_ == master_phase::configuring && sdo_.finished()) {
-      const sdo_step& s = script_[step_];
-      if (sdo_.state() == sdo_client::status::aborted && !s.optional) {
-        fail(sdo_.abort_code() == sdo_abort::sdo_protocol_timed_out ? master_failure::no_answer
-                                                                    : master_failure::sdo_refused,
-             sdo_.abort_code(), s.index, s.sub);
-        break;
-      }
-      // An optional read that timed out still means a silent node.
-      if (sdo_.state() == sdo_client::status::aborted &&
-          sdo_.abort_code() == sdo_abort::sdo_protocol_timed_out) {
-        fail(master_failure::no_answer, sdo_.abort_code(), s.index, s.sub);
-        break;
-      }
-      if (s.then) s.then(sdo_);
-      if (phase_ != master_phase::configuring) break;
-      if (++step_ == script_.size()) {
-        sdo_.clear();
-        (void)out_->send(nmt_frame(nmt_command::start, config_.node_id));
-        if (config_.drive_heartbeat_ms != 0) {
-          consumer_.configure({{config_.node_id,
-                                static_cast<std::uint16_t>(std::min<std::uint32_t>(
-                                    3u * config_.drive_heartbeat_ms, 0xFFFF))}});
-        }
-        phase_ = master_phase::running;
-        sync_timer_.start(config_.cycle_us);
-        if (mode_ == mode::target) master_.set_target(policy_, now_us_, config_.transition_timeout_us);
-        (void)out_->send(make_frame(cob::sync, {}));
-        break;
-      }
-      start_step();
-    }
-    if (phase_ == master_phase::configuring) next = earliest(next, sdo_.process(0));
-    return next;
+  if (heartbeat_lost_ && phase_ == master_phase::running) {
+    fail(master_failure::heartbeat_lost, sdo_abort::none, 0, 0,
+         node_text() + " does not answer (no heartbeat for " +
+             std::to_string(3u * config_.drive_heartbeat_ms) + " ms)");
+  }
+  heartbeat_lost_ = false;
+  const bool was_running = phase_ == master_phase::running;
+  if (current_) next = earliest(next, sdo_.process(elapsed_us));
+  drive_jobs();
+  if (phase_ == master_phase::failed && config_.retry_us != 0 && now_us_ >= retry_at_us_) {
+    restart(phase_reason::retrying, text_ + "; trying again");
+    drive_jobs();
   }
   if (phase_ == master_phase::running) {
-    if (sync_timer_.expired(elapsed_us)) (void)out_->send(make_frame(cob::sync, {}));
-    next = earliest(next, sync_timer_.left());
+    while (!outbox_.empty() && outbox_.front().second <= now_us_) {
+      send_word(outbox_.front().first);
+      outbox_.pop_front();
+    }
+    if (!outbox_.empty()) {
+      next = earliest(next, static_cast<std::uint32_t>(
+                                std::min<std::uint64_t>(outbox_.front().second - now_us_, no_deadline)));
+    }
+    if (config_.timing == pdo_timing::sync) {
+      // The SYNC that started the running phase counts as this cycle's.
+      if (was_running && sync_timer_.expired(elapsed_us)) (void)out_->send(make_frame(cob::sync, {}));
+      next = earliest(next, sync_timer_.left());
+    }
+    if (config_.poll_us != 0 && !current_) {
+      next = earliest(next, static_cast<std::uint32_t>(std::min<std::uint64_t>(
+                                next_poll_us_ > now_us_ ? next_poll_us_ - now_us_ : 0, no_deadline)));
+    }
+  }
+  if (current_) next = earliest(next, sdo_.process(0));
+  if (phase_ == master_phase::failed && config_.retry_us != 0) {
+    next = earliest(next, static_cast<std::uint32_t>(std::min<std::uint64_t>(
+                              retry_at_us_ > now_us_ ? retry_at_us_ - now_us_ : 0, no_deadline)));
   }
   return next;
 }
 
 std::uint32_t drive_master::poll(channel& in, std::uint32_t elapsed_us) {
   frame f;
-  while (in.receive(f)) on_frame(f);
+  for (int n = 0; n < 4096 && in.receive(f); ++n) on_frame(f);
   return process(elapsed_us);
 }
 

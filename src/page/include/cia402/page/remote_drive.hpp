@@ -3,25 +3,18 @@
 // instrument, so the server and the page are the same; what the page cannot do on a remote drive it
 // learns from `capabilities` and the `remote` part of each snapshot.
 //
-// Set-up, each an SDO transfer (the first required one that fails ends it, "does not answer" for a
-// timeout; after `retry_us` it starts again, so a node that comes later is picked up):
-//   1. 0x1000 must name device profile 402 (low word 0x0192);
-//   2. 0x1008 device name (optional); if it is "cia402 virtual drive" (a node of `cia402 bus`), an
-//      upload of 0x2001 must answer "write-only" (0x06010001): then the page may inject faults by
-//      writing error codes to 0x2001 (0 clears). No other drive's 0x2001 is ever written: on a real
-//      drive it is some manufacturer object of unknown meaning;
-//   3. the page's objects (option codes, ramps), 0x6040 (the word the page starts from, so
-//      connecting changes nothing), 0x60FF, 0x6041, 0x603F;
-//   4. 0x1017 = heartbeat_ms (optional; without it a silent node is found by SDO polling);
-//   5. TPDO1 = 0x6041 + 0x603F (0x603F only if mappable), event-driven (255), no inhibit time, so
-//      every state the drive reports arrives; TPDO2 = 0x606C, event-driven, 20 ms inhibit time
-//      (optional: without it 0x606C is polled by SDO); RPDO1 = 0x6040, event-driven;
-//   6. NMT start.
-// Then: commands go out in RPDO1 (the word from cia402::encode_command, other bits kept; a fault
-// reset is bit 7 high for reset_pulse_us, then low); writes of objects and 0x60FF are SDO downloads
-// and their refusals carry the drive's abort code; what no TPDO carries (0x1001, and 0x606C / 0x603F
-// when not mapped) is polled by SDO every poll_us. The transition numbers are inferred from the
-// observed states (transition_inference.hpp) and marked "inferred" in the snapshots.
+// The link is the project's one CANopen 402 master (cia402/canopen/drive_master.hpp), set up with
+// PDOs on change: TPDO1 = 0x6041 + 0x603F with no inhibit time, so every state the drive reports
+// arrives; TPDO2 = 0x606C with a 20 ms inhibit time; RPDO1 = 0x6040; the page's objects (option
+// codes, ramps) and 0x60FF read at set-up, and 0x6040 so that connecting changes nothing. The master
+// finds out whether the node is a `cia402 bus` node that takes injected faults at 0x2001; no other
+// drive's 0x2001 is ever written.
+//
+// Commands go out in RPDO1 (the word from cia402::encode_command, other bits kept; a fault reset is
+// bit 7 high for reset_pulse_us, then low); writes of objects and 0x60FF are SDO downloads through
+// the master and their refusals carry the drive's abort code; what no TPDO carries is polled every
+// poll_us. The transition numbers are inferred from the observed states (transition_inference.hpp)
+// and marked "inferred" in the snapshots.
 //
 // A lost heartbeat or any SDO timeout shows as status "no_answer" with "node N does not answer
 // (...)" on the page; the state is then UNKNOWN, commands are refused with 503, and set-up starts
