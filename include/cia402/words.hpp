@@ -51,4 +51,21 @@ inline constexpr int command_count = 6;
 /// "DISABLE_VOLTAGE", "QUICK_STOP", ...; never null.
 const char* command_name(command c) noexcept;
 
+/// The words that give a drive a fault-reset edge (S2: bit 7 rising acts, a level does not), in the
+/// order to send them, each for at least one of the drive's cycles: `word` without bit 7 first if
+/// the last word sent had it, then with it, then without it again. What a master sends for "Fault
+/// reset" whichever way it times the words (per cycle, or held for a pulse time).
+struct fault_reset_words {
+  std::uint16_t words[3] = {};
+  std::uint8_t count = 0;
+};
+constexpr fault_reset_words fault_reset_edge(std::uint16_t last_sent, std::uint16_t word) noexcept {
+  fault_reset_words r;
+  const auto low = static_cast<std::uint16_t>(word & ~control_bit::fault_reset);
+  if ((last_sent & control_bit::fault_reset) != 0) r.words[r.count++] = low;
+  r.words[r.count++] = static_cast<std::uint16_t>(low | control_bit::fault_reset);
+  r.words[r.count++] = low;
+  return r;
+}
+
 }  // namespace cia402

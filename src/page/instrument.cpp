@@ -23,7 +23,6 @@ using json = nlohmann::ordered_json;
 using detail::abort_text;
 using detail::hex;
 
-constexpr std::uint16_t bit7 = control_bit::fault_reset;
 
 }  // namespace
 
@@ -72,10 +71,9 @@ struct instrument::impl {
         w.tracked ? track(w.action, true) : log.report_now(w.action, "done", w.text);
     scripted.clear();
     if (w.fault_reset_edge) {
-      // Bit 7 set for one cycle after a cycle with it clear (S2), then cleared again.
-      if ((control_word & bit7) != 0) scripted.push_back(w.word);
-      scripted.push_back(static_cast<std::uint16_t>(w.word | bit7));
-      scripted.push_back(w.word);
+      // One word a cycle.
+      const fault_reset_words edge = fault_reset_edge(control_word, w.word);
+      scripted.insert(scripted.end(), edge.words, edge.words + edge.count);
     } else {
       apply_word(w.word);
     }

@@ -11,7 +11,6 @@ namespace {
 
 using support::hex;
 
-constexpr std::uint16_t bit7 = control_bit::fault_reset;
 std::string abort_text(sdo_abort code) {
   return "SDO abort " + hex(static_cast<std::uint32_t>(code), 8) + " (" + sdo_abort_text(code) + ")";
 }
@@ -374,13 +373,10 @@ void drive_master::send_control_word(std::uint16_t word, bool fault_reset_edge) 
     return;
   }
   // Each level of the edge held for reset_pulse_us, so the drive steps on both.
-  std::uint64_t at = now_us_;
-  if ((last_sent_ & bit7) != 0) {
-    outbox_.emplace_back(word, at);
-    at += config_.reset_pulse_us;
+  const fault_reset_words edge = cia402::fault_reset_edge(last_sent_, word);
+  for (std::uint8_t i = 0; i < edge.count; ++i) {
+    outbox_.emplace_back(edge.words[i], now_us_ + std::uint64_t{i} * config_.reset_pulse_us);
   }
-  outbox_.emplace_back(static_cast<std::uint16_t>(word | bit7), at);
-  outbox_.emplace_back(word, at + config_.reset_pulse_us);
 }
 
 void drive_master::send_word(std::uint16_t cw) {
