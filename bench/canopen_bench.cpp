@@ -11,8 +11,7 @@
 
 #include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/nmt.hpp"
-#include "cia402/canopen/sim_device.hpp"
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/virtual_drive_node.hpp"
 #include "cia402/canopen/virtual_bus.hpp"
 #include "cia402/master.hpp"
 
@@ -22,9 +21,7 @@ using namespace cia402;
 using namespace cia402::canopen;
 
 struct node {
-  std::unique_ptr<sim_device> dev;
-  std::unique_ptr<virtual_channel> ch;
-  std::unique_ptr<slave> sl;
+  std::unique_ptr<virtual_drive_node> drive;
   cia402::master m;
 };
 
@@ -38,21 +35,18 @@ void bm_bus_64_drives_1ms_sync(benchmark::State& state) {
   std::vector<node> nodes(drives);
   for (std::size_t i = 0; i < drives; ++i) {
     node& n = nodes[i];
-    n.dev = std::make_unique<sim_device>(p);
-    n.ch = bus.attach();
-    slave_config c;
-    c.objects = drive_objects();
-    c.node_id = static_cast<std::uint8_t>(i + 1);
-    n.sl = std::make_unique<slave>(*n.dev, *n.ch, c);
-    n.sl->write(0x1800, 2, 1);  // TPDO1 on every SYNC
+    const slave_config c = drive_node_config(static_cast<std::uint8_t>(i + 1));
+    std::unique_ptr<virtual_channel> ch = bus.attach();
     // With `filtered`, the node's CAN controller takes only what concerns it (NMT, SYNC, its SDO
     // and RPDO1), as hardware acceptance filters do; without, every node sees every frame.
     if (filtered) {
-      n.ch->accept_none();
+      ch->accept_none();
       for (std::uint32_t id : {cob::nmt, cob::sync, cob::sdo_rx + c.node_id, cob::rpdo1 + c.node_id}) {
-        n.ch->accept(id);
+        ch->accept(id);
       }
     }
+    n.drive = std::make_unique<virtual_drive_node>(p, std::move(ch), c);
+    n.drive->node().write(0x1800, 2, 1);  // TPDO1 on every SYNC
     n.m.set_target(policy, 0, 0);
   }
   master_ch->send(nmt_frame(nmt_command::start, 0));
@@ -61,7 +55,7 @@ void bm_bus_64_drives_1ms_sync(benchmark::State& state) {
   const std::uint64_t frames_before = bus.frames();
   for (auto _ : state) {
     master_ch->send(sync);
-    for (node& n : nodes) n.sl->poll(*n.ch, 1000);  // SYNC -> TPDO1, 1 ms of plant
+    for (node& n : nodes) n.drive->poll(1000);  // SYNC -> TPDO1, 1 ms of plant
     frame f;
     while (master_ch->receive(f)) {
       const std::size_t i = (f.id & 0x7F) - 1;
@@ -75,14 +69,14 @@ void bm_bus_64_drives_1ms_sync(benchmark::State& state) {
       rpdo.data[1] = static_cast<std::uint8_t>(cw >> 8);
       master_ch->send(rpdo);
     }
-    for (node& n : nodes) n.sl->poll(*n.ch, 0);  // RPDO1 acts at once (type 255)
+    for (node& n : nodes) n.drive->poll(0);  // RPDO1 acts at once (type 255)
     ++now;
   }
   const auto frames = static_cast<double>(bus.frames() - frames_before);
   state.counters["frames_per_second"] = benchmark::Counter(frames, benchmark::Counter::kIsRate);
   state.counters["frames_per_cycle"] = frames / static_cast<double>(state.iterations());
   std::size_t enabled = 0;
-  for (node& n : nodes) enabled += n.dev->drive().view().current() == state::operation_enabled;
+  for (node& n : nodes) enabled += n.drive->drive().view().current() == state::operation_enabled;
   state.counters["drives_enabled"] = static_cast<double>(enabled);
 }
 

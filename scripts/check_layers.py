@@ -24,6 +24,7 @@ LAYERS = [
     ("canopen/402", "include/cia402/canopen/drive_objects.hpp"),
     ("canopen/402", "include/cia402/canopen/drive_master.hpp"),
     ("canopen/402", "include/cia402/canopen/sim_device.hpp"),
+    ("canopen/402", "include/cia402/canopen/virtual_drive_node.hpp"),
     ("canopen/402", "src/canopen/402/"),
     ("canopen/306", "include/cia402/canopen/eds.hpp"),
     ("canopen/306", "src/canopen/306/"),

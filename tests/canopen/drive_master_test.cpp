@@ -9,19 +9,12 @@
 
 #include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/drive_master.hpp"
-#include "cia402/canopen/sim_device.hpp"
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/virtual_drive_node.hpp"
 #include "cia402/canopen/virtual_bus.hpp"
 #include "cia402/words.hpp"
 
 namespace cia402::canopen {
 namespace {
-
-struct drive_node {
-  std::unique_ptr<sim_device> dev;
-  std::unique_ptr<virtual_channel> ch;
-  std::unique_ptr<slave> sl;
-};
 
 class bench {
  public:
@@ -35,22 +28,16 @@ class bench {
     };
   }
   void add_drive(std::uint8_t id) {
-    drive_node n;
-    n.dev = std::make_unique<sim_device>(standard_profile());
-    n.ch = bus_.attach();
-    slave_config c;
-    c.objects = drive_objects();
-    c.node_id = id;
-    n.sl = std::make_unique<slave>(*n.dev, *n.ch, c);
-    drives_.push_back(std::move(n));
+    drives_.push_back(
+        std::make_unique<virtual_drive_node>(standard_profile(), bus_.attach(), drive_node_config(id)));
   }
   /// `ms` milliseconds in steps of 1 ms; the master stays silent with `master_alive` false.
   void run_ms(int ms, bool master_alive = true) {
     for (int i = 0; i < ms; ++i) {
       if (master_alive) master_->poll(*master_ch_, 1000);
-      for (drive_node& n : drives_) n.sl->poll(*n.ch, 1000);
+      for (auto& n : drives_) n->poll(1000);
       if (master_alive) master_->poll(*master_ch_, 0);
-      for (drive_node& n : drives_) n.sl->poll(*n.ch, 0);
+      for (auto& n : drives_) n->poll(0);
       if (master_alive) {
         master_->poll(*master_ch_, 0);
       } else {
@@ -69,8 +56,8 @@ class bench {
     return false;
   }
   drive_master& master() { return *master_; }
-  slave& node(std::size_t i = 0) { return *drives_[i].sl; }
-  sim::virtual_drive& drive(std::size_t i = 0) { return drives_[i].dev->drive(); }
+  slave& node(std::size_t i = 0) { return drives_[i]->node(); }
+  sim::virtual_drive& drive(std::size_t i = 0) { return drives_[i]->drive(); }
   void remove_drives() { drives_.clear(); }
   virtual_bus& bus() { return bus_; }
   /// Every frame sent on the bus since the last call, in order.
@@ -85,7 +72,7 @@ class bench {
 
  private:
   virtual_bus bus_;
-  std::vector<drive_node> drives_;
+  std::vector<std::unique_ptr<virtual_drive_node>> drives_;
   std::unique_ptr<virtual_channel> master_ch_;
   std::unique_ptr<virtual_channel> sniffer_;
   std::unique_ptr<drive_master> master_;
@@ -148,15 +135,12 @@ TEST(drive_master, disable_from_operation_enabled_reaches_switch_on_disabled) {
 
 TEST(drive_master, two_drives_on_one_bus_each_follow_their_own_master) {
   virtual_bus bus;
-  std::vector<drive_node> nodes;
+  std::vector<std::unique_ptr<virtual_drive_node>> nodes;
   std::vector<std::unique_ptr<virtual_channel>> chs;
   std::vector<std::unique_ptr<drive_master>> masters;
   for (std::uint8_t id : {1, 2}) {
-    drive_node n;
-    n.dev = std::make_unique<sim_device>(standard_profile());
-    n.ch = bus.attach();
-    n.sl = std::make_unique<slave>(*n.dev, *n.ch, drive_node_config(id));
-    nodes.push_back(std::move(n));
+    nodes.push_back(
+        std::make_unique<virtual_drive_node>(standard_profile(), bus.attach(), drive_node_config(id)));
     chs.push_back(bus.attach());
     drive_master_config c;
     c.node_id = id;
@@ -166,10 +150,10 @@ TEST(drive_master, two_drives_on_one_bus_each_follow_their_own_master) {
   masters[1]->set_target(state::ready_to_switch_on);
   for (int i = 0; i < 1500; ++i) {
     for (std::size_t k = 0; k < 2; ++k) masters[k]->poll(*chs[k], 1000);
-    for (drive_node& n : nodes) n.sl->poll(*n.ch, 1000);
+    for (auto& n : nodes) n->poll(1000);
   }
-  EXPECT_EQ(nodes[0].dev->drive().view().current(), state::operation_enabled);
-  EXPECT_EQ(nodes[1].dev->drive().view().current(), state::ready_to_switch_on);
+  EXPECT_EQ(nodes[0]->drive().view().current(), state::operation_enabled);
+  EXPECT_EQ(nodes[1]->drive().view().current(), state::ready_to_switch_on);
 }
 
 class quick_stop_code : public ::testing::TestWithParam<int> {};

@@ -14,8 +14,7 @@
 
 #include "cia402/canopen/drive_objects.hpp"
 #include "cia402/canopen/drive_master.hpp"
-#include "cia402/canopen/sim_device.hpp"
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/virtual_drive_node.hpp"
 #include "cia402/canopen/socketcand.hpp"
 
 namespace cia402::canopen {
@@ -119,12 +118,6 @@ class tcp_peer {
   bool connected_ = false;
 };
 
-struct drive_on_bus {
-  std::unique_ptr<sim_device> dev;
-  std::unique_ptr<virtual_channel> ch;
-  std::unique_ptr<slave> sl;
-};
-
 class socketcand_server_test : public ::testing::Test {
  protected:
   void SetUp() override { start({}); }
@@ -137,18 +130,15 @@ class socketcand_server_test : public ::testing::Test {
     ASSERT_NE(srv->port(), 0);
   }
   void add_drive(std::uint8_t id) {
-    drive_on_bus d;
-    d.dev = std::make_unique<sim_device>(standard_profile());
-    d.ch = bus.attach();
-    d.sl = std::make_unique<slave>(*d.dev, *d.ch, drive_node_config(id));
-    drives.push_back(std::move(d));
+    drives.push_back(
+        std::make_unique<virtual_drive_node>(standard_profile(), bus.attach(), drive_node_config(id)));
   }
   /// One cycle of the server loop: sockets, time, nodes, output.
   void spin(int cycles = 1, std::uint32_t us = 1000) {
     for (int i = 0; i < cycles; ++i) {
       srv->poll_sockets(0);
       srv->advance(us);
-      for (auto& d : drives) d.sl->poll(*d.ch, us);
+      for (auto& d : drives) d->poll(us);
       srv->flush();
     }
   }
@@ -158,7 +148,7 @@ class socketcand_server_test : public ::testing::Test {
     while (!done) {
       srv->poll_sockets(5);
       srv->advance(1000);
-      for (auto& d : drives) d.sl->poll(*d.ch, 1000);
+      for (auto& d : drives) d->poll(1000);
       srv->flush();
     }
   }
@@ -177,7 +167,7 @@ class socketcand_server_test : public ::testing::Test {
   }
 
   virtual_bus bus;
-  std::vector<drive_on_bus> drives;
+  std::vector<std::unique_ptr<virtual_drive_node>> drives;
   std::unique_ptr<socketcand::server> srv;
 };
 
@@ -299,7 +289,7 @@ TEST_F(socketcand_server_test, frames_for_unknown_nodes_pass_by_without_an_answe
   a->send("< send 67F 8 40 00 10 00 00 00 00 00 >< send 0 2 1 7f >");
   spin(10);
   EXPECT_EQ(a->take(), "");
-  EXPECT_EQ(drives[0].sl->state(), nmt_state::pre_operational);
+  EXPECT_EQ(drives[0]->node().state(), nmt_state::pre_operational);
 }
 
 TEST_F(socketcand_server_test, our_client_channel_joins_and_exchanges_frames) {
@@ -356,7 +346,7 @@ class master_over_socketcand : public socketcand_server_test {
     }
     return false;
   }
-  sim::virtual_drive& drive() { return drives[0].dev->drive(); }
+  sim::virtual_drive& drive() { return drives[0]->drive(); }
   std::unique_ptr<socketcand::client_channel> channel_;
 };
 
@@ -386,7 +376,7 @@ class quick_stop_over_socketcand : public master_over_socketcand,
 TEST_P(quick_stop_over_socketcand, quick_stop_follows_0x605A) {
   const int code = GetParam();
   add_drive(1);
-  ASSERT_EQ(drives[0].sl->write(0x605A, 0, code), sdo_abort::none);
+  ASSERT_EQ(drives[0]->node().write(0x605A, 0, code), sdo_abort::none);
   auto m = connect_master();
   m->set_target(state::operation_enabled);
   ASSERT_TRUE(run_until_reached(*m, 3000)) << m->failure_text();
@@ -405,16 +395,16 @@ class heartbeat_over_socketcand : public master_over_socketcand,
 TEST_P(heartbeat_over_socketcand, silent_master_makes_the_drive_apply_0x6007) {
   const int code = GetParam();
   add_drive(1);
-  ASSERT_EQ(drives[0].sl->write(0x6007, 0, code), sdo_abort::none);
+  ASSERT_EQ(drives[0]->node().write(0x6007, 0, code), sdo_abort::none);
   drive_master_config mc;
   mc.master_heartbeat_ms = 20;
   auto m = connect_master(mc);
   m->set_target(state::operation_enabled);
   ASSERT_TRUE(run_until_reached(*m, 3000)) << m->failure_text();
   run(*m, 100);
-  ASSERT_FALSE(drives[0].sl->connection_lost());
+  ASSERT_FALSE(drives[0]->node().connection_lost());
   run(*m, 500, /*alive=*/false);
-  EXPECT_TRUE(drives[0].sl->connection_lost());
+  EXPECT_TRUE(drives[0]->node().connection_lost());
   const state expected[4] = {state::operation_enabled, state::fault, state::switch_on_disabled,
                              state::switch_on_disabled};
   EXPECT_EQ(drive().view().current(), expected[code]);

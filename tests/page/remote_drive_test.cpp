@@ -14,8 +14,7 @@
 #include <thread>
 
 #include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/sim_device.hpp"
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/virtual_drive_node.hpp"
 #include "cia402/canopen/virtual_bus.hpp"
 #include "cia402/page/remote_drive.hpp"
 #include "cia402/profile.hpp"
@@ -48,12 +47,8 @@ class remote_bench {
  public:
   explicit remote_bench(remote_config config = test_config(),
                         const cia402::profile& p = cia402::standard_profile())
-      : dev_(std::make_unique<co::sim_device>(p)), drive_ch_(bus_.attach()) {
-    co::slave_config sc;
-    sc.objects = co::drive_objects();
-    sc.node_id = 1;
-    node_ = std::make_unique<co::slave>(*dev_, *drive_ch_, sc);
-    for (int i = 0; i < 10; ++i) node_->poll(*drive_ch_, 1000);  // power-up: T0, T1
+      : node_(std::make_unique<co::virtual_drive_node>(p, bus_.attach(), co::drive_node_config(1))) {
+    for (int i = 0; i < 10; ++i) node_->poll(1000);  // power-up: T0, T1
     page_ch_ = bus_.attach();
     remote_ = std::make_unique<remote_drive>(p, *page_ch_, config);
   }
@@ -61,13 +56,13 @@ class remote_bench {
   void run_ms(int ms) {
     for (int i = 0; i < ms; ++i) {
       remote_->step();
-      if (alive_) node_->poll(*drive_ch_, 1000);
+      if (alive_) node_->poll(1000);
       remote_->process(0);
-      if (alive_) node_->poll(*drive_ch_, 0);
+      if (alive_) node_->poll(0);
       remote_->process(0);
       if (!alive_) {
         co::frame f;
-        while (drive_ch_->receive(f)) {}
+        while (node_->bus_channel().receive(f)) {}
       }
     }
   }
@@ -101,13 +96,11 @@ class remote_bench {
     return s["results"].empty() ? json::object() : s["results"][0];
   }
   remote_drive& remote() { return *remote_; }
-  cia402::sim::virtual_drive& drive() { return dev_->drive(); }
+  cia402::sim::virtual_drive& drive() { return node_->drive(); }
 
  private:
   co::virtual_bus bus_;
-  std::unique_ptr<co::sim_device> dev_;
-  std::unique_ptr<co::virtual_channel> drive_ch_;
-  std::unique_ptr<co::slave> node_;
+  std::unique_ptr<co::virtual_drive_node> node_;
   std::unique_ptr<co::virtual_channel> page_ch_;
   std::unique_ptr<remote_drive> remote_;
   bool alive_ = true;

@@ -7,8 +7,7 @@
 #include <ostream>
 
 #include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/sim_device.hpp"
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/virtual_drive_node.hpp"
 #include "cia402/canopen/socketcand.hpp"
 #include "cia402/canopen/virtual_bus.hpp"
 #include "cli/common.hpp"
@@ -37,12 +36,6 @@ bool split_host_port(const std::string& text, std::string& host, std::uint16_t& 
   port = static_cast<std::uint16_t>(*p);
   return true;
 }
-
-struct virtual_node {
-  std::unique_ptr<canopen::sim_device> dev;
-  std::unique_ptr<canopen::virtual_channel> ch;
-  std::unique_ptr<canopen::slave> sl;
-};
 
 }  // namespace
 
@@ -107,17 +100,11 @@ int run_bus(const bus_args& args, std::ostream& out, std::ostream& err) {
   if (!choice.resolve(args.profile, args.profile_file, err)) return usage_error;
 
   canopen::virtual_bus bus;
-  std::vector<virtual_node> nodes;
+  std::vector<std::unique_ptr<canopen::virtual_drive_node>> nodes;
   for (std::uint8_t id : ids) {
-    virtual_node n;
-    n.dev = std::make_unique<canopen::sim_device>(choice.get());
-    n.ch = bus.attach();
-    canopen::slave_config sc;
-    sc.objects = canopen::drive_objects();
-    sc.node_id = id;
+    canopen::slave_config sc = canopen::drive_node_config(id);
     sc.heartbeat_ms = args.heartbeat_ms;
-    n.sl = std::make_unique<canopen::slave>(*n.dev, *n.ch, sc);
-    nodes.push_back(std::move(n));
+    nodes.push_back(std::make_unique<canopen::virtual_drive_node>(choice.get(), bus.attach(), sc));
   }
   canopen::socketcand::server server(bus, config);
   if (const auto ec = server.open()) {
@@ -150,7 +137,7 @@ int run_bus(const bus_args& args, std::ostream& out, std::ostream& err) {
     last += std::chrono::microseconds(step);
     server.advance(step);
     next_us = canopen::no_deadline;
-    for (virtual_node& n : nodes) next_us = std::min(next_us, n.sl->poll(*n.ch, step));
+    for (auto& n : nodes) next_us = std::min(next_us, n->poll(step));
     server.flush();
   }
   sigaction(SIGINT, &old_int, nullptr);

@@ -12,8 +12,7 @@
 #include "cia402/canopen/channel_url.hpp"
 #include "cia402/canopen/drive_master.hpp"
 #include "cia402/canopen/sdo_client.hpp"
-#include "cia402/canopen/sim_device.hpp"
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/virtual_drive_node.hpp"
 #include "cia402/canopen/virtual_bus.hpp"
 #include "cli/common.hpp"
 
@@ -38,15 +37,11 @@ class bus_session {
     }
     if (url.type == canopen::channel_url::kind::virtual_bus) {
       virtual_ = true;
-      dev_ = std::make_unique<canopen::sim_device>(p);
-      drive_ch_ = bus_.attach();
-      canopen::slave_config sc;
-      sc.objects = canopen::drive_objects();
-      sc.node_id = static_cast<std::uint8_t>(a.node);
-      slave_ = std::make_unique<canopen::slave>(*dev_, *drive_ch_, sc);
+      drive_ = std::make_unique<canopen::virtual_drive_node>(
+          p, bus_.attach(), canopen::drive_node_config(static_cast<std::uint8_t>(a.node)));
       master_ch_ = bus_.attach();
       channel_ = master_ch_.get();
-      for (int i = 0; i < 10; ++i) slave_->poll(*drive_ch_, 1000);  // past power-up (T0, T1)
+      for (int i = 0; i < 10; ++i) drive_->poll(1000);  // past power-up (T0, T1)
       frame_drain();
       return true;
     }
@@ -65,7 +60,7 @@ class bus_session {
   std::uint32_t wait(std::uint32_t wait_us) {
     if (virtual_) {
       const std::uint32_t step = 1000;
-      slave_->poll(*drive_ch_, step);
+      drive_->poll(step);
       return step;
     }
     pollfd p{channel_->native_handle(), POLLIN, 0};
@@ -79,7 +74,7 @@ class bus_session {
   }
   /// Lets the virtual drive answer at once (no time passes).
   void settle() {
-    if (virtual_) slave_->poll(*drive_ch_, 0);
+    if (virtual_) drive_->poll(0);
   }
   std::error_code failure() const { return channel_->failure(); }
   /// Drops what the virtual drive said while powering up (its boot-up message).
@@ -91,9 +86,7 @@ class bus_session {
  private:
   bool virtual_ = false;
   canopen::virtual_bus bus_;
-  std::unique_ptr<canopen::sim_device> dev_;
-  std::unique_ptr<canopen::virtual_channel> drive_ch_;
-  std::unique_ptr<canopen::slave> slave_;
+  std::unique_ptr<canopen::virtual_drive_node> drive_;
   std::unique_ptr<canopen::virtual_channel> master_ch_;
   std::unique_ptr<canopen::channel> real_;
   canopen::channel* channel_ = nullptr;
