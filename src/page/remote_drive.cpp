@@ -7,9 +7,9 @@
 #include <optional>
 #include <vector>
 
-#include "cia402/canopen/drive_master.hpp"
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/nmt.hpp"
+#include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/301/nmt.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/page/transition_inference.hpp"
 #include "cia402/words.hpp"

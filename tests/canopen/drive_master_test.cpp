@@ -7,10 +7,10 @@
 #include <memory>
 #include <vector>
 
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/drive_master.hpp"
-#include "cia402/canopen/virtual_drive_node.hpp"
-#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cia402/words.hpp"
 
 namespace cia402::canopen {

@@ -9,11 +9,11 @@
 
 #include <algorithm>
 
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/eds.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/306/eds.hpp"
 #include "cia402/objects.hpp"
-#include "cia402/canopen/sim_device.hpp"
-#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/canopen/402/sim_device.hpp"
+#include "cia402/canopen/transport/virtual_bus.hpp"
 
 namespace cia402::canopen {
 namespace {

@@ -9,10 +9,10 @@
 #include <memory>
 #include <vector>
 
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/nmt.hpp"
-#include "cia402/canopen/slave.hpp"
-#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/301/nmt.hpp"
+#include "cia402/canopen/301/slave.hpp"
+#include "cia402/canopen/transport/virtual_bus.hpp"
 #include "test_device.hpp"
 
 namespace cia402::canopen::test {

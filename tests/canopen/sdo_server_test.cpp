@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "cia402/canopen/sdo_client.hpp"
+#include "cia402/canopen/301/sdo_client.hpp"
 #include "network.hpp"
 
 namespace cia402::canopen::test {

@@ -4,8 +4,8 @@
 
 #include <cstdlib>
 
-#include "cia402/canopen/channel_url.hpp"
-#include "cia402/canopen/socketcan.hpp"
+#include "cia402/canopen/transport/channel_url.hpp"
+#include "cia402/canopen/transport/socketcan.hpp"
 
 namespace cia402::canopen {
 namespace {

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/drive_master.hpp"
-#include "cia402/canopen/virtual_drive_node.hpp"
-#include "cia402/canopen/socketcand.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/canopen/transport/socketcand.hpp"
 
 namespace cia402::canopen {
 namespace {

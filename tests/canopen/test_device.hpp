@@ -6,7 +6,7 @@
 #include <array>
 #include <cstdint>
 
-#include "cia402/canopen/device.hpp"
+#include "cia402/canopen/301/device.hpp"
 #include "cia402/drive.hpp"
 
 namespace cia402::canopen::test {

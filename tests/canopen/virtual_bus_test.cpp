@@ -2,7 +2,7 @@
 // acceptance filters and overruns behave like a CAN controller's.
 #include <gtest/gtest.h>
 
-#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/canopen/transport/virtual_bus.hpp"
 
 namespace cia402::canopen {
 namespace {

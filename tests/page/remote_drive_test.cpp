@@ -13,9 +13,9 @@
 #include <memory>
 #include <thread>
 
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/virtual_drive_node.hpp"
-#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cia402/page/remote_drive.hpp"
 #include "cia402/profile.hpp"
 

@@ -6,10 +6,10 @@
 #include <memory>
 #include <ostream>
 
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/virtual_drive_node.hpp"
-#include "cia402/canopen/socketcand.hpp"
-#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/canopen/transport/socketcand.hpp"
+#include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cli/common.hpp"
 
 namespace cia402::cli {

@@ -6,11 +6,11 @@
 #include <fstream>
 #include <ostream>
 
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/eds.hpp"
-#include "cia402/canopen/sim_device.hpp"
-#include "cia402/canopen/slave.hpp"
-#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/306/eds.hpp"
+#include "cia402/canopen/402/sim_device.hpp"
+#include "cia402/canopen/301/slave.hpp"
+#include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cli/common.hpp"
 
 namespace cia402::cli {

@@ -8,12 +8,12 @@
 #include <memory>
 #include <ostream>
 
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/channel_url.hpp"
-#include "cia402/canopen/drive_master.hpp"
-#include "cia402/canopen/sdo_client.hpp"
-#include "cia402/canopen/virtual_drive_node.hpp"
-#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/transport/channel_url.hpp"
+#include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/canopen/301/sdo_client.hpp"
+#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cli/common.hpp"
 
 namespace cia402::cli {

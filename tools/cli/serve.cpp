@@ -6,7 +6,7 @@
 #include <ostream>
 #include <pthread.h>
 
-#include "cia402/canopen/channel_url.hpp"
+#include "cia402/canopen/transport/channel_url.hpp"
 #include "cia402/page/instrument.hpp"
 #include "cia402/page/remote_drive.hpp"
 #include "cia402/page/runner.hpp"

@@ -1,4 +1,4 @@
-#include "cia402/canopen/nmt.hpp"
+#include "cia402/canopen/301/nmt.hpp"
 
 namespace cia402::canopen {
 

@@ -1,9 +1,9 @@
-#include "cia402/canopen/object_dictionary.hpp"
+#include "cia402/canopen/301/object_dictionary.hpp"
 
 #include <algorithm>
 #include <limits>
 
-#include "cia402/canopen/frame.hpp"
+#include "cia402/canopen/can/frame.hpp"
 
 namespace cia402::canopen {
 

@@ -1,9 +1,9 @@
-#include "cia402/canopen/sdo_client.hpp"
+#include "cia402/canopen/301/sdo_client.hpp"
 
 #include <algorithm>
 
-#include "cia402/canopen/frame.hpp"
-#include "cia402/canopen/sdo_server.hpp"
+#include "cia402/canopen/can/frame.hpp"
+#include "cia402/canopen/301/sdo_server.hpp"
 
 namespace cia402::canopen {
 

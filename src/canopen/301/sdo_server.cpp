@@ -1,8 +1,8 @@
-#include "cia402/canopen/sdo_server.hpp"
+#include "cia402/canopen/301/sdo_server.hpp"
 
 #include <algorithm>
 
-#include "cia402/canopen/frame.hpp"
+#include "cia402/canopen/can/frame.hpp"
 
 namespace cia402::canopen {
 namespace {

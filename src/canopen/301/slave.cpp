@@ -1,4 +1,4 @@
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/301/slave.hpp"
 
 #include <algorithm>
 

@@ -1,6 +1,6 @@
 // The node's PDOs (slave.hpp): the SYNC-driven and event-driven TPDOs with the device's change
 // reports, RPDOs, and the CiA 301 rules for their communication and mapping parameters.
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/301/slave.hpp"
 
 namespace cia402::canopen {
 namespace {

@@ -1,4 +1,4 @@
-#include "cia402/canopen/eds.hpp"
+#include "cia402/canopen/306/eds.hpp"
 
 #include <cstdio>
 #include <ostream>

@@ -1,8 +1,8 @@
-#include "cia402/canopen/drive_master.hpp"
+#include "cia402/canopen/402/drive_master.hpp"
 
 #include <algorithm>
 
-#include "cia402/canopen/pdo.hpp"
+#include "cia402/canopen/301/pdo.hpp"
 #include "cia402/support/text.hpp"
 #include "cia402/words.hpp"
 

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <iterator>
 
-#include "cia402/canopen/drive_master.hpp"
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/pdo.hpp"
+#include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/301/pdo.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/support/text.hpp"
 

@@ -1,4 +1,4 @@
-#include "cia402/canopen/drive_objects.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
 
 #include <string>
 

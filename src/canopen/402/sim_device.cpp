@@ -1,8 +1,8 @@
-#include "cia402/canopen/sim_device.hpp"
+#include "cia402/canopen/402/sim_device.hpp"
 
 #include <algorithm>
 
-#include "cia402/canopen/drive_objects.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
 
 namespace cia402::canopen {
 

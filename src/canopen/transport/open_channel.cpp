@@ -1,8 +1,8 @@
 #include <charconv>
 
-#include "cia402/canopen/channel_url.hpp"
-#include "cia402/canopen/socketcan.hpp"
-#include "cia402/canopen/socketcand.hpp"
+#include "cia402/canopen/transport/channel_url.hpp"
+#include "cia402/canopen/transport/socketcan.hpp"
+#include "cia402/canopen/transport/socketcand.hpp"
 
 namespace cia402::canopen {
 

@@ -1,4 +1,4 @@
-#include "cia402/canopen/socketcan.hpp"
+#include "cia402/canopen/transport/socketcan.hpp"
 
 #include <linux/can.h>
 #include <linux/can/raw.h>

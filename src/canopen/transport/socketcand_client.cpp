@@ -10,7 +10,7 @@
 #include <cerrno>
 #include <chrono>
 
-#include "cia402/canopen/socketcand.hpp"
+#include "cia402/canopen/transport/socketcand.hpp"
 
 namespace cia402::canopen::socketcand {
 namespace {

@@ -1,7 +1,7 @@
 #include <charconv>
 #include <cstdio>
 
-#include "cia402/canopen/socketcand.hpp"
+#include "cia402/canopen/transport/socketcand.hpp"
 
 namespace cia402::canopen::socketcand {
 namespace {

@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <cerrno>
 
-#include "cia402/canopen/socketcand.hpp"
+#include "cia402/canopen/transport/socketcand.hpp"
 
 namespace cia402::canopen::socketcand {
 

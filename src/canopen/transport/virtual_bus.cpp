@@ -1,4 +1,4 @@
-#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/canopen/transport/virtual_bus.hpp"
 
 #include <algorithm>
 

@@ -3,7 +3,7 @@
 // instrument, so the server and the page are the same; what the page cannot do on a remote drive it
 // learns from `capabilities` and the `remote` part of each snapshot.
 //
-// The link is the project's one CANopen 402 master (cia402/canopen/drive_master.hpp), set up with
+// The link is the project's one CANopen 402 master (cia402/canopen/402/drive_master.hpp), set up with
 // PDOs on change: TPDO1 = 0x6041 + 0x603F with no inhibit time, so every state the drive reports
 // arrives; TPDO2 = 0x606C with a 20 ms inhibit time; RPDO1 = 0x6040; the page's objects (option
 // codes, ramps) and 0x60FF read at set-up, and 0x6040 so that connecting changes nothing. The master
@@ -30,7 +30,7 @@
 #include <memory>
 #include <string>
 
-#include "cia402/canopen/channel.hpp"
+#include "cia402/canopen/can/channel.hpp"
 #include "cia402/page/backend.hpp"
 #include "cia402/profile.hpp"
 

@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "cia402/canopen/channel.hpp"
+#include "cia402/canopen/can/channel.hpp"
 
 namespace cia402::canopen {
 

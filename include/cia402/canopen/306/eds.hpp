@@ -9,7 +9,7 @@
 #include <iosfwd>
 #include <string>
 
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/301/slave.hpp"
 
 namespace cia402::canopen {
 

@@ -41,13 +41,13 @@
 #include <string>
 #include <vector>
 
-#include "cia402/canopen/channel.hpp"
-#include "cia402/canopen/device.hpp"
-#include "cia402/canopen/nmt.hpp"
-#include "cia402/canopen/object_dictionary.hpp"
-#include "cia402/canopen/pdo.hpp"
-#include "cia402/canopen/sdo_server.hpp"
-#include "cia402/canopen/timing.hpp"
+#include "cia402/canopen/can/channel.hpp"
+#include "cia402/canopen/301/device.hpp"
+#include "cia402/canopen/301/nmt.hpp"
+#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/canopen/301/pdo.hpp"
+#include "cia402/canopen/301/sdo_server.hpp"
+#include "cia402/canopen/301/timing.hpp"
 
 namespace cia402::canopen {
 

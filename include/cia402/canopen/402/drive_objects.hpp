@@ -25,8 +25,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "cia402/canopen/object_dictionary.hpp"
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/canopen/301/slave.hpp"
 
 namespace cia402::canopen {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <system_error>
 
-#include "cia402/canopen/frame.hpp"
+#include "cia402/canopen/can/frame.hpp"
 
 namespace cia402::canopen {
 

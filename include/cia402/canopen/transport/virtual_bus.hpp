@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "cia402/canopen/channel.hpp"
+#include "cia402/canopen/can/channel.hpp"
 
 namespace cia402::canopen {
 

@@ -31,8 +31,8 @@
 #include <system_error>
 #include <vector>
 
-#include "cia402/canopen/channel.hpp"
-#include "cia402/canopen/virtual_bus.hpp"
+#include "cia402/canopen/can/channel.hpp"
+#include "cia402/canopen/transport/virtual_bus.hpp"
 
 namespace cia402::canopen::socketcand {
 

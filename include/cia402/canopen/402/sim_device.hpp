@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "cia402/canopen/device.hpp"
+#include "cia402/canopen/301/device.hpp"
 #include "cia402/profile.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 

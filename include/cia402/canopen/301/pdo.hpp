@@ -5,7 +5,7 @@
 #include <array>
 #include <cstdint>
 
-#include "cia402/canopen/object_dictionary.hpp"
+#include "cia402/canopen/301/object_dictionary.hpp"
 
 namespace cia402::canopen {
 

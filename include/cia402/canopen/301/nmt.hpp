@@ -7,8 +7,8 @@
 #include <functional>
 #include <vector>
 
-#include "cia402/canopen/channel.hpp"
-#include "cia402/canopen/timing.hpp"
+#include "cia402/canopen/can/channel.hpp"
+#include "cia402/canopen/301/timing.hpp"
 
 namespace cia402::canopen {
 

@@ -9,8 +9,8 @@
 #include <span>
 #include <vector>
 
-#include "cia402/canopen/channel.hpp"
-#include "cia402/canopen/timing.hpp"
+#include "cia402/canopen/can/channel.hpp"
+#include "cia402/canopen/301/timing.hpp"
 #include "cia402/sdo_abort.hpp"
 
 namespace cia402::canopen {

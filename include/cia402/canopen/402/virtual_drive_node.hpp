@@ -6,10 +6,10 @@
 #include <cstdint>
 #include <memory>
 
-#include "cia402/canopen/channel.hpp"
-#include "cia402/canopen/drive_objects.hpp"
-#include "cia402/canopen/sim_device.hpp"
-#include "cia402/canopen/slave.hpp"
+#include "cia402/canopen/can/channel.hpp"
+#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/402/sim_device.hpp"
+#include "cia402/canopen/301/slave.hpp"
 #include "cia402/profile.hpp"
 
 namespace cia402::canopen {

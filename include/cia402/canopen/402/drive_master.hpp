@@ -42,10 +42,10 @@
 #include <utility>
 #include <vector>
 
-#include "cia402/canopen/channel.hpp"
-#include "cia402/canopen/nmt.hpp"
-#include "cia402/canopen/sdo_client.hpp"
-#include "cia402/canopen/timing.hpp"
+#include "cia402/canopen/can/channel.hpp"
+#include "cia402/canopen/301/nmt.hpp"
+#include "cia402/canopen/301/sdo_client.hpp"
+#include "cia402/canopen/301/timing.hpp"
 #include "cia402/master.hpp"
 #include "cia402/profile.hpp"
 

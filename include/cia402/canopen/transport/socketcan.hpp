@@ -5,7 +5,7 @@
 #include <string>
 #include <system_error>
 
-#include "cia402/canopen/channel.hpp"
+#include "cia402/canopen/can/channel.hpp"
 
 namespace cia402::canopen {
 
