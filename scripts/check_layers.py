@@ -30,6 +30,8 @@ LAYERS = [
     ("canopen/transport", "src/canopen/transport/"),
     ("canopen/301", "include/cia402/canopen/301/"),
     ("canopen/301", "src/canopen/301/"),
+    ("apps", "include/cia402/apps/"),
+    ("apps", "src/apps/"),
     ("page", "src/page/"),
     ("support", "src/support/"),
     ("profile_file", "include/cia402/profile_file.hpp"),
@@ -54,10 +56,11 @@ ALLOWED = {
     "canopen/306": {"core", "support", "canopen/can", "canopen/301"},
     "canopen/transport": {"core", "canopen/can"},
     "canopen/402": {"core", "support", "canopen/can", "canopen/301", "canopen/306", "sim"},
+    "apps": {"core", "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402"},
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
              "canopen/301", "canopen/306", "canopen/transport", "canopen/402"},
     "tools": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
-              "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "page"},
+              "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "apps", "page"},
 }
 
 # Where a quoted include is looked for, after the including file's own folder.

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cia402/apps/bus_host.hpp"
 #include "cia402/canopen/402/drive_objects.hpp"
 #include "cia402/canopen/402/drive_master.hpp"
 #include "cia402/canopen/402/virtual_drive_node.hpp"
@@ -124,33 +125,22 @@ class socketcand_server_test : public ::testing::Test {
   void start(socketcand::server_config cfg) {
     cfg.port = 0;
     if (cfg.join_grace_us == socketcand::server_config{}.join_grace_us) cfg.join_grace_us = 0;
-    srv.reset();
-    srv = std::make_unique<socketcand::server>(bus, cfg);
-    ASSERT_FALSE(srv->open());
+    host.restart_server(cfg);
+    srv = &host.server();
+    ASSERT_FALSE(host.open());
     ASSERT_NE(srv->port(), 0);
   }
   void add_drive(std::uint8_t id) {
-    drives.push_back(
-        std::make_unique<virtual_drive_node>(standard_profile(), bus.attach(), drive_node_config(id)));
+    host.add_drive(standard_profile(), drive_node_config(id));
   }
   /// One cycle of the server loop: sockets, time, nodes, output.
   void spin(int cycles = 1, std::uint32_t us = 1000) {
-    for (int i = 0; i < cycles; ++i) {
-      srv->poll_sockets(0);
-      srv->advance(us);
-      for (auto& d : drives) d->poll(us);
-      srv->flush();
-    }
+    for (int i = 0; i < cycles; ++i) (void)host.cycle(us, 0);
   }
   /// Runs the server loop (waiting on its sockets) until `done`: for a client whose connect()
   /// blocks in the test's own thread.
   void serve_until(const std::atomic<bool>& done) {
-    while (!done) {
-      srv->poll_sockets(5);
-      srv->advance(1000);
-      for (auto& d : drives) d->poll(1000);
-      srv->flush();
-    }
+    while (!done) (void)host.cycle(1000, 5);
   }
   /// A peer that has joined in raw mode.
   std::unique_ptr<tcp_peer> join(int receive_buffer = 0) {
@@ -166,9 +156,9 @@ class socketcand_server_test : public ::testing::Test {
     return p;
   }
 
-  virtual_bus bus;
-  std::vector<std::unique_ptr<virtual_drive_node>> drives;
-  std::unique_ptr<socketcand::server> srv;
+  apps::bus_host host{socketcand::server_config{}};
+  std::vector<std::unique_ptr<virtual_drive_node>>& drives = host.drives();
+  socketcand::server* srv = nullptr;
 };
 
 TEST_F(socketcand_server_test, handshake_answers_exactly_hi_ok_ok) {

@@ -6,10 +6,9 @@
 #include <memory>
 #include <ostream>
 
+#include "cia402/apps/bus_host.hpp"
 #include "cia402/canopen/402/drive_objects.hpp"
-#include "cia402/canopen/402/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/socketcand.hpp"
-#include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cli/common.hpp"
 
 namespace cia402::cli {
@@ -99,15 +98,13 @@ int run_bus(const bus_args& args, std::ostream& out, std::ostream& err) {
   profile_choice choice;
   if (!choice.resolve(args.profile, args.profile_file, err)) return usage_error;
 
-  canopen::virtual_bus bus;
-  std::vector<std::unique_ptr<canopen::virtual_drive_node>> nodes;
+  apps::bus_host host(config);
   for (std::uint8_t id : ids) {
     canopen::slave_config sc = canopen::drive_node_config(id);
     sc.heartbeat_ms = args.heartbeat_ms;
-    nodes.push_back(std::make_unique<canopen::virtual_drive_node>(choice.get(), bus.attach(), sc));
+    host.add_drive(choice.get(), sc);
   }
-  canopen::socketcand::server server(bus, config);
-  if (const auto ec = server.open()) {
+  if (const auto ec = host.open()) {
     err << "cia402 bus: cannot listen on " << args.listen << ": " << ec.message() << "\n";
     return usage_error;
   }
@@ -120,26 +117,11 @@ int run_bus(const bus_args& args, std::ostream& out, std::ostream& err) {
   sigaction(SIGINT, &action, &old_int);
   sigaction(SIGTERM, &action, &old_term);
 
-  out << "cia402 bus: socketcand on " << config.host << ":" << server.port() << " bus "
-      << config.bus_name << ", " << nodes.size() << " drive(s) (profile " << choice.get().name
+  out << "cia402 bus: socketcand on " << config.host << ":" << host.server().port() << " bus "
+      << config.bus_name << ", " << host.drives().size() << " drive(s) (profile " << choice.get().name
       << "), nodes " << args.nodes << std::endl;
 
-  // The real-time loop: the only place a clock is read. Each pass hands the nodes the time that
-  // really passed; the drives step their plants in 1 ms cycles of it.
-  using clock = std::chrono::steady_clock;
-  auto last = clock::now();
-  std::uint32_t next_us = 1000;
-  while (!stop_requested) {
-    server.poll_sockets(next_us == 0 ? 0 : 1);  // wake at least every millisecond
-    const auto now = clock::now();
-    const auto elapsed = std::chrono::duration_cast<std::chrono::microseconds>(now - last).count();
-    const auto step = static_cast<std::uint32_t>(std::min<long long>(elapsed, 1000000));
-    last += std::chrono::microseconds(step);
-    server.advance(step);
-    next_us = canopen::no_deadline;
-    for (auto& n : nodes) next_us = std::min(next_us, n->poll(step));
-    server.flush();
-  }
+  host.run(stop_requested);
   sigaction(SIGINT, &old_int, nullptr);
   sigaction(SIGTERM, &old_term, nullptr);
   out << "cia402 bus: stopped" << std::endl;

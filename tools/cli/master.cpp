@@ -8,6 +8,7 @@
 #include <memory>
 #include <ostream>
 
+#include "cia402/apps/elapsed_clock.hpp"
 #include "cia402/canopen/402/drive_objects.hpp"
 #include "cia402/canopen/transport/channel_url.hpp"
 #include "cia402/canopen/402/drive_master.hpp"
@@ -52,7 +53,7 @@ class bus_session {
       return false;
     }
     channel_ = real_.get();
-    last_ = std::chrono::steady_clock::now();
+    clock_ = apps::elapsed_clock();
     return true;
   }
   canopen::channel& channel() { return *channel_; }
@@ -66,11 +67,7 @@ class bus_session {
     pollfd p{channel_->native_handle(), POLLIN, 0};
     const int ms = static_cast<int>(std::min<std::uint32_t>(wait_us / 1000 + 1, 10));
     if (p.fd >= 0) ::poll(&p, 1, ms);
-    const auto now = std::chrono::steady_clock::now();
-    const auto us = std::chrono::duration_cast<std::chrono::microseconds>(now - last_).count();
-    const auto step = static_cast<std::uint32_t>(std::min<long long>(us, 1000000));
-    last_ += std::chrono::microseconds(step);
-    return step;
+    return clock_.take();
   }
   /// Lets the virtual drive answer at once (no time passes).
   void settle() {
@@ -90,7 +87,7 @@ class bus_session {
   std::unique_ptr<canopen::virtual_channel> master_ch_;
   std::unique_ptr<canopen::channel> real_;
   canopen::channel* channel_ = nullptr;
-  std::chrono::steady_clock::time_point last_;
+  apps::elapsed_clock clock_;
 
  public:
   bool open_failed_ = false;  // the URL was fine, the bus could not be reached

@@ -1,0 +1,30 @@
+// The wall clock as the layers below take time: microseconds passed since the last call. The only
+// clock the project's loops read (the page's cycle thread and HTTP keep-alive aside); everything
+// below the apps layer is handed time and never reads it.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+
+namespace cia402::apps {
+
+class elapsed_clock {
+ public:
+  elapsed_clock() : last_(clock::now()) {}
+
+  /// Microseconds since the last take() (or construction), at most `cap_us`: a process that was
+  /// stopped for a while goes on from where it was instead of replaying the gap.
+  std::uint32_t take(std::uint32_t cap_us = 1000000) {
+    const auto now = clock::now();
+    const auto us = std::chrono::duration_cast<std::chrono::microseconds>(now - last_).count();
+    const auto step = static_cast<std::uint32_t>(us < 0 ? 0 : (us > cap_us ? cap_us : us));
+    last_ = us > cap_us ? now : last_ + std::chrono::microseconds(step);
+    return step;
+  }
+
+ private:
+  using clock = std::chrono::steady_clock;
+  clock::time_point last_;
+};
+
+}  // namespace cia402::apps
