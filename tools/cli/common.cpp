@@ -14,36 +14,6 @@ std::optional<std::int64_t> parse_number(std::string_view text) {
                                 std::numeric_limits<std::uint32_t>::max());
 }
 
-std::string json_escape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += "\\u00" + hex(static_cast<unsigned char>(c), 2).substr(2);
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out;
-}
-
 std::string builtin_profile_names() {
   std::string list;
   for (std::size_t i = 0; i < builtin_profile_count(); ++i) {

@@ -24,9 +24,6 @@ std::optional<std::int64_t> parse_number(std::string_view text);
 /// "0x0237": 0x and `digits` upper-case hex digits.
 using support::hex;
 
-/// The text as the body of a JSON string (quotes, backslashes and control characters escaped).
-std::string json_escape(std::string_view text);
-
 /// The profile a command runs on: a built-in by name, or a profile file. Keeps a loaded file alive.
 class profile_choice {
  public:
