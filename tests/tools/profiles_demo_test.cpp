@@ -1,6 +1,8 @@
 // `cia402 profiles` and `cia402 demo`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <sstream>
 #include <string>
 #include <variant>
@@ -53,12 +55,14 @@ TEST(profiles, dump_of_an_unknown_profile_is_a_usage_error) {
   EXPECT_NE(r.err.find("cia403"), std::string::npos);
 }
 
-// One printed cycle of the demo: "step cw state statusword T torque brake ramp speed".
+// One printed cycle of the demo: "step cw state statusword T torque brake ramp rpm".
 struct demo_line {
   std::string state;
   std::string transition;
   std::string torque;
   std::string brake;
+  std::string ramp;
+  long rpm = -1;
 };
 
 std::vector<demo_line> demo_cycles(const std::string& out) {
@@ -69,7 +73,7 @@ std::vector<demo_line> demo_cycles(const std::string& out) {
     std::istringstream words(line);
     std::string step, cw, sw;
     demo_line d;
-    words >> step >> cw >> d.state >> sw >> d.transition >> d.torque >> d.brake;
+    words >> step >> cw >> d.state >> sw >> d.transition >> d.torque >> d.brake >> d.ramp >> d.rpm;
     cycles.push_back(d);
   }
   return cycles;
@@ -94,6 +98,24 @@ TEST_P(demo, runs_through_enable_fault_and_reset_and_ends_in_switch_on_disabled_
   EXPECT_TRUE(faulted) << r.out;
   EXPECT_EQ(cycles.back().state, "SWITCH_ON_DISABLED") << r.out;
   EXPECT_EQ(last_transition, "15") << r.out;
+}
+
+TEST_P(demo, the_simulated_motor_speeds_up_only_when_running_and_ends_at_rest) {
+  const auto r = test::run_tool({"demo", "--profile", builtin_profile(GetParam()).name});
+  const auto cycles = demo_cycles(r.out);
+  ASSERT_FALSE(cycles.empty()) << r.out;
+  long top = 0;
+  long before = 0;
+  for (const demo_line& c : cycles) {
+    top = std::max(top, c.rpm);
+    if (c.rpm > before) {
+      EXPECT_EQ(c.state, "OPERATION_ENABLED") << "only a running drive drives the motor\n" << r.out;
+      EXPECT_EQ(c.torque, "on") << r.out;
+    }
+    before = c.rpm;
+  }
+  EXPECT_EQ(top, 300) << r.out;
+  EXPECT_EQ(cycles.back().rpm, 0) << r.out;
 }
 
 TEST_P(demo, torque_and_released_brake_appear_only_where_the_profile_allows_torque) {

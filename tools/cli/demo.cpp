@@ -7,81 +7,84 @@
 
 #include "cia402/drive.hpp"
 #include "cia402/master.hpp"
+#include "cia402/objects.hpp"
+#include "cia402/sim/virtual_drive.hpp"
+#include "cia402/words.hpp"
 #include "cli/common.hpp"
 
 namespace cia402::cli {
 namespace {
 
-// A small plant, so that ramps take a few cycles: the motor runs at speed 3 under torque, loses 1
-// per cycle on the slow-down ramp and 2 on the faster stops, and the brake follows the drive's
-// command one cycle late; an engaged brake holds the shaft.
-struct demo_plant {
-  int speed = 0;
-  bool brake_engaged = true;
-
-  void follow(const drive_outputs& o, const profile& p) {
-    if (brake_engaged || !o.torque) {
-      speed = 0;
-    } else if (o.ramp == stop_ramp::none) {
-      if (p.info(o.current).activity == state_activity::run) speed = 3;
-    } else {
-      speed -= o.ramp == stop_ramp::slow_down ? 1 : 2;
-      if (speed < 0) speed = 0;
-    }
-    brake_engaged = !o.brake_released;
-  }
-  bool operator==(const demo_plant&) const = default;
-};
+// The simulator's plant, slowed to a pace a person can read: 100 ms cycles, ramps of one to three
+// cycles from 300 rpm, the brake one cycle late.
+sim::plant_config demo_plant() {
+  sim::plant_config c;
+  c.cycle_us = 100000;
+  c.brake_engage_delay_us = 100000;
+  c.brake_release_delay_us = 100000;
+  c.coast_deceleration = 1500;
+  c.standstill_window_rpm = 1;
+  return c;
+}
 
 constexpr int max_steps_per_event = 16;
 
 class demo_run {
  public:
-  demo_run(const profile& p, std::ostream& out) : p_(p), axis_(make_axis(p)), out_(out) {
+  demo_run(const profile& p, std::ostream& out) : p_(p), drive_(p, demo_plant()), out_(out) {
+    sim::drive_view v = drive_.view();
+    (void)v.write(object_index::profile_acceleration, 0, 3000);
+    (void)v.write(object_index::profile_deceleration, 0, 1000);
+    (void)v.write(object_index::quick_stop_deceleration, 0, 1500);
     out_ << "cia402 demo, profile " << p.name << ": " << p.title << "\n"
-         << "(plant: the motor runs at speed 3, ramps lose 1 or 2 a cycle, the brake follows one "
-            "cycle late)\n\n"
+         << "(the simulator's plant, 100 ms a cycle: from 300 rpm the ramps take one to three cycles, "
+            "the brake follows one cycle late)\n\n"
          << "step  cw      state                   statusword  T   torque  brake     ramp"
-            "           speed\n";
+            "           rpm\n";
   }
 
   void event(const std::string& label) {
-    out_ << "-- " << label << " (cw " << hex(inputs_.control_word, 4);
-    if (inputs_.fault_code != 0) out_ << ", fault cause " << hex(inputs_.fault_code, 4);
+    sim::drive_view v = drive_.view();
+    out_ << "-- " << label << " (cw " << hex(v.control_word(), 4);
+    if (v.fault_cause() != 0) out_ << ", fault cause " << hex(v.fault_cause(), 4);
     out_ << ")\n";
     for (int i = 0; i < max_steps_per_event; ++i) {
-      const demo_plant before = plant_;
-      inputs_.standstill = plant_.speed == 0;
-      inputs_.brake_engaged = plant_.brake_engaged;
-      const drive_outputs o = step(p_, axis_, inputs_);
-      plant_.follow(o, p_);
+      const std::int32_t rpm_before = v.velocity_rpm();
+      const bool brake_before = v.brake_engaged();
+      const drive_outputs o = drive_.step();
       print(o);
-      if (o.transition == no_transition && !stop_running(axis_) && plant_ == before) break;
+      const bool still = v.velocity_rpm() == rpm_before && v.brake_engaged() == brake_before;
+      if (o.transition == no_transition && !stop_running(v.state_of_axis().core) && still) break;
     }
   }
 
   void command_word(command c) {
     std::uint16_t word = 0;
     encode_command(p_, c, 0, word);
-    inputs_.control_word = word;
+    set_word(word);
   }
-  drive_inputs& inputs() { return inputs_; }
+  /// 0x60FF. Enabling clears the set-points (T4), so a target is given once the drive runs.
+  void set_target_rpm(std::int32_t rpm) {
+    (void)drive_.view().write(object_index::target_velocity, 0, rpm);
+  }
+  void set_word(std::uint16_t word) { (void)drive_.view().write(object_index::control_word, 0, word); }
+  std::uint16_t word() { return drive_.view().control_word(); }
+  sim::drive_view view() { return drive_.view(); }
 
  private:
   void print(const drive_outputs& o) {
-    out_ << std::left << std::setw(6) << ++step_ << std::setw(8) << hex(inputs_.control_word, 4)
+    sim::drive_view v = drive_.view();
+    out_ << std::left << std::setw(6) << ++step_ << std::setw(8) << hex(v.control_word(), 4)
          << std::setw(24) << state_name(o.current) << std::setw(12) << hex(o.status_word, 4)
          << std::setw(4)
          << (o.transition == no_transition ? std::string("-") : std::to_string(o.transition))
          << std::setw(8) << (o.torque ? "on" : "off") << std::setw(10)
          << (o.brake_released ? "released" : "engaged") << std::setw(15) << stop_ramp_name(o.ramp)
-         << plant_.speed << "\n";
+         << v.velocity_rpm() << "\n";
   }
 
   const profile& p_;
-  axis axis_;
-  drive_inputs inputs_;
-  demo_plant plant_;
+  sim::virtual_drive drive_;
   std::ostream& out_;
   int step_ = 0;
 };
@@ -97,6 +100,8 @@ void run_demo(const profile& p, std::ostream& out) {
   d.event("switch on");
   d.command_word(command::enable_operation);
   d.event("enable operation");
+  d.set_target_rpm(300);
+  d.event("target velocity 300 rpm");
   d.command_word(command::quick_stop);
   d.event("quick stop");
   d.command_word(command::disable_voltage);
@@ -105,14 +110,16 @@ void run_demo(const profile& p, std::ostream& out) {
   d.event("shutdown");
   d.command_word(command::enable_operation);
   d.event("enable operation (T3, then T4)");
-  d.inputs().fault_code = 0x2310;
+  d.set_target_rpm(300);
+  d.event("target velocity 300 rpm");
+  (void)d.view().inject_fault(0x2310);
   d.event("fault: continuous over-current");
-  d.inputs().control_word = static_cast<std::uint16_t>(d.inputs().control_word | 0x80u);
+  d.set_word(static_cast<std::uint16_t>(d.word() | control_bit::fault_reset));
   d.event("fault reset while the cause is present: used up, no change");
-  d.inputs().fault_code = 0;
-  d.inputs().control_word = static_cast<std::uint16_t>(d.inputs().control_word & ~0x80u);
+  d.view().clear_faults();
+  d.set_word(static_cast<std::uint16_t>(d.word() & ~control_bit::fault_reset));
   d.event("cause removed, bit 7 back to 0");
-  d.inputs().control_word = static_cast<std::uint16_t>(d.inputs().control_word | 0x80u);
+  d.set_word(static_cast<std::uint16_t>(d.word() | control_bit::fault_reset));
   d.event("fault reset");
 }
 
