@@ -39,10 +39,20 @@ TEST(cli_master, state_reads_the_status_word_over_sdo) {
   EXPECT_EQ(r.out, "node 1: SWITCH_ON_DISABLED (statusword 0x1250)\n");
 }
 
-TEST(cli_master, reset_of_a_drive_not_in_fault_does_nothing) {
+TEST(cli_master, reset_of_a_drive_not_in_fault_looks_and_changes_nothing) {
   const result r = run_tool({"master", "--can", "virtual", "reset"});
   EXPECT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.out.find("not in FAULT (SWITCH_ON_DISABLED), nothing to reset"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out, "node 1: SWITCH_ON_DISABLED (statusword 0x1250): not in FAULT, nothing to reset\n")
+      << "read over SDO, before any PDO is set up or the node started";
+}
+
+TEST(cli_master, guard_is_cleared_when_the_master_ends) {
+  const result r = run_tool({"master", "--can", "virtual", "--guard", "20", "enable"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("node 1: reached OPERATION_ENABLED\n"
+                       "node 1: no longer watching this master (0x1016 sub 1 = 0)\n"),
+            std::string::npos)
+      << r.out;
 }
 
 TEST(cli_master, bad_url_command_or_node_is_refused_with_status_2) {

@@ -56,6 +56,11 @@ class bench {
     return false;
   }
   drive_master& master() { return *master_; }
+  /// Another master in this one's place (a new `cia402 master` process), the same channel.
+  void replace_master(const drive_master_config& mc) {
+    master_.reset();
+    master_ = std::make_unique<drive_master>(*master_ch_, mc);
+  }
   slave& node(std::size_t i = 0) { return drives_[i]->node(); }
   sim::virtual_drive& drive(std::size_t i = 0) { return drives_[i]->drive(); }
   void remove_drives() { drives_.clear(); }
@@ -229,6 +234,37 @@ TEST_P(master_heartbeat_loss, silent_master_makes_the_drive_apply_0x6007) {
 }
 
 INSTANTIATE_TEST_SUITE_P(codes_0_to_3, master_heartbeat_loss, ::testing::Range(0, 4));
+
+TEST(drive_master, a_master_without_guard_clears_the_guard_a_gone_master_left_and_resets_the_fault) {
+  drive_master_config guarded;
+  guarded.master_heartbeat_ms = 20;
+  bench b(guarded);
+  ASSERT_EQ(b.node().write(0x6007, 0, 1), sdo_abort::none);  // 1 = fault
+  b.master().set_target(state::operation_enabled);
+  ASSERT_TRUE(b.run_until_reached(2000));
+  b.run_ms(500, /*master_alive=*/false);
+  ASSERT_EQ(b.drive().view().current(), state::fault);
+  b.replace_master({});
+  b.master().set_target(state::operation_enabled);
+  ASSERT_TRUE(b.run_until_reached(3000)) << b.master().failure_text() << " "
+                                         << state_name(b.master().observed());
+  std::int64_t watch = -1;
+  b.node().read(0x1016, 1, watch);
+  EXPECT_EQ(watch, 0) << "the entry for node 127 is cleared";
+  EXPECT_FALSE(b.node().connection_lost());
+  b.run_ms(500);
+  EXPECT_EQ(b.drive().view().current(), state::operation_enabled) << "and stays cleared";
+}
+
+TEST(drive_master, a_guard_of_another_master_is_left_alone) {
+  bench b;
+  ASSERT_EQ(b.node().write(0x1016, 1, (5 << 16) | 1000), sdo_abort::none);  // node 5 watched
+  b.master().set_target(state::switch_on_disabled);
+  ASSERT_TRUE(b.run_until_reached(2000));
+  std::int64_t watch = 0;
+  b.node().read(0x1016, 1, watch);
+  EXPECT_EQ(watch, (5 << 16) | 1000);
+}
 
 TEST(drive_master, missing_node_fails_with_no_answer_naming_the_first_request) {
   drive_master_config mc;

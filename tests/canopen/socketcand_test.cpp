@@ -404,3 +404,23 @@ INSTANTIATE_TEST_SUITE_P(codes_0_to_3, heartbeat_over_socketcand, ::testing::Ran
 
 }  // namespace
 }  // namespace cia402::canopen
+
+namespace cia402::canopen {
+namespace {
+
+TEST_F(socketcand_server_test, a_client_asking_for_a_bus_the_server_lacks_is_told_so_in_words) {
+  std::error_code ec;
+  std::string why;
+  std::atomic<bool> done{false};
+  std::thread server_loop([&] { serve_until(done); });
+  auto ch = socketcand::client_channel::connect("127.0.0.1", srv->port(), "can9", ec, why, 3000);
+  done = true;
+  server_loop.join();
+  EXPECT_EQ(ch, nullptr);
+  EXPECT_TRUE(ec);
+  EXPECT_EQ(why, "the socketcand server at 127.0.0.1:" + std::to_string(srv->port()) +
+                     " has no bus 'can9'");
+}
+
+}  // namespace
+}  // namespace cia402::canopen

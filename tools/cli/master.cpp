@@ -95,8 +95,10 @@ class bus_session {
 
 std::string word(std::uint16_t w) { return hex(w, 4); }
 
-int read_state(bus_session& s, const master_args& a, const profile& p, std::ostream& out,
-               std::ostream& err) {
+// The status word and error code over SDO, without configuring anything. False (and said on `err`)
+// when the node does not answer or refuses 0x6041.
+bool read_status(bus_session& s, const master_args& a, std::uint16_t& status_word,
+                 std::uint16_t& error_code, std::ostream& err) {
   canopen::sdo_client sdo(s.channel(), static_cast<std::uint8_t>(a.node), 500000);
   std::uint64_t waited = 0;
   const auto transfer = [&](std::uint16_t index) {
@@ -121,15 +123,28 @@ int read_state(bus_session& s, const master_args& a, const profile& p, std::ostr
           << hex(static_cast<std::uint32_t>(sdo.abort_code()), 8) << " ("
           << sdo_abort_text(sdo.abort_code()) << ")\n";
     }
-    return failed;
+    return false;
   }
-  const auto sw = static_cast<std::uint16_t>(sdo.value());
+  status_word = static_cast<std::uint16_t>(sdo.value());
+  error_code = transfer(0x603F) ? static_cast<std::uint16_t>(sdo.value()) : std::uint16_t{0};
+  return true;
+}
+
+std::string describe(const profile& p, int node, std::uint16_t status_word, std::uint16_t error_code) {
   state st = state::start;
-  const bool known = decode_status(p, sw, st);
-  out << "node " << a.node << ": " << (known ? state_name(st) : "UNKNOWN") << " (statusword "
-      << word(sw) << ")";
-  if (transfer(0x603F) && sdo.value() != 0) out << ", error code " << hex(static_cast<std::uint32_t>(sdo.value()), 4);
-  out << "\n";
+  const bool known = decode_status(p, status_word, st);
+  std::string text = "node " + std::to_string(node) + ": " + (known ? state_name(st) : "UNKNOWN") +
+                     " (statusword " + word(status_word) + ")";
+  if (error_code != 0) text += ", error code " + hex(error_code, 4);
+  return text;
+}
+
+int read_state(bus_session& s, const master_args& a, const profile& p, std::ostream& out,
+               std::ostream& err) {
+  std::uint16_t sw = 0;
+  std::uint16_t code = 0;
+  if (!read_status(s, a, sw, code, err)) return failed;
+  out << describe(p, a.node, sw, code) << "\n";
   return 0;
 }
 
@@ -168,6 +183,17 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
   bus_session session;
   if (!session.open(a, p, err)) return session.open_failed_ ? failed : usage_error;
   if (a.command == "state") return read_state(session, a, p, out, err);
+  if (a.command == "reset") {
+    // Look before touching: a drive that is not faulted keeps its PDOs and NMT state.
+    std::uint16_t sw = 0;
+    std::uint16_t code = 0;
+    if (!read_status(session, a, sw, code, err)) return failed;
+    state s = state::start;
+    if (!decode_status(p, sw, s) || (s != state::fault && s != state::fault_reaction_active)) {
+      out << describe(p, a.node, sw, code) << ": not in FAULT, nothing to reset\n";
+      return 0;
+    }
+  }
 
   canopen::drive_master_config mc;
   mc.node_id = static_cast<std::uint8_t>(a.node);
@@ -234,7 +260,10 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
         status = 0;
       } else {
         err << "cia402 master: node " << a.node << " did not get there within " << a.timeout_ms
-            << " ms (last seen " << state_name(m.observed()) << ")\n";
+            << " ms (last seen " << state_name(m.observed());
+        if (m.error_code() != 0) err << ", error code " << hex(m.error_code(), 4);
+        if (m.observed() == state::fault) err << "; is the fault cause still present?";
+        err << ")\n";
       }
       break;
     }
@@ -277,8 +306,10 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
         goto done;
       case master_outcome::timed_out:
         err << "cia402 master: node " << a.node << ": transition T" << int(m.core_master().transition())
-            << " did not happen in time (in " << state_name(m.observed())
-            << (m.observed() == state::fault ? "; is a fault cause still present?" : "") << ")\n";
+            << " did not happen in time (in " << state_name(m.observed());
+        if (m.error_code() != 0) err << ", error code " << hex(m.error_code(), 4);
+        if (m.observed() == state::fault) err << "; is the fault cause still present?";
+        err << ")\n";
         status = failed;
         goto done;
       case master_outcome::unreachable:
@@ -293,6 +324,33 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
     }
   }
 done:
+  if (a.guard_ms != 0 && m.phase() == canopen::master_phase::running) {
+    // Left armed, the drive would watch a master that is gone and apply 0x6007 (a fault, by
+    // default) a few heartbeats after this process ends.
+    bool ended = false;
+    bool cleared = false;
+    (void)m.write(0x1016, 1, 0, 4, [&](const canopen::sdo_result& r) {
+      ended = true;
+      cleared = r.ok();
+    });
+    for (std::uint64_t waited = 0; !ended && waited < 2000000 && !session.failure();) {
+      const std::uint32_t us = session.wait(next);
+      waited += us;
+      canopen::frame f;
+      while (session.channel().receive(f)) m.on_frame(f);
+      next = m.process(us);
+      session.settle();
+      while (session.channel().receive(f)) m.on_frame(f);
+      next = std::min(next, m.process(0));
+    }
+    if (cleared) {
+      out << "node " << a.node << ": no longer watching this master (0x1016 sub 1 = 0)\n";
+    } else {
+      err << "cia402 master: node " << a.node << " may still watch this master's heartbeat: "
+          << "clearing 0x1016 sub 1 failed; any master command without --guard clears it\n";
+      status = failed;
+    }
+  }
   sigaction(SIGINT, &old_int, nullptr);
   sigaction(SIGTERM, &old_term, nullptr);
   return status;

@@ -63,6 +63,7 @@ void drive_master::restart(phase_reason why, std::string text) {
   heartbeat_watched_ = false;
   error_code_mapped_ = false;
   velocity_mapped_ = false;
+  stale_guard_ = false;
   consumer_.configure({});
   heartbeat_lost_ = false;
   outbox_.clear();

@@ -108,6 +108,21 @@ void drive_master::build_script() {
     hb.then = note_done(heartbeat_watched_);
     script_.push_back(hb);
   }
+  if (config_.master_heartbeat_ms == 0) {
+    // A master of ours that asked to be watched and went away leaves the drive watching a silent
+    // node (and faulting on it, 0x6007): clear its entry, and only its.
+    sdo_job guard = read(0x1016, true);
+    guard.sub = 1;
+    guard.then = [this](const sdo_client& c) {
+      const auto v = static_cast<std::uint32_t>(c.value());
+      stale_guard_ = c.state() == sdo_client::status::done && (v & 0xFFFF) != 0 &&
+                     ((v >> 16) & 0x7F) == config_.master_node_id;
+    };
+    script_.push_back(guard);
+    sdo_job clear = write(0x1016, 1, 0, 4);
+    clear.wanted = [this] { return stale_guard_; };
+    script_.push_back(clear);
+  }
   if (config_.master_heartbeat_ms != 0) {
     const std::uint32_t watch = std::min<std::uint32_t>(3u * config_.master_heartbeat_ms, 0xFFFF);
     script_.push_back(

@@ -90,7 +90,14 @@ std::unique_ptr<client_channel> client_channel::connect(const std::string& host,
     return true;
   };
   if (!expect("< hi >", "the greeting")) return nullptr;
-  if (!write_all(fd, "< open " + bus + " >") || !expect("< ok >", "< open >")) return nullptr;
+  if (!write_all(fd, "< open " + bus + " >") || !expect("< ok >", "< open >")) {
+    // A server that refuses the bus says "< error could not open bus >": say it in words.
+    if (element.rfind("< error", 0) == 0) {
+      why = "the socketcand server at " + host + ":" + std::to_string(port) + " has no bus '" + bus +
+            "'";
+    }
+    return nullptr;
+  }
   if (!write_all(fd, "< rawmode >") || !expect("< ok >", "< rawmode >")) return nullptr;
   ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL, 0) | O_NONBLOCK);
   ec.clear();

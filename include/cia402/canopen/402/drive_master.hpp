@@ -14,7 +14,8 @@
 //   4. 0x1017 = drive heartbeat time (the master watches it at 3x; optional unless
 //      `heartbeat_required`: without it a silent node is found by SDO polling);
 //   5. with a master heartbeat: 0x1016 sub 1 = this master's node-ID and 3 x its period, so the drive
-//      applies 0x6007 when the master goes silent;
+//      applies 0x6007 when the master goes silent; without one, an entry for this master's node-ID
+//      that an earlier run left in 0x1016 sub 1 is cleared (another node's is left alone);
 //   6. TPDO1 = 0x6041 + 0x603F (0x6041 alone if the drive cannot map 0x603F): synchronous (type 1)
 //      with `pdo_timing::sync`, else on change (255) with no inhibit time, so every state arrives;
 //      TPDO2 = 0x606C on change with `map_velocity` (optional as a whole); RPDO1 = 0x6040 on receipt;
@@ -245,6 +246,7 @@ class drive_master {
   bool heartbeat_watched_ = false;
   bool error_code_mapped_ = false;
   bool velocity_mapped_ = false;
+  bool stale_guard_ = false;  // 0x1016 watches this master's node-ID, left by an earlier run
   std::map<std::uint16_t, std::int64_t> start_values_;
 
   axis options_;  // the drive's option codes, read at set-up
