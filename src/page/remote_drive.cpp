@@ -71,6 +71,7 @@ co::drive_master_config master_config(const profile& p, const remote_config& c) 
   m.node_id = c.node_id;
   m.cycle_us = c.cycle_us;
   m.drive_heartbeat_ms = c.heartbeat_ms;
+  m.master_heartbeat_ms = c.guard_ms;
   m.heartbeat_required = false;
   m.sdo_timeout_us = c.sdo_timeout_us;
   m.drive_profile = &p;

@@ -88,6 +88,15 @@ class remote_bench {
   }
 
   void silence() { alive_ = false; }
+  /// The node alone, as when the page's process is gone: what it sends is dropped unread.
+  void run_drive_only_ms(int ms) {
+    for (int i = 0; i < ms; ++i) {
+      node_->poll(1000);
+      co::frame f;
+      while (page_ch_->receive(f)) {}
+    }
+  }
+  co::virtual_drive_node& drive_node() { return *node_; }
   void revive() { alive_ = true; }
 
   json snapshot() const { return json::parse(remote_->snapshot_json()); }
@@ -308,6 +317,21 @@ TEST(remote_drive, silent_node_shows_does_not_answer_and_is_picked_up_again_when
   b.revive();
   ASSERT_TRUE(b.run_until_running(5000)) << b.remote().status_text();
   EXPECT_EQ(b.snapshot()["state"], "READY_TO_SWITCH_ON");
+}
+
+TEST(remote_drive, the_drive_watches_the_pages_heartbeat_and_applies_0x6007_when_the_page_is_gone) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running());
+  std::int64_t watch = 0;
+  ASSERT_EQ(b.drive_node().node().read(0x1016, 1, watch), cia402::sdo_abort::none);
+  EXPECT_EQ(watch, (127 << 16) | 300) << "node-ID 127, 3 x 100 ms";
+  b.run_ms(500);
+  EXPECT_FALSE(b.drive_node().node().connection_lost());
+  b.run_drive_only_ms(500);  // the page's server stopped
+  EXPECT_TRUE(b.drive_node().node().connection_lost());
+  std::int64_t err = 0;
+  ASSERT_EQ(b.drive_node().node().read(0x603F, 0, err), cia402::sdo_abort::none);
+  EXPECT_EQ(err, 0x8130) << "0x6007 = 1 by default: a fault with the heartbeat error code";
 }
 
 TEST(remote_drive, node_that_is_not_on_the_bus_does_not_answer_set_up) {

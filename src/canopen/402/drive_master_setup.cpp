@@ -125,8 +125,8 @@ void drive_master::build_script() {
   }
   if (config_.master_heartbeat_ms != 0) {
     const std::uint32_t watch = std::min<std::uint32_t>(3u * config_.master_heartbeat_ms, 0xFFFF);
-    script_.push_back(
-        write(0x1016, 1, (static_cast<std::int64_t>(config_.master_node_id) << 16) | watch, 4));
+    script_.push_back(write(0x1016, 1, (static_cast<std::int64_t>(config_.master_node_id) << 16) | watch,
+                            4, config_.heartbeat_required ? 0 : 4));
   }
 
   // TPDO1: status word (+ error code), at each SYNC or on every change.

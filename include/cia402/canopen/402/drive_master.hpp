@@ -60,7 +60,7 @@ struct drive_master_config {
   std::uint8_t master_node_id = 127;     ///< the master's own heartbeat identifier, 0x700 + this
   std::uint32_t cycle_us = 10000;        ///< SYNC period (pdo_timing::sync)
   std::uint16_t drive_heartbeat_ms = 100;   ///< written to the drive's 0x1017; 0 = not watched
-  bool heartbeat_required = true;           ///< false: a refused 0x1017 leaves the node polled
+  bool heartbeat_required = true;           ///< false: a refused 0x1017 or 0x1016 is run without
   std::uint16_t master_heartbeat_ms = 0;    ///< produced, and watched by the drive; 0 = off
   std::uint32_t sdo_timeout_us = 500000;
   std::uint64_t transition_timeout_us = 3000000;  ///< per transition, 0 = none

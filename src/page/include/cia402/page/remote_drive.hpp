@@ -8,7 +8,8 @@
 // arrives; TPDO2 = 0x606C with a 20 ms inhibit time; RPDO1 = 0x6040; the page's objects (option
 // codes, ramps) and 0x60FF read at set-up, and 0x6040 so that connecting changes nothing. The master
 // finds out whether the node is a `cia402 bus` node that takes injected faults at 0x2001; no other
-// drive's 0x2001 is ever written.
+// drive's 0x2001 is ever written. The page sends a heartbeat of its own (guard_ms) that the drive
+// watches, so when the page's server goes away the drive applies its 0x6007 reaction.
 //
 // Commands go out in RPDO1 (the word from cia402::encode_command, other bits kept; a fault reset is
 // bit 7 high for reset_pulse_us, then low); writes of objects and 0x60FF are SDO downloads through
@@ -42,6 +43,9 @@ struct remote_config {
   std::uint32_t cycle_us = 1000;          ///< the time one step() stands for
   std::uint32_t sdo_timeout_us = 500000;
   std::uint16_t heartbeat_ms = 100;       ///< written to 0x1017, watched at 3x; 0 = not used
+  /// The page's own heartbeat (node-ID 127), written to the drive's 0x1016 to be watched at 3x, so
+  /// a drive whose page went away applies 0x6007; 0 = none. A drive that refuses it is run without.
+  std::uint16_t guard_ms = 100;
   std::uint32_t retry_us = 1000000;       ///< set-up starts again this long after a failure
   std::uint32_t poll_us = 100000;         ///< SDO polling of what no TPDO carries
   std::uint32_t publish_us = 40000;       ///< at most one snapshot this often, only on change
