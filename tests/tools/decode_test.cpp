@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "cia402/master.hpp"
@@ -97,6 +99,33 @@ TEST(decode_control, profibus_profiles_use_the_stw_and_zsw_names) {
   }
   const auto std_word = test::run_tool({"decode", "--controlword", "0x0106"});
   EXPECT_NE(std_word.out.find("bit  8  1  Halt"), std::string::npos) << std_word.out;
+}
+
+TEST(decode_json, status_word_gives_the_state_and_16_named_bits) {
+  const auto r = test::run_tool({"decode", "--json", "0x0237"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["state"], "OPERATION_ENABLED");
+  EXPECT_EQ(j["word"], "0x0237");
+  ASSERT_EQ(j["bits"].size(), 16u);
+  EXPECT_EQ(j["bits"][2]["value"], 1);
+  EXPECT_EQ(j["bits"][3]["value"], 0);
+  const auto none = nlohmann::json::parse(test::run_tool({"decode", "--json", "0x0004"}).out);
+  EXPECT_TRUE(none["state"].is_null()) << "bit 2 alone matches no state";
+}
+
+TEST(decode_json, control_word_on_a_profibus_profile_has_no_halt_and_uses_its_names) {
+  const auto r = test::run_tool(
+      {"decode", "--json", "--controlword", "--profile", "s300-profibus", "0x010F"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["command"], "ENABLE_OPERATION");
+  EXPECT_EQ(j["halt"], false) << "bit 8 is not a halt on this profile";
+  const auto text = test::run_tool({"decode", "--controlword", "--profile", "s300-profibus", "0x010F"});
+  EXPECT_NE(text.out.find(j["bits"][8]["name"].get<std::string>()), std::string::npos)
+      << "the same names as the report";
+  EXPECT_EQ(j["bits"][0]["decoded"], true);
+  EXPECT_EQ(j["bits"][8]["decoded"], false);
 }
 
 TEST(decode_status, decimal_word_is_accepted) {

@@ -65,6 +65,8 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   decode->add_option("WORD", word_text, "the word, decimal or 0x hex")->required();
   bool as_control_word = false;
   decode->add_flag("--controlword", as_control_word, "WORD is a control word (0x6040)");
+  bool decode_json = false;
+  decode->add_flag("--json", decode_json, "one JSON object instead of the report, for scripts");
   add_profile_options(*decode, profile_name, profile_file);
 
   auto* profiles =
@@ -170,8 +172,14 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
       return usage_error;
     }
     const auto w = static_cast<std::uint16_t>(*word);
-    out << (as_control_word ? describe_control_word(choice.get(), w)
-                            : describe_status_word(choice.get(), w));
+    if (decode_json) {
+      out << (as_control_word ? control_word_json(choice.get(), w)
+                              : status_word_json(choice.get(), w))
+          << "\n";
+    } else {
+      out << (as_control_word ? describe_control_word(choice.get(), w)
+                              : describe_status_word(choice.get(), w));
+    }
     return 0;
   }
   if (demo->parsed()) {
