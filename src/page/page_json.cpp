@@ -95,9 +95,11 @@ json profile_info(const profile& p) {
     cia402::command c{};
     std::uint16_t word = 0;
     const bool plain = core_command_of(e.id, c);
-    cmds.push_back({{"key", e.key},
-                    {"action", e.action},
-                    {"available", !plain || encode_command(p, c, 0, word)}});
+    // Halt is a button only where the profile has a halt (0x605D): on the PROFIBUS profiles bit 8
+    // is something else (Jog), toggled as a bit under the profile's own name.
+    const bool available = e.id == page_command::halt ? p.spec(option::halt).exists()
+                                                      : !plain || encode_command(p, c, 0, word);
+    cmds.push_back({{"key", e.key}, {"action", e.action}, {"available", available}});
   }
   j["commands"] = std::move(cmds);
   j["halt_supported"] = p.spec(option::halt).exists();

@@ -13,10 +13,13 @@ std::variant<word_change, refused> press_button(const profile& p, page_command c
   word_change w;
   w.action = entry_of(c).action;
   if (c == page_command::halt) {
+    if (!p.spec(option::halt).exists()) {
+      return refused{409, std::string("profile ") + p.name + " has no halt; its bit 8 is \"" +
+                              bit_names_of(p).control[8] + "\", toggled as a bit"};
+    }
     w.word = static_cast<std::uint16_t>(control_word ^ bit8);
     w.tracked = false;
     w.text = std::string("done: halt bit 8 = ") + ((w.word & bit8) != 0 ? "1" : "0");
-    if (!p.spec(option::halt).exists()) w.text += " (this profile has no halt: bit 8 is ignored)";
     return w;
   }
   if (c == page_command::fault_reset) {

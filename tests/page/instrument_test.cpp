@@ -122,6 +122,29 @@ TEST(instrument, halt_toggles_bit_8_and_keeps_the_command) {
   EXPECT_EQ(snapshot(inst)["control_word"], "0x0006");
 }
 
+TEST(instrument, halt_is_not_offered_where_bit_8_is_not_a_halt) {
+  for (const char* name : {"s300-profibus", "ax2000-profibus"}) {
+    instrument inst(by_name(name));
+    run(inst, 10);
+    const json info = json::parse(inst.info_json(true, false));
+    bool listed = false;
+    for (const json& c : info["commands"]) {
+      if (c["key"] == "halt") {
+        listed = true;
+        EXPECT_FALSE(c["available"].get<bool>()) << name;
+      }
+    }
+    EXPECT_TRUE(listed) << name;
+    const auto r = inst.command(page_command::halt);
+    const auto* no = std::get_if<refused>(&r);
+    ASSERT_NE(no, nullptr) << name << ": Halt would set bit 8, which this profile calls Jog";
+    EXPECT_EQ(no->http_status, 409);
+    EXPECT_NE(no->reason.find("Jog"), std::string::npos) << no->reason;
+    run(inst, 5);
+    EXPECT_EQ(json::parse(inst.snapshot_json())["control_word"], "0x0000") << "nothing was sent";
+  }
+}
+
 TEST(instrument, fault_reset_is_one_edge_of_bit_7_and_leads_fault_to_switch_on_disabled_by_t15) {
   instrument inst(cia402::standard_profile());
   run(inst, 10);

@@ -318,6 +318,8 @@ function buildCommands() {
   const box = el('commands');
   box.textContent = '';
   for (const c of info.commands) {
+    // No Halt button where the profile has no halt: its bit 8 means something else there.
+    if (c.key === 'halt' && !c.available) continue;
     const b = document.createElement('button');
     b.type = 'button';
     b.className = 'command control';
@@ -330,7 +332,7 @@ function buildCommands() {
     }
     if (c.key === 'halt') {
       b.setAttribute('aria-pressed', 'false');
-      b.title = info.halt_supported ? 'toggles bit 8' : 'toggles bit 8 (this profile has no halt)';
+      b.title = 'toggles bit 8: stops on the 0x605D ramp while set';
     }
     b.addEventListener('click', () => post('/api/command', { command: c.key }));
     box.appendChild(b);

@@ -410,6 +410,22 @@ async function main() {
   const r = await stopServer(guarded);
   expect(r.code === 0, `guarded server exit ${JSON.stringify(r)}`);
 
+  // --- a PROFIBUS profile: the seed's names, no Halt -------------------------------------------
+  const profibus = await startServer(['--profile', 's300-profibus']);
+  const pb = await context.newPage();
+  currentPage = pb;
+  await pb.setViewportSize({ width: 1280, height: 800 });
+  await check('s300-profibus: no Halt button (bit 8 is Jog there), bits named as STW/ZSW', async () => {
+    await pb.goto(profibus.url);
+    await waitPresent(pb, 'SWITCH_ON_DISABLED');
+    expect(await pb.locator('button[data-command="halt"]').count() === 0, 'a Halt button is offered');
+    const text = await pb.textContent('body');
+    expect(text.includes('Jog'), 'bit 8 is not named Jog');
+    expect(text.includes('Inhibit voltage (active low)'), 'STW bit 1 lacks "(active low)"');
+  });
+  const pr = await stopServer(profibus);
+  expect(pr.code === 0, `profibus server exit ${JSON.stringify(pr)}`);
+
   // --- a drive on a CAN bus: cia402 serve --can against a cia402 bus node ----------------------
   const bus = await startBus(['--nodes', '1']);
   const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
