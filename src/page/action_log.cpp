@@ -20,7 +20,8 @@ action_log::action_log(rules r, std::function<standing()> how_it_stands)
     : rules_(std::move(r)), how_it_stands_(std::move(how_it_stands)) {}
 
 std::uint64_t action_log::track(std::string action, bool refuse_without_transition,
-                                std::optional<state> before, std::uint64_t now) {
+                                std::optional<state> before, std::uint64_t now,
+                                expectation expect) {
   finish_pending("superseded before it settled");
   tracked a;
   a.id = next_id_++;
@@ -29,6 +30,7 @@ std::uint64_t action_log::track(std::string action, bool refuse_without_transiti
   a.started = now;
   a.busy_until = now;
   a.refused_without_transition = refuse_without_transition;
+  a.expect = expect;
   result_entry r;
   r.id = a.id;
   r.action = a.action;
@@ -63,6 +65,14 @@ void action_log::finish_pending(const char* why_unsettled) {
   if (!a.transitions.empty()) {
     r.outcome = "done";
     r.text = transitions_text(a.transitions, s.now) + rules_.transitions_note;
+  } else if (a.refused_without_transition && a.expect == expectation::already_there) {
+    r.outcome = "nothing to do";
+    r.text = "nothing to do: already " + s.now_name;
+  } else if (a.refused_without_transition && a.expect == expectation::act &&
+             !s.waiting_for.empty()) {
+    // A level command stays in the control word: it acts once what holds it back is gone.
+    r.outcome = "waiting";
+    r.text = "waiting: " + s.waiting_for + "; " + a.action + " acts once it is gone";
   } else if (a.refused_without_transition) {
     r.outcome = "refused";
     r.text = std::string("refused: no transition from ") +

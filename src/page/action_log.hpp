@@ -20,7 +20,7 @@ namespace cia402::page::detail {
 struct result_entry {
   std::uint64_t id = 0;
   std::string action;
-  std::string outcome;  // "pending", "done", "refused"
+  std::string outcome;  // "pending", "done", "nothing to do", "waiting", "refused"
   std::string text;
   std::vector<int> transitions;
 };
@@ -44,6 +44,16 @@ class action_log {
     std::string now_name;      ///< the present state as the page shows it (maybe "UNKNOWN")
     /// What may have kept a command from acting, " (STO asserted, ...)", or "".
     std::string conditions;
+    /// What holds a command back that will act once it is gone: "STO asserted", "no DC-link
+    /// voltage", "a stop is ramping"; "" if nothing does.
+    std::string waiting_for;
+  };
+
+  /// What a command asks of the drive where it is now, judged when it is given.
+  enum class expectation : std::uint8_t {
+    act,             ///< a transition is expected
+    already_there,   ///< the command leads to the present state: nothing to do
+    edge,            ///< a fault-reset edge: used once, it does not wait for anything
   };
 
   /// An action waiting for the drive to settle.
@@ -55,6 +65,7 @@ class action_log {
     std::uint64_t busy_until = 0;  ///< the last time something went on (transition, stop, ...)
     std::vector<int> transitions;
     bool refused_without_transition = true;  ///< commands: yes; plant inputs: a plain report
+    expectation expect = expectation::act;
   };
 
   /// `how_it_stands` is asked when a tracked action is reported.
@@ -62,7 +73,8 @@ class action_log {
 
   /// Starts tracking an action (reporting it as pending); returns its id.
   std::uint64_t track(std::string action, bool refuse_without_transition,
-                      std::optional<state> before, std::uint64_t now);
+                      std::optional<state> before, std::uint64_t now,
+                      expectation expect = expectation::act);
   /// Reports an action that is over at once; returns its id.
   std::uint64_t report_now(std::string action, std::string outcome, std::string text);
 

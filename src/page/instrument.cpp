@@ -68,7 +68,8 @@ struct instrument::impl {
   // Logs a command or bit toggle and gives its word to the drive from the next cycle on.
   std::uint64_t change_word(const detail::word_change& w) {
     const std::uint64_t id =
-        w.tracked ? track(w.action, true) : log.report_now(w.action, "done", w.text);
+        w.tracked ? track(w.action, true, w.expect_in(table, control_word, drive.view().current()))
+                  : log.report_now(w.action, "done", w.text);
     scripted.clear();
     if (w.fault_reset_edge) {
       // One word a cycle.
@@ -80,9 +81,10 @@ struct instrument::impl {
     return id;
   }
 
-  std::uint64_t track(std::string action, bool refuse_without_transition) {
+  std::uint64_t track(std::string action, bool refuse_without_transition,
+                      detail::action_log::expectation expect = detail::action_log::expectation::act) {
     return log.track(std::move(action), refuse_without_transition, drive.view().current(),
-                     drive.cycle());
+                     drive.cycle(), expect);
   }
 
   std::string blocking_conditions() {
@@ -97,8 +99,17 @@ struct instrument::impl {
   }
 
   detail::action_log::standing how_it_stands() {
-    const state now = drive.view().current();
-    return {now, state_name(now), blocking_conditions()};
+    sim::drive_view v = drive.view();
+    const state now = v.current();
+    std::string waiting_for;
+    if (v.sto()) {
+      waiting_for = "STO asserted";
+    } else if (!v.dc_link()) {
+      waiting_for = "no DC-link voltage";
+    } else if (stop_running(v.state_of_axis().core)) {
+      waiting_for = "a stop is ramping";
+    }
+    return {now, state_name(now), blocking_conditions(), waiting_for};
   }
 
   void step_locked() {

@@ -264,12 +264,22 @@ struct remote_drive::impl {
   }
 
   detail::action_log::standing how_it_stands() const {
-    return {observed, shown_state(), conditions()};
+    // What the bus shows of it: status bit 4 (S11), and a stop state with the shaft still turning.
+    std::string waiting_for;
+    if (remote.status_known() && (remote.status_word() & status_bit::voltage_enabled) == 0) {
+      waiting_for = "no DC-link voltage";
+    } else if (state_known && velocity && *velocity != 0 &&
+               (table.info(observed).activity == state_activity::quick_stop ||
+                table.info(observed).activity == state_activity::fault_reaction)) {
+      waiting_for = "a stop is ramping";
+    }
+    return {observed, shown_state(), conditions(), waiting_for};
   }
 
-  std::uint64_t track(std::string action, bool refuse_without_transition) {
+  std::uint64_t track(std::string action, bool refuse_without_transition,
+                      detail::action_log::expectation expect = detail::action_log::expectation::act) {
     return log.track(std::move(action), refuse_without_transition,
-                     state_known ? std::optional<state>(observed) : std::nullopt, now_us);
+                     state_known ? std::optional<state>(observed) : std::nullopt, now_us, expect);
   }
 
   // Settled: nothing left to send, no transition and no change of velocity for settle_quiet. A
@@ -286,7 +296,11 @@ struct remote_drive::impl {
   // Logs a command or bit toggle and queues its word for RPDO1.
   std::uint64_t change_word(const detail::word_change& w) {
     const std::uint64_t id =
-        w.tracked ? track(w.action, true) : log.report_now(w.action, "done", w.text);
+        w.tracked
+            ? track(w.action, true,
+                    w.expect_in(table, control_word,
+                                state_known ? std::optional<state>(observed) : std::nullopt))
+            : log.report_now(w.action, "done", w.text);
     remote.send_control_word(w.word, w.fault_reset_edge);
     control_word = w.word;
     return id;

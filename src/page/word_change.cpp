@@ -35,6 +35,24 @@ std::variant<word_change, refused> press_button(const profile& p, page_command c
   return w;
 }
 
+action_log::expectation word_change::expect_in(const profile& p, std::uint16_t before,
+                                               std::optional<state> now) const {
+  const std::uint16_t bit7 = control_bit::fault_reset;
+  if (fault_reset_edge || ((word & bit7) != 0 && (before & bit7) == 0)) {
+    return action_log::expectation::edge;
+  }
+  if (!now) return action_log::expectation::act;
+  // The command leads to the present state (a row into it fires on it): the drive is where the
+  // command would take it, as Enable operation in OPERATION ENABLED or Shutdown in READY TO
+  // SWITCH ON.
+  const auto wanted = static_cast<std::uint32_t>(command_fact(p.decode(word)));
+  for (std::size_t r = 0; r < p.row_count; ++r) {
+    const transition_row& row = p.rows[r];
+    if (row.to == *now && (row.any.bits() & wanted) != 0) return action_log::expectation::already_there;
+  }
+  return action_log::expectation::act;
+}
+
 word_change flip_bit(const profile& p, std::uint16_t control_word, int bit) {
   word_change w;
   w.word = static_cast<std::uint16_t>(control_word ^ (1u << bit));

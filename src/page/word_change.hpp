@@ -5,9 +5,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <variant>
 
+#include "action_log.hpp"
 #include "cia402/page/backend.hpp"
 #include "cia402/profile.hpp"
 
@@ -21,6 +23,9 @@ struct word_change {
   /// Tracked until the drive settles; else over at once, reported as done with `text`.
   bool tracked = true;
   std::string text;
+  /// What the change asks of a drive in a given state (for the result when nothing happens).
+  action_log::expectation expect_in(const profile& p, std::uint16_t before,
+                                    std::optional<state> now) const;
 };
 
 /// A command button; refused (409) when the profile has no control word for it.

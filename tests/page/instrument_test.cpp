@@ -205,7 +205,7 @@ TEST(instrument, fault_reset_while_the_cause_persists_is_refused_and_names_the_c
   EXPECT_EQ(snapshot(inst)["state"], "FAULT");
 }
 
-TEST(instrument, switch_on_without_dc_link_is_refused_and_says_so) {
+TEST(instrument, switch_on_without_dc_link_waits_for_it_and_acts_when_it_returns) {
   instrument inst(cia402::standard_profile());
   run(inst, 10);
   inst.command(page_command::shutdown);
@@ -215,8 +215,51 @@ TEST(instrument, switch_on_without_dc_link_is_refused_and_says_so) {
   inst.change_plant(drop);
   run(inst, 100);
   inst.command(page_command::switch_on);
-  EXPECT_EQ(settled_result(inst)["text"],
-            "refused: no transition from READY_TO_SWITCH_ON for SWITCH_ON (no DC-link voltage)");
+  const json waiting = settled_result(inst);
+  EXPECT_EQ(waiting["outcome"], "waiting");
+  EXPECT_EQ(waiting["text"], "waiting: no DC-link voltage; SWITCH_ON acts once it is gone");
+  plant_change back;
+  back.dc_link = true;
+  inst.change_plant(back);
+  run(inst, 100);
+  EXPECT_EQ(snapshot(inst)["state"], "SWITCHED_ON") << "T3 on the word still in the control word";
+}
+
+TEST(instrument, a_command_that_leads_where_the_drive_is_has_nothing_to_do) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  inst.command(page_command::shutdown);
+  run(inst, 100);
+  inst.command(page_command::shutdown);  // again, in READY TO SWITCH ON
+  const json again = settled_result(inst);
+  EXPECT_EQ(again["outcome"], "nothing to do");
+  EXPECT_EQ(again["text"], "nothing to do: already READY_TO_SWITCH_ON");
+  inst.command(page_command::enable_operation);
+  run(inst, 100);
+  inst.command(page_command::enable_operation);  // again, in OPERATION ENABLED
+  EXPECT_EQ(settled_result(inst)["text"], "nothing to do: already OPERATION_ENABLED");
+}
+
+TEST(instrument, shutdown_under_sto_waits_for_sto_to_be_released) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  plant_change sto;
+  sto.sto = true;
+  inst.change_plant(sto);
+  run(inst, 100);
+  inst.command(page_command::shutdown);  // SWITCH ON DISABLED: T2 is held back by STO (S14)
+  const json r = settled_result(inst);
+  EXPECT_EQ(r["outcome"], "waiting");
+  EXPECT_EQ(r["text"], "waiting: STO asserted; SHUTDOWN acts once it is gone");
+}
+
+TEST(instrument, a_command_with_no_row_from_the_state_is_still_refused) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  inst.command(page_command::enable_operation);  // SWITCH ON DISABLED has no row for it
+  const json r = settled_result(inst);
+  EXPECT_EQ(r["outcome"], "refused");
+  EXPECT_EQ(r["text"], "refused: no transition from SWITCH_ON_DISABLED for ENABLE_OPERATION");
 }
 
 TEST(instrument, option_write_the_profile_refuses_is_an_sdo_abort_and_changes_nothing) {

@@ -274,6 +274,12 @@ async function main() {
     expect((await page.textContent('#state-name')) === 'OPERATION ENABLED', 'summary names the state');
   });
 
+  await check('Enable operation again is shown as nothing to do, not as refused', async () => {
+    await click(page, 'enable_operation');
+    await waitResult(page, 'nothing to do: already OPERATION_ENABLED');
+    expect(await page.getAttribute('#result', 'data-outcome') === 'nothing to do', 'marked nothing to do');
+  });
+
   await check('status word 0x0237 in bits 0..9 and its bits lit', async () => {
     const sw = await statusWord(page);
     // Bits 10..15 are the mode's and the plant's (target reached, pv speed 0 at standstill).
