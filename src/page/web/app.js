@@ -648,6 +648,21 @@ function setControl(allowed) {
 
 function connect() {
   const source = new EventSource('/api/events');
+  // While the stream is down every value on the page is old: the whole instrument is marked stale
+  // (grayed, controls off) until the next snapshot arrives.
+  const stale = (on) => {
+    document.body.classList.toggle('stale', on);
+    el('stale').hidden = !on;
+    for (const c of document.querySelectorAll('.control, .command, #target-input')) {
+      if (on) {
+        c.dataset.staleDisabled = c.disabled ? 'no' : 'yes';
+        c.disabled = true;
+      } else if (c.dataset.staleDisabled === 'yes') {
+        c.disabled = false;
+        delete c.dataset.staleDisabled;
+      }
+    }
+  };
   source.onopen = () => {
     el('link').textContent = 'live';
     el('link').dataset.live = 'true';
@@ -655,9 +670,11 @@ function connect() {
   source.onerror = () => {
     el('link').textContent = 'connection lost, retrying…';
     el('link').dataset.live = 'false';
+    if (!document.body.classList.contains('stale')) stale(true);
   };
   source.onmessage = (e) => {
     try {
+      if (document.body.classList.contains('stale')) stale(false);
       update(JSON.parse(e.data));
       document.body.dataset.version = snapshot.version;
     } catch (err) {

@@ -388,6 +388,15 @@ async function main() {
     expect(main.output.includes('stopping (SIGINT)'), 'it says it stops');
   });
 
+  await check('with the server gone the whole instrument is marked stale and its controls are off', async () => {
+    await page.waitForSelector('#stale:not([hidden])', { timeout: 8000 });
+    expect(await page.evaluate(() => document.body.classList.contains('stale')), 'body not marked stale');
+    const enabled = await page.evaluate(() =>
+      [...document.querySelectorAll('.command, .control')].filter((c) => !c.disabled).length);
+    expect(enabled === 0, `${enabled} controls still enabled on a dead page`);
+    await page.screenshot({ path: path.join(outDir, 'stale-1280x800.png') });
+  });
+
   // --- a server that requires its token -------------------------------------------------------
   const guarded = await startServer(['--token-required']);
   await check('--token-required prints a URL with ?token=', async () => {
