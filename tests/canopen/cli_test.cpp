@@ -55,6 +55,36 @@ TEST(cli_master, guard_is_cleared_when_the_master_ends) {
       << r.out;
 }
 
+TEST(cli_master, sdo_read_and_write_need_no_set_up_and_say_the_drives_answer) {
+  const result sw = run_tool({"master", "--can", "virtual", "sdo", "read", "0x6041"});
+  EXPECT_EQ(sw.status, 0) << sw.err;
+  EXPECT_EQ(sw.out, "node 1: 0x6041:0 = 4688 (0x1250)\n") << "SWITCH ON DISABLED, remote, voltage";
+  const result js = run_tool({"master", "--can", "virtual", "--json", "sdo", "read", "0x6041"});
+  EXPECT_EQ(js.out, "{\"node\":1,\"object\":\"0x6041:0\",\"value\":4688}\n");
+  const result w = run_tool({"master", "--can", "virtual", "sdo", "write", "0x60FF", "-300"});
+  EXPECT_EQ(w.status, 0) << w.err;
+  EXPECT_EQ(w.out, "node 1: 0x60FF:0 written: -300 (0xFFFFFED4)\n");
+  const result missing = run_tool({"master", "--can", "virtual", "sdo", "read", "0x6FFF"});
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("SDO abort 0x06020000"), std::string::npos) << missing.err;
+  const result too_big = run_tool({"master", "--can", "virtual", "sdo", "write", "0x6060", "300"});
+  EXPECT_EQ(too_big.status, 2) << "0x6060 is an INTEGER8: refused before anything is sent";
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "sdo", "read"}).status, 2);
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "sdo", "read", "0x6041:x"}).status, 2);
+}
+
+TEST(cli_master, nmt_sends_the_command_and_state_speaks_json) {
+  const result nmt = run_tool({"master", "--can", "virtual", "nmt", "preop"});
+  EXPECT_EQ(nmt.status, 0) << nmt.err;
+  EXPECT_EQ(nmt.out, "node 1: NMT preop sent\n");
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "nmt", "fly"}).status, 2);
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "enable", "now"}).status, 2);
+  const result state = run_tool({"master", "--can", "virtual", "--json", "state"});
+  EXPECT_EQ(state.out,
+            "{\"node\":1,\"state\":\"SWITCH_ON_DISABLED\",\"statusword\":\"0x1250\","
+            "\"error_code\":\"0x0000\"}\n");
+}
+
 TEST(cli_master, bad_url_command_or_node_is_refused_with_status_2) {
   EXPECT_EQ(run_tool({"master", "--can", "tcp://x", "enable"}).status, 2);
   EXPECT_NE(run_tool({"master", "--can", "tcp://x", "enable"}).err.find("is not socketcand://"),

@@ -6,9 +6,13 @@
 #include <chrono>
 #include <csignal>
 #include <memory>
+#include <optional>
 #include <ostream>
 
+#include <nlohmann/json.hpp>
+
 #include "cia402/apps/elapsed_clock.hpp"
+#include "cia402/objects.hpp"
 #include "cia402/canopen/402/drive_objects.hpp"
 #include "cia402/canopen/transport/channel_url.hpp"
 #include "cia402/canopen/402/drive_master.hpp"
@@ -144,9 +148,120 @@ int read_state(bus_session& s, const master_args& a, const profile& p, std::ostr
   std::uint16_t sw = 0;
   std::uint16_t code = 0;
   if (!read_status(s, a, sw, code, err)) return failed;
-  out << describe(p, a.node, sw, code) << "\n";
+  if (a.json) {
+    state st = state::start;
+    const bool known = decode_status(p, sw, st);
+    nlohmann::ordered_json j{{"node", a.node},
+                             {"state", known ? nlohmann::ordered_json(state_name(st)) : nullptr},
+                             {"statusword", word(sw)},
+                             {"error_code", hex(code, 4)}};
+    out << j.dump() << "\n";
+  } else {
+    out << describe(p, a.node, sw, code) << "\n";
+  }
   return 0;
 }
+
+// One SDO transfer on its own, no set-up: what a test bench scripts.
+int run_sdo(bus_session& s, const master_args& a, std::ostream& out, std::ostream& err) {
+  const auto& ops = a.operands;
+  const bool writing = !ops.empty() && ops[0] == "write";
+  if (ops.empty() || (ops[0] != "read" && ops[0] != "write") || ops.size() != (writing ? 3u : 2u)) {
+    err << "cia402 master: sdo read INDEX[:SUB] | sdo write INDEX[:SUB] VALUE\n";
+    return usage_error;
+  }
+  const std::string& where = ops[1];
+  const auto colon = where.find(':');
+  const auto index = parse_number(where.substr(0, colon));
+  const auto sub = colon == std::string::npos ? std::optional<std::int64_t>(0)
+                                               : parse_number(where.substr(colon + 1));
+  if (!index || *index < 0 || *index > 0xFFFF || !sub || *sub < 0 || *sub > 0xFF) {
+    err << "cia402 master: '" << where << "' is not INDEX[:SUB] (e.g. 0x6060 or 0x1018:1)\n";
+    return usage_error;
+  }
+  const auto idx = static_cast<std::uint16_t>(*index);
+  const auto sb = static_cast<std::uint8_t>(*sub);
+  // The size and sign of a CiA 402 object come from the one object table; others are 32 bits.
+  const object_description* known = find_drive_object(idx, sb);
+  const unsigned bytes = known != nullptr ? static_cast<unsigned>(type_size(known->type)) : 4u;
+  const bool is_signed = known != nullptr && type_signed(known->type);
+  std::int64_t value = 0;
+  if (writing) {
+    const auto v = parse_number(ops[2]);
+    if (!v) {
+      err << "cia402 master: '" << ops[2] << "' is not a number (decimal or 0x hex)\n";
+      return usage_error;
+    }
+    value = *v;
+    if (known != nullptr && (value < type_low(known->type) || value > type_high(known->type))) {
+      err << "cia402 master: " << value << " does not fit " << hex(idx, 4) << " ("
+          << known->name << "): " << type_low(known->type) << ".." << type_high(known->type) << "\n";
+      return usage_error;
+    }
+  }
+  canopen::sdo_client sdo(s.channel(), static_cast<std::uint8_t>(a.node), 500000);
+  if (writing) {
+    sdo.start_download(idx, sb, value, bytes);
+  } else {
+    sdo.start_upload(idx, sb);
+  }
+  for (std::uint64_t waited = 0; !sdo.finished() && waited < a.timeout_ms * 1000ull;) {
+    s.settle();
+    canopen::frame f;
+    while (s.channel().receive(f)) sdo.on_frame(f);
+    if (sdo.finished()) break;
+    const std::uint32_t us = s.wait(1000);
+    waited += us;
+    sdo.process(us);
+  }
+  const std::string object = hex(idx, 4) + ":" + std::to_string(sb);
+  if (sdo.state() != canopen::sdo_client::status::done) {
+    const sdo_abort code = sdo.finished() ? sdo.abort_code() : sdo_abort::sdo_protocol_timed_out;
+    if (a.json) {
+      out << nlohmann::ordered_json{{"node", a.node}, {"object", object},
+                                    {"abort", hex(static_cast<std::uint32_t>(code), 8)},
+                                    {"text", sdo_abort_text(code)}}
+                 .dump()
+          << "\n";
+    }
+    err << "cia402 master: node " << a.node << (writing ? " refused writing " : " refused reading ")
+        << object << ": SDO abort " << hex(static_cast<std::uint32_t>(code), 8) << " ("
+        << sdo_abort_text(code) << ")\n";
+    return failed;
+  }
+  if (!writing) value = sdo.value(is_signed);
+  if (a.json) {
+    out << nlohmann::ordered_json{{"node", a.node}, {"object", object}, {"value", value}}.dump()
+        << "\n";
+  } else {
+    out << "node " << a.node << ": " << object << (writing ? " written: " : " = ") << value
+        << " (" << hex(static_cast<std::uint64_t>(value) & ((bytes >= 8 ? 0 : (1ull << (8 * bytes))) - 1), 2 * static_cast<int>(bytes)) << ")\n";
+  }
+  return 0;
+}
+
+int run_nmt(bus_session& s, const master_args& a, std::ostream& out, std::ostream& err) {
+  struct named { const char* name; canopen::nmt_command command; };
+  constexpr named commands[] = {{"start", canopen::nmt_command::start},
+                                {"stop", canopen::nmt_command::stop},
+                                {"preop", canopen::nmt_command::enter_pre_operational},
+                                {"reset", canopen::nmt_command::reset_node},
+                                {"reset-communication", canopen::nmt_command::reset_communication}};
+  for (const named& n : commands) {
+    if (a.operands.size() == 1 && a.operands[0] == n.name) {
+      if (const auto ec = s.channel().send(canopen::nmt_frame(n.command, static_cast<std::uint8_t>(a.node)))) {
+        err << "cia402 master: sending NMT " << n.name << " failed: " << ec.message() << "\n";
+        return failed;
+      }
+      s.settle();
+      out << "node " << a.node << ": NMT " << n.name << " sent\n";
+      return 0;
+    }
+  }
+  err << "cia402 master: nmt start|stop|preop|reset|reset-communication\n";
+  return usage_error;
+}
+
 
 }  // namespace
 
@@ -159,9 +274,14 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
                   "socketcand://HOST:PORT/BUS, socketcan://IFACE, or virtual (a virtual drive in-process)")
       ->default_str("virtual");
   cmd->add_option("--node", args.node, "the drive's node-ID")->check(CLI::Range(1, 127))->default_str("1");
-  cmd->add_option("COMMAND", args.command, "state, enable, disable, quick-stop, reset or watch")
+  cmd->add_option("COMMAND", args.command,
+                  "state, enable, disable, quick-stop, reset, watch; sdo, nmt (no set-up)")
       ->required()
-      ->check(CLI::IsMember({"state", "enable", "disable", "quick-stop", "reset", "watch"}));
+      ->check(CLI::IsMember(
+          {"state", "enable", "disable", "quick-stop", "reset", "watch", "sdo", "nmt"}));
+  cmd->add_option("OPERANDS", args.operands,
+                  "sdo read INDEX[:SUB] | sdo write INDEX[:SUB] VALUE | nmt start|stop|preop|reset");
+  cmd->add_flag("--json", args.json, "state and sdo: print one JSON object");
   add_profile_options(*cmd, args.profile, args.profile_file, "the drive's profile");
   cmd->add_option("--cycle", args.cycle_ms, "SYNC period in ms")->check(CLI::Range(1, 1000))->default_str("10");
   cmd->add_option("--timeout", args.timeout_ms, "give up after this many ms (watch: stop after it; 0 = never)")
@@ -183,6 +303,12 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
   bus_session session;
   if (!session.open(a, p, err)) return session.open_failed_ ? failed : usage_error;
   if (a.command == "state") return read_state(session, a, p, out, err);
+  if (a.command == "sdo") return run_sdo(session, a, out, err);
+  if (a.command == "nmt") return run_nmt(session, a, out, err);
+  if (!a.operands.empty()) {
+    err << "cia402 master: " << a.command << " takes no operands\n";
+    return usage_error;
+  }
   if (a.command == "reset") {
     // Look before touching: a drive that is not faulted keeps its PDOs and NMT state.
     std::uint16_t sw = 0;

@@ -1,12 +1,14 @@
 // `cia402 master --can URL --node N COMMAND`: a CANopen master for one CiA 402 drive on a real or
 // virtual bus: NMT start, PDO set-up over SDO, then the core's master step over PDOs with SYNC
 // (canopen/drive_master.hpp). COMMAND: state (read 0x6041 over SDO and print), enable, disable,
-// quick-stop, reset (fault reset), watch (print state changes and EMCYs).
+// quick-stop, reset (fault reset), watch (print state changes and EMCYs); for test benches, without
+// any set-up: sdo read INDEX[:SUB], sdo write INDEX[:SUB] VALUE, nmt start|stop|preop|reset.
 #pragma once
 
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -18,6 +20,8 @@ struct master_args {
   std::string can = "virtual";  ///< socketcand://HOST:PORT/BUS, socketcan://IFACE, or virtual
   int node = 1;
   std::string command;
+  std::vector<std::string> operands;  ///< after sdo / nmt: what to read, write or send
+  bool json = false;                  ///< state and sdo: one JSON object a line
   std::string profile = "cia402";
   std::string profile_file;
   std::uint32_t cycle_ms = 10;       ///< SYNC period
