@@ -73,6 +73,32 @@ class bus_session {
     if (p.fd >= 0) ::poll(&p, 1, ms);
     return clock_.take();
   }
+  /// One pass of a master: waits for the next thing to do, hands it the frames and the time that
+  /// passed, lets a virtual drive answer at once. Returns the microseconds that passed; `next` is
+  /// when the master next wants to run.
+  std::uint32_t pump(canopen::drive_master& m, std::uint32_t& next) {
+    const std::uint32_t us = wait(next);
+    canopen::frame f;
+    while (channel_->receive(f)) m.on_frame(f);
+    next = m.process(us);
+    settle();
+    while (channel_->receive(f)) m.on_frame(f);
+    next = std::min(next, m.process(0));
+    return us;
+  }
+  /// Runs one started SDO transfer to its end, at most `timeout_us`; true when it is done.
+  bool finish(canopen::sdo_client& sdo, std::uint64_t timeout_us) {
+    for (std::uint64_t waited = 0; !sdo.finished() && waited < timeout_us;) {
+      settle();
+      canopen::frame f;
+      while (channel_->receive(f)) sdo.on_frame(f);
+      if (sdo.finished()) break;
+      const std::uint32_t us = wait(1000);
+      waited += us;
+      sdo.process(us);
+    }
+    return sdo.state() == canopen::sdo_client::status::done;
+  }
   /// Lets the virtual drive answer at once (no time passes).
   void settle() {
     if (virtual_) drive_->poll(0);
@@ -104,20 +130,10 @@ std::string word(std::uint16_t w) { return hex(w, 4); }
 bool read_status(bus_session& s, const master_args& a, std::uint16_t& status_word,
                  std::uint16_t& error_code, std::ostream& err) {
   canopen::sdo_client sdo(s.channel(), static_cast<std::uint8_t>(a.node), 500000);
-  std::uint64_t waited = 0;
   const auto transfer = [&](std::uint16_t index) {
     sdo.clear();
     sdo.start_upload(index, 0);
-    while (!sdo.finished() && waited < a.timeout_ms * 1000ull) {
-      s.settle();
-      canopen::frame f;
-      while (s.channel().receive(f)) sdo.on_frame(f);
-      if (sdo.finished()) break;
-      const std::uint32_t us = s.wait(1000);
-      waited += us;
-      sdo.process(us);
-    }
-    return sdo.state() == canopen::sdo_client::status::done;
+    return s.finish(sdo, a.timeout_ms * 1000ull);
   };
   if (!transfer(0x6041)) {
     if (sdo.abort_code() == sdo_abort::sdo_protocol_timed_out || !sdo.finished()) {
@@ -205,15 +221,7 @@ int run_sdo(bus_session& s, const master_args& a, std::ostream& out, std::ostrea
   } else {
     sdo.start_upload(idx, sb);
   }
-  for (std::uint64_t waited = 0; !sdo.finished() && waited < a.timeout_ms * 1000ull;) {
-    s.settle();
-    canopen::frame f;
-    while (s.channel().receive(f)) sdo.on_frame(f);
-    if (sdo.finished()) break;
-    const std::uint32_t us = s.wait(1000);
-    waited += us;
-    sdo.process(us);
-  }
+  (void)s.finish(sdo, a.timeout_ms * 1000ull);
   const std::string object = hex(idx, 4) + ":" + std::to_string(sb);
   if (sdo.state() != canopen::sdo_client::status::done) {
     const sdo_abort code = sdo.finished() ? sdo.abort_code() : sdo_abort::sdo_protocol_timed_out;
@@ -363,14 +371,7 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
       err << "cia402 master: the bus connection failed: " << ec.message() << "\n";
       break;
     }
-    const std::uint32_t us = session.wait(next);
-    elapsed += us;
-    canopen::frame f;
-    while (session.channel().receive(f)) m.on_frame(f);
-    next = m.process(us);
-    session.settle();
-    while (session.channel().receive(f)) m.on_frame(f);
-    next = std::min(next, m.process(0));
+    elapsed += session.pump(m, next);
 
     if (m.phase() == canopen::master_phase::failed) {
       err << "cia402 master: " << m.failure_text() << "\n";
@@ -460,14 +461,7 @@ done:
       cleared = r.ok();
     });
     for (std::uint64_t waited = 0; !ended && waited < 2000000 && !session.failure();) {
-      const std::uint32_t us = session.wait(next);
-      waited += us;
-      canopen::frame f;
-      while (session.channel().receive(f)) m.on_frame(f);
-      next = m.process(us);
-      session.settle();
-      while (session.channel().receive(f)) m.on_frame(f);
-      next = std::min(next, m.process(0));
+      waited += session.pump(m, next);
     }
     if (cleared) {
       out << "node " << a.node << ": no longer watching this master (0x1016 sub 1 = 0)\n";
