@@ -33,6 +33,43 @@ TEST(cli_master, enable_on_the_virtual_bus_reaches_operation_enabled) {
   EXPECT_NE(r.out.find("node 5: reached OPERATION_ENABLED"), std::string::npos) << r.out;
 }
 
+TEST(cli_master, velocity_writes_the_target_enables_and_waits_for_the_shaft) {
+  const result r = run_tool({"master", "--can", "virtual", "velocity", "600"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("node 1: 0x60FF target velocity = 600 rpm"), std::string::npos) << r.out;
+  const auto running = r.out.find("node 1: running at ");
+  ASSERT_NE(running, std::string::npos) << r.out;
+  // Within 1 % of the target, in OPERATION ENABLED.
+  const int rpm = std::stoi(r.out.substr(running + 19));
+  EXPECT_GE(rpm, 594);
+  EXPECT_LE(rpm, 606);
+  EXPECT_NE(r.out.find("rpm in OPERATION_ENABLED"), std::string::npos) << r.out;
+
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "velocity"}).status, 2);
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "velocity", "fast"}).status, 2);
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "velocity", "3000000000"}).status, 2);
+}
+
+TEST(cli_master, watch_json_prints_one_object_per_event) {
+  const result r = run_tool({"master", "--can", "virtual", "--json", "--timeout", "300", "watch"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  int count = 0;
+  bool started = false;
+  bool state_seen = false;
+  while (std::getline(lines, line)) {
+    ++count;
+    ASSERT_EQ(line.rfind("{\"node\":1,\"event\":\"", 0), 0u) << line;
+    started = started || line.find("\"event\":\"started\"") != std::string::npos;
+    state_seen = state_seen || line.find("\"event\":\"state\",\"state\":\"SWITCH_ON_DISABLED\"") !=
+                                   std::string::npos;
+  }
+  EXPECT_GE(count, 2);
+  EXPECT_TRUE(started) << r.out;
+  EXPECT_TRUE(state_seen) << r.out;
+}
+
 TEST(cli_master, state_reads_the_status_word_over_sdo) {
   const result r = run_tool({"master", "--can", "virtual", "state"});
   EXPECT_EQ(r.status, 0) << r.err;

@@ -3,7 +3,9 @@
 #include <poll.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <csignal>
 #include <memory>
 #include <optional>
@@ -283,13 +285,15 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
       ->default_str("virtual");
   cmd->add_option("--node", args.node, "the drive's node-ID")->check(CLI::Range(1, 127))->default_str("1");
   cmd->add_option("COMMAND", args.command,
-                  "state, enable, disable, quick-stop, reset, watch; sdo, nmt (no set-up)")
+                  "state, enable, disable, quick-stop, reset, watch, velocity; sdo, nmt (no set-up)")
       ->required()
       ->check(CLI::IsMember(
-          {"state", "enable", "disable", "quick-stop", "reset", "watch", "sdo", "nmt"}));
+          {"state", "enable", "disable", "quick-stop", "reset", "watch", "velocity", "sdo", "nmt"}));
   cmd->add_option("OPERANDS", args.operands,
-                  "sdo read INDEX[:SUB] | sdo write INDEX[:SUB] VALUE | nmt start|stop|preop|reset");
-  cmd->add_flag("--json", args.json, "state and sdo: print one JSON object");
+                  "velocity RPM | sdo read INDEX[:SUB] | sdo write INDEX[:SUB] VALUE | "
+                  "nmt start|stop|preop|reset");
+  cmd->add_flag("--json", args.json,
+                "one JSON object a line: state and sdo print one, the others one per event");
   add_profile_options(*cmd, args.profile, args.profile_file, "the drive's profile");
   cmd->add_option("--cycle", args.cycle_ms, "SYNC period in ms")->check(CLI::Range(1, 1000))->default_str("10");
   cmd->add_option("--timeout", args.timeout_ms, "give up after this many ms (watch: stop after it; 0 = never)")
@@ -313,7 +317,17 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
   if (a.command == "state") return read_state(session, a, p, out, err);
   if (a.command == "sdo") return run_sdo(session, a, out, err);
   if (a.command == "nmt") return run_nmt(session, a, out, err);
-  if (!a.operands.empty()) {
+  const bool velocity_command = a.command == "velocity";
+  std::int32_t rpm = 0;
+  if (velocity_command) {
+    const auto v = a.operands.size() == 1 ? parse_number(a.operands[0]) : std::nullopt;
+    const object_description* target = find_drive_object(0x60FF, 0);
+    if (!v || target == nullptr || *v < type_low(target->type) || *v > type_high(target->type)) {
+      err << "cia402 master: velocity RPM: one integer for 0x60FF (target velocity, rpm)\n";
+      return usage_error;
+    }
+    rpm = static_cast<std::int32_t>(*v);
+  } else if (!a.operands.empty()) {
     err << "cia402 master: " << a.command << " takes no operands\n";
     return usage_error;
   }
@@ -335,16 +349,41 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
   mc.drive_heartbeat_ms = a.heartbeat_ms;
   mc.master_heartbeat_ms = a.guard_ms;
   mc.drive_profile = &p;
+  // `velocity` reports the actual velocity it reached; `watch` shows it as it changes.
+  mc.map_velocity = velocity_command || a.command == "watch";
   canopen::drive_master m(session.channel(), mc);
+  // One line per event: prose, or with --json one JSON object.
+  const auto event = [&](nlohmann::ordered_json j, const std::string& text) {
+    if (a.json) {
+      nlohmann::ordered_json line{{"node", a.node}};
+      line.update(j);
+      out << line.dump() << "\n";
+    } else {
+      out << "node " << a.node << ": " << text << "\n";
+    }
+  };
   m.on_state = [&](state, state to, std::uint16_t sw) {
-    out << "node " << a.node << ": " << state_name(to) << " (statusword " << word(sw) << ")\n";
+    event({{"event", "state"}, {"state", state_name(to)}, {"statusword", word(sw)}},
+          std::string(state_name(to)) + " (statusword " + word(sw) + ")");
   };
   m.on_emcy = [&](std::uint16_t code, std::uint8_t reg, const std::uint8_t*) {
-    out << "node " << a.node << ": EMCY " << hex(code, 4) << " error register " << hex(reg, 2)
-        << (code == 0 ? " (error reset)" : "") << "\n";
+    event({{"event", "emcy"}, {"error_code", hex(code, 4)}, {"error_register", hex(reg, 2)}},
+          "EMCY " + hex(code, 4) + " error register " + hex(reg, 2) +
+              (code == 0 ? " (error reset)" : ""));
   };
   const bool watching = a.command == "watch";
-  if (a.command == "enable") m.set_target(state::operation_enabled);
+  if (watching) {
+    // At most one velocity line per 100 ms step of the value, not one per PDO.
+    m.on_velocity = [&, shown = std::optional<std::int32_t>()](std::int32_t v) mutable {
+      if (shown && std::abs(v - *shown) < 10 && v != 0) return;
+      if (shown && *shown == v) return;
+      shown = v;
+      event({{"event", "velocity"}, {"velocity_rpm", v}}, "velocity " + std::to_string(v) + " rpm");
+    };
+  }
+  bool velocity_written = false;
+  bool velocity_requested = false;
+  if (a.command == "enable" || velocity_command) m.set_target(state::operation_enabled);
   if (a.command == "disable") m.set_target(state::switch_on_disabled);
   bool reset_decided = false;  // reset acts only on a drive seen in FAULT (T15)
   if (a.command == "quick-stop") m.set_command(command::quick_stop);
@@ -362,7 +401,7 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
   std::uint64_t elapsed = 0;
   std::uint32_t next = 0;
   for (;;) {
-    if (stop_requested) {
+    if (stop_requested == 1) {
       status = watching || a.hold ? 0 : failed;
       if (status != 0) err << "cia402 master: interrupted\n";
       break;
@@ -379,9 +418,36 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
     }
     if (m.phase() == canopen::master_phase::running && !reported_running) {
       reported_running = true;
-      out << "node " << a.node << ": configured and started (TPDO1 = statusword, RPDO1 = "
-          << "controlword, SYNC every " << a.cycle_ms << " ms)\n";
+      event({{"event", "started"}, {"sync_ms", a.cycle_ms}},
+            "configured and started (TPDO1 = statusword, RPDO1 = controlword, SYNC every " +
+                std::to_string(a.cycle_ms) + " ms)");
     }
+    // After T4: entering OPERATION ENABLED clears the set-points on some profiles (002's T4).
+    if (velocity_command && !velocity_requested && m.phase() == canopen::master_phase::running &&
+        m.status_known() && m.observed() == state::operation_enabled) {
+      velocity_requested = true;
+      const bool queued = m.write(0x60FF, 0, rpm, 4, [&](const canopen::sdo_result& r) {
+        if (r.ok()) {
+          velocity_written = true;
+          event({{"event", "target_velocity"}, {"velocity_rpm", rpm}},
+                "0x60FF target velocity = " + std::to_string(rpm) + " rpm");
+        } else {
+          err << "cia402 master: node " << a.node << ": writing 0x60FF = " << rpm;
+          if (r.cancelled) {
+            err << " was cancelled (the link to the drive was lost)\n";
+          } else {
+            err << " refused: SDO abort " << hex(static_cast<std::uint32_t>(r.abort), 8) << " ("
+                << sdo_abort_text(r.abort) << ")\n";
+          }
+          stop_requested = 2;
+        }
+      });
+      if (!queued) {
+        err << "cia402 master: could not queue the write of 0x60FF\n";
+        break;
+      }
+    }
+    if (stop_requested == 2) break;
     if (a.timeout_ms != 0 && elapsed >= a.timeout_ms * 1000ull) {
       if (watching) {
         status = 0;
@@ -399,7 +465,8 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
       reset_decided = true;
       const state s = m.observed();
       if (s != state::fault && s != state::fault_reaction_active) {
-        out << "node " << a.node << ": not in FAULT (" << state_name(s) << "), nothing to reset\n";
+        event({{"event", "nothing_to_reset"}, {"state", state_name(s)}},
+              std::string("not in FAULT (") + state_name(s) + "), nothing to reset");
         status = 0;
         break;
       }
@@ -415,7 +482,8 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
       const bool held = s == state::quick_stop_active &&
                         (code == 0 || (code >= 5 && (m.status_word() & status_bit::target_reached)));
       if (status != 0 && (held || s == state::switch_on_disabled)) {
-        out << "node " << a.node << ": quick stop done, " << state_name(s) << "\n";
+        event({{"event", "quick_stop_done"}, {"state", state_name(s)}},
+              std::string("quick stop done, ") + state_name(s));
         status = 0;
         if (!a.hold) break;
       }
@@ -423,7 +491,19 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
     }
     switch (m.outcome()) {
       case master_outcome::reached:
-        if (status != 0) out << "node " << a.node << ": reached " << state_name(m.observed()) << "\n";
+        if (velocity_command) {
+          // Reached when the actual velocity is within 1 % (at least 1 rpm) of the target.
+          const auto v = m.velocity();
+          const std::int64_t tolerance = std::max<std::int64_t>(1, std::abs(std::int64_t{rpm}) / 100);
+          if (!velocity_written || !v || std::abs(std::int64_t{*v} - rpm) > tolerance) break;
+          if (status != 0) {
+            event({{"event", "reached"}, {"state", state_name(m.observed())}, {"velocity_rpm", *v}},
+                  "running at " + std::to_string(*v) + " rpm in " + state_name(m.observed()));
+          }
+        } else if (status != 0) {
+          event({{"event", "reached"}, {"state", state_name(m.observed())}},
+                std::string("reached ") + state_name(m.observed()));
+        }
         status = 0;
         if (!a.hold) goto done;
         break;

@@ -1,7 +1,8 @@
 // `cia402 master --can URL --node N COMMAND`: a CANopen master for one CiA 402 drive on a real or
 // virtual bus: NMT start, PDO set-up over SDO, then the core's master step over PDOs with SYNC
 // (canopen/drive_master.hpp). COMMAND: state (read 0x6041 over SDO and print), enable, disable,
-// quick-stop, reset (fault reset), watch (print state changes and EMCYs); for test benches, without
+// quick-stop, reset (fault reset), watch (print state changes, velocity and EMCYs), velocity RPM
+// (enable, write 0x60FF, wait until the shaft turns at it); for test benches, without
 // any set-up: sdo read INDEX[:SUB], sdo write INDEX[:SUB] VALUE, nmt start|stop|preop|reset.
 #pragma once
 
@@ -21,7 +22,7 @@ struct master_args {
   int node = 1;
   std::string command;
   std::vector<std::string> operands;  ///< after sdo / nmt: what to read, write or send
-  bool json = false;                  ///< state and sdo: one JSON object a line
+  bool json = false;                  ///< one JSON object a line (state, sdo: one; others: per event)
   std::string profile = "cia402";
   std::string profile_file;
   std::uint32_t cycle_ms = 10;       ///< SYNC period
