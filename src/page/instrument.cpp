@@ -5,6 +5,7 @@
 #include <deque>
 #include <mutex>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 
 #include "cia402/drive.hpp"
@@ -13,6 +14,7 @@
 #include "action_log.hpp"
 #include "page_json.hpp"
 #include "page_names.hpp"
+#include "recorder.hpp"
 #include "snapshot_board.hpp"
 #include "word_change.hpp"
 
@@ -56,6 +58,7 @@ struct instrument::impl {
   std::optional<transition_seen> last_transition;
 
   detail::snapshot_board board;
+  detail::recorder recording;
 
   // --- under the lock ------------------------------------------------------------------------
 
@@ -118,11 +121,17 @@ struct instrument::impl {
       scripted.pop_front();
     }
     const state before = drive.view().current();
+    sim::trace_row row = sim::begin_row(drive.time_us(), drive.constants(),
+                                        drive.view().state_of_axis());
     const drive_outputs out = drive.step();
+    sim::complete_row(row, out);
+    recording.record(row);
     const std::uint64_t now = drive.cycle();
     if (out.transition != no_transition) {
       last_transition = transition_seen{out.transition, before, out.current};
       if (auto* a = log.pending()) a->transitions.push_back(out.transition);
+      recording.note_transition({0, row.time_us, int{out.transition}, before, out.current,
+                                 row.control_word, out.status_word, false});
     }
     if (log.pending()) settle(out, now);
     if (now % config.publish_every == 0) {
@@ -289,6 +298,27 @@ std::string instrument::info_json(bool control, bool token_required) const {
 std::string instrument::snapshot_json() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->board.present_json(impl_->snapshot(true));
+}
+
+std::string instrument::recording_json(std::uint64_t rows_seen,
+                                       std::uint64_t transitions_seen) const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->recording.since_json(rows_seen, transitions_seen).dump();
+}
+
+std::string instrument::recording_file(recording_format format) const {
+  std::lock_guard lock(impl_->mutex);
+  std::ostringstream out;
+  if (format == recording_format::csv) {
+    impl_->recording.write_csv(out);
+  } else {
+    sim::trace_info info;
+    info.title = "instrument page recording";
+    info.profile_name = impl_->table.name;
+    info.cycle_us = impl_->drive.constants().cycle_us;
+    impl_->recording.write_vcd(out, info, format == recording_format::vcd_gtkwave);
+  }
+  return out.str();
 }
 
 std::optional<published> instrument::wait_for_update(std::uint64_t seen,

@@ -5,6 +5,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <sstream>
 #include <vector>
 
 #include "cia402/canopen/402/drive_master.hpp"
@@ -16,6 +17,7 @@
 #include "action_log.hpp"
 #include "page_json.hpp"
 #include "page_names.hpp"
+#include "recorder.hpp"
 #include "snapshot_board.hpp"
 #include "word_change.hpp"
 
@@ -149,6 +151,8 @@ struct remote_drive::impl {
 
   detail::action_log log;
   detail::snapshot_board board;
+  detail::recorder recording;
+  std::uint8_t transition_this_poll = no_transition;  // for the recorder's row
 
   std::string node_text() const { return "node " + std::to_string(config.node_id); }
 
@@ -216,6 +220,9 @@ struct remote_drive::impl {
         seen.from = chain.back().from;
       }
       last_transition = seen;
+      recording.note_transition({0, now_us, seen.number, seen.from, s, remote.last_sent(), sw,
+                                 true});
+      if (seen.number) transition_this_poll = static_cast<std::uint8_t>(*seen.number);
       if (auto* a = log.pending()) {
         for (const inferred_transition& t : chain) a->transitions.push_back(t.number);
         a->busy_until = now_us;
@@ -233,12 +240,35 @@ struct remote_drive::impl {
 
   void process(std::uint32_t elapsed_us) {
     now_us += elapsed_us;
+    transition_this_poll = no_transition;
     (void)remote.poll(bus, elapsed_us);
+    if (state_known) record_row();
     if (log.pending()) settle();
     if (now_us >= next_publish_us) {
       next_publish_us = now_us + config.publish_us;
       board.publish([this](bool with_time) { return snapshot(with_time); });
     }
+  }
+
+  // The recorder's row for this poll. The bus shows the words, the state, the velocity and the
+  // error code; the plant columns are what the status word and the state tell: DC link = status
+  // bit 4 (S11), torque and brake from the state's activity in the profile, STO and the fault
+  // cause unknown (recorded as off).
+  void record_row() {
+    sim::trace_row row;
+    row.time_us = now_us;
+    row.velocity = velocity ? std::int64_t{*velocity} * 1000000 : 0;
+    row.target_velocity = target_velocity;
+    row.control_word = remote.last_sent();
+    row.status_word = remote.status_word();
+    row.error_code = remote.error_code();
+    row.current = observed;
+    row.transition = transition_this_poll;
+    row.torque = table.info(observed).activity != state_activity::idle;
+    row.brake_released = row.torque;
+    row.brake_engaged = !row.torque;
+    row.dc_link = (row.status_word & status_bit::voltage_enabled) != 0;
+    recording.record(row);
   }
 
   // --- actions and results --------------------------------------------------------------------
@@ -554,6 +584,29 @@ std::string remote_drive::info_json(bool control, bool token_required) const {
 std::string remote_drive::snapshot_json() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->board.present_json(impl_->snapshot(true));
+}
+
+std::string remote_drive::recording_json(std::uint64_t rows_seen,
+                                         std::uint64_t transitions_seen) const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->recording.since_json(rows_seen, transitions_seen).dump();
+}
+
+std::string remote_drive::recording_file(recording_format format) const {
+  std::lock_guard lock(impl_->mutex);
+  std::ostringstream out;
+  if (format == recording_format::csv) {
+    impl_->recording.write_csv(out);
+  } else {
+    sim::trace_info info;
+    info.title = "instrument page recording of node " + std::to_string(impl_->config.node_id) +
+                 " (plant columns inferred from the status word)";
+    info.profile_name = impl_->table.name;
+    info.cycle_us = 1000;
+    info.brake_fitted = false;
+    impl_->recording.write_vcd(out, info, format == recording_format::vcd_gtkwave);
+  }
+  return out.str();
 }
 
 std::optional<published> remote_drive::wait_for_update(std::uint64_t seen,

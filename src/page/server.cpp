@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <charconv>
 #include <cstdio>
 #include <random>
 #include <set>
@@ -328,6 +329,33 @@ struct server::impl {
     });
     http.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
       events(res);
+    });
+    http.Get("/api/recording", [this](const httplib::Request& req, httplib::Response& res) {
+      std::uint64_t seen[2] = {0, 0};
+      const char* keys[2] = {"rows_seen", "transitions_seen"};
+      for (int i = 0; i < 2; ++i) {
+        if (!req.has_param(keys[i])) continue;
+        const std::string v = req.get_param_value(keys[i]);
+        const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), seen[i]);
+        if (ec != std::errc() || end != v.data() + v.size() || v.empty()) {
+          return send_error(res, 400, std::string(keys[i]) + " must be a count (0, 1, 2, ...)");
+        }
+      }
+      res.set_content(inst.recording_json(seen[0], seen[1]), "application/json");
+    });
+    http.Get("/api/recording.csv", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_header("Content-Disposition", "attachment; filename=\"cia402-recording.csv\"");
+      res.set_content(inst.recording_file(recording_format::csv), "text/csv");
+    });
+    http.Get("/api/recording.vcd", [this](const httplib::Request& req, httplib::Response& res) {
+      const std::string form = req.has_param("form") ? req.get_param_value("form") : "ieee";
+      if (form != "ieee" && form != "gtkwave") {
+        return send_error(res, 400, "form must be ieee (IEEE 1364) or gtkwave ($var string)");
+      }
+      res.set_header("Content-Disposition", "attachment; filename=\"cia402-recording.vcd\"");
+      res.set_content(inst.recording_file(form == "gtkwave" ? recording_format::vcd_gtkwave
+                                                            : recording_format::vcd),
+                      "text/plain");
     });
     http.Post("/api/command", [this](const httplib::Request& req, httplib::Response& res) {
       post(req, res, [this](const json& b) { return on_command(b); });

@@ -117,6 +117,61 @@ TEST_F(page_server, a_valid_command_is_obeyed) {
   EXPECT_EQ(json::parse(inst.snapshot_json())["state"], "READY_TO_SWITCH_ON");
 }
 
+// The recorder keeps every transition with its time and words, gives the page only what it has not
+// seen, and exports the same cycles as CSV and as IEEE 1364 VCD (or GTKWave's form on request).
+TEST_F(page_server, recorder_keeps_every_transition_and_exports_csv_and_vcd) {
+  start(false);
+  for (const char* c : {"shutdown", "switch_on", "enable_operation", "disable_voltage"}) {
+    ASSERT_EQ(post("/api/command", std::string(R"({"command":")") + c + "\"}")->status, 200);
+    step(20);
+  }
+  const auto all = client->Get("/api/recording");
+  ASSERT_TRUE(all);
+  ASSERT_EQ(all->status, 200);
+  const json rec = json::parse(all->body);
+  // Power-up (T0, T1), then T2, T3, T4 and T9: OPERATION ENABLED by disable voltage.
+  std::vector<int> numbers;
+  for (const json& t : rec["transitions"]) numbers.push_back(t["number"].get<int>());
+  EXPECT_EQ(numbers, (std::vector<int>{0, 1, 2, 3, 4, 9})) << rec["transitions"].dump();
+  const json& t4 = rec["transitions"][4];
+  EXPECT_EQ(t4["from"], "SWITCHED_ON");
+  EXPECT_EQ(t4["to"], "OPERATION_ENABLED");
+  EXPECT_EQ(t4["control_word"], "0x000F");
+  EXPECT_EQ(t4["status_word"].get<std::string>().substr(4), "37") << t4;
+  EXPECT_GT(t4["time_ms"].get<int>(), rec["transitions"][3]["time_ms"].get<int>());
+  // Only what came after: nothing new without a cycle, the next transition after one more command.
+  const std::string seen = "?rows_seen=" + std::to_string(rec["rows_seen"].get<std::uint64_t>()) +
+                           "&transitions_seen=" +
+                           std::to_string(rec["transitions_seen"].get<std::uint64_t>());
+  const json none = json::parse(client->Get(("/api/recording" + seen).c_str())->body);
+  EXPECT_TRUE(none["transitions"].empty());
+  EXPECT_TRUE(none["rows"].empty());
+  ASSERT_EQ(post("/api/command", R"({"command":"shutdown"})")->status, 200);
+  step(20);
+  const json next = json::parse(client->Get(("/api/recording" + seen).c_str())->body);
+  ASSERT_EQ(next["transitions"].size(), 1u) << next.dump();
+  EXPECT_EQ(next["transitions"][0]["number"], 2);
+  EXPECT_FALSE(next["rows"].empty());
+  EXPECT_EQ(client->Get("/api/recording?rows_seen=x")->status, 400);
+
+  const auto csv = client->Get("/api/recording.csv");
+  ASSERT_TRUE(csv);
+  EXPECT_EQ(csv->status, 200);
+  EXPECT_EQ(csv->body.rfind("time_us,controlword,statusword,state,transition", 0), 0u) << csv->body;
+  EXPECT_NE(csv->get_header_value("Content-Disposition").find("attachment"), std::string::npos);
+  // One line per kept row: every transition is a line of its own.
+  for (const char* row : {",OPERATION_ENABLED,4,", ",SWITCH_ON_DISABLED,9,"}) {
+    EXPECT_NE(csv->body.find(row), std::string::npos) << row;
+  }
+  const auto vcd = client->Get("/api/recording.vcd");
+  ASSERT_TRUE(vcd);
+  EXPECT_EQ(vcd->body.find("$var string"), std::string::npos);
+  EXPECT_NE(vcd->body.find("$timescale"), std::string::npos);
+  const auto gtk = client->Get("/api/recording.vcd?form=gtkwave");
+  EXPECT_NE(gtk->body.find("$var string"), std::string::npos);
+  EXPECT_EQ(client->Get("/api/recording.vcd?form=svg")->status, 400);
+}
+
 TEST_F(page_server, malformed_json_is_400_with_a_reason_and_changes_nothing) {
   start(false);
   const json before = observable();

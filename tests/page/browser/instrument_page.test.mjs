@@ -226,6 +226,7 @@ async function main() {
     args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
       '--disable-background-networking', '--disable-component-update', '--disable-sync'],
     viewport: { width: 1280, height: 800 },
+    acceptDownloads: true,
   });
   const page = context.pages()[0] || await context.newPage();
   currentPage = page;
@@ -356,6 +357,36 @@ async function main() {
     await page.click(bit4);
     await page.waitForFunction((w) => document.getElementById('cw-hex').textContent === w,
       `0x${before.toString(16).toUpperCase().padStart(4, '0')}`, { timeout: 8000 });
+  });
+
+  await check('the recorder lists every transition newest first and draws the timeline', async () => {
+    await page.waitForFunction(() => document.querySelectorAll('#history tr').length >= 8,
+      null, { timeout: 8000 });
+    const numbers = await page.$$eval('#history tr', (rows) => rows.map((r) => r.dataset.number));
+    // Newest first: T15 (fault reset), T14, T13 (the fault), T4, T3, T2, then T1, T0 at power-up.
+    expect(numbers.join(' ') === '15 14 13 4 3 2 1 0', `history ${numbers.join(' ')}`);
+    const first = await page.$$eval('#history tr:first-child td', (tds) => tds.map((t) => t.textContent));
+    expect(/^\d+\.\d{3} s$/.test(first[0]), `time cell '${first[0]}'`);
+    expect(/^0x[0-9A-F]{4}$/.test(first[3]) && /^0x[0-9A-F]{4}$/.test(first[4]), `words ${first}`);
+    expect(/transitions recorded/.test(await page.textContent('#recorder-count')), 'count shown');
+    expect(Number(await page.getAttribute('#timeline', 'data-rows')) > 3, 'timeline has rows');
+    await page.screenshot({ path: path.join(outDir, 'full-1280.png'), fullPage: true });
+  });
+
+  await check('the recorder exports CSV and VCD from the page', async () => {
+    for (const [id, start] of [['export-csv', 'time_us,controlword'], ['export-vcd', '$timescale'],
+      ['export-vcd-gtkwave', '$timescale']]) {
+      const [download] = await Promise.all([page.waitForEvent('download'), page.click(`#${id}`)]);
+      const file = path.join(outDir, download.suggestedFilename());
+      await download.saveAs(file);
+      const text = fs.readFileSync(file, 'utf8');
+      expect(text.startsWith(start) || text.includes(start), `${id}: starts ${text.slice(0, 40)}`);
+      if (id === 'export-csv') {
+        expect(/,FAULT,14,/.test(text) && /,SWITCH_ON_DISABLED,15,/.test(text), 'CSV holds T14, T15');
+      }
+      if (id === 'export-vcd') expect(!text.includes('$var string'), 'IEEE form has no $var string');
+      if (id === 'export-vcd-gtkwave') expect(text.includes('$var string'), 'GTKWave form');
+    }
   });
 
   await check('phone width 390x844: one column, diagram first, nothing wider than the screen', async () => {

@@ -57,6 +57,9 @@ struct plant_change {
   std::optional<bool> sto;                      ///< safe torque off asserted
 };
 
+/// The recorder's export formats: CSV, IEEE 1364 VCD (state as integer codes), GTKWave's VCD.
+enum class recording_format : std::uint8_t { csv, vcd, vcd_gtkwave };
+
 /// One published snapshot: its sequence number and JSON text.
 struct published {
   std::uint64_t version = 0;
@@ -87,6 +90,13 @@ class backend {
   virtual std::string info_json(bool control, bool token_required) const = 0;
   /// The present snapshot, built now.
   virtual std::string snapshot_json() const = 0;
+
+  /// The recorder: the rows and transitions after the counts a previous answer gave (0, 0: all
+  /// that is kept), as JSON text (see src/page/recorder.hpp).
+  virtual std::string recording_json(std::uint64_t rows_seen,
+                                     std::uint64_t transitions_seen) const = 0;
+  /// The whole recording as a file.
+  virtual std::string recording_file(recording_format format) const = 0;
 
   /// Waits until a snapshot newer than `seen` is published, or `timeout` passes, or close() is
   /// called. Returns the newest snapshot if it is newer than `seen`, else nothing.

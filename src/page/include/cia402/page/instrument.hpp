@@ -69,6 +69,9 @@ class instrument final : public backend {
   std::string info_json(bool control, bool token_required) const override;
   /// The present snapshot (state, words, plant, results), built now.
   std::string snapshot_json() const override;
+  std::string recording_json(std::uint64_t rows_seen,
+                             std::uint64_t transitions_seen) const override;
+  std::string recording_file(recording_format format) const override;
 
   /// Waits until a snapshot newer than `seen` is published, or `timeout` passes, or close() is
   /// called. Returns the newest snapshot if it is newer than `seen`, else nothing.

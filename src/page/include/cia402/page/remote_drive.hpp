@@ -93,6 +93,9 @@ class remote_drive final : public backend {
 
   std::string info_json(bool control, bool token_required) const override;
   std::string snapshot_json() const override;
+  std::string recording_json(std::uint64_t rows_seen,
+                             std::uint64_t transitions_seen) const override;
+  std::string recording_file(recording_format format) const override;
   std::optional<published> wait_for_update(std::uint64_t seen,
                                            std::chrono::milliseconds timeout) override;
   published latest() const override;

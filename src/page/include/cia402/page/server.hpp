@@ -6,6 +6,8 @@
 //   GET  /api/state        the present snapshot
 //   GET  /api/events       text/event-stream: a snapshot at once, then each published one
 //                          (at most 25 a second, only on change), a comment line as keep-alive
+//   GET  /api/recording    the recorder: rows and transitions after ?rows_seen=R&transitions_seen=T
+//   GET  /api/recording.csv, /api/recording.vcd[?form=gtkwave]   the whole recording as a file
 //   POST /api/command      {"command":"shutdown"|...|"fault_reset"|"halt"} or
 //                          {"command":"toggle_bit","bit":N}
 //   POST /api/plant        {"target_velocity":N, "fault":true, "fault_code":"0x1000",
