@@ -139,6 +139,59 @@ def test_drive_reaches_operation_enabled_over_pdos(client):
     assert fast is not None
 
 
+def test_tpdo_timing_a_standard_master_can_rely_on(client):
+    """CiA 301 0x1800.. sub 3 (inhibit, 100 us) and sub 5 (event timer, ms) as a master reads them,
+    then measured: each TPDO at least once a second while nothing changes, TPDO4 (status word +
+    velocity) at most every 10 ms while the drive ramps."""
+    send(client, 0x000, [0x01, NODE])
+    for n in range(4):
+        if n == 2:
+            continue  # PDO 3 maps nothing in a velocity drive (COB-ID invalid)
+        assert sdo_upload_expedited(client, NODE, 0x1800 + n, 5) == 1000, "TPDO%d event timer" % (n + 1)
+    assert sdo_upload_expedited(client, NODE, 0x1803, 3) == 100  # 10 ms
+    # Idle: every TPDO still comes, from the event timer.
+    seen = {}
+    end = time.monotonic() + 2.5
+    while time.monotonic() < end:
+        msg = client.recv(timeout=0.1)
+        if msg is not None and msg.arbitration_id in (0x181, 0x281, 0x481):
+            seen[msg.arbitration_id] = seen.get(msg.arbitration_id, 0) + 1
+    assert all(seen.get(i, 0) >= 2 for i in (0x181, 0x281, 0x481)), seen
+    # Ramping from 0 to 3000 rpm (3 s at the default 1000 rpm/s): count TPDO4 over one second.
+    send(client, 0x201, [0x06, 0x00])
+    time.sleep(0.05)
+    send(client, 0x201, [0x0F, 0x00])
+    time.sleep(0.1)
+    send(client, 0x501, [0x0F, 0x00] + list((3000).to_bytes(4, "little", signed=True)))
+    time.sleep(0.3)
+    while client.recv(timeout=0) is not None:
+        pass  # what queued up while sleeping is not part of the measured second
+    stamps = []
+    end = time.monotonic() + 1.0
+    while time.monotonic() < end:
+        msg = client.recv(timeout=0.1)
+        if msg is not None and msg.arbitration_id == 0x481:
+            stamps.append(msg.timestamp)
+    assert 50 <= len(stamps) <= 105, len(stamps)
+    send(client, 0x201, [0x00, 0x00])
+
+
+def test_modes_of_operation_round_trip_and_display_in_tpdo2(client):
+    """0x6060 written over SDO, 0x6061 read back at once and carried by TPDO2 (0x6041 + 0x6061)."""
+    send(client, 0x000, [0x01, NODE])
+    assert sdo_upload_expedited(client, NODE, 0x6061, 0) == 3  # profile velocity
+    answer = sdo_download(client, NODE, 0x6060, 0, 3, 1)
+    assert answer.data[0] == 0x60, "0x6060 = 3 refused"
+    assert sdo_upload_expedited(client, NODE, 0x6060, 0) == 3
+    assert sdo_upload_expedited(client, NODE, 0x6061, 0) == 3
+    tpdo2 = wait_for(client, lambda m: m.arbitration_id == 0x281 and len(m.data) == 3, timeout=2)
+    assert tpdo2 is not None and tpdo2.data[2] == 3
+    # A mode this drive does not have is refused with an abort, and 0x6061 stays.
+    refused = sdo_download(client, NODE, 0x6060, 0, 1, 1)
+    assert refused.data[0] == 0x80, "0x6060 = 1 (profile position) accepted by a velocity drive"
+    assert sdo_upload_expedited(client, NODE, 0x6061, 0) == 3
+
+
 def test_fault_sends_emcy_and_fault_reset_sends_emcy_0000(client):
     send(client, 0x000, [0x01, NODE])
     assert sdo_download(client, NODE, 0x2001, 0, 0x2310, 2).data[0] == 0x60  # inject over-current
