@@ -1,5 +1,7 @@
 #include "page_json.hpp"
 
+#include "cia402/objects.hpp"
+
 #include <algorithm>
 #include <cstdio>
 #include <tuple>
@@ -114,7 +116,13 @@ json profile_info(const profile& p) {
         if (p.spec(opt).allows(v)) values.push_back(v);
       }
     }
-    objects.push_back({{"index", hex(o.index, 4)}, {"name", o.name}, {"values", values}});
+    json entry = {{"index", hex(o.index, 4)}, {"name", o.name}, {"values", values}};
+    // The range the object table allows, so the page refuses an impossible value without a request.
+    if (const object_description* d = find_drive_object(o.index)) {
+      entry["min"] = d->low;
+      entry["max"] = d->high;
+    }
+    objects.push_back(std::move(entry));
   }
   j["objects"] = std::move(objects);
   return j;

@@ -76,9 +76,10 @@ const ROUTES = {
   'QUICK_STOP_ACTIVE>SWITCH_ON_DISABLED': {
     pts: [[400, 413], [400, 395], [334, 395], [334, 167], [275, 167]], label: [334, 300],
     vertical: true },
-  'OPERATION_ENABLED>QUICK_STOP_ACTIVE': { pts: [[275, 427], [375, 427]], label: [350, 418] },
-  'QUICK_STOP_ACTIVE>OPERATION_ENABLED': { pts: [[375, 447], [275, 447]], label: [350, 463] },
-  'FAULT_REACTION_ACTIVE>FAULT': { pts: [[460, 100], [460, 143]], label: [475, 122] },
+  // Numbers clear of the arrowheads even when accented (larger, boxed).
+  'OPERATION_ENABLED>QUICK_STOP_ACTIVE': { pts: [[275, 427], [375, 427]], label: [318, 414] },
+  'QUICK_STOP_ACTIVE>OPERATION_ENABLED': { pts: [[375, 447], [275, 447]], label: [332, 464] },
+  'FAULT_REACTION_ACTIVE>FAULT': { pts: [[460, 100], [460, 143]], label: [482, 118] },
   'FAULT>SWITCH_ON_DISABLED': { pts: [[375, 155], [275, 155]], label: [355, 146] },
 };
 
@@ -360,7 +361,20 @@ function buildObjects() {
       showResult('refused', 'the value must be an integer');
       return;
     }
-    post('/api/object', { index: sel.value, value: Number(v) });
+    // What the profile or the object table cannot take is refused here, as the drive would
+    // refuse it, without a request (and without a failed request in the browser's console).
+    const o = info.objects.find((x) => x.index === sel.value);
+    const n = Number(v);
+    const what = `WRITE ${sel.value} = ${v}: refused`;
+    if (o && o.values.length && !o.values.includes(n)) {
+      showResult('refused', `${what}: profile ${info.profile.name} supports ${o.values.join(', ')}`);
+      return;
+    }
+    if (o && o.min !== undefined && (n < o.min || n > o.max)) {
+      showResult('refused', `${what}: outside ${o.min}..${o.max}`);
+      return;
+    }
+    post('/api/object', { index: sel.value, value: n });
   });
   sel.addEventListener('change', () => fillObjectValue());
 }
@@ -724,7 +738,7 @@ function drawTimeline() {
   g.setTransform(dpr, 0, 0, dpr, 0, 0);
   g.clearRect(0, 0, w, h);
   const ink = getComputedStyle(canvas).color;
-  const left = 150, right = 8;
+  const left = 170, right = 8;
   const pw = w - left - right;
   const now = snapshot ? snapshot.time_ms + (performance.now() - received) : 0;
   const t0 = now - TIMELINE_MS;
@@ -800,7 +814,7 @@ function drawTimeline() {
     }
   };
   let top = bitsTop;
-  const short = (name) => (name.length > 20 ? name.slice(0, 19) + '…' : name);
+  const short = (name) => (name.length > 18 ? name.slice(0, 17) + '…' : name);
   for (const b of cwBits) { lane(`CW ${b.bit} ${short(b.name)}`, top, 'cw', b.bit); top += laneH + 1; }
   for (const b of swBits) { lane(`SW ${b.bit} ${short(b.name)}`, top, 'sw', b.bit); top += laneH + 1; }
 

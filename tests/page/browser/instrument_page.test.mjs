@@ -242,6 +242,15 @@ async function main() {
     await expectAccented(page, 1);
   });
 
+  const diagramTop = () => page.evaluate(() => document.getElementById('diagram').getBoundingClientRect().top);
+  const diagramAtStart = await diagramTop();
+
+  await check('at 1280x800 the target velocity and the fault, DC-link and STO switches are in view', async () => {
+    const bottoms = await page.evaluate(() => ['target-input', 'fault-switch', 'dc-switch', 'sto-switch']
+      .map((id) => Math.round(document.getElementById(id).getBoundingClientRect().bottom)));
+    expect(bottoms.every((b) => b > 0 && b <= 800), `bottoms ${bottoms} (the fold is at 800)`);
+  });
+
   await check('all 16 control-word and 16 status-word bits are shown with names', async () => {
     const n = await page.evaluate(() => [
       document.querySelectorAll('#control-bits button.bit').length,
@@ -370,6 +379,8 @@ async function main() {
     expect(/^0x[0-9A-F]{4}$/.test(first[3]) && /^0x[0-9A-F]{4}$/.test(first[4]), `words ${first}`);
     expect(/transitions recorded/.test(await page.textContent('#recorder-count')), 'count shown');
     expect(Number(await page.getAttribute('#timeline', 'data-rows')) > 3, 'timeline has rows');
+    // "Last transition 15 (FAULT → SWITCH ON DISABLED)" is longer than at power-up: nothing moved.
+    expect(await diagramTop() === diagramAtStart, `diagram moved from ${diagramAtStart} to ${await diagramTop()}`);
     await page.screenshot({ path: path.join(outDir, 'full-1280.png'), fullPage: true });
   });
 
@@ -389,6 +400,18 @@ async function main() {
     }
   });
 
+  await check('a value the profile does not take is refused on the page, without a failed request', async () => {
+    await page.selectOption('#object-index', '0x605A');
+    await page.fill('#object-value', '9');
+    await page.click('#object-form button');
+    await waitResult(page, 'WRITE 0x605A = 9: refused: profile cia402 supports 0, 1, 2, 3, 4, 5, 6, 7, 8');
+    await page.fill('#object-value', '-5');
+    await page.selectOption('#object-index', '0x6083');
+    await page.fill('#object-value', '-5');
+    await page.click('#object-form button');
+    await waitResult(page, 'WRITE 0x6083 = -5: refused: outside');
+  });
+
   await check('phone width 390x844: one column, diagram first, nothing wider than the screen', async () => {
     await page.setViewportSize({ width: 390, height: 844 });
     await page.waitForTimeout(300);
@@ -399,11 +422,14 @@ async function main() {
         scrollWidth: document.documentElement.scrollWidth,
         diagramWidth: d.width,
         order: top('.panel-diagram') < top('.panel-commands') && top('.panel-commands') < top('.panel-plant'),
+        statusBelowCommands: top('.panel-status') - top('.panel-commands'),
       };
     });
     expect(m.scrollWidth <= 390, `page is ${m.scrollWidth} px wide`);
     expect(m.diagramWidth > 300 && m.diagramWidth <= 390, `diagram is ${m.diagramWidth} px wide`);
     expect(m.order, 'diagram, commands, plant from the top');
+    expect(m.statusBelowCommands > 0 && m.statusBelowCommands < 700,
+      `the status word starts ${m.statusBelowCommands} px below the commands`);
     await expectPresentState(page, 'SWITCH_ON_DISABLED');
     await page.screenshot({ path: path.join(outDir, 'phone-390x844.png') });
     await page.screenshot({ path: path.join(outDir, 'phone-390x844-full.png'), fullPage: true });
