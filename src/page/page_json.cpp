@@ -9,6 +9,7 @@
 
 #include "cia402/master.hpp"
 #include "page_names.hpp"
+#include "vocabulary.hpp"
 
 namespace cia402::page {
 namespace detail {
@@ -125,6 +126,7 @@ json profile_info(const profile& p) {
     objects.push_back(std::move(entry));
   }
   j["objects"] = std::move(objects);
+  j.update(vocabulary_json(p));
   return j;
 }
 

@@ -100,8 +100,7 @@ function stateLabel(name) {
 }
 
 // Long names on two lines, split at the space nearest the middle.
-function lines(name) {
-  const text = label(name);
+function lines(text) {
   if (text.length <= 17) return [text];
   const mid = text.length / 2;
   let best = -1;
@@ -196,7 +195,8 @@ function drawDiagram() {
     const [cx, cy] = POS[name];
     const g = svg('g', { id: `state.${name}`, class: 'state other' }, nodes);
     g.dataset.state = name;
-    svg('title', {}, g).textContent = label(name);
+    const meaning = info.state_meanings && info.state_meanings[name];
+    svg('title', {}, g).textContent = meaning ? `${stateLabel(name)}: ${meaning}` : stateLabel(name);
     if (name === 'START') {
       svg('circle', { cx, cy, r: 8 }, g);
       const t = svg('text', { x: cx + 14, y: cy + 4, class: 'start-label' }, g);
@@ -204,7 +204,7 @@ function drawDiagram() {
       continue;
     }
     svg('rect', { x: cx - W / 2, y: cy - H / 2, width: W, height: H, rx: 6 }, g);
-    const ls = lines(name);
+    const ls = lines(stateLabel(name).toUpperCase());
     ls.forEach((line, i) => {
       const t = svg('text', { x: cx, y: cy + 4.5 + (i - (ls.length - 1) / 2) * 15 }, g);
       t.textContent = line;
@@ -239,9 +239,17 @@ function drawGroupRow(row, frames, arrows, labels) {
   el('legend').appendChild(note);
 }
 
+// The transition's event and action, as the profile's document words them.
+function transitionText(n) {
+  const t = info.transition_texts && info.transition_texts[String(n)];
+  if (!t) return `transition ${n}`;
+  return `${n}. Event: ${t.event}${t.action ? `\nAction: ${t.action}` : ''}`;
+}
+
 function drawNumber(parent, n, ends, x, y) {
   const g = svg('g', { id: `n${n}.${ends}`, class: `number t${n}` }, parent);
   g.dataset.number = n;
+  svg('title', {}, g).textContent = transitionText(n);
   svg('rect', { x: x - 13, y: y - 11, width: 26, height: 22, rx: 3 }, g);
   const t = svg('text', { x, y: y + 5 }, g);
   t.textContent = String(n);
@@ -330,7 +338,9 @@ function buildCommands() {
     b.type = 'button';
     b.className = 'command control';
     b.dataset.command = c.key;
-    b.textContent = COMMAND_LABELS[c.key] || c.action;
+    b.textContent = (info.command_labels && info.command_labels[c.key]) || COMMAND_LABELS[c.key] ||
+      c.action;
+    if (b.textContent !== COMMAND_LABELS[c.key]) b.title = `CiA 402: ${COMMAND_LABELS[c.key]}`;
     if (!c.available) {
       b.disabled = true;
       b.dataset.unavailable = 'true';
@@ -480,11 +490,11 @@ function hexBits(hex) {
 function update(s) {
   snapshot = s;
   received = performance.now();
-  el('state-name').textContent = label(s.state);
+  el('state-name').textContent = stateLabel(s.state);
   const last = s.last_transition;
   const number = last && last.number !== null ? last.number : '?';
   el('last-transition').textContent = last
-    ? `${number} (${label(last.from)} → ${label(last.to)})${last.inferred ? ', inferred' : ''}`
+    ? `${number} (${stateLabel(last.from)} → ${stateLabel(last.to)})${last.inferred ? ', inferred' : ''}`
     : 'none';
   updateDiagram(s);
   showRemote(s);
@@ -895,7 +905,8 @@ async function main() {
   const res = await fetch('/api/info', { headers });
   info = await res.json();
   const p = info.profile;
-  el('profile').textContent = `profile ${p.name}${p.seed ? ` (seed ${p.seed})` : ''}: ${p.title}`;
+  el('profile').textContent = `${p.title} (profile ${p.name})`;
+  if (p.seed) el('profile').title = `transition table from the drive manual ${p.seed}`;
   document.title = `${p.name}: instrument control`;
   drawDiagram();
   buildBits();

@@ -281,7 +281,7 @@ async function main() {
     await click(page, 'enable_operation');
     await expectPresentState(page, 'OPERATION_ENABLED');
     await expectAccented(page, 4);
-    expect((await page.textContent('#state-name')) === 'OPERATION ENABLED', 'summary names the state');
+    expect((await page.textContent('#state-name')) === 'Operation enabled', 'summary names the state');
   });
 
   await check('Enable operation again is shown as nothing to do, not as refused', async () => {
@@ -494,6 +494,27 @@ async function main() {
     const text = await pb.textContent('body');
     expect(text.includes('Jog'), 'bit 8 is not named Jog');
     expect(text.includes('Inhibit voltage (active low)'), 'STW bit 1 lacks "(active low)"');
+  });
+
+  await check("s300-profibus: the seed's own words, its meanings and events as hover text, no jargon", async () => {
+    const words = await pb.evaluate(() => ({
+      box: document.getElementById('state.SWITCH_ON_DISABLED').textContent,
+      boxTitle: document.querySelector('[id="state.SWITCH_ON_DISABLED"] title').textContent,
+      quickStop: document.querySelector('button[data-command="quick_stop"]').textContent,
+      disableVoltage: document.querySelector('button[data-command="disable_voltage"]').textContent,
+      faultReset: document.querySelector('button[data-command="fault_reset"]').textContent,
+      t11: document.querySelector('[id^="n11."] title').textContent,
+      summary: document.getElementById('state-name').textContent,
+      header: document.querySelector('header').textContent,
+    }));
+    expect(words.box.includes('SWITCH-ON') && words.box.includes('INHIBITED'), `box '${words.box}'`);
+    expect(words.boxTitle.includes('Parameters can be transferred'), `hover '${words.boxTitle}'`);
+    expect(words.quickStop === 'Fast stop' && words.disableVoltage === 'Inhibit voltage' &&
+      words.faultReset === 'Error reset', `commands ${JSON.stringify(words)}`);
+    expect(words.t11.includes('Event: Bit 2 is canceled') && words.t11.includes('emergency ramp'),
+      `T11 hover '${words.t11}'`);
+    expect(words.summary === 'Switch-on inhibited', `summary '${words.summary}'`);
+    expect(!/\.txt|semantics\.md|S1\.\./.test(words.header), `header '${words.header}'`);
   });
   const pr = await stopServer(profibus);
   expect(pr.code === 0, `profibus server exit ${JSON.stringify(pr)}`);
