@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <deque>
 #include <mutex>
 #include <optional>
@@ -30,19 +31,28 @@ using detail::hex;
 
 struct instrument::impl {
   impl(const profile& p, const instrument_config& c)
-      : table(p),
+      : table(&p),
         config(c),
-        drive(p, c.plant),
+        drive(std::make_unique<sim::virtual_drive>(p, c.plant)),
         log({c.results_kept, c.settle_quiet, c.settle_limit,
              "still busy when the instrument stopped waiting", ""},
             [this] { return how_it_stands(); }) {
     if (config.publish_every == 0) config.publish_every = 1;
+    if (config.selectable.empty()) {
+      for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
+        config.selectable.push_back(&builtin_profile(i));
+      }
+    }
+    if (std::find(config.selectable.begin(), config.selectable.end(), &p) ==
+        config.selectable.end()) {
+      config.selectable.insert(config.selectable.begin(), &p);
+    }
   }
 
-  const profile& table;
+  const profile* table;  // the profile in use; select_profile() changes it with the drive
   instrument_config config;
   // mutable: views for reading are taken in const snapshots; reads change nothing.
-  mutable sim::virtual_drive drive;
+  mutable std::unique_ptr<sim::virtual_drive> drive;
 
   mutable std::mutex mutex;  // guards all here but the board, which has a lock of its own
 
@@ -65,13 +75,13 @@ struct instrument::impl {
   void apply_word(std::uint16_t word) {
     control_word = word;
     // The object interface takes any 16-bit control word.
-    drive.write(sim::object::control_word, 0, word);
+    drive->write(sim::object::control_word, 0, word);
   }
 
   // Logs a command or bit toggle and gives its word to the drive from the next cycle on.
   std::uint64_t change_word(const detail::word_change& w) {
     const std::uint64_t id =
-        w.tracked ? track(w.action, true, w.expect_in(table, control_word, drive.view().current()))
+        w.tracked ? track(w.action, true, w.expect_in(*table, control_word, drive->view().current()))
                   : log.report_now(w.action, "done", w.text);
     scripted.clear();
     if (w.fault_reset_edge) {
@@ -86,12 +96,12 @@ struct instrument::impl {
 
   std::uint64_t track(std::string action, bool refuse_without_transition,
                       detail::action_log::expectation expect = detail::action_log::expectation::act) {
-    return log.track(std::move(action), refuse_without_transition, drive.view().current(),
-                     drive.cycle(), expect);
+    return log.track(std::move(action), refuse_without_transition, drive->view().current(),
+                     drive->cycle(), expect);
   }
 
   std::string blocking_conditions() {
-    sim::drive_view v = drive.view();
+    sim::drive_view v = drive->view();
     std::string s;
     auto add = [&s](const char* what) { s += (s.empty() ? " (" : ", ") + std::string(what); };
     if (v.fault_cause() != 0) add(("fault cause " + hex(v.fault_cause(), 4) + " present").c_str());
@@ -102,7 +112,7 @@ struct instrument::impl {
   }
 
   detail::action_log::standing how_it_stands() {
-    sim::drive_view v = drive.view();
+    sim::drive_view v = drive->view();
     const state now = v.current();
     std::string waiting_for;
     if (v.sto()) {
@@ -120,13 +130,13 @@ struct instrument::impl {
       apply_word(scripted.front());
       scripted.pop_front();
     }
-    const state before = drive.view().current();
-    sim::trace_row row = sim::begin_row(drive.time_us(), drive.constants(),
-                                        drive.view().state_of_axis());
-    const drive_outputs out = drive.step();
+    const state before = drive->view().current();
+    sim::trace_row row = sim::begin_row(drive->time_us(), drive->constants(),
+                                        drive->view().state_of_axis());
+    const drive_outputs out = drive->step();
     sim::complete_row(row, out);
     recording.record(row);
-    const std::uint64_t now = drive.cycle();
+    const std::uint64_t now = drive->cycle();
     if (out.transition != no_transition) {
       last_transition = transition_seen{out.transition, before, out.current};
       if (auto* a = log.pending()) a->transitions.push_back(out.transition);
@@ -143,8 +153,8 @@ struct instrument::impl {
   // A stop the state itself runs (QUICK STOP ACTIVE, FAULT REACTION ACTIVE) counts as running
   // until the shaft stands, so the transition that ends it (T12, T14) is reported with the action.
   void settle(const drive_outputs& out, std::uint64_t now) {
-    const sim::drive_view v = drive.view();
-    const state_activity act = table.info(out.current).activity;
+    const sim::drive_view v = drive->view();
+    const state_activity act = table->info(out.current).activity;
     const bool stop_running = cia402::stop_running(v.state_of_axis().core) ||
                               ((act == state_activity::quick_stop ||
                                 act == state_activity::fault_reaction) &&
@@ -153,14 +163,14 @@ struct instrument::impl {
   }
 
   json snapshot(bool with_time) const {
-    const sim::drive_view v = drive.view();
+    const sim::drive_view v = drive->view();
     const drive_outputs& out = v.outputs();
     const state now = v.current();
     json j;
     j["state"] = state_name(now);
     j["status_word"] = hex(out.status_word, 4);
     j["control_word"] = hex(control_word, 4);
-    j["decodes_to"] = command_name(table.decode(control_word));
+    j["decodes_to"] = command_name(table->decode(control_word));
     if (last_transition) {
       j["last_transition"] = {{"number", last_transition->number},
                               {"from", state_name(last_transition->from)},
@@ -181,15 +191,16 @@ struct instrument::impl {
     j["sto"] = v.sto();
     j["fault_cause"] = hex(v.fault_cause(), 4);
     json objects = json::object();
-    for (const object_name& o : object_names(table)) {
+    for (const object_name& o : object_names(*table)) {
       std::int64_t value = 0;
       if (v.read(o.index, 0, value) == sdo_abort::none) objects[hex(o.index, 4)] = value;
     }
     j["objects"] = std::move(objects);
     j["results"] = log.results_json();
+    j["profile"] = table->name;
     if (with_time) {
-      j["cycle"] = drive.cycle();
-      j["time_ms"] = drive.time_us() / 1000;
+      j["cycle"] = drive->cycle();
+      j["time_ms"] = drive->time_us() / 1000;
     }
     return j;
   }
@@ -207,12 +218,12 @@ void instrument::step() {
 
 std::uint64_t instrument::cycle() const {
   std::lock_guard lock(impl_->mutex);
-  return impl_->drive.cycle();
+  return impl_->drive->cycle();
 }
 
 reply instrument::command(page_command c) {
   std::lock_guard lock(impl_->mutex);
-  const auto change = detail::press_button(impl_->table, c, impl_->control_word);
+  const auto change = detail::press_button(*impl_->table, c, impl_->control_word);
   if (const refused* no = std::get_if<refused>(&change)) return *no;
   return accepted{impl_->change_word(std::get<detail::word_change>(change))};
 }
@@ -220,7 +231,30 @@ reply instrument::command(page_command c) {
 reply instrument::toggle_control_bit(int bit) {
   if (bit < 0 || bit > 15) return refused{400, "bit must be 0..15"};
   std::lock_guard lock(impl_->mutex);
-  return accepted{impl_->change_word(detail::flip_bit(impl_->table, impl_->control_word, bit))};
+  return accepted{impl_->change_word(detail::flip_bit(*impl_->table, impl_->control_word, bit))};
+}
+
+reply instrument::select_profile(std::string_view name) {
+  std::lock_guard lock(impl_->mutex);
+  impl& m = *impl_;
+  const profile* chosen = nullptr;
+  std::string names;
+  for (const profile* p : m.config.selectable) {
+    if (name == p->name) chosen = p;
+    names += (names.empty() ? "" : ", ") + std::string(p->name);
+  }
+  if (chosen == nullptr) {
+    return refused{400, "no profile '" + std::string(name) + "' here (" + names + ")"};
+  }
+  if (m.log.pending()) m.log.finish_pending("the profile was changed");
+  m.drive = std::make_unique<sim::virtual_drive>(*chosen, m.config.plant);
+  m.table = chosen;
+  m.control_word = 0;
+  m.scripted.clear();
+  m.last_transition.reset();
+  m.recording.clear();
+  return accepted{m.log.report_now("PROFILE " + std::string(chosen->name), "done",
+                                   std::string("done: ") + chosen->title + ", from power-up")};
 }
 
 reply instrument::write_object(std::uint16_t index, std::int64_t value) {
@@ -230,7 +264,7 @@ reply instrument::write_object(std::uint16_t index, std::int64_t value) {
   std::lock_guard lock(impl_->mutex);
   impl& m = *impl_;
   const std::string action = "WRITE " + hex(index, 4) + " = " + std::to_string(value);
-  const sdo_abort r = m.drive.write(index, 0, value);
+  const sdo_abort r = m.drive->write(index, 0, value);
   if (r != sdo_abort::none) {
     const std::string text = "refused: " + abort_text(r);
     m.log.report_now(action, "refused", text);
@@ -245,7 +279,7 @@ reply instrument::change_plant(const plant_change& change) {
   }
   std::lock_guard lock(impl_->mutex);
   impl& m = *impl_;
-  sim::drive_view v = m.drive.view();
+  sim::drive_view v = m.drive->view();
   std::string action;
   auto add = [&action](const std::string& what) { action += (action.empty() ? "" : ", ") + what; };
   if (change.target_velocity) {
@@ -282,13 +316,18 @@ reply instrument::change_plant(const plant_change& change) {
 
 std::string instrument::info_json(bool control, bool token_required) const {
   std::lock_guard lock(impl_->mutex);
-  json j = detail::profile_info(impl_->table);
+  json j = detail::profile_info(*impl_->table);
   j["backend"] = "virtual";
+  json profiles = json::array();
+  for (const profile* p : impl_->config.selectable) {
+    profiles.push_back({{"name", p->name}, {"title", p->title}});
+  }
+  j["profiles"] = std::move(profiles);
   j["control"] = control;
   j["token_required"] = token_required;
-  j["cycle_us"] = impl_->drive.constants().cycle_us;
+  j["cycle_us"] = impl_->drive->constants().cycle_us;
   // Snapshots come at most this often (the plot holds a value across a gap between them).
-  j["publish_ms"] = impl_->config.publish_every * impl_->drive.constants().cycle_us / 1000.0;
+  j["publish_ms"] = impl_->config.publish_every * impl_->drive->constants().cycle_us / 1000.0;
   // The virtual drive's plant takes every input the page offers.
   j["capabilities"] = {
       {"fault", true}, {"dc_link", true}, {"sto", true}, {"reasons", json::object()}};
@@ -314,8 +353,8 @@ std::string instrument::recording_file(recording_format format) const {
   } else {
     sim::trace_info info;
     info.title = "instrument page recording";
-    info.profile_name = impl_->table.name;
-    info.cycle_us = impl_->drive.constants().cycle_us;
+    info.profile_name = impl_->table->name;
+    info.cycle_us = impl_->drive->constants().cycle_us;
     impl_->recording.write_vcd(out, info, format == recording_format::vcd_gtkwave);
   }
   return out.str();

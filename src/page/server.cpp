@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <charconv>
 #include <cstdio>
@@ -122,11 +123,11 @@ bool is_loopback_address(std::string_view host) {
 }
 
 struct server::impl {
-  impl(backend& i, server_options o) : inst(i), options(std::move(o)) {
+  impl(std::vector<axis> a, server_options o) : axes(std::move(a)), options(std::move(o)) {
     if (options.token_required && options.token.empty()) options.token = make_token();
   }
 
-  backend& inst;
+  std::vector<axis> axes;
   server_options options;
   httplib::Server http;
   std::thread thread;
@@ -177,10 +178,12 @@ struct server::impl {
   template <typename Act>
   void post(const httplib::Request& req, httplib::Response& res, Act act) {
     if (const auto e = check_post(req)) return send_error(res, e->status, e->reason);
+    backend* inst = axis_of(req, res);
+    if (inst == nullptr) return;
     const json body = json::parse(req.body, nullptr, false);
     if (body.is_discarded()) return send_error(res, 400, "body is not valid JSON");
     if (!body.is_object()) return send_error(res, 400, "body must be a JSON object");
-    std::variant<reply, request_error> r = act(body);
+    std::variant<reply, request_error> r = act(*inst, body);
     if (auto* e = std::get_if<request_error>(&r)) return send_error(res, e->status, e->reason);
     const reply& rep = std::get<reply>(r);
     if (const auto* ok = std::get_if<accepted>(&rep)) return send_json(res, 200, {{"id", ok->id}});
@@ -194,7 +197,21 @@ struct server::impl {
     send_json(res, no.http_status, j);
   }
 
-  std::variant<reply, request_error> on_command(const json& body) {
+  // The drive a request names with ?axis=K (1..N; the first without it), or nullptr with the
+  // refusal sent.
+  backend* axis_of(const httplib::Request& req, httplib::Response& res) {
+    if (!req.has_param("axis")) return axes.front().drive;
+    const std::string v = req.get_param_value("axis");
+    std::size_t k = 0;
+    const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), k);
+    if (ec != std::errc() || end != v.data() + v.size() || k < 1 || k > axes.size()) {
+      send_error(res, 404, "no axis '" + v + "' (1.." + std::to_string(axes.size()) + ")");
+      return nullptr;
+    }
+    return axes[k - 1].drive;
+  }
+
+  std::variant<reply, request_error> on_command(backend& inst, const json& body) {
     if (auto k = unknown_key(body, {"command", "bit"})) return request_error{400, *k};
     if (!body.contains("command") || !body["command"].is_string()) {
       return request_error{400, "'command' (a string) is required"};
@@ -216,7 +233,7 @@ struct server::impl {
     return inst.command(c);
   }
 
-  std::variant<reply, request_error> on_plant(const json& body) {
+  std::variant<reply, request_error> on_plant(backend& inst, const json& body) {
     if (auto k = unknown_key(body, {"target_velocity", "fault", "fault_code", "fault_class",
                                     "dc_link", "sto"})) {
       return request_error{400, *k};
@@ -258,7 +275,15 @@ struct server::impl {
     return inst.change_plant(c);
   }
 
-  std::variant<reply, request_error> on_object(const json& body) {
+  std::variant<reply, request_error> on_profile(backend& inst, const json& body) {
+    if (auto k = unknown_key(body, {"profile"})) return request_error{400, *k};
+    if (!body.contains("profile") || !body["profile"].is_string()) {
+      return request_error{400, "'profile' (a profile's name) is required"};
+    }
+    return inst.select_profile(body["profile"].get_ref<const std::string&>());
+  }
+
+  std::variant<reply, request_error> on_object(backend& inst, const json& body) {
     if (auto k = unknown_key(body, {"index", "value"})) return request_error{400, *k};
     if (!body.contains("index") || !body.contains("value")) {
       return request_error{400, "'index' and 'value' are required"};
@@ -322,13 +347,37 @@ struct server::impl {
     http.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
 
     http.Get("/api/info", [this](const httplib::Request& req, httplib::Response& res) {
-      res.set_content(inst.info_json(may_control(req), options.token_required), "application/json");
+      backend* inst = axis_of(req, res);
+      if (inst == nullptr) return;
+      json j = json::parse(inst->info_json(may_control(req), options.token_required));
+      const auto k = static_cast<std::size_t>(std::find_if(axes.begin(), axes.end(), [&](const axis& a) {
+                       return a.drive == inst;
+                     }) - axes.begin());
+      j["axis"] = k + 1;
+      j["axis_label"] = axes[k].label;
+      j["axes"] = axes.size();
+      res.set_content(j.dump(), "application/json");
     });
-    http.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_content(inst.snapshot_json(), "application/json");
+    http.Get("/api/axes", [this](const httplib::Request&, httplib::Response& res) {
+      // The overview: each axis's present state in a few values.
+      json list = json::array();
+      for (std::size_t k = 0; k < axes.size(); ++k) {
+        const json s = json::parse(axes[k].drive->snapshot_json(), nullptr, false);
+        json entry{{"axis", k + 1}, {"label", axes[k].label}};
+        if (s.is_object()) {
+          for (const char* key : {"profile", "state", "status_word", "velocity", "error_code"}) {
+            if (s.contains(key)) entry[key] = s[key];
+          }
+        }
+        list.push_back(std::move(entry));
+      }
+      send_json(res, 200, list);
     });
-    http.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
-      events(res);
+    http.Get("/api/state", [this](const httplib::Request& req, httplib::Response& res) {
+      if (backend* inst = axis_of(req, res)) res.set_content(inst->snapshot_json(), "application/json");
+    });
+    http.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
+      if (backend* inst = axis_of(req, res)) events(*inst, res);
     });
     http.Get("/api/recording", [this](const httplib::Request& req, httplib::Response& res) {
       std::uint64_t seen[2] = {0, 0};
@@ -341,39 +390,48 @@ struct server::impl {
           return send_error(res, 400, std::string(keys[i]) + " must be a count (0, 1, 2, ...)");
         }
       }
-      res.set_content(inst.recording_json(seen[0], seen[1]), "application/json");
+      if (backend* inst = axis_of(req, res)) {
+        res.set_content(inst->recording_json(seen[0], seen[1]), "application/json");
+      }
     });
-    http.Get("/api/recording.csv", [this](const httplib::Request&, httplib::Response& res) {
+    http.Get("/api/recording.csv", [this](const httplib::Request& req, httplib::Response& res) {
+      backend* inst = axis_of(req, res);
+      if (inst == nullptr) return;
       res.set_header("Content-Disposition", "attachment; filename=\"cia402-recording.csv\"");
-      res.set_content(inst.recording_file(recording_format::csv), "text/csv");
+      res.set_content(inst->recording_file(recording_format::csv), "text/csv");
     });
     http.Get("/api/recording.vcd", [this](const httplib::Request& req, httplib::Response& res) {
       const std::string form = req.has_param("form") ? req.get_param_value("form") : "ieee";
       if (form != "ieee" && form != "gtkwave") {
         return send_error(res, 400, "form must be ieee (IEEE 1364) or gtkwave ($var string)");
       }
+      backend* inst = axis_of(req, res);
+      if (inst == nullptr) return;
       res.set_header("Content-Disposition", "attachment; filename=\"cia402-recording.vcd\"");
-      res.set_content(inst.recording_file(form == "gtkwave" ? recording_format::vcd_gtkwave
+      res.set_content(inst->recording_file(form == "gtkwave" ? recording_format::vcd_gtkwave
                                                             : recording_format::vcd),
                       "text/plain");
     });
     http.Post("/api/command", [this](const httplib::Request& req, httplib::Response& res) {
-      post(req, res, [this](const json& b) { return on_command(b); });
+      post(req, res, [this](backend& d, const json& b) { return on_command(d, b); });
     });
     http.Post("/api/plant", [this](const httplib::Request& req, httplib::Response& res) {
-      post(req, res, [this](const json& b) { return on_plant(b); });
+      post(req, res, [this](backend& d, const json& b) { return on_plant(d, b); });
     });
     http.Post("/api/object", [this](const httplib::Request& req, httplib::Response& res) {
-      post(req, res, [this](const json& b) { return on_object(b); });
+      post(req, res, [this](backend& d, const json& b) { return on_object(d, b); });
     });
-    for (const char* path : {"/api/command", "/api/plant", "/api/object"}) {
+    http.Post("/api/profile", [this](const httplib::Request& req, httplib::Response& res) {
+      post(req, res, [this](backend& d, const json& b) { return on_profile(d, b); });
+    });
+    for (const char* path : {"/api/command", "/api/plant", "/api/object", "/api/profile"}) {
       http.Get(path, [](const httplib::Request&, httplib::Response& res) {
         send_error(res, 405, "use POST with a JSON body");
       });
     }
   }
 
-  void events(httplib::Response& res) {
+  void events(backend& inst, httplib::Response& res) {
     if (streams.fetch_add(1) >= options.max_event_streams) {
       streams.fetch_sub(1);
       return send_error(res, 503, "too many event streams open");
@@ -386,7 +444,7 @@ struct server::impl {
     auto st = std::make_shared<stream_state>();
     res.set_chunked_content_provider(
         "text/event-stream",
-        [this, st](std::size_t, httplib::DataSink& sink) {
+        [this, st, &inst](std::size_t, httplib::DataSink& sink) {
           std::string chunk;
           if (!st->started) {
             st->started = true;
@@ -416,7 +474,10 @@ struct server::impl {
 };
 
 server::server(backend& inst, server_options options)
-    : impl_(std::make_unique<impl>(inst, std::move(options))) {
+    : server(std::vector<axis>{{"axis 1", &inst}}, std::move(options)) {}
+
+server::server(std::vector<axis> axes, server_options options)
+    : impl_(std::make_unique<impl>(std::move(axes), std::move(options))) {
   impl_->routes();
 }
 

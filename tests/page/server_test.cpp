@@ -428,3 +428,65 @@ TEST(page_server_token, tokens_are_32_hex_digits_and_differ) {
 }
 
 }  // namespace
+
+namespace {
+
+// Several drives behind one page: each request names its axis, and one axis's command, profile
+// and recording leave the others alone.
+TEST(page_server_axes, each_axis_is_its_own_drive_and_may_switch_profile) {
+  instrument one{cia402::standard_profile()};
+  instrument two{cia402::standard_profile()};
+  server_options o;
+  o.port = 0;
+  server http({{"axis 1", &one}, {"axis 2", &two}}, o);
+  ASSERT_TRUE(http.bind()) << http.error();
+  http.start();
+  httplib::Client client("127.0.0.1", http.bound_port());
+  for (int i = 0; i < 10; ++i) {
+    one.step();
+    two.step();
+  }
+  const auto r = client.Post("/api/command?axis=2", R"({"command":"shutdown"})", "application/json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200) << r->body;
+  for (int i = 0; i < 10; ++i) {
+    one.step();
+    two.step();
+  }
+  const json axes = json::parse(client.Get("/api/axes")->body);
+  ASSERT_EQ(axes.size(), 2u);
+  EXPECT_EQ(axes[0]["label"], "axis 1");
+  EXPECT_EQ(axes[0]["state"], "SWITCH_ON_DISABLED");
+  EXPECT_EQ(axes[1]["state"], "READY_TO_SWITCH_ON");
+  const json info2 = json::parse(client.Get("/api/info?axis=2")->body);
+  EXPECT_EQ(info2["axis"], 2);
+  EXPECT_EQ(info2["axes"], 2);
+  for (const char* bad : {"/api/state?axis=3", "/api/state?axis=0", "/api/info?axis=x"}) {
+    EXPECT_EQ(client.Get(bad)->status, 404) << bad;
+  }
+  EXPECT_EQ(client.Post("/api/command?axis=3", R"({"command":"shutdown"})", "application/json")->status,
+            404);
+
+  // Axis 1 under the PROFIBUS profile of seed 003: from power-up, with its own words.
+  const auto p = client.Post("/api/profile?axis=1", R"({"profile":"s300-profibus"})", "application/json");
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->status, 200) << p->body;
+  for (int i = 0; i < 10; ++i) one.step();
+  const json info1 = json::parse(client.Get("/api/info")->body);
+  EXPECT_EQ(info1["profile"]["name"], "s300-profibus");
+  EXPECT_EQ(info1["state_names"]["SWITCH_ON_DISABLED"], "Switch-on inhibited");
+  EXPECT_EQ(info1["command_labels"]["quick_stop"], "Fast stop");
+  const json s1 = json::parse(client.Get("/api/state")->body);
+  EXPECT_EQ(s1["profile"], "s300-profibus");
+  EXPECT_EQ(s1["state"], "SWITCH_ON_DISABLED");
+  const json rec = json::parse(client.Get("/api/recording")->body);
+  ASSERT_FALSE(rec["transitions"].empty());
+  EXPECT_EQ(rec["transitions"][0]["number"], 0);  // a new recording from power-up
+  EXPECT_EQ(json::parse(client.Get("/api/state?axis=2")->body)["profile"], "cia402");
+  const auto unknown = client.Post("/api/profile", R"({"profile":"nonesuch"})", "application/json");
+  EXPECT_EQ(unknown->status, 400);
+  EXPECT_NE(unknown->body.find("ax2000-profibus"), std::string::npos) << unknown->body;
+  http.stop();
+}
+
+}  // namespace

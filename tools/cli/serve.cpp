@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <csignal>
 #include <memory>
+#include <vector>
 #include <ostream>
 #include <pthread.h>
 
@@ -44,11 +45,20 @@ CLI::App* add_serve_subcommand(CLI::App& app, serve_args& args) {
                               "show a drive on a CAN bus instead of running a virtual drive here: "
                               "socketcand://HOST:PORT/BUS (e.g. a cia402 bus) or socketcan://IFACE")
                   ->type_name("URL");
-  cmd->add_option("--node", args.node, "with --can: the drive's node-ID")
+  auto* node = cmd->add_option("--node", args.nodes,
+                               "with --can: the drive's node-ID; repeat it for several drives, one "
+                               "axis of the page each")
+                   ->type_name("N")
+                   ->check(CLI::Range(1, 127))
+                   ->default_str("1")
+                   ->needs(can);
+  cmd->add_option("--nodes", args.virtual_axes,
+                  "without --can: run this many virtual drives, one axis of the page each")
       ->type_name("N")
-      ->check(CLI::Range(1, 127))
+      ->check(CLI::Range(1, 16))
       ->default_str("1")
-      ->needs(can);
+      ->excludes(can)
+      ->excludes(node);
   return cmd;
 }
 
@@ -62,11 +72,21 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   const bool loopback = page::is_loopback_address(args.bind);
   options.token_required = args.token_required || !loopback;
 
-  // The drive behind the page: a virtual drive here, or a remote one on a bus.
-  std::unique_ptr<canopen::channel> channel;
-  std::unique_ptr<page::backend> drive;
+  // The drives behind the page: virtual drives here, or remote ones on a bus (a channel each, so
+  // each master sees every frame).
+  std::vector<std::unique_ptr<canopen::channel>> channels;
+  std::vector<std::unique_ptr<page::backend>> drives;
+  std::vector<page::axis> axes;
+  std::vector<const profile*> selectable;
+  for (std::size_t i = 0; i < builtin_profile_count(); ++i) selectable.push_back(&builtin_profile(i));
+  if (find_builtin_profile(choice.get().name) != &choice.get()) selectable.push_back(&choice.get());
   if (args.can.empty()) {
-    drive = std::make_unique<page::instrument>(choice.get());
+    for (int k = 1; k <= args.virtual_axes; ++k) {
+      page::instrument_config ic;
+      ic.selectable = selectable;
+      drives.push_back(std::make_unique<page::instrument>(choice.get(), ic));
+      axes.push_back({"axis " + std::to_string(k), drives.back().get()});
+    }
   } else {
     canopen::channel_url url;
     std::string why;
@@ -79,18 +99,26 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
              "on a CAN bus start `cia402 bus` and give its socketcand:// URL\n";
       return refused;
     }
-    channel = canopen::open_channel(url, why);
-    if (!channel) {
-      err << "cia402 serve: cannot reach the bus " << args.can << ": " << why << "\n";
-      return unreachable;
+    for (const int node : args.nodes) {
+      for (const page::axis& a : axes) {
+        if (a.label == "node " + std::to_string(node)) {
+          err << "cia402 serve: --node " << node << " is given twice\n";
+          return refused;
+        }
+      }
+      channels.push_back(canopen::open_channel(url, why));
+      if (!channels.back()) {
+        err << "cia402 serve: cannot reach the bus " << args.can << ": " << why << "\n";
+        return unreachable;
+      }
+      page::remote_config rc;
+      rc.node_id = static_cast<std::uint8_t>(node);
+      rc.bus_name = args.can;
+      drives.push_back(std::make_unique<page::remote_drive>(choice.get(), *channels.back(), rc));
+      axes.push_back({"node " + std::to_string(node), drives.back().get()});
     }
-    page::remote_config rc;
-    rc.node_id = static_cast<std::uint8_t>(args.node);
-    rc.bus_name = args.can;
-    drive = std::make_unique<page::remote_drive>(choice.get(), *channel, rc);
   }
-  page::backend& inst = *drive;
-  page::server http(inst, options);
+  page::server http(axes, options);
 
   // SIGINT and SIGTERM are blocked in every thread (the server's and the cycle thread inherit the
   // mask) and taken here by sigwait, so stopping is ordinary code, not a signal handler.
@@ -108,16 +136,22 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
     err << "cia402 serve: " << http.error() << "\n";
     return refused;
   }
-  page::cycle_runner runner(inst, std::chrono::microseconds(1000));
-  runner.start();
+  std::vector<std::unique_ptr<page::cycle_runner>> runners;
+  for (auto& d : drives) {
+    runners.push_back(std::make_unique<page::cycle_runner>(*d, std::chrono::microseconds(1000)));
+    runners.back()->start();
+  }
   http.start();
 
+  std::string what;
+  for (const page::axis& a : axes) what += (what.empty() ? "" : ", ") + a.label;
   if (args.can.empty()) {
-    out << "cia402 serve: profile " << choice.get().name << ", instrument page at " << http.url()
-        << "\n";
+    out << "cia402 serve: profile " << choice.get().name
+        << (axes.size() > 1 ? ", " + std::to_string(axes.size()) + " virtual drives" : std::string())
+        << ", instrument page at " << http.url() << "\n";
   } else {
-    out << "cia402 serve: node " << args.node << " on " << args.can << " (profile "
-        << choice.get().name << "), instrument page at " << http.url() << "\n";
+    out << "cia402 serve: " << what << " on " << args.can << " (profile " << choice.get().name
+        << "), instrument page at " << http.url() << "\n";
   }
   if (!loopback) {
     out << "cia402 serve: listening on " << args.bind
@@ -132,9 +166,9 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   sigwait(&stop_signals, &signal_number);
   out << "cia402 serve: stopping (" << (signal_number == SIGINT ? "SIGINT" : "SIGTERM") << ")"
       << std::endl;
-  inst.close();
+  for (auto& d : drives) d->close();
   http.stop();
-  runner.stop();
+  for (auto& r : runners) r->stop();
   pthread_sigmask(SIG_SETMASK, &previous, nullptr);
   return 0;
 }

@@ -1,11 +1,13 @@
-// `cia402 serve`: the instrument control page (seed 003_83442f2f4b0b2bb9.txt) for one virtual drive
-// run in real time, or with --can URL --node N for a drive on a CAN bus (a `cia402 bus` node or a
+// `cia402 serve`: the instrument control page (seed 003_83442f2f4b0b2bb9.txt) for virtual drives
+// run in real time (--nodes N: N axes), or with --can URL --node N [--node M ...] for drives on a
+// CAN bus (a `cia402 bus` node or a
 // real drive; src/page/include/cia402/page/remote_drive.hpp), served over HTTP; see
 // src/page/include/cia402/page/server.hpp.
 #pragma once
 
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -20,7 +22,8 @@ struct serve_args {
   int port = 8402;              ///< 0: any free port (the URL printed names it)
   bool token_required = false;  ///< also on for any --bind address that is not loopback
   std::string can;              ///< socketcand://HOST:PORT/BUS or socketcan://IFACE; "" = virtual drive
-  int node = 1;                 ///< with --can: the drive's node-ID
+  std::vector<int> nodes{1};    ///< with --can: the drives' node-IDs, one axis each
+  int virtual_axes = 1;         ///< without --can: how many virtual drives (--nodes N)
 };
 
 /// Registers the subcommand on `app`, filling `args` when it is parsed.

@@ -4,7 +4,16 @@
 'use strict';
 
 const SVG = 'http://www.w3.org/2000/svg';
-const token = new URLSearchParams(location.search).get('token') || '';
+const params = new URLSearchParams(location.search);
+const token = params.get('token') || '';
+// Which of the server's drives this page shows (?axis=K; the first without it).
+const axisParam = params.get('axis') || '';
+
+// An API path for this page's axis.
+function api(path) {
+  if (!axisParam) return path;
+  return `${path}${path.includes('?') ? '&' : '?'}axis=${encodeURIComponent(axisParam)}`;
+}
 const el = (id) => document.getElementById(id);
 
 let info = null;       // /api/info
@@ -20,7 +29,7 @@ async function post(path, body) {
   if (token) headers['X-Cia402-Token'] = token;
   let reply;
   try {
-    const res = await fetch(path, { method: 'POST', headers, body: JSON.stringify(body) });
+    const res = await fetch(api(path), { method: 'POST', headers, body: JSON.stringify(body) });
     reply = await res.json().catch(() => ({}));
     if (!res.ok) {
       showResult('refused', reply.error || `HTTP ${res.status}`);
@@ -488,6 +497,11 @@ function hexBits(hex) {
 }
 
 function update(s) {
+  if (s.profile && info && s.profile !== info.profile.name) {
+    // The drive runs under another profile now (chosen here or in another page): draw it anew.
+    location.reload();
+    return;
+  }
   snapshot = s;
   received = performance.now();
   el('state-name').textContent = stateLabel(s.state);
@@ -661,6 +675,72 @@ function niceStep(raw) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// The profile (a virtual drive starts again under the one chosen) and the overview of several axes.
+
+function buildProfileChoice() {
+  const wrap = el('profile-choice');
+  if (!info.profiles || info.profiles.length < 2) return;
+  const sel = el('profile-select');
+  for (const p of info.profiles) {
+    const o = document.createElement('option');
+    o.value = p.name;
+    o.textContent = `${p.name}: ${p.title}`;
+    o.selected = p.name === info.profile.name;
+    sel.appendChild(o);
+  }
+  wrap.hidden = false;
+  sel.classList.add('control');
+  sel.addEventListener('change', async () => {
+    const r = await post('/api/profile', { profile: sel.value });
+    if (r) location.reload();
+    else sel.value = info.profile.name;
+  });
+}
+
+function axisHref(k) {
+  const q = new URLSearchParams(location.search);
+  q.set('axis', String(k));
+  return `?${q.toString()}`;
+}
+
+function buildAxes() {
+  if (!info.axes || info.axes < 2) return;
+  el('axes').hidden = false;
+  el('axis-name').textContent = `${info.axis_label}: `;
+  const refresh = async () => {
+    try {
+      const res = await fetch('/api/axes');
+      if (!res.ok) return;
+      const list = await res.json();
+      const nav = el('axes');
+      nav.textContent = '';
+      for (const a of list) {
+        const link = document.createElement('a');
+        link.className = 'axis-card';
+        link.href = axisHref(a.axis);
+        link.dataset.axis = a.axis;
+        if (a.axis === info.axis) link.setAttribute('aria-current', 'page');
+        const name = document.createElement('b');
+        name.textContent = a.label;
+        const state = document.createElement('span');
+        state.className = 'axis-state';
+        state.textContent = a.state ? label(a.state) : '–';
+        const more = document.createElement('span');
+        more.className = 'axis-more';
+        more.textContent = `${a.status_word || ''} · ${a.velocity === null || a.velocity === undefined ? '–' : a.velocity} rpm` +
+          (a.error_code && a.error_code !== '0x0000' ? ` · error ${a.error_code}` : '');
+        link.append(name, state, more);
+        nav.appendChild(link);
+      }
+    } catch (e) {
+      // The stale marking tells that the server is gone.
+    }
+  };
+  refresh();
+  setInterval(refresh, 1000);
+}
+
+// ---------------------------------------------------------------------------------------------
 // The recorder: the server keeps every transition and each cycle where something changed
 // (/api/recording); the page asks for what it has not seen twice a second, lists the transitions
 // newest first and draws the last 30 s as a timeline. The exports are the server's whole recording.
@@ -670,8 +750,8 @@ const TIMELINE_MS = 30000;
 
 async function pollRecording() {
   try {
-    const res = await fetch(
-      `/api/recording?rows_seen=${recorder.rowsSeen}&transitions_seen=${recorder.transitionsSeen}`);
+    const res = await fetch(api(
+      `/api/recording?rows_seen=${recorder.rowsSeen}&transitions_seen=${recorder.transitionsSeen}`));
     if (!res.ok) return;
     const r = await res.json();
     if (r.rows_seen < recorder.rowsSeen || r.transitions_seen < recorder.transitionsSeen) {
@@ -864,7 +944,7 @@ function setControl(allowed) {
 }
 
 function connect() {
-  const source = new EventSource('/api/events');
+  const source = new EventSource(api('/api/events'));
   // While the stream is down every value on the page is old: the whole instrument is marked stale
   // (grayed, controls off) until the next snapshot arrives.
   const stale = (on) => {
@@ -902,12 +982,15 @@ function connect() {
 
 async function main() {
   const headers = token ? { 'X-Cia402-Token': token } : {};
-  const res = await fetch('/api/info', { headers });
+  const res = await fetch(api('/api/info'), { headers });
   info = await res.json();
   const p = info.profile;
   el('profile').textContent = `${p.title} (profile ${p.name})`;
   if (p.seed) el('profile').title = `transition table from the drive manual ${p.seed}`;
   document.title = `${p.name}: instrument control`;
+  for (const a of document.querySelectorAll('.exports a')) a.href = api(a.getAttribute('href'));
+  buildProfileChoice();
+  buildAxes();
   drawDiagram();
   buildBits();
   buildCommands();

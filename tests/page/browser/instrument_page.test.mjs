@@ -519,6 +519,45 @@ async function main() {
   const pr = await stopServer(profibus);
   expect(pr.code === 0, `profibus server exit ${JSON.stringify(pr)}`);
 
+  // --- several axes, and choosing the profile on the page ----------------------------------------
+  const multi = await startServer(['--nodes', '3']);
+  const mp = await context.newPage();
+  currentPage = mp;
+  await mp.setViewportSize({ width: 1280, height: 800 });
+  const cardState = (k) => mp.textContent(`.axis-card[data-axis="${k}"] .axis-state`);
+  await check('--nodes 3: an overview card per axis, the one shown marked', async () => {
+    await mp.goto(multi.url);
+    await waitPresent(mp, 'SWITCH_ON_DISABLED');
+    await mp.waitForFunction(() => document.querySelectorAll('.axis-card').length === 3, null,
+      { timeout: 8000 });
+    expect(await mp.getAttribute('.axis-card[data-axis="1"]', 'aria-current') === 'page', 'axis 1 marked');
+    expect((await mp.textContent('h1')).startsWith('axis 1'), 'the heading names the axis');
+  });
+  await check('--nodes 3: axis 2 is a drive of its own: its Shutdown leaves axes 1 and 3 alone', async () => {
+    await mp.click('.axis-card[data-axis="2"]');
+    await mp.waitForURL(/axis=2/);
+    await waitPresent(mp, 'SWITCH_ON_DISABLED');
+    await click(mp, 'shutdown');
+    await waitPresent(mp, 'READY_TO_SWITCH_ON');
+    await mp.waitForFunction(() => document.querySelector('.axis-card[data-axis="2"] .axis-state')
+      .textContent === 'READY TO SWITCH ON', null, { timeout: 8000 });
+    expect(await cardState(1) === 'SWITCH ON DISABLED' && await cardState(3) === 'SWITCH ON DISABLED',
+      `axes 1 and 3: ${await cardState(1)}, ${await cardState(3)}`);
+    await mp.screenshot({ path: path.join(outDir, 'axes-1280x800.png') });
+  });
+  await check('choosing s300-profibus on the page restarts axis 2 under it, in its own words', async () => {
+    await mp.selectOption('#profile-select', 's300-profibus');
+    await mp.waitForFunction(() => document.getElementById('profile').textContent.includes('s300-profibus'),
+      null, { timeout: 8000 });
+    await waitPresent(mp, 'SWITCH_ON_DISABLED');
+    expect(await mp.textContent('#state-name') === 'Switch-on inhibited', 'seed 003 state name');
+    expect(await mp.locator('button[data-command="halt"]').count() === 0, 'no Halt on PROFIBUS');
+    const r = await (await fetch(`${multi.url.split('?')[0]}api/state?axis=1`)).json();
+    expect(r.profile === 'cia402', `axis 1 runs ${r.profile}`);
+  });
+  const mr = await stopServer(multi);
+  expect(mr.code === 0, `--nodes server exit ${JSON.stringify(mr)}`);
+
   // --- a drive on a CAN bus: cia402 serve --can against a cia402 bus node ----------------------
   const bus = await startBus(['--nodes', '1']);
   const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);

@@ -85,6 +85,13 @@ class backend {
   /// the request (and says so in the `capabilities` of its info).
   virtual reply change_plant(const plant_change& change) = 0;
 
+  /// Runs the drive under another profile (by name): a virtual drive starts again from power-up
+  /// with it. A drive on a bus has the profile it was started with, and refuses.
+  virtual reply select_profile(std::string_view name) {
+    return refused{409, "profile " + std::string(name) +
+                            ": a drive on a bus keeps the profile `cia402 serve --profile` gave it"};
+  }
+
   /// The profile, the bit names, the transition rows, the capabilities: what the page draws once.
   /// `control` tells the page whether its requests will be obeyed.
   virtual std::string info_json(bool control, bool token_required) const = 0;

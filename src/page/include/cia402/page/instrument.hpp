@@ -38,6 +38,9 @@ struct instrument_config {
   std::uint32_t settle_limit = 15000;
   /// Results kept for the page, newest first.
   std::size_t results_kept = 8;
+  /// The profiles the page may switch to (each must outlive the instrument); empty: the built-in
+  /// ones and the instrument's own.
+  std::vector<const profile*> selectable;
 };
 
 class instrument final : public backend {
@@ -58,6 +61,9 @@ class instrument final : public backend {
   reply command(page_command c) override;
   /// Flips one bit (0..15) of the control word.
   reply toggle_control_bit(int bit) override;
+  /// Starts again from power-up under another of the selectable profiles; the recording and the
+  /// control word start over, the results say so.
+  reply select_profile(std::string_view name) override;
   /// Writes an object through the drive's object interface (option codes, ramps, 0x60FF, ...).
   /// A write the drive refuses gives its SDO abort code and changes nothing.
   reply write_object(std::uint16_t index, std::int64_t value) override;

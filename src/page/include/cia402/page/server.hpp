@@ -2,6 +2,7 @@
 // for commands, bit toggles, object writes and plant inputs; live snapshots as Server-Sent Events.
 //
 //   GET  /                 the page (index.html, app.js, style.css)
+//   GET  /api/axes         the overview: each axis's label, profile, state, status word, velocity
 //   GET  /api/info         profile, bit names, transition rows; "control": may this client control
 //   GET  /api/state        the present snapshot
 //   GET  /api/events       text/event-stream: a snapshot at once, then each published one
@@ -13,6 +14,10 @@
 //   POST /api/plant        {"target_velocity":N, "fault":true, "fault_code":"0x1000",
 //                          "fault_class":2, "dc_link":false, "sto":true} (any of them)
 //   POST /api/object       {"index":"0x605A","value":6}
+//   POST /api/profile      {"profile":"s300-profibus"}: a virtual drive starts again under it
+//
+// Every /api/ path but /api/axes takes ?axis=K (1..N) to name one of several drives; without it,
+// the first.
 //
 // Every POST needs Content-Type application/json and a JSON object body of at most
 // server_options::max_body bytes; unknown keys, wrong types and out-of-range values are refused
@@ -26,6 +31,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "cia402/page/backend.hpp"
 
@@ -49,10 +55,19 @@ std::string make_token();
 /// True for 127.0.0.0/8, ::1 and "localhost".
 bool is_loopback_address(std::string_view host);
 
+/// One drive the page serves, and how the overview names it ("axis 2", "node 5").
+struct axis {
+  std::string label;
+  backend* drive = nullptr;
+};
+
 class server {
  public:
   /// The backend (the in-process instrument or a remote drive) must outlive the server.
   server(backend& inst, server_options options);
+  /// Several drives (at least one), each an axis of the page: every /api/ path takes ?axis=K
+  /// (1..N, the first without it). The backends must outlive the server.
+  server(std::vector<axis> axes, server_options options);
   ~server();
   server(const server&) = delete;
   server& operator=(const server&) = delete;
