@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The browser test of the instrument page, as CTest runs it:
-#   run.sh CIA402_BINARY WORK_DIR SCREENSHOT_PNG   (SCREENSHOT_PNG is written with
-#                                                  CIA402_UPDATE_SCREENSHOT=1)
+#   run.sh CIA402_BINARY WORK_DIR SCREENSHOT_PNG   (SCREENSHOT_PNG, and three more pictures beside
+#                                                  it, are written with CIA402_UPDATE_SCREENSHOT=1)
 # Installs playwright-core with `npm ci` from this folder's package-lock.json into WORK_DIR (no
 # browser download: Debian's /usr/bin/chromium is used), then runs instrument_page.test.mjs.
 # Exit 77 (CTest: skipped) with the reason printed when node, npm or chromium is missing, or when
@@ -37,4 +37,12 @@ fi
 
 export CIA402_NODE_MODULES="$work/node_modules"
 export CIA402_CHROMIUM="$chromium"
-exec node "$here/instrument_page.test.mjs" "$cia402" "$work/output" "$screenshot"
+node "$here/instrument_page.test.mjs" "$cia402" "$work/output" "$screenshot"
+# With CIA402_UPDATE_SCREENSHOT=1 the docs' other pictures follow: phone width, several axes, the
+# recorder (the whole page at 1280 px).
+if [ "${CIA402_UPDATE_SCREENSHOT:-0}" = 1 ]; then
+  images=$(dirname "$screenshot")
+  cp "$work/output/phone-390x844.png" "$images/instrument-page-phone.png"
+  cp "$work/output/axes-1280x800.png" "$images/axes.png"
+  cp "$work/output/full-1280.png" "$images/instrument-page-full.png"
+fi
