@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """`cia402 serve --can` end to end, as CTest runs it:  serve_can_test.py CIA402_BINARY
 
-Starts `cia402 bus --listen 127.0.0.1:0 --nodes 1` (a free loopback port, printed by the bus), then
-`cia402 serve --can socketcand://127.0.0.1:PORT/can0 --node 1 --port 0`, and drives the page's HTTP
+Starts `cia402 bus --listen 127.0.0.1:0 --nodes 1-2` (a free loopback port, printed by the bus), then
+`cia402 serve --can socketcand://127.0.0.1:PORT/can0 --node 1 --node 2 --port 0` (two axes), and
+drives the page's HTTP
 API with the standard library only: the node is set up, Shutdown / Switch on / Enable operation
 reach OPERATION ENABLED by the inferred transitions 2, 3, 4 (the standard's numbers, seed
 002_522d2c0bb8f5a5f8.txt); a fault through the bus node's 0x2001 gives FAULT, a reset after the
-cause is gone SWITCH ON DISABLED by 15; STO is refused with the reason; when the bus goes away the
+cause is gone SWITCH ON DISABLED by 15; STO is refused with the reason; node 2 is an axis of its
+own; the recorder holds the inferred transitions; when the bus goes away the
 page says so and the server keeps answering. Both processes are stopped by their PIDs.
 """
 import json
@@ -112,10 +114,10 @@ def main():
     bus = serve = None
     checks = 0
     try:
-        bus = Process([cia402, 'bus', '--listen', '127.0.0.1:0', '--nodes', '1'])
+        bus = Process([cia402, 'bus', '--listen', '127.0.0.1:0', '--nodes', '1-2'])
         port = int(bus.wait_for(r'socketcand on 127\.0\.0\.1:(\d+)').group(1))
         serve = Process([cia402, 'serve', '--can', f'socketcand://127.0.0.1:{port}/can0',
-                         '--node', '1', '--port', '0'])
+                         '--node', '1', '--node', '2', '--port', '0'])
         base = serve.wait_for(r'instrument page at (http://\S+/)').group(1)
 
         s = wait_state(base, lambda s: s['remote']['status'] == 'running', 'set-up of node 1')
@@ -155,6 +157,35 @@ def main():
         checks += 1
         print('ok 4 - fault through 0x2001: FAULT by T13, T14; reset: SWITCH_ON_DISABLED by T15')
 
+        # Node 2: an axis of its own, set up by its own master; its Shutdown leaves node 1 alone.
+        wait_state(base + '', lambda s: True, 'axis 1')
+        deadline = time.monotonic() + 10
+        while True:
+            _, s2 = request(base + 'api/state?axis=2')
+            if s2['remote']['status'] == 'running' or time.monotonic() > deadline:
+                break
+            time.sleep(0.05)
+        assert s2['remote']['status'] == 'running' and s2['remote']['node'] == 2, s2['remote']
+        status, reply = request(base + 'api/command?axis=2', {'command': 'shutdown'})
+        assert status == 200, (status, reply)
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:
+            _, axes = request(base + 'api/axes')
+            if axes[1]['state'] == 'READY_TO_SWITCH_ON':
+                break
+            time.sleep(0.05)
+        assert [a['label'] for a in axes] == ['node 1', 'node 2'], axes
+        assert axes[1]['state'] == 'READY_TO_SWITCH_ON', axes
+        assert axes[0]['state'] == 'SWITCH_ON_DISABLED', axes
+        _, rec = request(base + 'api/recording')
+        numbers = [t['number'] for t in rec['transitions']]
+        assert numbers[-6:] == [2, 3, 4, 13, 14, 15] or numbers[-5:] == [3, 4, 13, 14, 15], numbers
+        assert all(t['inferred'] for t in rec['transitions']), rec['transitions']
+        _, rec2 = request(base + 'api/recording?axis=2')
+        assert [t['number'] for t in rec2['transitions']] == [2], rec2['transitions']
+        checks += 1
+        print('ok 5 - node 2 is an axis of its own; the recorder holds each node\'s inferred transitions')
+
         assert bus.stop() == 0, bus.output
         s = wait_state(base, lambda s: s['remote']['status'] != 'running', 'the bus going away')
         assert s['state'] == 'UNKNOWN', s['state']
@@ -162,7 +193,7 @@ def main():
         status, reply = request(base + 'api/command', {'command': 'shutdown'})
         assert status == 503, (status, reply)
         checks += 1
-        print(f"ok 5 - bus gone: the page says \"{s['remote']['text']}\", commands get 503")
+        print(f"ok 6 - bus gone: the page says \"{s['remote']['text']}\", commands get 503")
 
         assert serve.stop() == 0, serve.output
         print(f'{checks} checks passed')

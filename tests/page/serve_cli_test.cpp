@@ -39,6 +39,10 @@ TEST(cli_serve_can, can_virtual_is_refused_with_a_pointer_to_cia402_bus) {
 TEST(cli_serve_can, node_without_can_or_outside_1_to_127_is_a_usage_error) {
   EXPECT_NE(run_tool({"serve", "--node", "3", "--port", "0"}).status, 0);
   EXPECT_NE(run_tool({"serve", "--can", "socketcand://127.0.0.1:1/can0", "--node", "128"}).status, 0);
+  // --nodes N is for virtual drives; on a bus each drive is named by --node.
+  EXPECT_EQ(run_tool({"serve", "--can", "socketcand://127.0.0.1:1/can0", "--nodes", "2"}).status, 2);
+  EXPECT_EQ(run_tool({"serve", "--nodes", "17", "--port", "0"}).status, 2);
+  EXPECT_EQ(run_tool({"serve", "--nodes", "0", "--port", "0"}).status, 2);
 }
 
 TEST(cli_serve_can, a_bus_nobody_listens_on_fails_with_status_1_and_says_why) {
