@@ -255,6 +255,27 @@ TEST_F(pdo_test, cob_id_rules_give_0x06090030) {
   EXPECT_EQ(write(0x1400, 2, 253, 1), 0x06090030u);
 }
 
+// A node must not be silenced by its own configuration: an identifier of its own services, or one
+// another of its PDOs or SYNC uses, is refused for SYNC and for every PDO (0x06090030), and the
+// node still answers SDO afterwards.
+TEST_F(pdo_test, cob_ids_that_collide_with_the_nodes_own_services_are_refused) {
+  const std::uint32_t own_sdo_request = 0x600 + id;
+  for (const std::uint32_t taken : {own_sdo_request, 0x580u + id, 0x700u + id, 0x000u,
+                                    0x203u /* RPDO1 */, 0x183u /* TPDO1 */}) {
+    EXPECT_EQ(write(0x1005, 0, taken, 4), 0x06090030u) << std::hex << taken;
+  }
+  EXPECT_EQ(write(0x1005, 0, 0x090, 4), 0u);  // a free identifier is taken
+  // PDOs: not SYNC, not the node's EMCY, not another PDO in use.
+  ASSERT_EQ(write(0x1800, 1, 0x80000183, 4), 0u);
+  EXPECT_EQ(write(0x1800, 1, 0x090, 4), 0x06090030u);      // now the SYNC identifier
+  EXPECT_EQ(write(0x1800, 1, 0x080 + id, 4), 0x06090030u); // this node's EMCY
+  EXPECT_EQ(write(0x1800, 1, 0x283, 4), 0x06090030u);      // TPDO2 sends on it
+  EXPECT_EQ(write(0x1800, 1, 0x203, 4), 0x06090030u);      // RPDO1 receives on it
+  EXPECT_EQ(write(0x1800, 1, 0x1F3, 4), 0u);               // free
+  // Still reachable: an SDO upload is answered, not taken as SYNC.
+  EXPECT_EQ(write(0x1017, 0, 100, 2), 0u);
+}
+
 TEST_F(pdo_test, inhibit_time_of_a_valid_tpdo_cannot_change) {
   EXPECT_EQ(write(0x1800, 3, 10, 2), 0x06090030u);
   ASSERT_EQ(write(0x1800, 1, 0x80000183, 4), 0u);

@@ -168,8 +168,11 @@ sdo_abort slave::write_checked(object_dictionary::slot& s, std::int64_t v) {
   const auto u = static_cast<std::uint32_t>(v);
   switch (index) {
     case 0x1005:
-      // This node consumes SYNC only (bit 30 would make it the producer); 11-bit identifiers.
-      if ((u & 0x7FFFF800u) != 0) return sdo_abort::invalid_value;
+      // This node consumes SYNC only (bit 30 would make it the producer); 11-bit identifiers; an
+      // identifier of its own services taken as SYNC would silence them.
+      if ((u & 0x7FFFF800u) != 0 || cob_id_taken(u & max_base_id, 0x1005)) {
+        return sdo_abort::invalid_value;
+      }
       s.number = v;
       sync_id_ = u & max_base_id;
       return sdo_abort::none;
@@ -199,6 +202,26 @@ sdo_abort slave::write_checked(object_dictionary::slot& s, std::int64_t v) {
       s.number = v;
       return sdo_abort::none;
   }
+}
+
+bool slave::cob_id_taken(std::uint32_t id, std::uint16_t writing) const {
+  // NMT, SDO, heartbeat, LSS and the other identifiers CiA 301 §7.3.5 keeps from configuration.
+  if (restricted_can_id(id)) return true;
+  if (writing != 0x1005 && id == sync_id_) return true;
+  if (writing != 0x1014 && od_.find(0x1014, 0) != nullptr &&
+      id == (static_cast<std::uint32_t>(od_.number(0x1014, 0)) & max_base_id)) {
+    return true;
+  }
+  // Every PDO in use, receive or transmit, but the one being written.
+  for (const std::uint16_t base : {std::uint16_t{0x1400}, std::uint16_t{0x1800}}) {
+    for (std::uint16_t n = 0; n < 4; ++n) {
+      const auto comm = static_cast<std::uint16_t>(base + n);
+      if (comm == writing || od_.find(comm, 1) == nullptr) continue;
+      const auto other = static_cast<std::uint32_t>(od_.number(comm, 1));
+      if ((other & pdo_cob_invalid) == 0 && (other & max_base_id) == id) return true;
+    }
+  }
+  return false;
 }
 
 sdo_abort slave::read(std::uint16_t index, std::uint8_t sub, std::int64_t& value) {

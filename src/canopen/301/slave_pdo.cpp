@@ -165,7 +165,7 @@ sdo_abort slave::write_pdo_parameter(object_dictionary::slot& s, std::int64_t v)
         // Bits 11..29 (29-bit identifiers are not offered) must be 0; a valid PDO keeps its
         // CAN-ID; an enabled PDO needs a mapping and an identifier it may use.
         if ((u & 0x3FFFF800u) != 0 || (valid && cfg.valid && can_id != cfg.can_id) ||
-            (valid && restricted_can_id(can_id)) || (valid && cfg.count == 0)) {
+            (valid && cob_id_taken(can_id, comm)) || (valid && cfg.count == 0)) {
           return sdo_abort::invalid_value;
         }
         break;

@@ -135,6 +135,9 @@ class slave final : private object_access, private device_events {
   void error_changed(std::uint16_t code) noexcept override;
 
   sdo_abort write_checked(object_dictionary::slot& s, std::int64_t v);
+  /// A CAN identifier this node may not take for `writing` (0x1005, 0x1014 or a PDO's communication
+  /// object): reserved by CiA 301, or already SYNC, this node's EMCY or another PDO in use.
+  bool cob_id_taken(std::uint32_t id, std::uint16_t writing) const;
   sdo_abort write_pdo_parameter(object_dictionary::slot& s, std::int64_t v);
   sdo_abort read_value(const object_dictionary::slot& s, std::int64_t& v);
   sdo_abort check_mapping_entry(bool receive, std::uint32_t entry) const;
