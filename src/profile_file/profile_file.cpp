@@ -513,6 +513,9 @@ const char* state_activity_name(state_activity a) noexcept {
 
 profile_load_result load_profile_toml(std::string_view text, std::string_view source_name) {
   const std::string name(source_name);
+  if (const auto bad = toml_reading::check_toml_text(text)) {
+    return profile_file_error{bad->line, bad->column, bad->reason, name};
+  }
   try {
     const toml::table root = toml::parse(text, std::string_view(name));
     return load(root);
@@ -526,12 +529,10 @@ profile_load_result load_profile_toml(std::string_view text, std::string_view so
 }
 
 profile_load_result load_profile_toml_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return profile_file_error{0, 0, "cannot open the file", path};
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return profile_file_error{0, 0, "cannot read the file", path};
-  return load_profile_toml(text.str(), path);
+  std::string why;
+  const std::optional<std::string> text = toml_reading::read_small_file(path, why);
+  if (!text) return profile_file_error{0, 0, why, path};
+  return load_profile_toml(*text, path);
 }
 
 std::string dump_profile_toml(const profile& p) {

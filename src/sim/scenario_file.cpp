@@ -165,6 +165,11 @@ struct loader {
     if (by_name && by_file) refuse(*by_file, "give either 'profile' or 'profile_file', not both");
     if (by_file) {
       const std::string_view file = get_string(*by_file, "profile_file");
+      // A scenario names a profile file, never any file: one that is not a .toml file is not read,
+      // so a scenario cannot make the tool open a device or show a line of a foreign file.
+      if (file.size() < 6 || file.substr(file.size() - 5) != ".toml") {
+        refuse(*by_file, "profile_file must name a .toml profile file");
+      }
       std::filesystem::path path(file);
       if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
       profile_load_result loaded = load_profile_toml_file(path.string());
@@ -573,6 +578,9 @@ const char* invariant_name(invariant i) noexcept {
 scenario_load_result load_scenario_toml(std::string_view text, std::string_view source_name,
                                         const std::string& base_dir) {
   const std::string name(source_name);
+  if (const auto bad = toml_reading::check_toml_text(text)) {
+    return scenario_error{bad->line, bad->column, bad->reason, name};
+  }
   try {
     const toml::table root = toml::parse(text, std::string_view(name));
     loader l;
@@ -591,13 +599,11 @@ scenario_load_result load_scenario_toml(std::string_view text, std::string_view 
 }
 
 scenario_load_result load_scenario_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return scenario_error{0, 0, "cannot open the file", path};
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return scenario_error{0, 0, "cannot read the file", path};
+  std::string why;
+  const std::optional<std::string> text = toml_reading::read_small_file(path, why);
+  if (!text) return scenario_error{0, 0, why, path};
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  return load_scenario_toml(text.str(), path, dir.empty() ? std::string(".") : dir.string());
+  return load_scenario_toml(*text, path, dir.empty() ? std::string(".") : dir.string());
 }
 
 }  // namespace cia402::sim

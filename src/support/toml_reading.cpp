@@ -1,6 +1,9 @@
 #include "cia402/support/toml_reading.hpp"
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <system_error>
 #include <utility>
 
 namespace cia402::toml_reading {
@@ -87,6 +90,153 @@ const toml::table& get_table(const toml::node& n, std::string_view what) {
   const auto* v = n.as_table();
   if (v == nullptr) refuse_type(n, what, "a table");
   return *v;
+}
+
+namespace {
+
+// Length of the UTF-8 sequence starting at text[i] (1..4), or 0 when it is not one (overlong
+// forms, surrogates, above U+10FFFF, truncated).
+std::size_t utf8_length(std::string_view text, std::size_t i) {
+  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char c = b(i);
+  if (c < 0x80) return 1;
+  std::size_t n = 0;
+  unsigned char lo = 0x80;
+  unsigned char hi = 0xBF;
+  if (c >= 0xC2 && c <= 0xDF) {
+    n = 2;
+  } else if (c >= 0xE0 && c <= 0xEF) {
+    n = 3;
+    if (c == 0xE0) lo = 0xA0;
+    if (c == 0xED) hi = 0x9F;
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    n = 4;
+    if (c == 0xF0) lo = 0x90;
+    if (c == 0xF4) hi = 0x8F;
+  } else {
+    return 0;
+  }
+  if (i + n > text.size()) return 0;
+  if (b(i + 1) < lo || b(i + 1) > hi) return 0;
+  for (std::size_t k = 2; k < n; ++k) {
+    if (b(i + k) < 0x80 || b(i + k) > 0xBF) return 0;
+  }
+  return n;
+}
+
+}  // namespace
+
+std::optional<refusal> check_toml_text(std::string_view text) {
+  if (text.size() > max_file_bytes) {
+    return refusal{0, 0, "larger than " + std::to_string(max_file_bytes) + " bytes"};
+  }
+  enum class in { code, comment, basic, literal, multi_basic, multi_literal };
+  in where = in::code;
+  int line = 1;
+  int column = 1;
+  const auto at = [&](std::size_t i, std::string_view s) { return text.substr(i, s.size()) == s; };
+  for (std::size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    if (c == '\0') return refusal{line, column, "a NUL byte"};
+    const std::size_t n = utf8_length(text, i);
+    if (n == 0) return refusal{line, column, "not UTF-8 text"};
+    if (n > 1 && where == in::code) {
+      return refusal{line, column, "a non-ASCII character outside a string or comment"};
+    }
+    std::size_t step = n;
+    bool escaped = false;  // a backslash and the character after it
+    switch (where) {
+      case in::code:
+        if (c == '#') {
+          where = in::comment;
+        } else if (at(i, "\"\"\"")) {
+          where = in::multi_basic;
+          step = 3;
+        } else if (at(i, "'''")) {
+          where = in::multi_literal;
+          step = 3;
+        } else if (c == '"') {
+          where = in::basic;
+        } else if (c == '\'') {
+          where = in::literal;
+        }
+        break;
+      case in::comment:
+        if (c == '\n') where = in::code;
+        break;
+      case in::basic:
+        if (c == '\\' && i + 1 < text.size() && text[i + 1] != '\n') {
+          escaped = true;
+        } else if (c == '"' || c == '\n') {
+          where = in::code;
+        }
+        break;
+      case in::literal:
+        if (c == '\'' || c == '\n') where = in::code;
+        break;
+      case in::multi_basic:
+        if (c == '\\' && i + 1 < text.size() && text[i + 1] != '\n') {
+          escaped = true;
+        } else if (at(i, "\"\"\"")) {
+          where = in::code;
+          step = 3;
+        }
+        break;
+      case in::multi_literal:
+        if (at(i, "'''")) {
+          where = in::code;
+          step = 3;
+        }
+        break;
+    }
+    if (escaped) {
+      // The escaped character may be a multi-byte one: take it whole.
+      const std::size_t m = utf8_length(text, i + 1);
+      if (m == 0) return refusal{line, column + 1, "not UTF-8 text"};
+      step = 1 + m;
+    }
+    for (std::size_t k = i; k < i + step && k < text.size(); ++k) {
+      if (text[k] == '\n') {
+        ++line;
+        column = 1;
+      } else if ((static_cast<unsigned char>(text[k]) & 0xC0) != 0x80) {
+        ++column;
+      }
+    }
+    i += step;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> read_small_file(const std::string& path, std::string& why) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st)) {
+    why = "cannot open the file";
+    return std::nullopt;
+  }
+  if (!std::filesystem::is_regular_file(st)) {
+    why = "not a regular file";
+    return std::nullopt;
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    why = "cannot open the file";
+    return std::nullopt;
+  }
+  // Read at most one byte more than allowed: a file too large is refused without reading it all.
+  std::string text(max_file_bytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) {
+    why = "cannot read the file";
+    return std::nullopt;
+  }
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > max_file_bytes) {
+    why = "larger than " + std::to_string(max_file_bytes) + " bytes";
+    return std::nullopt;
+  }
+  return text;
 }
 
 }  // namespace cia402::toml_reading

@@ -2,10 +2,9 @@
 // Line numbers are counted in the test texts themselves.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 #include <variant>
-
-#include <string>
 
 #include "cia402/profile_file.hpp"
 #include "helpers.hpp"
@@ -38,6 +37,47 @@ std::string rows(int n) {
 
 TEST(profile_file_errors, toml_syntax_error_is_refused_at_its_line) {
   expect_refused("base = \"cia402\"\nname = \"x\"\nspeed_limit_rpm = = 3\n", 3, 0, "");
+}
+
+// toml++ 3.3.0 reaches undefined behaviour on some non-ASCII input (the two bytes 0xD0 0xB9 among
+// them, found by fuzzing): the text is checked before the parser sees it.
+TEST(profile_file_errors, non_ascii_outside_strings_and_invalid_utf8_never_reach_the_parser) {
+  expect_refused("\xd0\xb9", 1, 1, "non-ASCII character outside a string or comment");
+  expect_refused("base = \"cia402\"\nname = x\xd0\xb9\n", 2, 9, "non-ASCII");
+  expect_refused("base = \"cia402\"\nname = \"\xcf\"\n", 2, 9, "not UTF-8");
+  expect_refused("base = \"cia402\"\nname = \"\xed\xa0\x80\"\n", 2, 9, "not UTF-8");  // a surrogate
+  expect_refused("base = \"cia402\"\nname = \"\xc0\xaf\"\n", 2, 9, "not UTF-8");      // overlong
+  expect_refused(std::string("base = \"cia402\"\0\n", 17), 1, 16, "NUL");
+  // In strings and comments UTF-8 is welcome.
+  const auto ok = load_profile_toml(
+      "# \xc3\x9c" "bergang, \xd0\xb9\nbase = \"cia402\"\nname = \"x\"\n"
+      "title = \"Fr\xc3\xa4sspindel \\\"\xd0\xb9\\\" '''\"\n",
+      "test.toml");
+  ASSERT_TRUE(std::holds_alternative<custom_profile>(ok))
+      << std::get<profile_file_error>(ok).message();
+  EXPECT_EQ(std::string(std::get<custom_profile>(ok).get().title),
+            "Fr\xc3\xa4sspindel \"\xd0\xb9\" '''");
+}
+
+TEST(profile_file_errors, only_a_regular_file_of_at_most_1_mib_is_read) {
+  for (const char* path : {"/dev/zero", "/dev/null", "/tmp"}) {
+    const auto r = load_profile_toml_file(path);
+    ASSERT_TRUE(std::holds_alternative<profile_file_error>(r)) << path;
+    EXPECT_EQ(std::get<profile_file_error>(r).reason, "not a regular file") << path;
+  }
+  const std::string big = ::testing::TempDir() + "cia402-big-profile.toml";
+  {
+    std::FILE* f = std::fopen(big.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    const std::string line(1023, '#');
+    for (int i = 0; i < 1025; ++i) std::fprintf(f, "%s\n", line.c_str());
+    std::fclose(f);
+  }
+  const auto r = load_profile_toml_file(big);
+  ASSERT_TRUE(std::holds_alternative<profile_file_error>(r));
+  EXPECT_NE(std::get<profile_file_error>(r).reason.find("larger than 1048576 bytes"),
+            std::string::npos);
+  std::remove(big.c_str());
 }
 
 TEST(profile_file_errors, unterminated_array_is_refused) {

@@ -110,6 +110,11 @@ TEST(scenario_file, the_profile_must_exist) {
   expect_refusal(header + "profile = \"cia402\"\nprofile_file = \"custom-drive.toml\"\n", 5,
                  "either");
   expect_refusal(header + "profile_file = \"no-such-file.toml\"\n", 4, "cannot open");
+  // Only a .toml file is read, and only a regular one: never a device, a FIFO or a foreign file
+  // whose lines an error would show.
+  expect_refusal(header + "profile_file = \"/dev/zero\"\n", 4, "must name a .toml profile file");
+  expect_refusal(header + "profile_file = \"/etc/passwd\"\n", 4, "must name a .toml profile file");
+  expect_refusal(header + "profile_file = \"/dev/stdin\"\n", 4, "must name a .toml profile file");
 }
 
 TEST(scenario_file, a_profile_file_is_found_next_to_the_scenario) {

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -41,5 +42,18 @@ std::string_view get_string(const toml::node& n, std::string_view what);
 bool get_bool(const toml::node& n, std::string_view what);
 const toml::array& get_array(const toml::node& n, std::string_view what);
 const toml::table& get_table(const toml::node& n, std::string_view what);
+
+/// The largest profile or scenario file read (the built-in ones are a few KiB).
+inline constexpr std::size_t max_file_bytes = 1 << 20;
+
+/// Checks text before the TOML parser sees it, because toml++ 3.3.0 (Debian 12's) reaches
+/// undefined behaviour on some non-ASCII input: at most max_file_bytes, no NUL, valid UTF-8, and
+/// non-ASCII characters only inside strings and comments (keys and bare values are ASCII in every
+/// format the project reads). The refusal names the line and column of the first offending byte.
+std::optional<refusal> check_toml_text(std::string_view text);
+
+/// The contents of a regular file of at most max_file_bytes, or the reason it cannot be had (not
+/// a regular file: a device, a FIFO, a directory; too large; unreadable). Never echoes the file.
+std::optional<std::string> read_small_file(const std::string& path, std::string& why);
 
 }  // namespace cia402::toml_reading
