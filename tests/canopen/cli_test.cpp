@@ -160,6 +160,11 @@ TEST(cli_bus, bad_options_are_refused_before_listening) {
   EXPECT_EQ(run_tool({"bus", "--nodes", "1,1"}).status, 2);
   EXPECT_EQ(run_tool({"bus", "--listen", "nowhere"}).status, 2);
   EXPECT_EQ(run_tool({"bus", "--profile", "nosuch"}).status, 2);
+  // socketcand has no authentication: beyond loopback only when asked for by name.
+  const result remote = run_tool({"bus", "--listen", "0.0.0.0:0"});
+  EXPECT_EQ(remote.status, 2);
+  EXPECT_NE(remote.err.find("no authentication"), std::string::npos) << remote.err;
+  EXPECT_NE(remote.err.find("--allow-remote"), std::string::npos) << remote.err;
 }
 
 TEST(cli_bus, node_lists_parse_ranges_and_singles) {

@@ -227,6 +227,57 @@ TEST_F(socketcand_server_test, seventeenth_client_is_refused_and_the_others_go_o
   EXPECT_FALSE(peers[15]->take().empty());
 }
 
+// A client that writes and closes at once: every frame it sent reaches the bus, whatever the
+// number of bytes (exactly 4,096 and 8,192 were the sizes that lost frames: the read that filled
+// the buffer was followed by EOF, and the connection was dropped before its bytes were handled).
+TEST_F(socketcand_server_test, frames_sent_together_with_a_close_all_reach_the_bus) {
+  for (const std::size_t total : {4095u, 4096u, 4097u, 8192u}) {
+    auto listener = join();
+    auto sender = join();
+    // "< send 123 1 00 >" is 17 bytes; pad the first element with spaces to hit `total` exactly.
+    const std::string element = "< send 123 1 00 >";
+    const std::size_t count = total / element.size();
+    std::string burst(total - count * element.size(), ' ');
+    for (std::size_t i = 0; i < count; ++i) burst += element;
+    ASSERT_EQ(burst.size(), total);
+    sender->send(burst);
+    sender->close();
+    std::string got;
+    for (int i = 0; i < 20; ++i) {
+      spin();
+      got += listener->take();
+    }
+    std::size_t frames = 0;
+    for (std::size_t at = got.find("< frame 123 "); at != std::string::npos;
+         at = got.find("< frame 123 ", at + 1)) {
+      ++frames;
+    }
+    EXPECT_EQ(frames, count) << total << " bytes";
+    listener->close();
+    spin(2);
+  }
+}
+
+// Connections that never open the bus are dropped after open_timeout_us, so they cannot hold
+// every slot; a client that opened stays however quiet it is.
+TEST_F(socketcand_server_test, a_client_that_never_opens_the_bus_is_dropped_after_the_timeout) {
+  socketcand::server_config cfg;
+  cfg.open_timeout_us = 50000;
+  start(cfg);
+  auto quiet_but_open = join();
+  std::vector<std::unique_ptr<tcp_peer>> idle;
+  for (int i = 0; i < 15; ++i) {
+    idle.push_back(std::make_unique<tcp_peer>(srv->port()));
+    spin();
+  }
+  EXPECT_EQ(srv->clients(), 16u);
+  spin(60);  // 60 ms of bus time
+  EXPECT_EQ(srv->clients(), 1u);
+  EXPECT_NE(idle[0]->take().find("< error no open within the time allowed >"), std::string::npos);
+  auto newcomer = join();  // a slot is free again
+  EXPECT_EQ(srv->clients(), 2u);
+}
+
 TEST_F(socketcand_server_test, client_that_never_reads_is_dropped_without_stalling_the_others) {
   socketcand::server_config cfg;
   cfg.max_backlog = 8192;

@@ -9,6 +9,7 @@
 #include "cia402/apps/bus_host.hpp"
 #include "cia402/canopen/402/drive_objects.hpp"
 #include "cia402/canopen/transport/socketcand.hpp"
+#include "cia402/page/server.hpp"
 #include "cli/common.hpp"
 
 namespace cia402::cli {
@@ -72,8 +73,13 @@ CLI::App* add_bus_subcommand(CLI::App& app, bus_args& args) {
       "bus",
       "Serve a virtual CAN bus over socketcand (TCP) with virtual CiA 402 drives as CANopen nodes, "
       "stepping in real time until SIGINT/SIGTERM");
-  cmd->add_option("--listen", args.listen, "HOST:PORT to listen on; port 0 picks a free one")
+  cmd->add_option("--listen", args.listen,
+                  "HOST:PORT to listen on; port 0 picks a free one; anything but loopback needs "
+                  "--allow-remote")
       ->default_str("127.0.0.1:29536");
+  cmd->add_flag("--allow-remote", args.allow_remote,
+                "listen beyond loopback although socketcand has no authentication: whoever reaches "
+                "the port controls the drives");
   cmd->add_option("--nodes", args.nodes, "node-IDs of the drives: 1-4, 2, 1,5,9")->default_str("1-4");
   add_profile_options(*cmd, args.profile, args.profile_file);
   cmd->add_option("--bus-name", args.bus_name, "the bus name clients open")->default_str("can0");
@@ -92,6 +98,13 @@ int run_bus(const bus_args& args, std::ostream& out, std::ostream& err) {
   canopen::socketcand::server_config config;
   if (!split_host_port(args.listen, config.host, config.port, why)) {
     err << "cia402 bus: --listen " << args.listen << ": " << why << "\n";
+    return usage_error;
+  }
+  if (!page::is_loopback_address(config.host) && !args.allow_remote) {
+    err << "cia402 bus: --listen " << args.listen
+        << ": socketcand has no authentication, so whoever reaches that address controls every "
+           "drive on the bus; listen on loopback (127.0.0.1), or add --allow-remote on a network "
+           "you trust\n";
     return usage_error;
   }
   config.bus_name = args.bus_name;

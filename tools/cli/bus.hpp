@@ -17,6 +17,7 @@ namespace cia402::cli {
 
 struct bus_args {
   std::string listen = "127.0.0.1:29536";  ///< HOST:PORT; port 0 = any free port (printed)
+  bool allow_remote = false;  ///< listen beyond loopback (socketcand has no authentication)
   std::string nodes = "1-4";               ///< "1-4", "2", "1,5,9"
   std::string profile = "cia402";
   std::string profile_file;

@@ -20,6 +20,7 @@ struct server::client {
   std::unique_ptr<virtual_channel> ch;  // attached on open
   std::string out;
   std::uint64_t raw_since_us = 0;
+  std::uint64_t since_us = 0;  // when it connected
   bool closing = false;  // close once `out` is written
   bool dead = false;
   explicit client(std::size_t max_line) : reader(max_line) {}
@@ -52,7 +53,8 @@ std::error_code server::open() {
     return std::make_error_code(std::errc::invalid_argument);
   }
   if (::bind(listen_fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) return last_error();
-  if (::listen(listen_fd_, 16) != 0) return last_error();
+  // Room for a burst of connects: a full queue makes clients wait for SYN retries (1 s each).
+  if (::listen(listen_fd_, SOMAXCONN) != 0) return last_error();
   socklen_t len = sizeof addr;
   ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&addr), &len);
   port_ = ntohs(addr.sin_port);
@@ -98,6 +100,7 @@ void server::accept_clients() {
     }
     auto c = std::make_unique<client>(config_.max_line);
     c->fd = fd;
+    c->since_us = now_us_;
     queue(*c, "< hi >");
     write_out(*c);
     clients_.push_back(std::move(c));
@@ -106,6 +109,7 @@ void server::accept_clients() {
 
 void server::read_client(client& c) {
   char buf[4096];
+  bool peer_gone = false;
   for (;;) {
     const ssize_t n = ::read(c.fd, buf, sizeof buf);
     if (n > 0) {
@@ -113,10 +117,9 @@ void server::read_client(client& c) {
       if (static_cast<std::size_t>(n) < sizeof buf) break;
       continue;
     }
-    if (n == 0 || (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) {
-      drop(c);  // the peer closed (perhaps mid-transfer): its nodes time out by themselves
-      return;
-    }
+    // The peer closed (perhaps mid-transfer): what it sent before is still handled below, so a
+    // client that writes and closes at once loses nothing.
+    if (n == 0 || (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) peer_gone = true;
     break;
   }
   std::string element;
@@ -130,7 +133,24 @@ void server::read_client(client& c) {
     }
     handle(c, element);
   }
+  if (peer_gone) {
+    drop(c);  // its nodes time out by themselves
+    return;
+  }
   if (!c.dead) write_out(c);
+}
+
+void server::advance(std::uint32_t elapsed_us) noexcept {
+  now_us_ += elapsed_us;
+  // A client that has not opened the bus within open_timeout_us holds a slot for nothing.
+  for (auto& c : clients_) {
+    if (!c->dead && c->m == client::mode::no_bus && now_us_ - c->since_us >= config_.open_timeout_us) {
+      static constexpr char refusal[] = "< error no open within the time allowed >";
+      (void)!::send(c->fd, refusal, sizeof refusal - 1, MSG_NOSIGNAL);
+      ++errors_sent_;
+      drop(*c);
+    }
+  }
 }
 
 void server::handle(client& c, std::string_view element) {

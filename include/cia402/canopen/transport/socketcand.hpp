@@ -73,6 +73,9 @@ struct server_config {
   std::size_t max_line = 256;
   std::size_t max_backlog = 1u << 20;  ///< bytes of unsent output before a client is dropped
   std::uint32_t join_grace_us = 100000;
+  /// A client must `open` the bus within this time (bus time, advance()) or it is dropped, so
+  /// idle connections cannot hold every slot.
+  std::uint64_t open_timeout_us = 10000000;
 };
 
 /// A virtual CAN bus served over TCP. Every client is a channel on `bus`, so it sees every other
@@ -91,8 +94,8 @@ class server {
   /// Waits up to `timeout_ms` for sockets, then accepts and reads whatever is ready; frames the
   /// clients send go onto the bus at once.
   void poll_sockets(int timeout_ms);
-  /// Advances the time stamped on frames and the join grace.
-  void advance(std::uint32_t elapsed_us) noexcept { now_us_ += elapsed_us; }
+  /// Advances the time stamped on frames, the join grace and the open timeout.
+  void advance(std::uint32_t elapsed_us) noexcept;
   /// Writes the bus's frames to the clients in raw mode (call after the nodes ran).
   void flush();
 
