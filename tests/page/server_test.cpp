@@ -239,8 +239,45 @@ TEST_F(page_server, wrong_content_type_is_415_and_changes_nothing) {
   const json before = observable();
   expect_refused(post("/api/command", R"({"command":"shutdown"})", {}, "text/plain"), 415,
                  "application/json");
+  // A type that only starts with application/json is another type.
+  for (const char* type : {"application/jsonx", "application/json-seq", "application/json5"}) {
+    expect_refused(post("/api/command", R"({"command":"shutdown"})", {}, type), 415,
+                   "application/json");
+  }
   step(5);
   EXPECT_EQ(observable(), before);
+  // Parameters are allowed, and the type is case-insensitive.
+  const auto ok = post("/api/command", R"({"command":"shutdown"})", {},
+                       "Application/JSON; charset=utf-8");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200) << ok->body;
+}
+
+TEST_F(page_server, a_key_given_twice_is_400_and_changes_nothing) {
+  start(false);
+  const json before = observable();
+  expect_refused(post("/api/command", R"({"command":"shutdown","command":"switch_on"})"), 400,
+                 "given twice");
+  expect_refused(post("/api/plant", R"({"sto":false,"sto":true})"), 400, "given twice");
+  step(5);
+  EXPECT_EQ(observable(), before);
+}
+
+TEST_F(page_server, kept_alive_requests_are_answered_without_a_delayed_ack_wait) {
+  start(false);
+  // 20 requests on one kept-alive connection: with Nagle on each waited ~40 ms for an ACK.
+  client->set_keep_alive(true);
+  client->set_tcp_nodelay(true);  // the client's own writes must not wait either
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 20; ++i) {
+    const auto r = post("/api/command", R"({"command":"toggle_bit","bit":11})");
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200);
+  }
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                      std::chrono::steady_clock::now() - t0).count();
+  // 20 x 40 ms would be 800 ms; a loaded machine still answers well below that.
+  EXPECT_LT(ms, 400) << ms << " ms for 20 requests";
 }
 
 TEST_F(page_server, option_write_refused_by_the_drive_is_422_with_its_sdo_abort) {

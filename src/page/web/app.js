@@ -5,7 +5,19 @@
 
 const SVG = 'http://www.w3.org/2000/svg';
 const params = new URLSearchParams(location.search);
-const token = params.get('token') || '';
+// The token printed by `cia402 serve` arrives in the URL once; it is kept for this tab only
+// (sessionStorage) and taken out of the address bar and the history at once.
+const token = (() => {
+  const given = params.get('token');
+  if (given) {
+    try { sessionStorage.setItem('cia402-token', given); } catch (e) { /* storage off: URL only */ }
+    params.delete('token');
+    const rest = params.toString();
+    history.replaceState(null, '', `${location.pathname}${rest ? `?${rest}` : ''}${location.hash}`);
+    return given;
+  }
+  try { return sessionStorage.getItem('cia402-token') || ''; } catch (e) { return ''; }
+})();
 // Which of the server's drives this page shows (?axis=K; the first without it).
 const axisParam = params.get('axis') || '';
 

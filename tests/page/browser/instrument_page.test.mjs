@@ -479,6 +479,15 @@ async function main() {
     await expectPresentState(viewer, 'READY_TO_SWITCH_ON');
     await expectAccented(viewer, 2);
   });
+  await check('the token leaves the address bar at once and control survives a reload', async () => {
+    const address = await viewer.evaluate(() => location.href);
+    expect(!address.includes('token'), `address bar still shows ${address}`);
+    await viewer.reload();
+    await waitPresent(viewer, 'READY_TO_SWITCH_ON');
+    expect(await viewer.isHidden('#view-only'), 'view-only after a reload');
+    await click(viewer, 'disable_voltage');
+    await expectPresentState(viewer, 'SWITCH_ON_DISABLED');
+  });
   const r = await stopServer(guarded);
   expect(r.code === 0, `guarded server exit ${JSON.stringify(r)}`);
 
