@@ -1,6 +1,7 @@
 #include "cia402/page/server.hpp"
 
 #include <arpa/inet.h>
+#include <sys/socket.h>
 #include <httplib.h>
 
 #include <nlohmann/json.hpp>
@@ -30,6 +31,13 @@ void send_json(httplib::Response& res, int status, const json& body) {
 
 void send_error(httplib::Response& res, int status, const std::string& reason) {
   send_json(res, status, json{{"error", reason}});
+}
+
+// A Content-Length of digits only, at most `max`.
+bool length_within(const std::string& text, std::size_t max) {
+  std::size_t n = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+  return ec == std::errc() && end == text.data() + text.size() && !text.empty() && n <= max;
 }
 
 // Equal-time comparison, so the time a refusal takes tells nothing about the token.
@@ -130,6 +138,7 @@ struct server::impl {
 
   std::vector<axis> axes;
   server_options options;
+  int listen_fd = -1;  // the listening socket, once bound
   httplib::Server http;
   std::thread thread;
   std::atomic<bool> stopping{false};
@@ -325,15 +334,37 @@ struct server::impl {
     // cpp-httplib's default sets SO_REUSEPORT, so a second `cia402 serve` on the same port would
     // listen too and the two would answer in turn. SO_REUSEADDR alone still allows a restart while
     // old connections linger, and makes the second bind fail.
-    http.set_socket_options([](socket_t sock) {
+    http.set_socket_options([this](socket_t sock) {
       const int yes = 1;
       ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+      listen_fd = sock;
     });
     http.set_payload_max_length(options.max_body);
+    // A client that sends its request slowly holds a worker only this long per read.
+    http.set_read_timeout(options.read_timeout);
+    http.set_write_timeout(std::chrono::seconds(5));
+    // What a request may bring is checked on its head, before any body is read: a chunked body (no
+    // length known before it is read whole), a length over max_body, too many header lines.
+    http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+      std::optional<request_error> e;
+      if (req.has_header("Transfer-Encoding")) {
+        e = request_error{411, "chunked bodies are not accepted: send Content-Length"};
+      } else if (req.has_header("Content-Length") &&
+                 !length_within(req.get_header_value("Content-Length"), options.max_body)) {
+        e = request_error{413, "body larger than " + std::to_string(options.max_body) + " bytes"};
+      } else if (req.headers.size() > options.max_headers) {
+        e = request_error{431, "more than " + std::to_string(options.max_headers) + " header lines"};
+      }
+      if (!e) return httplib::Server::HandlerResponse::Unhandled;
+      // The unread body must not be taken for the next request: this connection ends here.
+      res.set_header("Connection", "close");
+      send_error(res, e->status, e->reason);
+      return httplib::Server::HandlerResponse::Handled;
+    });
     // Small answers on kept-alive connections: without it each waited ~40 ms for a delayed ACK.
     http.set_tcp_nodelay(true);
     // Event streams hold a thread each while open; leave room for ordinary requests.
-    const auto threads = static_cast<std::size_t>(options.max_event_streams) + 8;
+    const auto threads = static_cast<std::size_t>(options.max_event_streams) + options.workers;
     http.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
     http.set_default_headers({
         {"Content-Security-Policy",
@@ -528,6 +559,9 @@ bool server::bind() {
     return false;
   }
   m.port = port;
+  // cpp-httplib listens with a queue of 5: a burst of connects then waits for SYN retries (1 s
+  // each). Listening again on the bound socket sets the queue's length.
+  if (m.listen_fd >= 0) ::listen(m.listen_fd, SOMAXCONN);
   return true;
 }
 

@@ -2,6 +2,11 @@
 // requests get a 4xx with a JSON reason and change nothing; with a token required the page is
 // view-only without it; the event stream delivers snapshots as the drive changes.
 #include <gtest/gtest.h>
+#include <unistd.h>
+#include <sys/socket.h>
+#include <poll.h>
+#include <netinet/in.h>
+#include <arpa/inet.h>
 #include <httplib.h>
 
 #include <nlohmann/json.hpp>
@@ -524,6 +529,98 @@ TEST(page_server_axes, each_axis_is_its_own_drive_and_may_switch_profile) {
   EXPECT_EQ(unknown->status, 400);
   EXPECT_NE(unknown->body.find("ax2000-profibus"), std::string::npos) << unknown->body;
   http.stop();
+}
+
+}  // namespace
+
+namespace {
+
+// A raw TCP client: what a misbehaving one sends, byte for byte.
+class raw_client {
+ public:
+  explicit raw_client(int port) {
+    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  }
+  ~raw_client() { ::close(fd_); }
+  bool connected() const { return connected_; }
+  bool send(const std::string& s) {
+    return ::send(fd_, s.data(), s.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(s.size());
+  }
+  /// What arrives within `ms`, until the server closes or a JSON answer's body ended.
+  std::string receive(int ms) {
+    std::string out;
+    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+    char buf[4096];
+    while (std::chrono::steady_clock::now() < end) {
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, 20) <= 0) continue;
+      const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+      if (n <= 0) break;
+      out.append(buf, static_cast<std::size_t>(n));
+      if (out.find("\r\n\r\n") != std::string::npos && out.back() == '}') break;
+    }
+    return out;
+  }
+
+ private:
+  int fd_ = -1;
+  bool connected_ = false;
+};
+
+// Memory stays bounded whatever a request claims: the head decides, before any body is read.
+TEST_F(page_server, a_chunked_or_oversized_body_is_refused_on_its_head_without_reading_it) {
+  start(false);
+  const json before = observable();
+  raw_client chunked(http->bound_port());
+  ASSERT_TRUE(chunked.connected());
+  ASSERT_TRUE(chunked.send("POST /api/command HTTP/1.1\r\nHost: 127.0.0.1\r\n"
+                           "Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n"));
+  // 4 MiB of chunks: refused before they are read, so sending may fail once the server closed.
+  const std::string chunk = "100000\r\n" + std::string(0x100000, 'x') + "\r\n";
+  for (int i = 0; i < 4 && chunked.send(chunk); ++i) {}
+  const std::string answer = chunked.receive(2000);
+  EXPECT_EQ(answer.rfind("HTTP/1.1 411", 0), 0u) << answer.substr(0, 200);
+
+  raw_client big(http->bound_port());
+  ASSERT_TRUE(big.send("POST /api/command HTTP/1.1\r\nHost: 127.0.0.1\r\n"
+                       "Content-Type: application/json\r\nContent-Length: 200000000\r\n\r\n"));
+  const std::string answer2 = big.receive(2000);  // at once: the 200 MB never come
+  EXPECT_EQ(answer2.rfind("HTTP/1.1 413", 0), 0u) << answer2.substr(0, 200);
+
+  std::string many = "GET /api/state HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+  for (int i = 0; i < 100; ++i) many += "X-Filler-" + std::to_string(i) + ": 1\r\n";
+  raw_client headers(http->bound_port());
+  ASSERT_TRUE(headers.send(many + "\r\n"));
+  const std::string answer3 = headers.receive(2000);
+  EXPECT_EQ(answer3.rfind("HTTP/1.1 431", 0), 0u) << answer3.substr(0, 200);
+  step(5);
+  EXPECT_EQ(observable(), before);
+}
+
+// Forty clients that send a request line and then nothing hold a worker each for at most the
+// read timeout; the page stays reachable meanwhile.
+TEST_F(page_server, slow_clients_do_not_make_the_page_unreachable) {
+  start(false);
+  std::vector<std::unique_ptr<raw_client>> slow;
+  for (int i = 0; i < 40; ++i) {
+    slow.push_back(std::make_unique<raw_client>(http->bound_port()));
+    ASSERT_TRUE(slow.back()->send("GET /api/state HTTP/1.1\r\nHost: 127.0.0.1\r\n"));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto r = client->Get("/api/state");
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                      std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_LT(ms, 1500) << "the page took " << ms << " ms behind 40 slow clients";
+  // And the slow ones are let go after the read timeout (2 s), not kept for ever.
+  EXPECT_EQ(slow[0]->receive(4000).find("200 OK"), std::string::npos);
 }
 
 }  // namespace

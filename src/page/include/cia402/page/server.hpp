@@ -45,7 +45,12 @@ struct server_options {
   bool token_required = false;
   std::string token;  ///< the token; make_token() when empty and required
   std::size_t max_body = 4096;
+  std::size_t max_headers = 64;  ///< header lines a request may have (431 beyond)
   int max_event_streams = 16;
+  /// Threads for ordinary requests besides the event streams: a few slow clients cannot take
+  /// them all, each is dropped after read_timeout without a byte.
+  std::size_t workers = 48;
+  std::chrono::milliseconds read_timeout{2000};
   std::chrono::milliseconds keep_alive{15000};  ///< SSE comment line when nothing was published
 };
 
