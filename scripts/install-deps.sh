@@ -8,6 +8,7 @@ packages=(
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfmt-dev libcpp-httplib-dev
   graphviz valgrind
+  clang libclang-rt-14-dev
   gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib
   chromium python3-can python3-pytest
 )

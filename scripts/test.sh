@@ -4,7 +4,7 @@
 #   dev preset: build + ctest; asan-ubsan preset: build + ctest; no-exceptions preset: build the core
 #   alone as C++17 without exceptions or RTTI; release preset: benchmarks (a short run, ratios to the
 #   baseline), instructions per step (callgrind), the Cortex-M4 flash and RAM, the state diagrams
-#   against docs/diagrams; then
+#   against docs/diagrams; the libFuzzer targets for 30 s each (tests/fuzz/run.sh); then
 #   scripts/test-consumer.sh.
 set -euo pipefail
 
@@ -63,6 +63,10 @@ bash bench/instructions/instructions.sh build/release/bench/cia402_instructions
 bash bench/cortex_m4/size.sh build/cortex-m4
 bash scripts/diagrams.sh build/release/tools/cia402 --check
 done_steps+=("release: bench, cortex-m4 size, diagrams")
+
+banner fuzz
+bash tests/fuzz/run.sh 30
+done_steps+=("fuzz: 6 targets, 30 s each")
 
 banner consumer
 bash scripts/test-consumer.sh

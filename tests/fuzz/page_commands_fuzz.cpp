@@ -1,0 +1,67 @@
+// The instrument page's actions in any order: a refused action changes nothing the page shows, and
+// no sequence crashes. Each input byte pair is one action; cycles pass between them.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+
+#include <nlohmann/json.hpp>
+
+#include "cia402/page/instrument.hpp"
+#include "cia402/profile.hpp"
+
+using namespace cia402::page;
+
+namespace {
+
+// What an action could change (time and results aside).
+nlohmann::json observable(const instrument& inst) {
+  nlohmann::json s = nlohmann::json::parse(inst.snapshot_json());
+  return {s["state"], s["control_word"], s["dc_link"], s["sto"], s["fault_cause"],
+          s["target_velocity"], s["objects"], s["profile"]};
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return 0;
+  instrument inst(cia402::builtin_profile(data[0] % cia402::builtin_profile_count()));
+  for (int k = 0; k < 5; ++k) inst.step();
+  for (std::size_t i = 1; i + 1 < size && i < 200; i += 2) {
+    const std::uint8_t what = data[i];
+    const std::uint8_t arg = data[i + 1];
+    const nlohmann::json before = observable(inst);
+    reply r = accepted{};
+    switch (what % 6) {
+      case 0: r = inst.command(static_cast<page_command>(arg % 8)); break;
+      case 1: r = inst.toggle_control_bit(static_cast<int>(arg) - 8); break;
+      case 2: {
+        constexpr std::uint16_t indices[] = {0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007,
+                                             0x6083, 0x6040, 0x60FF, 0x1234};
+        r = inst.write_object(indices[arg % 10], static_cast<std::int8_t>(arg) * 37);
+        break;
+      }
+      case 3: {
+        plant_change c;
+        if (arg & 1) c.target_velocity = static_cast<std::int64_t>(static_cast<std::int8_t>(arg)) << (arg % 40);
+        if (arg & 2) c.fault = (arg & 4) != 0;
+        c.fault_code = static_cast<std::uint16_t>(arg * 31);
+        c.fault_class = static_cast<std::uint8_t>(arg % 6);
+        if (arg & 8) c.dc_link = (arg & 16) != 0;
+        if (arg & 32) c.sto = (arg & 64) != 0;
+        r = inst.change_plant(c);
+        break;
+      }
+      case 4: {
+        const char* names[] = {"cia402", "s300-profibus", "nonesuch", ""};
+        r = inst.select_profile(names[arg % 4]);
+        break;
+      }
+      default:
+        for (int k = 0; k < arg; ++k) inst.step();
+        continue;
+    }
+    if (std::holds_alternative<refused>(r) && observable(inst) != before) std::abort();
+    inst.step();
+  }
+  return 0;
+}
