@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Builds cia402 and passes every test: the one command CI runs (.ci/run). As root on a fresh Debian 12
 # it installs what it needs first. Exits non-zero at the first failure.
-#   dev preset: build + ctest; asan-ubsan preset: build + ctest; no-exceptions preset: build the core
+#   dev preset: build + ctest; asan-ubsan preset: build + ctest; the soak test (tests/soak/soak.py)
+#   on the dev build; the tsan preset: the page and CANopen tests under ThreadSanitizer;
+#   no-exceptions preset: build the core
 #   alone as C++17 without exceptions or RTTI; release preset: benchmarks (a short run, ratios to the
 #   baseline), instructions per step (callgrind), the Cortex-M4 flash and RAM, the state diagrams
 #   against docs/diagrams; the libFuzzer targets for 30 s each (tests/fuzz/run.sh); then
@@ -49,6 +51,18 @@ for preset in dev asan-ubsan; do
   ctest --preset "$preset"
   done_steps+=("$preset: $(test_count "$preset") tests passed")
 done
+
+banner soak
+python3 tests/soak/soak.py build/dev/tools/cia402
+done_steps+=("soak: bus and serve under load, nothing lost")
+
+banner tsan
+cmake --preset tsan
+cmake --build --preset tsan
+# The threaded parts: the page server (HTTP threads, the cycle thread, event streams) and the bus.
+TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build/tsan/tests/page/page_tests
+TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build/tsan/tests/canopen/canopen_tests
+done_steps+=("tsan: page and CANopen tests")
 
 banner no-exceptions
 cmake --preset no-exceptions
