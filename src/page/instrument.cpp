@@ -6,7 +6,6 @@
 #include <deque>
 #include <mutex>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 
 #include "cia402/drive.hpp"
@@ -347,17 +346,11 @@ std::string instrument::recording_json(std::uint64_t rows_seen,
 
 std::string instrument::recording_file(recording_format format) const {
   std::lock_guard lock(impl_->mutex);
-  std::ostringstream out;
-  if (format == recording_format::csv) {
-    impl_->recording.write_csv(out);
-  } else {
-    sim::trace_info info;
-    info.title = "instrument page recording";
-    info.profile_name = impl_->table->name;
-    info.cycle_us = impl_->drive->constants().cycle_us;
-    impl_->recording.write_vcd(out, info, format == recording_format::vcd_gtkwave);
-  }
-  return out.str();
+  sim::trace_info info;
+  info.title = "instrument page recording";
+  info.profile_name = impl_->table->name;
+  info.cycle_us = impl_->drive->constants().cycle_us;
+  return impl_->recording.file(format, info);
 }
 
 std::optional<published> instrument::wait_for_update(std::uint64_t seen,

@@ -1,6 +1,7 @@
 #include "recorder.hpp"
 
 #include <ostream>
+#include <sstream>
 
 #include "page_json.hpp"
 
@@ -102,6 +103,16 @@ void recorder::write_csv(std::ostream& out) const { sim::write_csv(out, kept_wit
 void recorder::write_vcd(std::ostream& out, sim::trace_info info, bool gtkwave) const {
   info.vcd_standard = !gtkwave;
   sim::write_vcd(out, kept_with_last(), info);
+}
+
+std::string recorder::file(recording_format format, const sim::trace_info& info) const {
+  std::ostringstream out;
+  if (format == recording_format::csv) {
+    write_csv(out);
+  } else {
+    write_vcd(out, info, format == recording_format::vcd_gtkwave);
+  }
+  return out.str();
 }
 
 }  // namespace cia402::page::detail

@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cia402/page/backend.hpp"
 #include "cia402/sim/trace.hpp"
 #include "cia402/state.hpp"
 
@@ -69,6 +70,8 @@ class recorder {
   /// IEEE 1364 VCD (state and ramp as integer codes named in a $comment), or with `gtkwave` the
   /// GTKWave form with `$var string`.
   void write_vcd(std::ostream& out, sim::trace_info info, bool gtkwave) const;
+  /// The whole recording as a file of that format; `info` names it in a VCD.
+  std::string file(recording_format format, const sim::trace_info& info) const;
 
  private:
   std::vector<sim::trace_row> kept_with_last() const;

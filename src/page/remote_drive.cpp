@@ -5,7 +5,6 @@
 #include <map>
 #include <mutex>
 #include <optional>
-#include <sstream>
 #include <vector>
 
 #include "cia402/canopen/402/drive_master.hpp"
@@ -594,19 +593,13 @@ std::string remote_drive::recording_json(std::uint64_t rows_seen,
 
 std::string remote_drive::recording_file(recording_format format) const {
   std::lock_guard lock(impl_->mutex);
-  std::ostringstream out;
-  if (format == recording_format::csv) {
-    impl_->recording.write_csv(out);
-  } else {
-    sim::trace_info info;
-    info.title = "instrument page recording of node " + std::to_string(impl_->config.node_id) +
-                 " (plant columns inferred from the status word)";
-    info.profile_name = impl_->table.name;
-    info.cycle_us = 1000;
-    info.brake_fitted = false;
-    impl_->recording.write_vcd(out, info, format == recording_format::vcd_gtkwave);
-  }
-  return out.str();
+  sim::trace_info info;
+  info.title = "instrument page recording of node " + std::to_string(impl_->config.node_id) +
+               " (plant columns inferred from the status word)";
+  info.profile_name = impl_->table.name;
+  info.cycle_us = 1000;
+  info.brake_fitted = false;
+  return impl_->recording.file(format, info);
 }
 
 std::optional<published> remote_drive::wait_for_update(std::uint64_t seen,

@@ -596,8 +596,8 @@ function update(s) {
 // The velocity plot: the last 10 s, the newest value held up to now between updates (updates come
 // only when something changed).
 
-function drawPlot() {
-  const canvas = el('plot');
+// A canvas sized to its CSS box at the screen's pixel ratio, cleared: its context and CSS size.
+function fitCanvas(canvas) {
   const dpr = window.devicePixelRatio || 1;
   const w = canvas.clientWidth, h = canvas.clientHeight;
   if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
@@ -607,6 +607,12 @@ function drawPlot() {
   const g = canvas.getContext('2d');
   g.setTransform(dpr, 0, 0, dpr, 0, 0);
   g.clearRect(0, 0, w, h);
+  return { g, w, h };
+}
+
+function drawPlot() {
+  const canvas = el('plot');
+  const { g, w, h } = fitCanvas(canvas);
   const css = getComputedStyle(canvas);
   const ink = css.color, grid = css.getPropertyValue('--grid').trim() || '#ccc';
   const left = 48, right = 8, top = 8, bottom = 20;
@@ -830,15 +836,7 @@ function addHistory(list) {
 function drawTimeline() {
   const canvas = el('timeline');
   if (!info || !canvas.clientWidth) return;
-  const dpr = window.devicePixelRatio || 1;
-  const w = canvas.clientWidth, h = canvas.clientHeight;
-  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
-    canvas.width = Math.round(w * dpr);
-    canvas.height = Math.round(h * dpr);
-  }
-  const g = canvas.getContext('2d');
-  g.setTransform(dpr, 0, 0, dpr, 0, 0);
-  g.clearRect(0, 0, w, h);
+  const { g, w, h } = fitCanvas(canvas);
   const ink = getComputedStyle(canvas).color;
   const left = 170, right = 8;
   const pw = w - left - right;
