@@ -1,6 +1,13 @@
 #include "cia402/page/server.hpp"
 
 #include <arpa/inet.h>
+#include <vector>
+#include <functional>
+#include <unistd.h>
+#include <poll.h>
+#include <netinet/tcp.h>
+#include <mutex>
+#include <map>
 #include <sys/socket.h>
 #include <httplib.h>
 
@@ -106,6 +113,35 @@ struct request_error {
   std::string reason;
 };
 
+// cpp-httplib 0.11.4 (Debian 12's, a compiled library) reads a request's whole head, every header
+// line of it, before any hook of ours runs, and its per-connection entry point is private. So the
+// page's server is two: `guard_server` only accepts, and checks each connection before anything is
+// read (the head complete within the read timeout, at most `max_head` bytes and `max_headers`
+// lines, a bounded number of connections per client address); then `inner_server`, which holds the
+// routes, processes it. The entry point is reached through its member pointer, named by an
+// explicit instantiation (where access rules do not apply).
+using process_member = bool (httplib::Server::*)(socket_t);
+template <process_member member>
+struct process_access {
+  friend process_member process_connection() { return member; }
+};
+process_member process_connection();
+template struct process_access<&httplib::Server::process_and_close_socket>;
+
+// The server with the routes: it never listens; it processes the connections the guard admits.
+struct inner_server : httplib::Server {
+  // Its keep-alive loop runs while this is a valid socket: the guard's listening one.
+  void adopt_listener(socket_t s) { svr_sock_ = s; }
+  bool process(socket_t sock) { return (this->*process_connection())(sock); }
+};
+
+// The listening server: each accepted connection is checked, then handed to `inner`.
+struct guard_server : httplib::Server {
+  std::function<bool(socket_t)> admit;  // false: answered and closed here
+  bool process_and_close_socket(socket_t sock) override { return admit(sock); }
+};
+
+
 }  // namespace
 
 std::string make_token() {
@@ -139,13 +175,124 @@ struct server::impl {
   std::vector<axis> axes;
   server_options options;
   int listen_fd = -1;  // the listening socket, once bound
-  httplib::Server http;
+  guard_server front;  // accepts and admits
+  inner_server http;   // the routes
+  std::mutex clients_mutex;
+  std::map<std::string, int> connections;  // open connections per non-loopback client address
   std::thread thread;
   std::atomic<bool> stopping{false};
   std::atomic<bool> listen_returned{false};  // the listening thread is done (or never listened)
   std::atomic<int> streams{0};
   int port = -1;
   std::string error;
+
+  // --- admission: before cpp-httplib reads a byte ---------------------------------------------
+
+  // A refusal written straight to the socket (the request was never parsed).
+  static void answer_and_close(socket_t sock, int status, const std::string& reason) {
+    const char* text = status == 408 ? "Request Timeout"
+                       : status == 431 ? "Request Header Fields Too Large"
+                                       : "Service Unavailable";
+    const std::string body = json{{"error", reason}}.dump();
+    const std::string head = "HTTP/1.1 " + std::to_string(status) + " " + text +
+                             "\r\nContent-Type: application/json\r\nContent-Length: " +
+                             std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n";
+    const std::string all = head + body;
+    (void)::send(sock, all.data(), all.size(), MSG_NOSIGNAL);
+    ::shutdown(sock, SHUT_RDWR);
+    ::close(sock);
+  }
+
+  // Waits (peeking, nothing consumed) until the first request's head is complete. 0: the peer
+  // went away; otherwise the refusal's status and reason, or 200 to go on.
+  request_error wait_for_head(socket_t sock) const {
+    const auto deadline = std::chrono::steady_clock::now() + options.read_timeout;
+    std::vector<char> buf(options.max_head + 1);
+    ssize_t seen = -1;
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+          deadline - std::chrono::steady_clock::now());
+      if (left.count() <= 0) {
+        return {408, "the request head did not arrive within " +
+                         std::to_string(options.read_timeout.count()) + " ms"};
+      }
+      pollfd p{sock, POLLIN | POLLRDHUP, 0};
+      (void)::poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 50)));
+      const bool peer_done = (p.revents & (POLLRDHUP | POLLHUP | POLLERR)) != 0;
+      const ssize_t n = ::recv(sock, buf.data(), buf.size(), MSG_PEEK | MSG_DONTWAIT);
+      if (n == 0) return {0, ""};
+      if (n < 0) {
+        if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) continue;
+        return {0, ""};
+      }
+      const std::string_view text(buf.data(), static_cast<std::size_t>(n));
+      const auto end = text.find("\r\n\r\n");
+      const std::string_view head = text.substr(0, end == std::string_view::npos ? text.size() : end);
+      std::size_t lines = 0;
+      for (std::size_t at = head.find("\r\n"); at != std::string_view::npos; at = head.find("\r\n", at + 2)) {
+        ++lines;
+      }
+      if (lines > options.max_headers) {
+        return {431, "more than " + std::to_string(options.max_headers) + " header lines"};
+      }
+      if (end != std::string_view::npos) return {200, ""};
+      if (peer_done) return {0, ""};  // it stopped sending before its head was complete
+      if (static_cast<std::size_t>(n) > options.max_head) {
+        return {431, "request head larger than " + std::to_string(options.max_head) + " bytes"};
+      }
+      // Data waits unread, so poll returns at once: only a grown head is worth another look.
+      if (n == seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      seen = n;
+    }
+  }
+
+  bool admit(socket_t sock) {
+    const int yes = 1;
+    ::setsockopt(sock, IPPROTO_TCP, TCP_NODELAY, &yes, sizeof yes);
+    // Connections per client address, beyond loopback (on loopback every client is one address,
+    // the page's own among them).
+    std::string address;
+    sockaddr_storage peer{};
+    socklen_t len = sizeof peer;
+    if (::getpeername(sock, reinterpret_cast<sockaddr*>(&peer), &len) == 0) {
+      char text[INET6_ADDRSTRLEN] = {};
+      if (peer.ss_family == AF_INET) {
+        inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(&peer)->sin_addr, text, sizeof text);
+      } else if (peer.ss_family == AF_INET6) {
+        inet_ntop(AF_INET6, &reinterpret_cast<sockaddr_in6*>(&peer)->sin6_addr, text, sizeof text);
+      }
+      address = text;
+    }
+    const bool counted = !address.empty() && !is_loopback_address(address);
+    if (counted) {
+      std::lock_guard lock(clients_mutex);
+      if (connections[address] >= options.max_connections_per_client) {
+        answer_and_close(sock, 503, "too many connections from " + address);
+        return true;
+      }
+      ++connections[address];
+    }
+    struct release {
+      impl* self;
+      const std::string& address;
+      bool counted;
+      ~release() {
+        if (!counted) return;
+        std::lock_guard lock(self->clients_mutex);
+        if (--self->connections[address] == 0) self->connections.erase(address);
+      }
+    } on_exit{this, address, counted};
+    const request_error head = wait_for_head(sock);
+    if (head.status == 0) {
+      ::close(sock);
+      return true;
+    }
+    if (head.status != 200) {
+      answer_and_close(sock, head.status, head.reason);
+      return true;
+    }
+    return http.process(sock);  // closes the socket
+  }
 
   bool has_token(const httplib::Request& req) const {
     return req.has_header(token_header) &&
@@ -334,7 +481,8 @@ struct server::impl {
     // cpp-httplib's default sets SO_REUSEPORT, so a second `cia402 serve` on the same port would
     // listen too and the two would answer in turn. SO_REUSEADDR alone still allows a restart while
     // old connections linger, and makes the second bind fail.
-    http.set_socket_options([this](socket_t sock) {
+    front.admit = [this](socket_t sock) { return admit(sock); };
+    front.set_socket_options([this](socket_t sock) {
       const int yes = 1;
       ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
       listen_fd = sock;
@@ -363,9 +511,11 @@ struct server::impl {
     });
     // Small answers on kept-alive connections: without it each waited ~40 ms for a delayed ACK.
     http.set_tcp_nodelay(true);
+    // One request per connection, so every request passes the guard's checks on its head.
+    http.set_keep_alive_max_count(1);
     // Event streams hold a thread each while open; leave room for ordinary requests.
     const auto threads = static_cast<std::size_t>(options.max_event_streams) + options.workers;
-    http.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+    front.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
     http.set_default_headers({
         {"Content-Security-Policy",
          "default-src 'self'; img-src 'self' data:; style-src 'self'; script-src 'self'; "
@@ -549,8 +699,8 @@ bool server::bind() {
   }
   int port = -1;
   if (m.options.port == 0) {
-    port = m.http.bind_to_any_port(m.options.bind);
-  } else if (m.http.bind_to_port(m.options.bind, m.options.port)) {
+    port = m.front.bind_to_any_port(m.options.bind);
+  } else if (m.front.bind_to_port(m.options.bind, m.options.port)) {
     port = m.options.port;
   }
   if (port < 0) {
@@ -562,6 +712,7 @@ bool server::bind() {
   // cpp-httplib listens with a queue of 5: a burst of connects then waits for SYN retries (1 s
   // each). Listening again on the bound socket sets the queue's length.
   if (m.listen_fd >= 0) ::listen(m.listen_fd, SOMAXCONN);
+  m.http.adopt_listener(m.listen_fd);
   return true;
 }
 
@@ -572,7 +723,7 @@ const server_options& server::options() const { return impl_->options; }
 void server::start() {
   if (impl_->port < 0 || impl_->thread.joinable()) return;
   impl_->thread = std::thread([this] {
-    impl_->http.listen_after_bind();
+    impl_->front.listen_after_bind();
     impl_->listen_returned = true;
   });
 }
@@ -582,12 +733,13 @@ void server::stop() {
   // A stop before the thread has begun to listen would be lost and the join below would wait for
   // ever: wait until it listens (or has given up) first.
   if (impl_->thread.joinable()) {
-    while (!impl_->http.is_running() && !impl_->listen_returned) {
+    while (!impl_->front.is_running() && !impl_->listen_returned) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   }
-  impl_->http.stop();
+  impl_->front.stop();
   if (impl_->thread.joinable()) impl_->thread.join();
+  impl_->http.adopt_listener(INVALID_SOCKET);
 }
 
 std::string server::url() const {

@@ -2,6 +2,7 @@
 // requests get a 4xx with a JSON reason and change nothing; with a token required the page is
 // view-only without it; the event stream delivers snapshots as the drive changes.
 #include <gtest/gtest.h>
+#include <ifaddrs.h>
 #include <unistd.h>
 #include <sys/socket.h>
 #include <poll.h>
@@ -538,12 +539,12 @@ namespace {
 // A raw TCP client: what a misbehaving one sends, byte for byte.
 class raw_client {
  public:
-  explicit raw_client(int port) {
+  explicit raw_client(int port, const std::string& host = "127.0.0.1") {
     fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
     sockaddr_in a{};
     a.sin_family = AF_INET;
     a.sin_port = htons(static_cast<std::uint16_t>(port));
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    inet_pton(AF_INET, host.c_str(), &a.sin_addr);
     connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
   }
   ~raw_client() { ::close(fd_); }
@@ -621,6 +622,90 @@ TEST_F(page_server, slow_clients_do_not_make_the_page_unreachable) {
   EXPECT_LT(ms, 1500) << "the page took " << ms << " ms behind 40 slow clients";
   // And the slow ones are let go after the read timeout (2 s), not kept for ever.
   EXPECT_EQ(slow[0]->receive(4000).find("200 OK"), std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+// The guard reads nothing: a head that never ends, or ends too late, is answered before cpp-httplib
+// would have read it (one GET with 40 MB of header lines used to be read whole and answered 200).
+TEST_F(page_server, an_endless_or_slow_request_head_is_refused_before_it_is_read) {
+  start(false);
+  raw_client endless(http->bound_port());
+  std::string lines = "GET /api/state HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+  while (lines.size() < 40000) lines += "X-A: 1\r\n";  // 5,000 short lines, no end of head
+  ASSERT_TRUE(endless.send(lines));
+  const std::string a = endless.receive(3000);
+  EXPECT_EQ(a.rfind("HTTP/1.1 431", 0), 0u) << a.substr(0, 200);
+
+  raw_client wide(http->bound_port());
+  ASSERT_TRUE(wide.send("GET /api/state HTTP/1.1\r\nX-Big: " + std::string(20000, 'b')));
+  const std::string b = wide.receive(3000);
+  EXPECT_EQ(b.rfind("HTTP/1.1 431", 0), 0u) << b.substr(0, 200);
+
+  // A header line every 300 ms: the head is not complete within the read timeout (2 s).
+  raw_client slow(http->bound_port());
+  ASSERT_TRUE(slow.send("GET /api/state HTTP/1.1\r\n"));
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string c;
+  for (int i = 0; i < 20 && c.empty(); ++i) {
+    slow.send("X-Slow: 1\r\n");
+    c = slow.receive(300);
+  }
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                      std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(c.rfind("HTTP/1.1 408", 0), 0u) << c.substr(0, 200);
+  EXPECT_LT(ms, 4000) << "the slow head was kept " << ms << " ms";
+}
+
+// Beyond loopback one client address may hold a bounded number of connections; on loopback all
+// clients share one address (the page's own too), so none is counted there.
+TEST(page_server_guard, connections_per_client_address_are_bounded_beyond_loopback) {
+  std::string address;
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) == 0) {
+    for (ifaddrs* i = list; i != nullptr && address.empty(); i = i->ifa_next) {
+      if (i->ifa_addr == nullptr || i->ifa_addr->sa_family != AF_INET) continue;
+      char text[INET_ADDRSTRLEN] = {};
+      inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(i->ifa_addr)->sin_addr, text, sizeof text);
+      if (!cia402::page::is_loopback_address(text)) address = text;
+    }
+    ::freeifaddrs(list);
+  }
+  if (address.empty()) GTEST_SKIP() << "no IPv4 address beyond loopback on this machine";
+  instrument inst{cia402::standard_profile()};
+  server_options o;
+  o.bind = address;
+  o.port = 0;
+  o.token_required = true;
+  o.token = token;
+  o.max_connections_per_client = 3;
+  server http(inst, o);
+  ASSERT_TRUE(http.bind()) << http.error();
+  http.start();
+  const auto connect = [&] {
+    auto c = std::make_unique<raw_client>(http.bound_port(), address);
+    EXPECT_TRUE(c->connected());
+    return c;
+  };
+  std::vector<std::unique_ptr<raw_client>> held;
+  for (int i = 0; i < 3; ++i) {
+    held.push_back(connect());
+    ASSERT_TRUE(held.back()->send("GET /api/state HTTP/1.1\r\n"));  // and nothing more yet
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  auto fourth = connect();
+  const std::string refused = fourth->receive(2000);
+  EXPECT_EQ(refused.rfind("HTTP/1.1 503", 0), 0u) << refused.substr(0, 200);
+  EXPECT_NE(refused.find("too many connections from " + address), std::string::npos);
+  held.clear();  // their slots come back
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  auto fifth = connect();
+  ASSERT_TRUE(fifth->send("GET /api/state HTTP/1.1\r\nHost: x\r\n\r\n"));
+  const std::string ok = fifth->receive(2000);
+  EXPECT_EQ(ok.rfind("HTTP/1.1 200", 0), 0u) << ok.substr(0, 200);
+  http.stop();
 }
 
 }  // namespace

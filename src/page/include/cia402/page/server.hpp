@@ -46,10 +46,14 @@ struct server_options {
   std::string token;  ///< the token; make_token() when empty and required
   std::size_t max_body = 4096;
   std::size_t max_headers = 64;  ///< header lines a request may have (431 beyond)
+  std::size_t max_head = 16384;  ///< bytes of a request's head (431 beyond)
+  /// Open connections one client address may hold (beyond loopback; 503 beyond).
+  int max_connections_per_client = 32;
   int max_event_streams = 16;
   /// Threads for ordinary requests besides the event streams: a few slow clients cannot take
   /// them all, each is dropped after read_timeout without a byte.
   std::size_t workers = 48;
+  /// The whole head of a request must arrive within this (408), and each later read too.
   std::chrono::milliseconds read_timeout{2000};
   std::chrono::milliseconds keep_alive{15000};  ///< SSE comment line when nothing was published
 };
