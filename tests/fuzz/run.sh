@@ -24,9 +24,10 @@ status=0
 for t in "${targets[@]}"; do
   work="$out/$t"
   mkdir -p "$work/new" "$work/crashes"
-  # -rss_limit_mb: memory stays bounded; -timeout: no input may take a second.
+  # -rss_limit_mb: memory stays bounded; -timeout: no input may hang (10 s, with the sanitizers on
+  # a loaded machine).
   if ! "build/fuzz/tests/fuzz/$t" "$work/new" "tests/fuzz/corpus/$t" \
-      -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=1 -print_final_stats=1 \
+      -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
       -artifact_prefix="$work/crashes/" >"$work/log.txt" 2>&1; then
     status=1
     echo "fuzz: $t FAILED, see $work/log.txt and $work/crashes/" >&2
