@@ -239,7 +239,7 @@ reply instrument::select_profile(std::string_view name) {
   const profile* chosen = nullptr;
   std::string names;
   for (const profile* p : m.config.selectable) {
-    if (name == p->name) chosen = p;
+    if (chosen == nullptr && name == p->name) chosen = p;  // the instrument's own profile is first
     names += (names.empty() ? "" : ", ") + std::string(p->name);
   }
   if (chosen == nullptr) {

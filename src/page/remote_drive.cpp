@@ -219,8 +219,14 @@ struct remote_drive::impl {
         seen.from = chain.back().from;
       }
       last_transition = seen;
-      recording.note_transition({0, now_us, seen.number, seen.from, s, remote.last_sent(), sw,
-                                 true});
+      // Every row of the chain goes into the history (one status word may show two, T13 and T14);
+      // a change no chain explains goes in without a number.
+      if (chain.empty()) {
+        recording.note_transition({0, now_us, std::nullopt, observed, s, remote.last_sent(), sw, true});
+      }
+      for (const inferred_transition& t : chain) {
+        recording.note_transition({0, now_us, int{t.number}, t.from, t.to, remote.last_sent(), sw, true});
+      }
       if (seen.number) transition_this_poll = static_cast<std::uint8_t>(*seen.number);
       if (auto* a = log.pending()) {
         for (const inferred_transition& t : chain) a->transitions.push_back(t.number);

@@ -1,15 +1,11 @@
 #include "cia402/page/server.hpp"
 
 #include <arpa/inet.h>
-#include <vector>
-#include <functional>
-#include <unistd.h>
-#include <poll.h>
-#include <netinet/tcp.h>
-#include <mutex>
-#include <map>
-#include <sys/socket.h>
 #include <httplib.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -18,8 +14,13 @@
 #include <cctype>
 #include <charconv>
 #include <cstdio>
+#include <functional>
+#include <map>
+#include <mutex>
 #include <random>
 #include <set>
+#include <stdexcept>
+#include <vector>
 #include <thread>
 
 #include "web_assets.hpp"
@@ -137,7 +138,7 @@ struct inner_server : httplib::Server {
 
 // The listening server: each accepted connection is checked, then handed to `inner`.
 struct guard_server : httplib::Server {
-  std::function<bool(socket_t)> admit;  // false: answered and closed here
+  std::function<bool(socket_t)> admit;  // checks, then processes or refuses; closes the socket
   bool process_and_close_socket(socket_t sock) override { return admit(sock); }
 };
 
@@ -169,6 +170,7 @@ bool is_loopback_address(std::string_view host) {
 
 struct server::impl {
   impl(std::vector<axis> a, server_options o) : axes(std::move(a)), options(std::move(o)) {
+    if (axes.empty()) throw std::invalid_argument("the page needs at least one drive");
     if (options.token_required && options.token.empty()) options.token = make_token();
   }
 
@@ -247,6 +249,8 @@ struct server::impl {
   }
 
   bool admit(socket_t sock) {
+    // Small answers and event-stream chunks go out at once: with Nagle on, a second small write on
+    // a connection waited up to ~40 ms for the client's delayed ACK.
     const int yes = 1;
     ::setsockopt(sock, IPPROTO_TCP, TCP_NODELAY, &yes, sizeof yes);
     // Connections per client address, beyond loopback (on loopback every client is one address,
@@ -379,8 +383,8 @@ struct server::impl {
 
   // The drive a request names with ?axis=K (1..N; the first without it), or nullptr with the
   // refusal sent.
-  backend* axis_of(const httplib::Request& req, httplib::Response& res) {
-    if (!req.has_param("axis")) return axes.front().drive;
+  const axis* axis_named(const httplib::Request& req, httplib::Response& res) const {
+    if (!req.has_param("axis")) return &axes.front();
     const std::string v = req.get_param_value("axis");
     std::size_t k = 0;
     const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), k);
@@ -388,7 +392,11 @@ struct server::impl {
       send_error(res, 404, "no axis '" + v + "' (1.." + std::to_string(axes.size()) + ")");
       return nullptr;
     }
-    return axes[k - 1].drive;
+    return &axes[k - 1];
+  }
+  backend* axis_of(const httplib::Request& req, httplib::Response& res) const {
+    const axis* a = axis_named(req, res);
+    return a != nullptr ? a->drive : nullptr;
   }
 
   std::variant<reply, request_error> on_command(backend& inst, const json& body) {
@@ -492,7 +500,8 @@ struct server::impl {
     http.set_read_timeout(options.read_timeout);
     http.set_write_timeout(std::chrono::seconds(5));
     // What a request may bring is checked on its head, before any body is read: a chunked body (no
-    // length known before it is read whole), a length over max_body, too many header lines.
+    // length known before it is read whole), a length over max_body. (The head itself the guard
+    // checked before it was read.)
     http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
       std::optional<request_error> e;
       if (req.has_header("Transfer-Encoding")) {
@@ -500,8 +509,6 @@ struct server::impl {
       } else if (req.has_header("Content-Length") &&
                  !length_within(req.get_header_value("Content-Length"), options.max_body)) {
         e = request_error{413, "body larger than " + std::to_string(options.max_body) + " bytes"};
-      } else if (req.headers.size() > options.max_headers) {
-        e = request_error{431, "more than " + std::to_string(options.max_headers) + " header lines"};
       }
       if (!e) return httplib::Server::HandlerResponse::Unhandled;
       // The unread body must not be taken for the next request: this connection ends here.
@@ -509,8 +516,6 @@ struct server::impl {
       send_error(res, e->status, e->reason);
       return httplib::Server::HandlerResponse::Handled;
     });
-    // Small answers on kept-alive connections: without it each waited ~40 ms for a delayed ACK.
-    http.set_tcp_nodelay(true);
     // One request per connection, so every request passes the guard's checks on its head.
     http.set_keep_alive_max_count(1);
     // Event streams hold a thread each while open; leave room for ordinary requests.
@@ -554,14 +559,11 @@ struct server::impl {
     http.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
 
     http.Get("/api/info", [this](const httplib::Request& req, httplib::Response& res) {
-      backend* inst = axis_of(req, res);
-      if (inst == nullptr) return;
-      json j = json::parse(inst->info_json(may_control(req), options.token_required));
-      const auto k = static_cast<std::size_t>(std::find_if(axes.begin(), axes.end(), [&](const axis& a) {
-                       return a.drive == inst;
-                     }) - axes.begin());
-      j["axis"] = k + 1;
-      j["axis_label"] = axes[k].label;
+      const axis* a = axis_named(req, res);
+      if (a == nullptr) return;
+      json j = json::parse(a->drive->info_json(may_control(req), options.token_required));
+      j["axis"] = static_cast<std::size_t>(a - axes.data()) + 1;
+      j["axis_label"] = a->label;
       j["axes"] = axes.size();
       res.set_content(j.dump(), "application/json");
     });

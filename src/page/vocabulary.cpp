@@ -77,7 +77,8 @@ struct transition_words {
   const char* action;
 };
 
-// Seed 002, CoE table 7.8.
+// Seed 002, CoE table 7.8. Its text lost words where the table's cells broke ("The | immediately"
+// in T6, T8..T10; the end of T14's action); there the standard's wording completes the sentence.
 constexpr transition_words seed_002[] = {
     {0, "Automatic transition after reset application", "Drive device initialisation shall be performed"},
     {1, "Automatic transition", "Communication shall be activated"},

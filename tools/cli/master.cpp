@@ -373,9 +373,10 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
   };
   const bool watching = a.command == "watch";
   if (watching) {
-    // At most one velocity line per 100 ms step of the value, not one per PDO.
+    // A line when the velocity moved by 10 rpm or more since the last one, or stopped: not one
+    // per PDO while it ramps.
     m.on_velocity = [&, shown = std::optional<std::int32_t>()](std::int32_t v) mutable {
-      if (shown && std::abs(v - *shown) < 10 && v != 0) return;
+      if (shown && std::abs(std::int64_t{v} - *shown) < 10 && v != 0) return;
       if (shown && *shown == v) return;
       shown = v;
       event({{"event", "velocity"}, {"velocity_rpm", v}}, "velocity " + std::to_string(v) + " rpm");

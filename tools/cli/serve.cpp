@@ -77,14 +77,10 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   std::vector<std::unique_ptr<canopen::channel>> channels;
   std::vector<std::unique_ptr<page::backend>> drives;
   std::vector<page::axis> axes;
-  std::vector<const profile*> selectable;
-  for (std::size_t i = 0; i < builtin_profile_count(); ++i) selectable.push_back(&builtin_profile(i));
-  if (find_builtin_profile(choice.get().name) != &choice.get()) selectable.push_back(&choice.get());
   if (args.can.empty()) {
     for (int k = 1; k <= args.virtual_axes; ++k) {
-      page::instrument_config ic;
-      ic.selectable = selectable;
-      drives.push_back(std::make_unique<page::instrument>(choice.get(), ic));
+      // Selectable on the page: the built-in profiles and this one (instrument_config's default).
+      drives.push_back(std::make_unique<page::instrument>(choice.get()));
       axes.push_back({"axis " + std::to_string(k), drives.back().get()});
     }
   } else {

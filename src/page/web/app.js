@@ -773,7 +773,7 @@ async function pollRecording() {
     if (!res.ok) return;
     const r = await res.json();
     if (r.rows_seen < recorder.rowsSeen || r.transitions_seen < recorder.transitionsSeen) {
-      // A new recording (the server restarted or switched profiles): start over.
+      // A new recording (the server restarted; a profile switch reloads the page): start over.
       recorder.rowsSeen = 0;
       recorder.transitionsSeen = 0;
       recorder.rows = [];

@@ -187,8 +187,8 @@ def test_modes_of_operation_round_trip_and_display_in_tpdo2(client):
     tpdo2 = wait_for(client, lambda m: m.arbitration_id == 0x281 and len(m.data) == 3, timeout=2)
     assert tpdo2 is not None and tpdo2.data[2] == 3
     # A mode this drive does not have is refused with an abort, and 0x6061 stays.
-    refused = sdo_download(client, NODE, 0x6060, 0, 1, 1)
-    assert refused.data[0] == 0x80, "0x6060 = 1 (profile position) accepted by a velocity drive"
+    refused = sdo_download(client, NODE, 0x6060, 0, 2, 1)
+    assert refused.data[0] == 0x80, "0x6060 = 2 (velocity mode, not offered) accepted"
     assert sdo_upload_expedited(client, NODE, 0x6061, 0) == 3
 
 

@@ -75,7 +75,8 @@ class server {
   /// The backend (the in-process instrument or a remote drive) must outlive the server.
   server(backend& inst, server_options options);
   /// Several drives (at least one), each an axis of the page: every /api/ path takes ?axis=K
-  /// (1..N, the first without it). The backends must outlive the server.
+  /// (1..N, the first without it). The backends must outlive the server. Throws
+  /// std::invalid_argument for no axis at all.
   server(std::vector<axis> axes, server_options options);
   ~server();
   server(const server&) = delete;
