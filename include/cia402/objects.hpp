@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string_view>
 
 #include "cia402/sdo_abort.hpp"
 
@@ -23,7 +24,8 @@ enum class object_type : std::uint8_t {
 
 enum class object_access : std::uint8_t { read_only, write_only, read_write };
 
-/// One object (sub-index 0: the drive profile's objects are all simple variables today).
+/// One entry of the table: a simple variable (sub-index 0), or one entry of an array or record, whose
+/// sub-index 0 (read-only UNSIGNED8) holds the highest sub-index that follows (0x607D, 0x608F, ...).
 struct object_description {
   std::uint16_t index;
   std::uint8_t sub;
@@ -74,7 +76,7 @@ constexpr bool type_signed(object_type t) noexcept {
 /// The drive profile's objects, in index order.
 std::size_t drive_object_count() noexcept;
 const object_description& drive_object(std::size_t i) noexcept;
-/// The object at index/sub, or nullptr.
+/// The entry at index/sub, or nullptr.
 const object_description* find_drive_object(std::uint16_t index, std::uint8_t sub = 0) noexcept;
 
 /// Whether a write of `value` is allowed: read_only_object, value_too_low / value_too_high (outside
@@ -99,7 +101,49 @@ inline constexpr std::uint16_t profile_acceleration = 0x6083;
 inline constexpr std::uint16_t profile_deceleration = 0x6084;
 inline constexpr std::uint16_t quick_stop_deceleration = 0x6085;
 inline constexpr std::uint16_t target_velocity = 0x60FF;
+inline constexpr std::uint16_t position_demand_value = 0x6062;
+inline constexpr std::uint16_t position_actual_value = 0x6064;
+inline constexpr std::uint16_t following_error_window = 0x6065;
+inline constexpr std::uint16_t following_error_time_out = 0x6066;
+inline constexpr std::uint16_t position_window = 0x6067;
+inline constexpr std::uint16_t position_window_time = 0x6068;
+inline constexpr std::uint16_t target_torque = 0x6071;
+inline constexpr std::uint16_t torque_actual_value = 0x6077;
+inline constexpr std::uint16_t target_position = 0x607A;
+inline constexpr std::uint16_t home_offset = 0x607C;
+inline constexpr std::uint16_t software_position_limit = 0x607D;  ///< sub 1 min, sub 2 max
+inline constexpr std::uint16_t profile_velocity = 0x6081;
+inline constexpr std::uint16_t end_velocity = 0x6082;
+inline constexpr std::uint16_t torque_slope = 0x6087;
+inline constexpr std::uint16_t position_encoder_resolution = 0x608F;  ///< sub 1 increments, 2 revolutions
+inline constexpr std::uint16_t homing_method = 0x6098;
+inline constexpr std::uint16_t homing_speeds = 0x6099;  ///< sub 1 switch search, 2 zero search
+inline constexpr std::uint16_t homing_acceleration = 0x609A;
+inline constexpr std::uint16_t position_offset = 0x60B0;
+inline constexpr std::uint16_t velocity_offset = 0x60B1;
+inline constexpr std::uint16_t torque_offset = 0x60B2;
+inline constexpr std::uint16_t interpolation_time_period = 0x60C2;  ///< sub 1 value, 2 index
+inline constexpr std::uint16_t following_error_actual_value = 0x60F4;
 inline constexpr std::uint16_t supported_drive_modes = 0x6502;
 }  // namespace object_index
+
+/// Modes of operation (0x6060 / 0x6061) and their bits in 0x6502 (CiA 402-2).
+namespace mode {
+inline constexpr std::int8_t profile_position = 1;
+inline constexpr std::int8_t profile_velocity = 3;
+inline constexpr std::int8_t profile_torque = 4;
+inline constexpr std::int8_t homing = 6;
+inline constexpr std::int8_t cyclic_synchronous_position = 8;
+inline constexpr std::int8_t cyclic_synchronous_velocity = 9;
+inline constexpr std::int8_t cyclic_synchronous_torque = 10;
+/// The bit of 0x6502 that announces mode m (1..10), 0 for any other value.
+constexpr std::uint32_t supported_bit(std::int64_t m) noexcept {
+  return m >= 1 && m <= 10 ? std::uint32_t{1} << (m - 1) : 0u;
+}
+/// "pp", "pv", "tq", "hm", "csp", "csv", "cst", or "" for a mode without a short name.
+const char* short_name(std::int64_t m) noexcept;
+/// Accepts the short names above and the numbers; false for anything else.
+bool parse(std::string_view text, std::int8_t& out) noexcept;
+}  // namespace mode
 
 }  // namespace cia402

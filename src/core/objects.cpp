@@ -20,12 +20,36 @@ constexpr object_description ramp(std::uint16_t index, const char* name,
   return o;
 }
 
+constexpr const char* permille = "permille";
+
+constexpr object_description at_least_1(object_description o) noexcept {
+  o.low = 1;
+  return o;
+}
+
+constexpr object_description limited(object_description o, std::int64_t low, std::int64_t high) noexcept {
+  o.low = low;
+  o.high = high;
+  return o;
+}
+
+// Sub-index 0 of an array or record: how many entries follow.
+constexpr object_description highest_sub(std::uint16_t index, std::uint8_t count, const char* name) noexcept {
+  return {index, 0, T::unsigned8, A::read_only, false, count, count, count, name, ""};
+}
+
+constexpr object_description sub(std::uint16_t index, std::uint8_t sub_index, T type, const char* name,
+                                 const char* unit, std::int64_t default_value) noexcept {
+  return {index, sub_index, type, A::read_write, false, type_low(type), type_high(type), default_value,
+          name, unit};
+}
+
 // The option codes are INTEGER16 on the bus; which values a drive takes is its profile's (S5..S10).
 constexpr object_description option_code(std::uint16_t index, const char* name) noexcept {
   return var(index, T::integer16, A::read_write, false, name);
 }
 
-// In index order. Profile velocity (mode 3) is the one mode today; 0x6502 bit 2 says so.
+// In index order, sub-indices ascending within an index.
 constexpr object_description objects[] = {
     option_code(0x6007, "Abort connection option code"),
     var(0x603F, T::unsigned16, A::read_only, true, "Error code"),
@@ -36,24 +60,64 @@ constexpr object_description objects[] = {
     option_code(0x605C, "Disable operation option code"),
     option_code(0x605D, "Halt option code"),
     option_code(0x605E, "Fault reaction option code"),
+    // Which modes a drive runs is its own (0x6502); profile velocity is the power-on mode.
     var(0x6060, T::integer8, A::read_write, true, "Modes of operation", "", 3),
     var(0x6061, T::integer8, A::read_only, true, "Modes of operation display", "", 3),
+    var(0x6062, T::integer32, A::read_only, true, "Position demand value", "inc"),
+    var(0x6064, T::integer32, A::read_only, true, "Position actual value", "inc"),
+    // 0xFFFFFFFF switches the following-error check off (CiA 402-2).
+    var(0x6065, T::unsigned32, A::read_write, true, "Following error window", "inc", 10000),
+    var(0x6066, T::unsigned16, A::read_write, true, "Following error time out", "ms", 10),
+    var(0x6067, T::unsigned32, A::read_write, true, "Position window", "inc", 10),
+    var(0x6068, T::unsigned16, A::read_write, true, "Position window time", "ms", 0),
     var(0x606C, T::integer32, A::read_only, true, "Velocity actual value", "rpm"),
+    var(0x6071, T::integer16, A::read_write, true, "Target torque", permille),
+    var(0x6077, T::integer16, A::read_only, true, "Torque actual value", permille),
+    var(0x607A, T::integer32, A::read_write, true, "Target position", "inc"),
+    var(0x607C, T::integer32, A::read_write, true, "Home offset", "inc"),
+    highest_sub(0x607D, 2, "Software position limit"),
+    sub(0x607D, 1, T::integer32, "Min position limit", "inc", -2147483647LL - 1),
+    sub(0x607D, 2, T::integer32, "Max position limit", "inc", 2147483647LL),
+    var(0x6081, T::unsigned32, A::read_write, true, "Profile velocity", "rpm", 1000),
+    var(0x6082, T::unsigned32, A::read_write, true, "End velocity", "rpm"),
     ramp(0x6083, "Profile acceleration", 1000),
     ramp(0x6084, "Profile deceleration", 1000),
     ramp(0x6085, "Quick stop deceleration", 10000),
+    at_least_1(var(0x6087, T::unsigned32, A::read_write, true, "Torque slope", "permille/s", 10000)),
+    // Increments per revolution = sub 1 / sub 2; the virtual drive's motor revolutions stay 1, and
+    // an encoder has at most 2^24 increments a revolution (so every product stays in range).
+    highest_sub(0x608F, 2, "Position encoder resolution"),
+    limited(sub(0x608F, 1, T::unsigned32, "Encoder increments", "inc", 10000), 1, 1 << 24),
+    limited(sub(0x608F, 2, T::unsigned32, "Motor revolutions", "", 1), 1, 1),
+    var(0x6098, T::integer8, A::read_write, true, "Homing method", "", 35),
+    highest_sub(0x6099, 2, "Homing speeds"),
+    sub(0x6099, 1, T::unsigned32, "Speed during search for switch", "rpm", 500),
+    sub(0x6099, 2, T::unsigned32, "Speed during search for zero", "rpm", 50),
+    at_least_1(var(0x609A, T::unsigned32, A::read_write, true, "Homing acceleration", "rpm/s", 1000)),
+    var(0x60B0, T::integer32, A::read_write, true, "Position offset", "inc"),
+    var(0x60B1, T::integer32, A::read_write, true, "Velocity offset", "rpm"),
+    var(0x60B2, T::integer16, A::read_write, true, "Torque offset", permille),
+    // Period = value x 10^index s. Information for the master: the drive takes a set-point every
+    // cycle (every SYNC on CANopen).
+    highest_sub(0x60C2, 2, "Interpolation time period"),
+    sub(0x60C2, 1, T::unsigned8, "Interpolation time period value", "", 1),
+    limited(sub(0x60C2, 2, T::integer8, "Interpolation time index", "", -3), -6, 0),
+    var(0x60F4, T::integer32, A::read_only, true, "Following error actual value", "inc"),
     var(0x60FF, T::integer32, A::read_write, true, "Target velocity", "rpm"),
-    var(0x6502, T::unsigned32, A::read_only, false, "Supported drive modes", "", 1 << 2),
+    // pp (bit 0), pv (2), tq (3), hm (5), csp (7), csv (8), cst (9).
+    var(0x6502, T::unsigned32, A::read_only, false, "Supported drive modes", "", 0x3AD),
 };
 constexpr std::size_t count = sizeof(objects) / sizeof(objects[0]);
 
 constexpr bool in_index_order() noexcept {
   for (std::size_t i = 1; i < count; ++i) {
-    if (objects[i - 1].index >= objects[i].index) return false;
+    const bool after = objects[i - 1].index < objects[i].index ||
+                       (objects[i - 1].index == objects[i].index && objects[i - 1].sub < objects[i].sub);
+    if (!after) return false;
   }
   return true;
 }
-static_assert(in_index_order(), "the object table is kept in index order");
+static_assert(in_index_order(), "the object table is kept in index and sub-index order");
 
 }  // namespace
 
@@ -66,6 +130,51 @@ const object_description* find_drive_object(std::uint16_t index, std::uint8_t su
     if (o.index == index && o.sub == sub) return &o;
   }
   return nullptr;
+}
+
+namespace {
+struct mode_name {
+  std::int8_t number;
+  const char* name;
+};
+constexpr mode_name mode_names[] = {{mode::profile_position, "pp"}, {mode::profile_velocity, "pv"},
+                                    {mode::profile_torque, "tq"}, {mode::homing, "hm"},
+                                    {mode::cyclic_synchronous_position, "csp"},
+                                    {mode::cyclic_synchronous_velocity, "csv"},
+                                    {mode::cyclic_synchronous_torque, "cst"}};
+}  // namespace
+
+const char* mode::short_name(std::int64_t m) noexcept {
+  for (const mode_name& n : mode_names) {
+    if (n.number == m) return n.name;
+  }
+  return "";
+}
+
+bool mode::parse(std::string_view text, std::int8_t& out) noexcept {
+  for (const mode_name& n : mode_names) {
+    if (text == n.name) {
+      out = n.number;
+      return true;
+    }
+  }
+  if (text.empty() || text.size() > 4) return false;
+  int value = 0;
+  bool negative = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (i == 0 && c == '-' && text.size() > 1) {
+      negative = true;
+    } else if (c >= '0' && c <= '9') {
+      value = value * 10 + (c - '0');
+    } else {
+      return false;
+    }
+  }
+  value = negative ? -value : value;
+  if (value < -128 || value > 127) return false;
+  out = static_cast<std::int8_t>(value);
+  return true;
 }
 
 }  // namespace cia402

@@ -70,6 +70,12 @@ void profile_position::reset(std::int64_t position) noexcept {
   target_ = position;
 }
 
+void profile_position::reset(const shaft& s) noexcept {
+  *this = profile_position{};
+  shaft_ = s;
+  target_ = s.position;
+}
+
 pp_status profile_position::step(const pp_command& cmd, const pp_parameters& par,
                                  std::uint32_t dt_us) noexcept {
   // The set-point handshake: an offered set-point (bit 4's rising edge) is taken if there is room:
@@ -79,15 +85,20 @@ pp_status profile_position::step(const pp_command& cmd, const pp_parameters& par
   last_new_setpoint_ = cmd.new_setpoint;
   if (offered) {
     const std::int64_t base = queued_valid_ ? queued_ : target_;
-    const std::int64_t absolute = cmd.relative ? base + cmd.target : cmd.target;
+    const std::int64_t wanted = cmd.relative ? base + cmd.target : cmd.target;
+    const std::int64_t absolute = wanted < par.min_position   ? par.min_position
+                                  : wanted > par.max_position ? par.max_position
+                                                              : wanted;
     if (cmd.change_immediately || !active_) {
       target_ = absolute;
+      limited_ = absolute != wanted;
       active_ = true;
       queued_valid_ = false;
       acknowledge_ = true;
       in_window_us_ = 0;
     } else if (!queued_valid_) {
       queued_ = absolute;
+      queued_limited_ = absolute != wanted;
       queued_valid_ = true;
       queued_blends_ = cmd.change_on_setpoint;
       acknowledge_ = true;
@@ -148,6 +159,7 @@ pp_status profile_position::step(const pp_command& cmd, const pp_parameters& par
       in_window_us_ = 0;
       if (queued_valid_) {
         target_ = queued_;
+        limited_ = queued_limited_;
         active_ = true;
         queued_valid_ = false;
       }
@@ -159,6 +171,7 @@ pp_status profile_position::step(const pp_command& cmd, const pp_parameters& par
   pp_status st;
   st.demand = shaft_.position;
   st.setpoint_acknowledge = acknowledge_;
+  st.limited = limited_;
   const bool at_rest = shaft_.velocity == 0;
   if (cmd.halt) {
     st.target_reached = at_rest;

@@ -58,10 +58,44 @@ void set_flag(axis_state& a, std::uint8_t flag, bool on) noexcept {
   a.flags = static_cast<std::uint8_t>(on ? (a.flags | flag) : (a.flags & ~flag));
 }
 
-// The plant over one cycle under the outputs the drive just decided: first the shaft (with the
-// brake as it was at the start of the cycle), then the brake.
-void follow(const profile& p, const plant_constants& k, axis_state& a,
-            const drive_outputs& out) noexcept {
+bool add_fault_cause(axis_state& a, std::uint16_t code, std::uint8_t error_class) noexcept;
+
+__extension__ typedef __int128 wide;
+
+constexpr std::int64_t sign_of(std::int64_t v) noexcept { return (v > 0) - (v < 0); }
+
+std::int64_t clamp(std::int64_t v, std::int64_t lo, std::int64_t hi) noexcept {
+  return v < lo ? lo : (v > hi ? hi : v);
+}
+
+// A mode change takes effect at the start of the next cycle's motion: the new mode takes the shaft
+// over as it is (pp with no set-point brakes it, homing waits for its start), and 0x6061 shows it.
+void enter_mode(axis_state& a) noexcept {
+  a.operation_mode = a.requested_mode;
+  a.pp.reset(motion::shaft{a.position, a.position_fraction, a.velocity});
+  a.homing.reset();
+  a.demand = a.position;
+  a.torque_demand = a.torque;
+  a.following_error_us = 0;
+  a.mode_status = 0;
+}
+
+// 0x607D: on when the minimum lies below the maximum.
+bool limits_on(const axis_state& a) noexcept { return a.objects.min_position < a.objects.max_position; }
+
+// Moving outwards at or past a software limit.
+bool beyond_limit(const axis_state& a, std::int64_t position, std::int64_t velocity) noexcept {
+  return limits_on(a) && ((position >= a.objects.max_position && velocity > 0) ||
+                          (position <= a.objects.min_position && velocity < 0));
+}
+
+// Micro-rpm per cycle of a stop ramp (not coast, not none).
+std::int64_t ramp_step(const plant_constants& k, const axis_state& a, stop_ramp r) noexcept;
+
+// The velocity modes' plant (profile velocity, and every mode while a stop runs or torque is off):
+// the velocity approaches its goal on the ramps, the position integrates it.
+void velocity_follow(const profile& p, const plant_constants& k, axis_state& a,
+                     const drive_outputs& out, motion::shaft& s, bool brake_holds) noexcept {
   const std::int64_t cycle = k.cycle_us;
   std::int64_t goal = 0;
   std::int64_t up = 0;
@@ -70,19 +104,234 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
     down = k.coast_step;  // coasting: friction only
   } else if (out.ramp != stop_ramp::none && out.ramp != stop_ramp::coast) {
     down = ramp_step(k, a, out.ramp);
-  } else if (p.info(out.current).activity == state_activity::run) {
+  } else if (p.info(out.current).activity == state_activity::run && a.operation_mode == cia402::mode::profile_velocity) {
     goal = std::int64_t{effective_target(a)} * micro;
     up = std::int64_t{a.acceleration} * cycle;
     down = std::int64_t{a.deceleration} * cycle;
+    if (beyond_limit(a, s.position, goal)) {  // a software limit stops on the quick-stop ramp
+      goal = 0;
+      down = std::int64_t{a.quick_stop_deceleration} * cycle;
+    }
   } else {
     down = std::int64_t{a.deceleration} * cycle;  // torque held without motion (e.g. hold states)
   }
-  if (k.brake_fitted && (a.flags & sim_flag::brake_closed)) {
+  if (brake_holds) {
     goal = 0;  // an engaged (or still releasing) brake holds the shaft: nothing accelerates
     up = 0;
     down += k.brake_step;
   }
-  a.velocity = approach(a.velocity, goal, up, down);
+  motion::advance(s, approach(s.velocity, goal, up, down), k.cycle_us, a.objects.increments_per_rev);
+}
+
+// The torque modes' shaft: the motor's torque against friction and the load accelerates the inertia.
+void torque_follow(const plant_constants& k, axis_state& a, motion::shaft& s,
+                   std::int64_t torque) noexcept {
+  const std::int64_t v = s.velocity;
+  std::int64_t net = torque - k.load;
+  if (v != 0) {
+    net -= sign_of(v) * k.friction;
+  } else {
+    net = net > k.friction ? net - k.friction : (net < -k.friction ? net + k.friction : 0);
+  }
+  std::int64_t v_new = v + net * k.torque_acceleration / 1000 * std::int64_t{k.cycle_us};
+  if (v != 0 && sign_of(v_new) != sign_of(v) && sign_of(torque - k.load) != sign_of(v_new)) {
+    v_new = 0;  // friction stops the shaft; it does not turn it back
+  }
+  v_new = clamp(v_new, -k.max_velocity, k.max_velocity);
+  if (beyond_limit(a, s.position, v_new)) {
+    v_new = approach(v, 0, 0, std::int64_t{a.quick_stop_deceleration} * k.cycle_us);
+    a.mode_status |= status_bit::internal_limit_active;
+  }
+  motion::advance(s, v_new, k.cycle_us, a.objects.increments_per_rev);
+}
+
+// The torque a velocity change took (permille): inertia, friction and load. What 0x6077 shows in
+// the modes that command a velocity or a position.
+std::int32_t torque_of_motion(const plant_constants& k, const axis_state& a, std::int64_t v_old,
+                              std::int64_t v_new) noexcept {
+  // micro-rpm per microsecond is rpm/s.
+  const std::int64_t accel = (v_new - v_old) / std::int64_t{k.cycle_us};
+  const std::int64_t moving = v_new != 0 ? v_new : v_old;
+  const std::int64_t t = accel * 1000 / (k.torque_acceleration ? k.torque_acceleration : 1) +
+                         sign_of(moving) * k.friction + (moving != 0 || a.torque != 0 ? k.load : 0);
+  return static_cast<std::int32_t>(clamp(t, -32768, 32767));
+}
+
+// The following error check of the position modes (0x6065, 0x6066): beyond the window for longer
+// than the time out, status bit 13 and the fault 0x8611 (which the drive answers by 0x605E).
+bool following_error_check(const plant_constants& k, axis_state& a) noexcept {
+  const std::uint32_t window = a.objects.following_error_window;
+  const std::int64_t error = following_error(a);
+  if (window == 0xFFFFFFFFu || (error < 0 ? -error : error) <= std::int64_t{window}) {
+    a.following_error_us = 0;
+    return false;
+  }
+  const std::uint32_t room = UINT32_MAX - a.following_error_us;
+  a.following_error_us += k.cycle_us < room ? k.cycle_us : room;
+  if (a.following_error_us <= std::uint32_t{a.objects.following_error_time_out} * 1000u) return false;
+  if (!(a.flags & sim_flag::following_error_raised)) {
+    a.flags |= sim_flag::following_error_raised;
+    add_fault_cause(a, following_error_code, 2);
+  }
+  return true;
+}
+
+// One cycle of the shaft in a mode other than profile velocity, while the drive runs. Returns the
+// mode's status bits (10..13).
+std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_outputs& out,
+                           motion::shaft& s, bool& torque_set) noexcept {
+  const mode_objects& o = a.objects;
+  const std::uint16_t cw = a.control_word;
+  const bool cleared = (a.flags & sim_flag::setpoints_cleared) != 0;
+  std::uint16_t status = 0;
+  switch (a.operation_mode) {
+    case cia402::mode::profile_position: {
+      motion::pp_command cmd;
+      cmd.new_setpoint = (cw & (1u << 4)) != 0;
+      cmd.change_immediately = (cw & (1u << 5)) != 0;
+      cmd.relative = (cw & (1u << 6)) != 0;
+      cmd.halt = (cw & control_bit::halt) != 0;
+      cmd.change_on_setpoint = (cw & (1u << 9)) != 0;
+      cmd.target = o.target_position;
+      motion::pp_parameters par;
+      par.profile_velocity_rpm = o.profile_velocity;
+      par.end_velocity_rpm = o.end_velocity;
+      par.acceleration_rpm_s = a.acceleration;
+      // A halt brakes on the ramp 0x605D chose (S8).
+      par.deceleration_rpm_s = out.ramp != stop_ramp::none
+                                   ? static_cast<std::uint32_t>(ramp_step(k, a, out.ramp) / k.cycle_us)
+                                   : a.deceleration;
+      par.position_window = o.position_window;
+      par.position_window_time_ms = o.position_window_time;
+      par.increments_per_rev = o.increments_per_rev;
+      if (limits_on(a)) {
+        par.min_position = o.min_position;
+        par.max_position = o.max_position;
+      }
+      const motion::pp_status st = a.pp.step(cmd, par, k.cycle_us);
+      s = a.pp.state();
+      a.demand = st.demand;
+      status = static_cast<std::uint16_t>((st.target_reached ? status_bit::target_reached : 0u) |
+                                          (st.setpoint_acknowledge ? 1u << 12 : 0u) |
+                                          (st.limited ? status_bit::internal_limit_active : 0u));
+      break;
+    }
+    case cia402::mode::homing: {
+      motion::homing_parameters par;
+      par.method = o.homing_method;
+      par.switch_speed_rpm = o.homing_switch_speed;
+      par.zero_speed_rpm = o.homing_zero_speed;
+      par.acceleration_rpm_s = o.homing_acceleration;
+      par.home_offset = o.home_offset;
+      par.increments_per_rev = o.increments_per_rev;
+      par.home_switch_at = k.home_switch_position;
+      par.index_at = k.index_position;
+      const motion::homing_status st = a.homing.step((cw & (1u << 4)) != 0, par, s, k.cycle_us);
+      a.demand = s.position;
+      status = static_cast<std::uint16_t>((st.target_reached ? status_bit::target_reached : 0u) |
+                                          (st.attained ? 1u << 12 : 0u) | (st.error ? 1u << 13 : 0u));
+      break;
+    }
+    case cia402::mode::cyclic_synchronous_position: {
+      // The set-point of this cycle (sampled at SYNC on CANopen): the position loop reaches it
+      // within the cycle unless the motor's top speed cannot.
+      std::int64_t demand = std::int64_t{o.target_position} + o.position_offset;
+      if (limits_on(a)) {
+        const std::int64_t cut = clamp(demand, o.min_position, o.max_position);
+        if (cut != demand) status |= status_bit::internal_limit_active;
+        demand = cut;
+      }
+      a.demand = demand;
+      const wide per_cycle = static_cast<wide>(k.max_velocity) * o.increments_per_rev * k.cycle_us /
+                             static_cast<wide>(60'000'000'000'000LL);
+      const std::int64_t reach = static_cast<std::int64_t>(per_cycle);
+      const std::int64_t step = clamp(demand - s.position, -reach, reach);
+      const std::int64_t before = s.position;
+      s.position += step;
+      s.fraction = 0;
+      s.velocity = static_cast<std::int64_t>(static_cast<wide>(s.position - before) *
+                                             60'000'000'000'000LL /
+                                             (static_cast<wide>(o.increments_per_rev) * k.cycle_us));
+      status |= 1u << 12;  // the drive follows the command value
+      if (following_error_check(k, a)) status |= 1u << 13;
+      break;
+    }
+    case cia402::mode::cyclic_synchronous_velocity: {
+      const std::int64_t goal = clamp((std::int64_t{cleared ? 0 : a.target_velocity} + o.velocity_offset) * micro,
+                                      -k.max_velocity, k.max_velocity);
+      std::int64_t v_new = approach(s.velocity, goal, k.max_acceleration_step, k.max_acceleration_step);
+      if (beyond_limit(a, s.position, v_new)) {
+        v_new = approach(s.velocity, 0, 0, std::int64_t{a.quick_stop_deceleration} * k.cycle_us);
+        status |= status_bit::internal_limit_active;
+      }
+      motion::advance(s, v_new, k.cycle_us, o.increments_per_rev);
+      a.demand = s.position;
+      status |= 1u << 12;
+      break;
+    }
+    case cia402::mode::profile_torque:
+    case cia402::mode::cyclic_synchronous_torque: {
+      const std::int64_t target = cleared ? 0 : o.target_torque;
+      std::int64_t demand;
+      if (a.operation_mode == cia402::mode::profile_torque) {
+        // The demand ramps to the target at the torque slope 0x6087.
+        const std::int64_t slope = std::int64_t{o.torque_slope} * k.cycle_us / 1'000'000;
+        const std::int64_t step_max = slope > 0 ? slope : 1;
+        demand = a.torque_demand + clamp(target - a.torque_demand, -step_max, step_max);
+        if (demand == target) status |= status_bit::target_reached;
+      } else {
+        demand = clamp(target + o.torque_offset, -32768, 32767);
+        status |= 1u << 12;
+      }
+      a.torque_demand = static_cast<std::int32_t>(demand);
+      a.mode_status = 0;
+      torque_follow(k, a, s, demand);
+      status |= a.mode_status;
+      a.torque = a.torque_demand;
+      torque_set = true;
+      a.demand = s.position;
+      break;
+    }
+    default: break;
+  }
+  return status;
+}
+
+// The plant over one cycle under the outputs the drive just decided: first the shaft (with the
+// brake as it was at the start of the cycle), then the brake.
+void follow(const profile& p, const plant_constants& k, axis_state& a,
+            const drive_outputs& out) noexcept {
+  if (a.requested_mode != a.operation_mode) enter_mode(a);
+  const std::int64_t v_old = a.velocity;
+  motion::shaft s{a.position, a.position_fraction, a.velocity};
+  const bool brake_holds = k.brake_fitted && (a.flags & sim_flag::brake_closed);
+  const bool run = out.torque && !brake_holds && p.info(out.current).activity == state_activity::run;
+  // The mode moves the shaft while the drive runs and no stop does; in pp a halt too (the target
+  // stays and the move resumes when bit 8 falls).
+  const bool halt = (a.control_word & control_bit::halt) != 0 && !stop_running(a.core);
+  const bool mode_moves = run && (out.ramp == stop_ramp::none ||
+                                  (halt && a.operation_mode == cia402::mode::profile_position));
+  std::uint16_t status = 0;
+  bool torque_set = false;
+  if (mode_moves && a.operation_mode != cia402::mode::profile_velocity) {
+    status = move_in_mode(k, a, out, s, torque_set);
+  } else {
+    velocity_follow(p, k, a, out, s, brake_holds);
+    if (a.operation_mode == cia402::mode::profile_position) a.pp.reset(s);  // no set-point survives a stop
+    if (a.operation_mode == cia402::mode::homing) a.homing.interrupt();
+    a.demand = s.position;
+    a.torque_demand = 0;
+    a.following_error_us = 0;
+    if (a.operation_mode == cia402::mode::profile_velocity && run && out.ramp == stop_ramp::none &&
+        beyond_limit(a, s.position, s.velocity)) {
+      status |= status_bit::internal_limit_active;
+    }
+  }
+  a.position = s.position;
+  a.position_fraction = s.fraction;
+  a.velocity = s.velocity;
+  a.mode_status = status;
+  if (!torque_set) a.torque = out.torque ? torque_of_motion(k, a, v_old, s.velocity) : 0;
 
   if (!k.brake_fitted) return;
   const bool open = out.brake_released;
@@ -112,6 +361,25 @@ void remove_fault_at(axis_state& a, int i) noexcept {
   a.fault_classes[max_fault_causes - 1] = 0;
 }
 
+bool add_fault_cause(axis_state& a, std::uint16_t code, std::uint8_t error_class) noexcept {
+  if (code == 0) return false;
+  for (int i = 0; i < max_fault_causes; ++i) {
+    if (a.fault_codes[i] == code) {
+      remove_fault_at(a, i);
+      break;
+    }
+  }
+  bool kept_all = true;
+  if (fault_count(a) == max_fault_causes) {
+    remove_fault_at(a, 0);
+    kept_all = false;
+  }
+  const int n = fault_count(a);
+  a.fault_codes[n] = code;
+  a.fault_classes[n] = error_class;
+  return kept_all;
+}
+
 }  // namespace
 
 const char* check_plant_config(const plant_config& c) noexcept {
@@ -131,6 +399,20 @@ const char* check_plant_config(const plant_config& c) noexcept {
   }
   if (c.standstill_window_rpm > 1000000) return "standstill window must be at most 1000000 rpm";
   if (c.target_window_rpm > 1000000) return "target window must be at most 1000000 rpm";
+  if (c.max_velocity_rpm < 1 || c.max_velocity_rpm > 100000) return "max velocity must be 1..100000 rpm";
+  if (c.max_acceleration_rpm_s < 1 || c.max_acceleration_rpm_s > 100000000) {
+    return "max acceleration must be 1..100000000 rpm/s";
+  }
+  if (c.torque_acceleration_rpm_s < 1 || c.torque_acceleration_rpm_s > 100000000) {
+    return "torque acceleration must be 1..100000000 rpm/s";
+  }
+  if (c.friction_permille > 1000) return "friction must be 0..1000 permille";
+  if (c.load_permille < -1000 || c.load_permille > 1000) return "load must be -1000..1000 permille";
+  constexpr std::int64_t reach = std::int64_t{1} << 40;
+  if (c.home_switch_position < -reach || c.home_switch_position > reach ||
+      c.index_position < -reach || c.index_position > reach) {
+    return "home switch and index positions must be within +-2^40 increments";
+  }
   return nullptr;
 }
 
@@ -146,12 +428,56 @@ plant_constants plant_constants::from(const plant_config& c) noexcept {
   k.current_limit_percent = static_cast<std::uint16_t>(c.current_limit_percent);
   k.voltage_limit_percent = static_cast<std::uint16_t>(c.voltage_limit_percent);
   k.brake_fitted = c.brake_fitted;
+  k.max_velocity = std::int64_t{c.max_velocity_rpm} * micro;
+  k.max_acceleration_step = std::int64_t{c.max_acceleration_rpm_s} * c.cycle_us;
+  k.torque_acceleration = c.torque_acceleration_rpm_s;
+  k.friction = static_cast<std::int32_t>(c.friction_permille);
+  k.load = c.load_permille;
+  k.home_switch_position = c.home_switch_position;
+  k.index_position = c.index_position;
   return k;
 }
+
+namespace {
+
+// The default of an entry of the one object table.
+std::int64_t default_of(std::uint16_t index, std::uint8_t sub = 0) noexcept {
+  const object_description* o = find_drive_object(index, sub);
+  return o != nullptr ? o->default_value : 0;
+}
+
+template <typename T>
+T default_as(std::uint16_t index, std::uint8_t sub = 0) noexcept {
+  return static_cast<T>(default_of(index, sub));
+}
+
+}  // namespace
 
 axis_state make_axis_state(const profile& p) noexcept {
   axis_state a;
   a.core = make_axis(p);
+  a.acceleration = default_as<std::uint32_t>(object::profile_acceleration);
+  a.deceleration = default_as<std::uint32_t>(object::profile_deceleration);
+  a.quick_stop_deceleration = default_as<std::uint32_t>(object::quick_stop_deceleration);
+  a.requested_mode = a.operation_mode = default_as<std::int8_t>(object::modes_of_operation);
+  mode_objects& o = a.objects;
+  o.min_position = default_as<std::int32_t>(object::software_position_limit, 1);
+  o.max_position = default_as<std::int32_t>(object::software_position_limit, 2);
+  o.profile_velocity = default_as<std::uint32_t>(object::profile_velocity);
+  o.end_velocity = default_as<std::uint32_t>(object::end_velocity);
+  o.torque_slope = default_as<std::uint32_t>(object::torque_slope);
+  o.following_error_window = default_as<std::uint32_t>(object::following_error_window);
+  o.position_window = default_as<std::uint32_t>(object::position_window);
+  o.increments_per_rev = default_as<std::uint32_t>(object::position_encoder_resolution, 1);
+  o.homing_switch_speed = default_as<std::uint32_t>(object::homing_speeds, 1);
+  o.homing_zero_speed = default_as<std::uint32_t>(object::homing_speeds, 2);
+  o.homing_acceleration = default_as<std::uint32_t>(object::homing_acceleration);
+  o.following_error_time_out = default_as<std::uint16_t>(object::following_error_time_out);
+  o.position_window_time = default_as<std::uint16_t>(object::position_window_time);
+  o.homing_method = default_as<std::int8_t>(object::homing_method);
+  o.interpolation_value = default_as<std::uint8_t>(object::interpolation_time_period, 1);
+  o.interpolation_index = default_as<std::int8_t>(object::interpolation_time_period, 2);
+  a.pp.reset(0);
   return a;
 }
 
@@ -183,9 +509,16 @@ inline drive_inputs inputs_of(const plant_constants& k, const axis_state& a) noe
   // Status bit 11 while a stop at the current or voltage limit is still braking.
   const bool internal_limit = !standstill && (a.last.ramp == stop_ramp::current_limit ||
                                               a.last.ramp == stop_ramp::voltage_limit);
-  in.status_bits = static_cast<std::uint16_t>((target_reached ? status_bit::target_reached : 0u) |
-                                              (internal_limit ? status_bit::internal_limit_active : 0u) |
-                                              (standstill ? 0x1000u : 0u));  // pv: speed = 0
+  // Profile velocity shows target reached and bit 12 "speed = 0" from the velocity; every other
+  // mode what its motion produced last cycle (move_in_mode).
+  const std::uint16_t mode_bits =
+      a.operation_mode == cia402::mode::profile_velocity
+          ? static_cast<std::uint16_t>((target_reached ? status_bit::target_reached : 0u) |
+                                       (standstill ? 0x1000u : 0u) |
+                                       (a.mode_status & status_bit::internal_limit_active))
+          : a.mode_status;
+  in.status_bits = static_cast<std::uint16_t>(mode_bits |
+                                              (internal_limit ? status_bit::internal_limit_active : 0u));
   in.actual_speed_rpm = velocity_rpm(a);
   return in;
 }
@@ -209,7 +542,21 @@ const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_
   a.last.clear_setpoints = out.clear_setpoints;
   a.last.error_code = out.error_code;
   a.last.error_register = out.error_register;
-  if (out.clear_setpoints) a.flags |= sim_flag::setpoints_cleared;
+  if (out.clear_setpoints) {
+    a.flags |= sim_flag::setpoints_cleared;
+    a.pp.reset(motion::shaft{a.position, a.position_fraction, a.velocity});
+  }
+  // A following error is an event: once the drive has reacted (FAULT), its cause is gone and a
+  // fault reset can clear 0x603F.
+  if ((a.flags & sim_flag::following_error_raised) && out.current == state::fault) {
+    for (int i = 0; i < max_fault_causes; ++i) {
+      if (a.fault_codes[i] == following_error_code) {
+        remove_fault_at(a, i);
+        break;
+      }
+    }
+    a.flags &= static_cast<std::uint8_t>(~sim_flag::following_error_raised);
+  }
   follow(p, k, a, out);
   return a.last;
 }
@@ -221,14 +568,18 @@ namespace {
 // object alike; what a value means is the switch's below.
 sdo_abort describe(const profile& p, std::uint16_t index, std::uint8_t sub,
                    const object_description*& out) noexcept {
-  out = find_drive_object(index, 0);
+  out = find_drive_object(index, sub);
   option o;
-  if (out == nullptr || (option_of_index(index, o) && !p.spec(o).exists())) {
+  if ((out == nullptr && find_drive_object(index, 0) == nullptr) ||
+      (option_of_index(index, o) && !p.spec(o).exists())) {
     return sdo_abort::object_does_not_exist;
   }
-  if (sub != 0) return sdo_abort::sub_index_does_not_exist;
+  if (out == nullptr) return sdo_abort::sub_index_does_not_exist;
   return sdo_abort::none;
 }
+
+// The set-point objects end the "set-points cleared" of T4 when written.
+void setpoint_written(axis_state& a) noexcept { set_flag(a, sim_flag::setpoints_cleared, false); }
 
 }  // namespace
 
@@ -242,19 +593,61 @@ sdo_abort write_object(const profile& p, axis_state& a, std::uint16_t index, std
   if (const sdo_abort r = check_write(*o, value); r != sdo_abort::none) return r;
   option opt;
   if (option_of_index(index, opt)) return write_option(p, a.core, index, static_cast<std::int32_t>(value));
+  mode_objects& m = a.objects;
+  const auto i32 = static_cast<std::int32_t>(value);
+  const auto u32 = static_cast<std::uint32_t>(value);
   switch (index) {
     case object::control_word: a.control_word = static_cast<std::uint16_t>(value); break;
     case object::target_velocity:
-      a.target_velocity = static_cast<std::int32_t>(value);
-      set_flag(a, sim_flag::setpoints_cleared, false);
+      a.target_velocity = i32;
+      setpoint_written(a);
       break;
-    case object::profile_acceleration: a.acceleration = static_cast<std::uint32_t>(value); break;
-    case object::profile_deceleration: a.deceleration = static_cast<std::uint32_t>(value); break;
-    case object::quick_stop_deceleration:
-      a.quick_stop_deceleration = static_cast<std::uint32_t>(value);
+    case object::profile_acceleration: a.acceleration = u32; break;
+    case object::profile_deceleration: a.deceleration = u32; break;
+    case object::quick_stop_deceleration: a.quick_stop_deceleration = u32; break;
+    case object::modes_of_operation: {
+      const object_description* supported = find_drive_object(object::supported_drive_modes);
+      if (supported == nullptr || !(cia402::mode::supported_bit(value) &
+                                    static_cast<std::uint32_t>(supported->default_value))) {
+        return sdo_abort::invalid_value;
+      }
+      a.requested_mode = static_cast<std::int8_t>(value);
       break;
-    case object::modes_of_operation:
-      if (value != profile_velocity_mode) return sdo_abort::invalid_value;
+    }
+    case object::target_position:
+      m.target_position = i32;
+      setpoint_written(a);
+      break;
+    case object::target_torque:
+      m.target_torque = static_cast<std::int16_t>(value);
+      setpoint_written(a);
+      break;
+    case object::position_offset: m.position_offset = i32; break;
+    case object::velocity_offset: m.velocity_offset = i32; break;
+    case object::torque_offset: m.torque_offset = static_cast<std::int16_t>(value); break;
+    case object::home_offset: m.home_offset = i32; break;
+    case object::software_position_limit:
+      (sub == 1 ? m.min_position : m.max_position) = i32;
+      break;
+    case object::profile_velocity: m.profile_velocity = u32; break;
+    case object::end_velocity: m.end_velocity = u32; break;
+    case object::torque_slope: m.torque_slope = u32; break;
+    case object::following_error_window: m.following_error_window = u32; break;
+    case object::following_error_time_out: m.following_error_time_out = static_cast<std::uint16_t>(value); break;
+    case object::position_window: m.position_window = u32; break;
+    case object::position_window_time: m.position_window_time = static_cast<std::uint16_t>(value); break;
+    case object::position_encoder_resolution:
+      if (sub == 1) m.increments_per_rev = u32;
+      break;  // sub 2 (motor revolutions) takes only 1: the table's limits
+    case object::homing_method:
+      if (!motion::homing::supports(value)) return sdo_abort::invalid_value;
+      m.homing_method = static_cast<std::int8_t>(value);
+      break;
+    case object::homing_speeds: (sub == 1 ? m.homing_switch_speed : m.homing_zero_speed) = u32; break;
+    case object::homing_acceleration: m.homing_acceleration = u32; break;
+    case object::interpolation_time_period:
+      if (sub == 1) m.interpolation_value = static_cast<std::uint8_t>(value);
+      else m.interpolation_index = static_cast<std::int8_t>(value);
       break;
     default: return sdo_abort::object_does_not_exist;
   }
@@ -278,6 +671,13 @@ sdo_abort read_object(const profile& p, const axis_state& a, std::uint16_t index
     if (r == sdo_abort::none) value = v;
     return r;
   }
+  if (sub == 0 && o->access == object_access::read_only && o->low == o->high) {
+    value = o->default_value;  // sub-index 0 of an array or record: its entry count
+    return sdo_abort::none;
+  }
+  const mode_objects& m = a.objects;
+  // Positions are INTEGER32 on the bus: they wrap as a 32-bit encoder count does.
+  const auto wrap = [](std::int64_t v) { return static_cast<std::int64_t>(static_cast<std::int32_t>(v)); };
   switch (index) {
     case object::control_word: value = a.control_word; break;
     case object::status_word: value = a.last.status_word; break;
@@ -287,32 +687,41 @@ sdo_abort read_object(const profile& p, const axis_state& a, std::uint16_t index
     case object::profile_deceleration: value = a.deceleration; break;
     case object::quick_stop_deceleration: value = a.quick_stop_deceleration; break;
     case object::error_code: value = a.core.error_code; break;
-    case object::modes_of_operation:
-    case object::modes_of_operation_display: value = profile_velocity_mode; break;
+    case object::modes_of_operation: value = a.requested_mode; break;
+    case object::modes_of_operation_display: value = a.operation_mode; break;
     case object::supported_drive_modes: value = o->default_value; break;
+    case object::position_demand_value: value = wrap(a.demand); break;
+    case object::position_actual_value: value = wrap(a.position); break;
+    case object::following_error_actual_value: value = wrap(following_error(a)); break;
+    case object::torque_actual_value: value = a.torque; break;
+    case object::target_position: value = m.target_position; break;
+    case object::target_torque: value = m.target_torque; break;
+    case object::position_offset: value = m.position_offset; break;
+    case object::velocity_offset: value = m.velocity_offset; break;
+    case object::torque_offset: value = m.torque_offset; break;
+    case object::home_offset: value = m.home_offset; break;
+    case object::software_position_limit: value = sub == 1 ? m.min_position : m.max_position; break;
+    case object::profile_velocity: value = m.profile_velocity; break;
+    case object::end_velocity: value = m.end_velocity; break;
+    case object::torque_slope: value = m.torque_slope; break;
+    case object::following_error_window: value = m.following_error_window; break;
+    case object::following_error_time_out: value = m.following_error_time_out; break;
+    case object::position_window: value = m.position_window; break;
+    case object::position_window_time: value = m.position_window_time; break;
+    case object::position_encoder_resolution: value = sub == 1 ? m.increments_per_rev : 1; break;
+    case object::homing_method: value = m.homing_method; break;
+    case object::homing_speeds: value = sub == 1 ? m.homing_switch_speed : m.homing_zero_speed; break;
+    case object::homing_acceleration: value = m.homing_acceleration; break;
+    case object::interpolation_time_period:
+      value = sub == 1 ? m.interpolation_value : m.interpolation_index;
+      break;
     default: return sdo_abort::object_does_not_exist;
   }
   return sdo_abort::none;
 }
 
 bool drive_view::inject_fault(std::uint16_t code, std::uint8_t error_class) noexcept {
-  if (code == 0) return false;
-  axis_state& a = *axis_;
-  for (int i = 0; i < max_fault_causes; ++i) {
-    if (a.fault_codes[i] == code) {
-      remove_fault_at(a, i);
-      break;
-    }
-  }
-  bool kept_all = true;
-  if (fault_count(a) == max_fault_causes) {
-    remove_fault_at(a, 0);
-    kept_all = false;
-  }
-  const int n = fault_count(a);
-  a.fault_codes[n] = code;
-  a.fault_classes[n] = error_class;
-  return kept_all;
+  return add_fault_cause(*axis_, code, error_class);
 }
 
 bool drive_view::clear_fault(std::uint16_t code) noexcept {

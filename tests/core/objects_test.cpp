@@ -39,6 +39,25 @@ TEST(objects, the_table_holds_the_drive_objects_with_their_types_and_access) {
       {0x6085, object_type::unsigned32, object_access::read_write},
       {0x60FF, object_type::integer32, object_access::read_write},
       {0x6502, object_type::unsigned32, object_access::read_only},
+      {0x6062, object_type::integer32, object_access::read_only},
+      {0x6064, object_type::integer32, object_access::read_only},
+      {0x6065, object_type::unsigned32, object_access::read_write},
+      {0x6066, object_type::unsigned16, object_access::read_write},
+      {0x6067, object_type::unsigned32, object_access::read_write},
+      {0x6068, object_type::unsigned16, object_access::read_write},
+      {0x6071, object_type::integer16, object_access::read_write},
+      {0x6077, object_type::integer16, object_access::read_only},
+      {0x607A, object_type::integer32, object_access::read_write},
+      {0x607C, object_type::integer32, object_access::read_write},
+      {0x6081, object_type::unsigned32, object_access::read_write},
+      {0x6082, object_type::unsigned32, object_access::read_write},
+      {0x6087, object_type::unsigned32, object_access::read_write},
+      {0x6098, object_type::integer8, object_access::read_write},
+      {0x609A, object_type::unsigned32, object_access::read_write},
+      {0x60B0, object_type::integer32, object_access::read_write},
+      {0x60B1, object_type::integer32, object_access::read_write},
+      {0x60B2, object_type::integer16, object_access::read_write},
+      {0x60F4, object_type::integer32, object_access::read_only},
   };
   for (const expected& e : table) {
     const object_description* o = find_drive_object(e.index);
@@ -54,7 +73,19 @@ TEST(objects, the_table_holds_the_drive_objects_with_their_types_and_access) {
   EXPECT_EQ(find_drive_object(0x6040, 1), nullptr) << "sub-index 1 does not exist";
   EXPECT_EQ(find_drive_object(0x6000), nullptr);
   for (std::size_t i = 1; i < drive_object_count(); ++i) {
-    EXPECT_LT(drive_object(i - 1).index, drive_object(i).index) << "kept in index order";
+    const object_description& a = drive_object(i - 1);
+    const object_description& b = drive_object(i);
+    EXPECT_TRUE(a.index < b.index || (a.index == b.index && a.sub < b.sub))
+        << "kept in index and sub-index order: " << std::hex << b.index;
+  }
+  // An array's sub-index 0 is read-only and counts the entries that follow it.
+  for (std::uint16_t index : {0x607D, 0x608F, 0x6099, 0x60C2}) {
+    const object_description* count = find_drive_object(index, 0);
+    ASSERT_NE(count, nullptr) << std::hex << index;
+    EXPECT_EQ(count->access, object_access::read_only);
+    EXPECT_EQ(count->default_value, 2);
+    EXPECT_NE(find_drive_object(index, 2), nullptr);
+    EXPECT_EQ(find_drive_object(index, 3), nullptr);
   }
 }
 

@@ -29,7 +29,7 @@ TEST(objects, writes_to_read_only_objects_abort_with_0x06010002_and_change_nothi
 TEST(objects, unknown_indices_abort_with_0x06020000_for_read_and_write) {
   virtual_drive d(standard_profile());
   std::int64_t v = 0;
-  for (std::uint16_t index : {0x0000, 0x1000, 0x2000, 0x6042, 0x607A, 0xFFFF}) {
+  for (std::uint16_t index : {0x0000, 0x1000, 0x2000, 0x6042, 0x6063, 0xFFFF}) {
     EXPECT_EQ(d.write(index, 0, 0), sdo_abort::object_does_not_exist) << std::hex << index;
     EXPECT_EQ(d.write(index, 3, 0), sdo_abort::object_does_not_exist) << std::hex << index;
     EXPECT_EQ(d.read(index, 0, v), sdo_abort::object_does_not_exist) << std::hex << index;
@@ -97,7 +97,10 @@ INSTANTIATE_TEST_SUITE_P(
         range_case{0x605A, -40000, sdo_abort::value_too_low},
         range_case{0x605D, 0, sdo_abort::invalid_value}, range_case{0x605E, 4, sdo_abort::none},
         range_case{0x6007, 3, sdo_abort::none}, range_case{0x6007, 4, sdo_abort::invalid_value},
-        range_case{0x6060, 3, sdo_abort::none}, range_case{0x6060, 1, sdo_abort::invalid_value},
+        range_case{0x6060, 3, sdo_abort::none}, range_case{0x6060, 1, sdo_abort::none},
+        range_case{0x6060, 2, sdo_abort::invalid_value}, range_case{0x6060, 7, sdo_abort::invalid_value},
+        range_case{0x6060, 0, sdo_abort::invalid_value}, range_case{0x6098, 37, sdo_abort::none},
+        range_case{0x6098, 1, sdo_abort::invalid_value},
         range_case{0x6060, 128, sdo_abort::value_too_high}),
     [](const auto& info) {
       const auto& c = info.param;
@@ -181,8 +184,9 @@ TEST(objects, the_virtual_drive_answers_every_object_of_the_one_table) {
       EXPECT_EQ(d.write(o.index, o.sub, value), sdo_abort::read_only_object);
       continue;
     }
-    if (o.index == 0x6060 || (o.index >= 0x605A && o.index <= 0x605E) || o.index == 0x6007) {
-      continue;  // which values these take is the profile's (S5..S10) and the mode's
+    if (o.index == 0x6060 || o.index == 0x6098 || (o.index >= 0x605A && o.index <= 0x605E) ||
+        o.index == 0x6007) {
+      continue;  // which values these take is the profile's (S5..S10), the modes' and the methods
     }
     EXPECT_EQ(d.write(o.index, o.sub, o.low - 1), sdo_abort::value_too_low);
     EXPECT_EQ(d.write(o.index, o.sub, o.high + 1), sdo_abort::value_too_high);

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <climits>
 
 namespace cia402::motion {
 
@@ -47,6 +48,9 @@ struct pp_parameters {
   std::uint32_t position_window = 10;          ///< 0x6067, increments
   std::uint32_t position_window_time_ms = 0;   ///< 0x6068
   std::uint32_t increments_per_rev = 10000;    ///< 0x608F
+  /// 0x607D: a set-point beyond a limit is taken as the limit (status bit 11 says so).
+  std::int64_t min_position = INT64_MIN;
+  std::int64_t max_position = INT64_MAX;
 };
 
 /// What the master commands in profile position mode this cycle.
@@ -65,6 +69,7 @@ struct pp_status {
   bool target_reached = false;        ///< bit 10: at the target (within the window for its time),
                                       ///< or at standstill after a halt
   std::int64_t demand = 0;            ///< 0x6062 position demand, increments
+  bool limited = false;               ///< bit 11: the running set-point was cut to 0x607D
 };
 
 /// Profile position mode: a trapezoidal profile to each set-point, one set-point queued behind the
@@ -74,6 +79,9 @@ class profile_position {
  public:
   /// Starts at rest at `position` with no set-point (as when the mode is entered).
   void reset(std::int64_t position) noexcept;
+  /// Takes over a shaft in whatever motion it is (a mode change while moving): no set-point, so the
+  /// profile brakes it to rest on the deceleration ramp.
+  void reset(const shaft& s) noexcept;
 
   pp_status step(const pp_command& cmd, const pp_parameters& par, std::uint32_t dt_us) noexcept;
 
@@ -93,6 +101,8 @@ class profile_position {
   bool queued_blends_ = false;     // bit 9 with the queued set-point: do not stop at the running one
   bool last_new_setpoint_ = false;
   bool acknowledge_ = false;
+  bool limited_ = false;           // the running set-point was cut to a software limit
+  bool queued_limited_ = false;
 };
 
 }  // namespace cia402::motion

@@ -12,6 +12,9 @@
 #include <cstdint>
 
 #include "cia402/drive.hpp"
+#include "cia402/motion/homing.hpp"
+#include "cia402/motion/trajectory.hpp"
+#include "cia402/objects.hpp"
 #include "cia402/profile.hpp"
 
 namespace cia402::sim {
@@ -44,6 +47,24 @@ struct plant_config {
   /// A stop at the voltage limit (codes 4 and 8) decelerates at this percentage of the deceleration
   /// 0x6084: the DC link can take back no more energy than the normal slow-down ramp returns.
   std::uint32_t voltage_limit_percent = 100;
+
+  // The motor and machine behind the operation modes other than profile velocity.
+  /// The fastest the motor turns (rpm): cyclic set-points beyond it are followed at this speed (the
+  /// following error grows), torque modes saturate at it.
+  std::uint32_t max_velocity_rpm = 6000;
+  /// The fastest the motor accelerates in csv (rpm/s).
+  std::uint32_t max_acceleration_rpm_s = 100000;
+  /// Inertia: the acceleration (rpm/s) rated torque (1000 permille) gives the unloaded shaft.
+  std::uint32_t torque_acceleration_rpm_s = 20000;
+  /// Coulomb friction (permille of rated torque) against the motion; at rest it holds the shaft
+  /// until the torque exceeds it.
+  std::uint32_t friction_permille = 20;
+  /// A constant load torque (permille of rated torque, signed: positive pulls negative).
+  std::int32_t load_permille = 0;
+  /// The home switch is active at positions >= this (increments); an index pulse comes at
+  /// index_position and every revolution from there (homing method 3, 33, 34).
+  std::int64_t home_switch_position = 50000;
+  std::int64_t index_position = 0;
 };
 
 /// nullptr when the configuration is usable, else the reason ("cycle_us must be 1..1000000").
@@ -61,6 +82,13 @@ struct plant_constants {
   std::uint16_t current_limit_percent = 200;
   std::uint16_t voltage_limit_percent = 100;
   bool brake_fitted = true;
+  std::int64_t max_velocity = 0;      ///< micro-rpm
+  std::int64_t max_acceleration_step = 0;  ///< micro-rpm a cycle
+  std::int64_t torque_acceleration = 0;    ///< rpm/s at rated torque
+  std::int32_t friction = 0;          ///< permille
+  std::int32_t load = 0;              ///< permille
+  std::int64_t home_switch_position = 0;
+  std::int64_t index_position = 0;
 
   /// Requires check_plant_config(c) == nullptr.
   static plant_constants from(const plant_config& c) noexcept;
@@ -74,7 +102,39 @@ inline constexpr std::uint8_t connection_lost = 1u << 2;  ///< fieldbus connecti
 inline constexpr std::uint8_t setpoints_cleared = 1u << 3;  ///< 0x60FF reads as 0 until written
 inline constexpr std::uint8_t brake_closed = 1u << 4;     ///< the brake holds the shaft now
 inline constexpr std::uint8_t brake_commanded_open = 1u << 5;  ///< last drive_outputs.brake_released
+/// The following error (0x8611) is a fault cause until the drive has reached FAULT.
+inline constexpr std::uint8_t following_error_raised = 1u << 6;
 }  // namespace sim_flag
+
+/// The objects of the operation modes (CiA 402-2) as one axis holds them; defaults from the object
+/// table (cia402/objects.hpp).
+struct mode_objects {
+  std::int32_t target_position = 0;            ///< 0x607A
+  std::int32_t position_offset = 0;            ///< 0x60B0
+  std::int32_t velocity_offset = 0;            ///< 0x60B1
+  std::int32_t home_offset = 0;                ///< 0x607C
+  std::int32_t min_position = 0;               ///< 0x607D sub 1
+  std::int32_t max_position = 0;               ///< 0x607D sub 2
+  std::uint32_t profile_velocity = 0;          ///< 0x6081
+  std::uint32_t end_velocity = 0;              ///< 0x6082
+  std::uint32_t torque_slope = 0;              ///< 0x6087, permille/s
+  std::uint32_t following_error_window = 0;    ///< 0x6065; 0xFFFFFFFF = no check
+  std::uint32_t position_window = 0;           ///< 0x6067
+  std::uint32_t increments_per_rev = 0;        ///< 0x608F sub 1 (sub 2 is 1)
+  std::uint32_t homing_switch_speed = 0;       ///< 0x6099 sub 1
+  std::uint32_t homing_zero_speed = 0;         ///< 0x6099 sub 2
+  std::uint32_t homing_acceleration = 0;       ///< 0x609A
+  std::uint16_t following_error_time_out = 0;  ///< 0x6066, ms
+  std::uint16_t position_window_time = 0;      ///< 0x6068, ms
+  std::int16_t target_torque = 0;              ///< 0x6071
+  std::int16_t torque_offset = 0;              ///< 0x60B2
+  std::int8_t homing_method = 0;               ///< 0x6098
+  std::uint8_t interpolation_value = 0;        ///< 0x60C2 sub 1
+  std::int8_t interpolation_index = 0;         ///< 0x60C2 sub 2
+};
+
+/// The fault cause a following error beyond 0x6065 for longer than 0x6066 raises (CiA 402).
+inline constexpr std::uint16_t following_error_code = 0x8611;
 
 /// How many fault causes one axis holds at once.
 inline constexpr int max_fault_causes = 4;
@@ -96,6 +156,21 @@ struct axis_state {
   std::uint16_t fault_codes[max_fault_causes] = {};
   std::uint8_t fault_classes[max_fault_causes] = {};
   std::uint8_t flags = sim_flag::dc_link | sim_flag::brake_closed;  ///< sim_flag bits
+
+  // The operation modes.
+  std::int8_t requested_mode = cia402::mode::profile_velocity;  ///< 0x6060 as written
+  std::int8_t operation_mode = cia402::mode::profile_velocity;  ///< 0x6061: the mode it runs
+  /// The mode-specific status bits (10..13) this cycle's motion produced, shown by the next cycle.
+  std::uint16_t mode_status = 0;
+  std::int64_t position = 0;           ///< 0x6064, increments
+  std::int64_t position_fraction = 0;  ///< parts of an increment (motion::shaft::fraction_unit)
+  std::int64_t demand = 0;             ///< 0x6062
+  std::int32_t torque = 0;             ///< 0x6077, permille of rated torque
+  std::int32_t torque_demand = 0;      ///< the profile torque mode's ramped demand
+  std::uint32_t following_error_us = 0;  ///< how long the following error has been beyond 0x6065
+  mode_objects objects;
+  motion::profile_position pp;
+  motion::homing homing;
 };
 
 /// A fresh axis at power-on: the profile's default option codes, the motion objects' defaults, DC
@@ -115,6 +190,9 @@ const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_
 inline std::int32_t effective_target(const axis_state& a) noexcept {
   return (a.flags & sim_flag::setpoints_cleared) ? 0 : a.target_velocity;
 }
+
+/// 0x60F4: the position demand minus the actual position.
+inline std::int64_t following_error(const axis_state& a) noexcept { return a.demand - a.position; }
 
 /// Actual velocity as 0x606C reports it: rpm, rounded towards zero.
 inline std::int32_t velocity_rpm(const axis_state& a) noexcept {

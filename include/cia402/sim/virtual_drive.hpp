@@ -21,8 +21,8 @@ inline constexpr std::uint16_t error_register = 0x1001;  ///< UINT8, read-only (
 /// Option codes 0x605A..0x605E and 0x6007 go to cia402::write_option / read_option.
 }  // namespace object
 
-/// The profile velocity mode, the only mode the plant runs (0x6060 / 0x6061).
-inline constexpr std::int64_t profile_velocity_mode = 3;
+/// The mode a drive powers up in (0x6060 / 0x6061); cia402::mode lists every mode the plant runs.
+inline constexpr std::int64_t profile_velocity_mode = cia402::mode::profile_velocity;
 
 /// Writes an object of one axis. Results: none; object_does_not_exist (unknown index, or an option
 /// code the profile lacks); sub_index_does_not_exist (sub != 0); read_only_object (0x6041, 0x606C,
@@ -81,6 +81,14 @@ class drive_view {
   /// 0x60FF as written, and the set-point the motion side follows (0 after T4 until rewritten).
   std::int32_t target_velocity() const noexcept { return axis_->target_velocity; }
   std::int32_t effective_target() const noexcept { return sim::effective_target(*axis_); }
+  /// The operation modes: 0x6061 (the mode running), 0x6060 (as written), 0x6064 position actual
+  /// (increments, exact), 0x6062 demand, 0x60F4 following error, 0x6077 torque (permille).
+  std::int8_t operation_mode() const noexcept { return axis_->operation_mode; }
+  std::int8_t requested_mode() const noexcept { return axis_->requested_mode; }
+  std::int64_t position() const noexcept { return axis_->position; }
+  std::int64_t position_demand() const noexcept { return axis_->demand; }
+  std::int64_t following_error() const noexcept { return sim::following_error(*axis_); }
+  std::int32_t torque() const noexcept { return axis_->torque; }
   /// The brake holds the shaft (true when none is fitted).
   bool brake_engaged() const noexcept { return sim::brake_engaged(*constants_, *axis_); }
   /// The feedback the next cycle will give the drive.

@@ -189,6 +189,8 @@ std::vector<object_entry> drive_objects() {
 
   // The drive profile's objects, from the one table the whole project reads (cia402/objects.hpp);
   // their values are the device's.
+  // An entry with sub-indices (0x607D, 0x608F, 0x6099, 0x60C2) is an ARRAY when its entries share
+  // one type, else a RECORD; its sub-index 0 is the table's own read-only count.
   for (std::size_t i = 0; i < drive_object_count(); ++i) {
     const object_description& d = drive_object(i);
     const access acc = d.access == cia402::object_access::read_only    ? access::ro
@@ -199,8 +201,20 @@ std::vector<object_entry> drive_objects() {
     // The limits a write must keep, where they are narrower than the type (a ramp of 0 would never
     // end): the EDS says so as LowLimit / HighLimit.
     if (d.low != type_low(d.type) || d.high != type_high(d.type)) e = limited(std::move(e), d.low, d.high);
-    const bool mandatory_object = d.index == 0x6040 || d.index == 0x6041;
-    t.push_back(single(d.index, mandatory_object ? mandatory : optional, std::move(e)));
+    const bool has_subs = i + 1 < drive_object_count() && drive_object(i + 1).index == d.index;
+    if (d.sub != 0 || !has_subs) {
+      if (d.sub != 0 && !t.empty() && t.back().index == d.index) {
+        if (t.back().subs.size() > 1 && t.back().subs[1].type != e.type) t.back().code = object_code::record;
+        t.back().subs.push_back(std::move(e));
+        continue;
+      }
+      const bool mandatory_object = d.index == 0x6040 || d.index == 0x6041;
+      t.push_back(single(d.index, mandatory_object ? mandatory : optional, std::move(e)));
+      continue;
+    }
+    // Sub-index 0 of an array: a constant count, served by the dictionary itself.
+    sub_entry count = var(0, "Highest sub-index supported", data_type::unsigned8, access::ro, d.default_value);
+    t.push_back(group(d.index, d.name, object_code::array, optional, {std::move(count)}));
   }
   return t;
 }
