@@ -190,7 +190,7 @@ std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_
       cmd.new_setpoint = (cw & (1u << 4)) != 0;
       cmd.change_immediately = (cw & (1u << 5)) != 0;
       cmd.relative = (cw & (1u << 6)) != 0;
-      cmd.halt = (cw & control_bit::halt) != 0;
+      cmd.halt = out.ramp != stop_ramp::none;  // only a halt reaches here with a ramp (follow)
       cmd.change_on_setpoint = (cw & (1u << 9)) != 0;
       cmd.target = o.target_position;
       motion::pp_parameters par;
