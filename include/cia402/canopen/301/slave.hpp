@@ -43,6 +43,7 @@
 
 #include "cia402/canopen/can/channel.hpp"
 #include "cia402/canopen/301/device.hpp"
+#include "cia402/canopen/301/dictionary_access.hpp"
 #include "cia402/canopen/301/nmt.hpp"
 #include "cia402/canopen/301/object_dictionary.hpp"
 #include "cia402/canopen/301/pdo.hpp"
@@ -72,7 +73,7 @@ inline constexpr std::uint16_t heartbeat_lost = 0x8130;   ///< life guard / hear
 inline constexpr std::uint16_t pdo_length = 0x8210;       ///< PDO not processed: length error
 }  // namespace node_error
 
-class slave final : private object_access, private device_events {
+class slave final : private dictionary_access, private device_events {
  public:
   /// Sends the boot-up message and enters PRE-OPERATIONAL. Device and channel must outlive it; the
   /// node attaches itself to the device's reports until it is destroyed.
@@ -94,8 +95,8 @@ class slave final : private object_access, private device_events {
 
   /// Local object access with every rule the SDO server applies (what an application on the node
   /// would use). Values travel as int64; strings through read_text / write_text.
-  sdo_abort read(std::uint16_t index, std::uint8_t sub, std::int64_t& value);
-  sdo_abort write(std::uint16_t index, std::uint8_t sub, std::int64_t value);
+  using dictionary_access::read;
+  using dictionary_access::write;
   /// Any object as its bytes on the bus (strings as text).
   sdo_abort read_bytes(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t>& bytes) {
     return upload(index, sub, bytes);
@@ -122,24 +123,17 @@ class slave final : private object_access, private device_events {
     bool requested = false;  // an object it maps changed: sample it
   };
 
-  // object_access (the SDO server's view)
-  sdo_abort check_download(std::uint16_t index, std::uint8_t sub, std::size_t size,
-                           bool size_known) noexcept override;
-  sdo_abort download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
-                     bool size_indicated) noexcept override;
-  sdo_abort upload(std::uint16_t index, std::uint8_t sub,
-                   std::vector<std::uint8_t>& data) noexcept override;
-
   // device_events (the device's reports)
   void object_changed(std::uint16_t index, std::uint8_t sub) noexcept override;
   void error_changed(std::uint16_t code) noexcept override;
 
-  sdo_abort write_checked(object_dictionary::slot& s, std::int64_t v);
+  // dictionary_access: what a value that keeps the dictionary's rules does.
+  sdo_abort write_value(object_dictionary::slot& s, std::int64_t v) override;
   /// A CAN identifier this node may not take for `writing` (0x1005, 0x1014 or a PDO's communication
   /// object): reserved by CiA 301, or already SYNC, this node's EMCY or another PDO in use.
   bool cob_id_taken(std::uint32_t id, std::uint16_t writing) const;
   sdo_abort write_pdo_parameter(object_dictionary::slot& s, std::int64_t v);
-  sdo_abort read_value(const object_dictionary::slot& s, std::int64_t& v);
+  sdo_abort read_value(const object_dictionary::slot& s, std::int64_t& v) override;
   sdo_abort check_mapping_entry(bool receive, std::uint32_t entry) const;
   void resolve_pdos();
   pdo_config resolve(std::uint16_t comm, std::uint16_t mapping) const;
