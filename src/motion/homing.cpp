@@ -60,6 +60,15 @@ homing_status homing::step(bool start, const homing_parameters& par, shaft& s,
     case phase::search_switch: goal = switch_speed; break;
     case phase::leave_switch: goal = -zero_speed; break;
     case phase::search_index: goal = par.method == 34 ? zero_speed : -zero_speed; break;
+    case phase::returning: {
+      // Back to the home position found, no faster than it can still stop there.
+      const std::int64_t distance = home_at_ - s.position;
+      const std::int64_t cap = braking_speed(distance < 0 ? -distance : distance, par.acceleration_rpm_s, 0,
+                                             static_cast<std::uint32_t>(resolution));
+      const std::int64_t speed = cap < zero_speed ? cap : zero_speed;
+      goal = distance > 0 ? speed : (distance < 0 ? -speed : 0);
+      break;
+    }
     case phase::idle:
     case phase::stopping:
     case phase::done:
@@ -67,6 +76,16 @@ homing_status homing::step(bool start, const homing_parameters& par, shaft& s,
   }
   const std::int64_t before = s.position;
   advance(s, towards(s.velocity, goal, accel_step), dt_us, static_cast<std::uint32_t>(resolution));
+  if (phase_ == phase::returning) {
+    // Arrived within a slow last cycle: exactly at home, at rest.
+    const bool passed = (before - home_at_) * (s.position - home_at_) <= 0;
+    const std::int64_t slow = accel_step > 0 ? accel_step : 1;
+    if (passed && (s.velocity <= slow && s.velocity >= -slow)) {
+      s.position = home_at_;
+      s.fraction = 0;
+      s.velocity = 0;
+    }
+  }
   const std::int64_t after = s.position;
   travelled_ += after > before ? after - before : before - after;
 
@@ -97,21 +116,25 @@ homing_status homing::step(bool start, const homing_parameters& par, shaft& s,
     case phase::failed: break;
   }
   if (phase_ == phase::stopping && s.velocity == 0) {
-    // Home found and the shaft at rest: it now reads home as the home offset.
-    if (par.method != 35 && par.method != 37) s.position += par.home_offset - home_at_;
-    phase_ = phase::done;
+    // Home found and the shaft at rest past it: it now reads home as the home offset, and goes back
+    // to stand there.
+    if (par.method != 35 && par.method != 37) {
+      s.position += par.home_offset - home_at_;
+      home_at_ = par.home_offset;
+    }
+    phase_ = s.position == home_at_ ? phase::done : phase::returning;
   }
-  if (running() && phase_ != phase::stopping &&
+  if (phase_ == phase::returning && s.position == home_at_ && s.velocity == 0) phase_ = phase::done;
+  if (running() && phase_ != phase::stopping && phase_ != phase::returning &&
       travelled_ > max_search_revolutions * resolution) {
     phase_ = phase::failed;
   }
 
   homing_status st;
   const bool at_rest = s.velocity == 0;
-  st.attained = phase_ == phase::done || phase_ == phase::stopping;
+  st.attained = phase_ == phase::done || phase_ == phase::stopping || phase_ == phase::returning;
   st.target_reached = (phase_ == phase::done) || ((phase_ == phase::idle || phase_ == phase::failed) && at_rest);
   st.error = phase_ == phase::failed;
-  if (phase_ == phase::stopping) st.attained = true;
   return st;
 }
 

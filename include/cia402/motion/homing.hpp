@@ -8,7 +8,8 @@
 //      negative direction at sub 2, and home at the first index pulse after it went inactive;
 //   33 / 34 the first index pulse in the negative / positive direction, at 0x6099 sub 2;
 //   35 / 37 the current position is home (35 is the older number of 37); no motion.
-// Every velocity change is at the homing acceleration 0x609A.
+// Every velocity change is at the homing acceleration 0x609A. A search stops past the pulse it found
+// and then goes back to stand exactly at home.
 #pragma once
 
 #include <cstdint>
@@ -58,10 +59,10 @@ class homing {
   bool running() const noexcept { return phase_ != phase::idle && phase_ != phase::done && phase_ != phase::failed; }
 
  private:
-  enum class phase : std::uint8_t { idle, search_switch, leave_switch, search_index, stopping, done, failed };
+  enum class phase : std::uint8_t { idle, search_switch, leave_switch, search_index, stopping, returning, done, failed };
   phase phase_ = phase::idle;
   bool last_start_ = false;
-  std::int64_t home_at_ = 0;      // the index pulse found, in the old coordinates
+  std::int64_t home_at_ = 0;      // the index pulse found: in the old coordinates until at rest
   std::int64_t travelled_ = 0;    // increments since the run started, for the search limit
 };
 
