@@ -323,7 +323,7 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
     a.torque_demand = 0;
     a.following_error_us = 0;
     if (a.operation_mode == cia402::mode::profile_velocity && run && out.ramp == stop_ramp::none &&
-        beyond_limit(a, s.position, s.velocity)) {
+        beyond_limit(a, s.position, effective_target(a))) {
       status |= status_bit::internal_limit_active;
     }
   }
