@@ -106,7 +106,9 @@ TEST(eds, entries_carry_type_access_default_and_mapping_of_the_dictionary) {
   EXPECT_EQ(eds.at("1018").at("SubNumber"), "0x5");
   EXPECT_EQ(eds.at("1018sub4").at("DefaultValue"), "$NODEID+0x0");
   EXPECT_EQ(eds.at("1A01sub2").at("DefaultValue"), "0x60610008");
-  EXPECT_EQ(eds.at("1802sub1").at("DefaultValue"), "$NODEID+0x80000380") << "TPDO3 starts invalid";
+  EXPECT_EQ(eds.at("1802sub1").at("DefaultValue"), "$NODEID+0x380") << "TPDO3 carries the position";
+  EXPECT_EQ(eds.at("1802sub2").at("DefaultValue"), "0x01") << "on every SYNC";
+  EXPECT_EQ(eds.at("1A02sub2").at("DefaultValue"), "0x60640020");
   EXPECT_EQ(eds.at("1800").at("SubNumber"), "0x5") << "sub 4 is reserved";
   // Spelled as CiA 306 spells them: parsers read the keys case-sensitively.
   EXPECT_EQ(eds.at("DeviceInfo").at("NrOfRXPDO"), "4");

@@ -39,7 +39,7 @@ class pdo_test : public ::testing::Test {
   network net;
 };
 
-TEST_F(pdo_test, defaults_are_the_cia402_predefined_set_with_pdo3_disabled) {
+TEST_F(pdo_test, defaults_are_the_cia402_predefined_set_with_pdo3_synchronous) {
   const pdo_config& r1 = node().rpdo(0);
   EXPECT_TRUE(r1.valid);
   EXPECT_EQ(r1.can_id, 0x203u);
@@ -51,7 +51,11 @@ TEST_F(pdo_test, defaults_are_the_cia402_predefined_set_with_pdo3_disabled) {
   ASSERT_EQ(r2.count, 2);
   EXPECT_EQ(r2.map[1].index, 0x6060);
   EXPECT_EQ(r2.length, 3);
-  EXPECT_FALSE(node().rpdo(2).valid);
+  const pdo_config& r3 = node().rpdo(2);
+  EXPECT_TRUE(r3.valid);
+  EXPECT_EQ(r3.can_id, 0x403u);
+  EXPECT_EQ(r3.map[1].index, 0x607A) << "target position for a csp master";
+  EXPECT_EQ(r3.transmission_type, 1) << "taken at the next SYNC";
   const pdo_config& r4 = node().rpdo(3);
   EXPECT_EQ(r4.can_id, 0x503u);
   EXPECT_EQ(r4.map[1].index, 0x60FF);
@@ -59,10 +63,12 @@ TEST_F(pdo_test, defaults_are_the_cia402_predefined_set_with_pdo3_disabled) {
   EXPECT_EQ(node().tpdo(0).can_id, 0x183u);
   EXPECT_EQ(node().tpdo(0).map[0].index, 0x6041);
   EXPECT_EQ(node().tpdo(1).map[1].index, 0x6061);
-  EXPECT_FALSE(node().tpdo(2).valid);
+  EXPECT_TRUE(node().tpdo(2).valid);
+  EXPECT_EQ(node().tpdo(2).can_id, 0x383u);
+  EXPECT_EQ(node().tpdo(2).map[1].index, 0x6064);
   EXPECT_EQ(node().tpdo(3).can_id, 0x483u);
   EXPECT_EQ(node().tpdo(3).map[1].index, 0x606C);
-  for (int n = 0; n < 4; ++n) EXPECT_EQ(node().tpdo(n).transmission_type, 255);
+  for (int n = 0; n < 4; ++n) EXPECT_EQ(node().tpdo(n).transmission_type, n == 2 ? 1 : 255) << n;
 }
 
 TEST_F(pdo_test, no_pdo_flows_before_operational) {
@@ -108,14 +114,14 @@ TEST_F(pdo_test, a_reported_change_is_sampled_and_sent_once) {
   const auto status = net.with_id(0x183);
   ASSERT_EQ(status.size(), 1u);
   EXPECT_EQ(get_le(status[0].data.data(), 2) & 0x6F, 0x21u);  // READY TO SWITCH ON
-  // Each TPDO that maps the status word is sampled once for the change (TPDO1, 2 and 4: 1 + 2 + 2
-  // objects), none after.
+  // Each event-driven TPDO that maps the status word is sampled once for the change (TPDO1, 2 and
+  // 4: 1 + 2 + 2 objects), none after; TPDO3 waits for a SYNC.
   int mapped = 0;
   for (int n = 0; n < pdo_count; ++n) {
     const pdo_config& t = node().tpdo(n);
     bool maps_status = false;
     for (std::uint8_t i = 0; i < t.count; ++i) maps_status |= t.map[i].index == 0x6041;
-    if (t.valid && maps_status) mapped += t.count;
+    if (t.valid && maps_status && t.transmission_type == 255) mapped += t.count;
   }
   EXPECT_EQ(mapped, 5);
   EXPECT_EQ(dev().reads - reads_before, mapped);

@@ -134,12 +134,16 @@ std::vector<object_entry> drive_objects() {
        plus_node(var(1, "COB-ID client to server", data_type::unsigned32, access::ro, 0x600)),
        plus_node(var(2, "COB-ID server to client", data_type::unsigned32, access::ro, 0x580))}));
 
-  // CiA 402 predefined PDO set; PDO 3 (position) has no objects in a pv-only drive.
+  // CiA 402 predefined PDO set. PDO 3 carries the position for a cyclic synchronous position
+  // master: taken at (RPDO) and sent on (TPDO) every SYNC.
   const std::vector<std::uint32_t> rpdo_maps[pdo_count] = {
       {map_entry(0x6040, 0, 16)},
       {map_entry(0x6040, 0, 16), map_entry(0x6060, 0, 8)},
-      {},
+      {map_entry(0x6040, 0, 16), map_entry(0x607A, 0, 32)},
       {map_entry(0x6040, 0, 16), map_entry(0x60FF, 0, 32)}};
+  constexpr std::int64_t event_driven = 255;
+  constexpr std::int64_t every_sync = 1;
+  const std::int64_t transmission[pdo_count] = {event_driven, event_driven, every_sync, event_driven};
   // A master can rely on each TPDO at least every second (event timer), and the one that carries the
   // velocity sends at most every 10 ms while the drive ramps (inhibit time): without them a ramping
   // drive sent about 850 frames/s. The status word alone (TPDO1) has no inhibit time, so every
@@ -149,7 +153,7 @@ std::vector<object_entry> drive_objects() {
   const std::vector<std::uint32_t> tpdo_maps[pdo_count] = {
       {map_entry(0x6041, 0, 16)},
       {map_entry(0x6041, 0, 16), map_entry(0x6061, 0, 8)},
-      {},
+      {map_entry(0x6041, 0, 16), map_entry(0x6064, 0, 32)},
       {map_entry(0x6041, 0, 16), map_entry(0x606C, 0, 32)}};
   for (int n = 0; n < pdo_count; ++n) {
     const auto num = std::to_string(n + 1);
@@ -161,7 +165,7 @@ std::vector<object_entry> drive_objects() {
         {var(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 2),
          plus_node(var(1, "COB-ID used by RPDO", data_type::unsigned32, access::rw,
                        invalid + 0x200 + off)),
-         var(2, "Transmission type", data_type::unsigned8, access::rw, 255)}));
+         var(2, "Transmission type", data_type::unsigned8, access::rw, transmission[n])}));
     t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1600 + n), "RPDO" + num + " mapping parameter",
                             rpdo_maps[n]));
   }
@@ -175,7 +179,7 @@ std::vector<object_entry> drive_objects() {
         {var(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 5),
          plus_node(var(1, "COB-ID used by TPDO", data_type::unsigned32, access::rw,
                        invalid + 0x180 + off)),
-         var(2, "Transmission type", data_type::unsigned8, access::rw, 255),
+         var(2, "Transmission type", data_type::unsigned8, access::rw, transmission[n]),
          var(3, "Inhibit time", data_type::unsigned16, access::rw, tpdo_inhibit_100us[n]),
          var(5, "Event timer", data_type::unsigned16, access::rw, tpdo_event_timer_ms)}));
     t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1A00 + n), "TPDO" + num + " mapping parameter",

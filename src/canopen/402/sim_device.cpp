@@ -41,6 +41,26 @@ void sim_device::report_changes() noexcept {
     velocity_rpm_ = velocity;
     changed(object_index::velocity_actual_value, 0);
   }
+  // The operation modes' actual values, as the bus reads them (0x6064 wraps as INTEGER32).
+  const auto position = static_cast<std::int32_t>(v.position());
+  if (position != position_) {
+    position_ = position;
+    changed(object_index::position_actual_value, 0);
+  }
+  const auto demand = static_cast<std::int32_t>(v.position_demand());
+  if (demand != demand_) {
+    demand_ = demand;
+    changed(object_index::position_demand_value, 0);
+    changed(object_index::following_error_actual_value, 0);
+  }
+  if (v.torque() != torque_) {
+    torque_ = v.torque();
+    changed(object_index::torque_actual_value, 0);
+  }
+  if (v.operation_mode() != mode_) {
+    mode_ = v.operation_mode();
+    changed(object_index::modes_of_operation_display, 0);
+  }
 }
 
 std::array<std::uint8_t, 5> sim_device::manufacturer_error_field() const noexcept {

@@ -13,12 +13,13 @@
 //   virtual drive, 0 clears every cause. Write-only because it is a command, not a state.
 // - PDO defaults are the CiA 402 predefined set (as drive manuals restate it, e.g. Kollmorgen S300
 //   CANopen manual §5.3.1.3): RPDO1 = 0x6040; RPDO2 = 0x6040 + 0x6060; RPDO3 = 0x6040 + 0x607A
-//   (target position: not in a pv-only drive, so RPDO3 starts disabled and empty); RPDO4 = 0x6040 +
-//   0x60FF. TPDO1 = 0x6041; TPDO2 = 0x6041 + 0x6061; TPDO3 = 0x6041 + 0x6064 (position: disabled and
-//   empty, as RPDO3); TPDO4 = 0x6041 + 0x606C. Transmission type 255 (event-driven) everywhere;
-//   every TPDO has an event timer of 1000 ms (a master can rely on hearing each one every second)
-//   and TPDO4, which carries the velocity, an inhibit time of 10 ms (at most 100 frames/s while the
-//   drive ramps, where it sent about 850).
+//   (target position); RPDO4 = 0x6040 + 0x60FF. TPDO1 = 0x6041; TPDO2 = 0x6041 + 0x6061; TPDO3 =
+//   0x6041 + 0x6064 (position actual value); TPDO4 = 0x6041 + 0x606C. PDO 3 is what a cyclic
+//   synchronous position master needs, so it is synchronous (transmission type 1: RPDO3 takes effect
+//   at the next SYNC, TPDO3 goes out on every SYNC); the others are event-driven (255). Every
+//   event-driven TPDO has an event timer of 1000 ms (a master can rely on hearing each one every
+//   second) and TPDO4, which carries the velocity, an inhibit time of 10 ms (at most 100 frames/s
+//   while the drive ramps, where it sent about 850).
 // - 0x1016 has 4 consumer entries; 0x1017 defaults to 0 (no heartbeat) as CiA 301 does.
 #pragma once
 

@@ -47,6 +47,10 @@ class sim_device final : public device {
   std::uint16_t status_word_ = 0;
   std::uint16_t error_code_ = 0;
   std::int32_t velocity_rpm_ = 0;
+  std::int32_t position_ = 0;
+  std::int32_t demand_ = 0;
+  std::int32_t torque_ = 0;
+  std::int8_t mode_ = 0;
 };
 
 }  // namespace cia402::canopen
