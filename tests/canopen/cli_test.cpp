@@ -50,6 +50,39 @@ TEST(cli_master, velocity_writes_the_target_enables_and_waits_for_the_shaft) {
   EXPECT_EQ(run_tool({"master", "--can", "virtual", "velocity", "3000000000"}).status, 2);
 }
 
+TEST(cli_master, mode_switches_0x6060_and_waits_for_0x6061) {
+  const result r = run_tool({"master", "--can", "virtual", "mode", "csp"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("node 1: mode 8 (csp)"), std::string::npos) << r.out;
+  const result json = run_tool({"master", "--can", "virtual", "--json", "mode", "6"});
+  ASSERT_EQ(json.status, 0) << json.err;
+  EXPECT_NE(json.out.find(R"({"node":1,"event":"mode","mode":6,"name":"hm"})"), std::string::npos) << json.out;
+  // vl (2) is not among the modes 0x6502 announces: the drive's abort, exit 1.
+  const result refused = run_tool({"master", "--can", "virtual", "mode", "2"});
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("06090030"), std::string::npos) << refused.err;
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "mode", "warp"}).status, 2);
+}
+
+TEST(cli_master, move_runs_the_set_point_handshake_to_the_target) {
+  const result r = run_tool({"master", "--can", "virtual", "move", "20000", "--velocity", "600"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("node 1: set-point 20000"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("node 1: target reached, position 20000"), std::string::npos) << r.out;
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "move"}).status, 2);
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "move", "3000000000"}).status, 2);
+}
+
+TEST(cli_master, home_sets_the_position_to_the_home_offset) {
+  for (const char* method : {"37", "3"}) {
+    const result r = run_tool({"master", "--can", "virtual", "home", "--method", method, "--offset", "1234"});
+    ASSERT_EQ(r.status, 0) << method << r.err;
+    EXPECT_NE(r.out.find("node 1: homing attained, position 1234"), std::string::npos) << method << r.out;
+  }
+  const result refused = run_tool({"master", "--can", "virtual", "home", "--method", "1"});
+  EXPECT_EQ(refused.status, 1) << "method 1 needs a limit switch the virtual drive lacks";
+}
+
 TEST(cli_master, watch_json_prints_one_object_per_event) {
   const result r = run_tool({"master", "--can", "virtual", "--json", "--timeout", "300", "watch"});
   ASSERT_EQ(r.status, 0) << r.err;

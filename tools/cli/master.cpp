@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <csignal>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -273,6 +274,222 @@ int run_nmt(bus_session& s, const master_args& a, std::ostream& out, std::ostrea
 }
 
 
+// `mode`, `move` and `home`: the operation modes over the bus. Each writes what it needs by SDO,
+// waits for 0x6061 to show the mode, enables the drive with the core's master step where it moves,
+// and then runs the mode's handshake on the control word's mode bits (CiA 402-2): pp bit 4 (new
+// set-point) until bit 12 (acknowledge), then bit 10 (target reached); homing bit 4 (start) until
+// bits 12 and 10 (attained), or bit 13 (homing error).
+int run_motion(bus_session& session, const master_args& a, const profile& p, std::ostream& out,
+               std::ostream& err) {
+  const bool moving = a.command != "mode";
+  std::int8_t wanted_mode = 0;
+  std::int64_t target = 0;
+  if (a.command == "mode") {
+    if (a.operands.size() != 1 || !mode::parse(a.operands[0], wanted_mode)) {
+      err << "cia402 master: mode MODE: pp, pv, tq, hm, csp, csv, cst or the number of 0x6060\n";
+      return usage_error;
+    }
+  } else if (a.command == "move") {
+    const auto v = a.operands.size() == 1 ? parse_number(a.operands[0]) : std::nullopt;
+    if (!v || *v < type_low(object_type::integer32) || *v > type_high(object_type::integer32)) {
+      err << "cia402 master: move POSITION: one integer for 0x607A (target position, increments)\n";
+      return usage_error;
+    }
+    target = *v;
+    wanted_mode = mode::profile_position;
+  } else {
+    if (!a.operands.empty()) {
+      err << "cia402 master: home takes no operands (--method, --offset)\n";
+      return usage_error;
+    }
+    wanted_mode = mode::homing;
+  }
+  // What goes over SDO first (0x607A after enabling: entering OPERATION ENABLED clears set-points
+  // on some profiles, 002's T4).
+  struct write_job {
+    std::uint16_t index;
+    std::int64_t value;
+    unsigned bytes;
+  };
+  std::vector<write_job> before{{0x6060, wanted_mode, 1}};
+  if (a.homing_method) before.push_back({0x6098, *a.homing_method, 1});
+  if (a.home_offset) before.push_back({0x607C, *a.home_offset, 4});
+  if (a.profile_velocity) before.push_back({0x6081, *a.profile_velocity, 4});
+  std::vector<write_job> after_enable;
+  if (a.command == "move") after_enable.push_back({0x607A, target, 4});
+
+  canopen::drive_master_config mc;
+  mc.node_id = static_cast<std::uint8_t>(a.node);
+  mc.cycle_us = a.cycle_ms * 1000;
+  mc.drive_heartbeat_ms = a.heartbeat_ms;
+  mc.master_heartbeat_ms = a.guard_ms;
+  mc.drive_profile = &p;
+  canopen::drive_master m(session.channel(), mc);
+  const auto event = [&](nlohmann::ordered_json j, const std::string& text) {
+    if (a.json) {
+      nlohmann::ordered_json line{{"node", a.node}};
+      line.update(j);
+      out << line.dump() << "\n";
+    } else {
+      out << "node " << a.node << ": " << text << "\n";
+    }
+  };
+  m.on_state = [&](state, state to, std::uint16_t sw) {
+    event({{"event", "state"}, {"state", state_name(to)}, {"statusword", word(sw)}},
+          std::string(state_name(to)) + " (statusword " + word(sw) + ")");
+  };
+
+  enum class phase { write_before, confirm_mode, enable, write_after, offer, wait_ack, wait_done, read_position };
+  phase now = phase::write_before;
+  std::size_t next_job = 0;
+  bool job_busy = false;
+  bool failed_job = false;
+  bool done = false;
+  std::int64_t position = 0;
+  const auto run_job = [&](const write_job& j) {
+    job_busy = true;
+    const bool queued = m.write(j.index, 0, j.value, j.bytes, [&, j](const canopen::sdo_result& r) {
+      job_busy = false;
+      if (r.ok()) return;
+      failed_job = true;
+      err << "cia402 master: node " << a.node << ": writing " << hex(j.index, 4) << " = " << j.value;
+      if (r.cancelled) {
+        err << " was cancelled (the link to the drive was lost)\n";
+      } else {
+        err << " refused: SDO abort " << hex(static_cast<std::uint32_t>(r.abort), 8) << " ("
+            << sdo_abort_text(r.abort) << ")\n";
+      }
+    });
+    if (!queued) {
+      job_busy = false;
+      failed_job = true;
+      err << "cia402 master: could not queue the write of " << hex(j.index, 4) << "\n";
+    }
+  };
+  const auto read_job = [&](std::uint16_t index, bool is_signed, std::function<void(std::int64_t)> use) {
+    job_busy = true;
+    const bool queued = m.read(index, 0, is_signed, [&, index, use](const canopen::sdo_result& r) {
+      job_busy = false;
+      if (r.ok()) {
+        use(r.value);
+        return;
+      }
+      failed_job = true;
+      err << "cia402 master: node " << a.node << ": reading " << hex(index, 4) << " failed\n";
+    });
+    if (!queued) {
+      job_busy = false;
+      failed_job = true;
+    }
+  };
+  constexpr std::uint16_t bit10 = 1u << 10, bit12 = 1u << 12, bit13 = 1u << 13;
+  const std::uint16_t relative = a.relative ? 0x40 : 0;
+  bool seen_busy = false;  // the mode showed it left "target reached" (or never had it)
+
+  stop_requested = 0;
+  int status = failed;
+  std::uint64_t elapsed = 0;
+  std::uint32_t next = 0;
+  while (!done) {
+    if (stop_requested != 0) {
+      err << "cia402 master: interrupted\n";
+      break;
+    }
+    if (const auto ec = session.failure()) {
+      err << "cia402 master: the bus connection failed: " << ec.message() << "\n";
+      break;
+    }
+    elapsed += session.pump(m, next);
+    if (m.phase() == canopen::master_phase::failed) {
+      err << "cia402 master: " << m.failure_text() << "\n";
+      break;
+    }
+    if (failed_job) break;
+    if (a.timeout_ms != 0 && elapsed >= a.timeout_ms * 1000ull) {
+      err << "cia402 master: node " << a.node << ": " << a.command << " did not finish within " << a.timeout_ms
+          << " ms (last statusword " << word(m.status_word()) << ")\n";
+      break;
+    }
+    if (m.phase() != canopen::master_phase::running || job_busy) continue;
+    if (m.status_known() && m.observed() == state::fault && now >= phase::enable) {
+      err << "cia402 master: node " << a.node << " faulted, error code " << hex(m.error_code(), 4) << "\n";
+      break;
+    }
+    const std::uint16_t sw = m.status_word();
+    switch (now) {
+      case phase::write_before:
+        if (next_job < before.size()) {
+          run_job(before[next_job++]);
+        } else {
+          now = phase::confirm_mode;
+        }
+        break;
+      case phase::confirm_mode:
+        read_job(0x6061, true, [&](std::int64_t shown) {
+          if (shown != wanted_mode) return;  // not switched yet: read again
+          event({{"event", "mode"}, {"mode", shown}, {"name", mode::short_name(shown)}},
+                std::string("mode ") + std::to_string(shown) + " (" + mode::short_name(shown) + ")");
+          if (!moving) {
+            status = 0;
+            done = true;
+            return;
+          }
+          m.set_target(state::operation_enabled);
+          now = phase::enable;
+        });
+        break;
+      case phase::enable:
+        if (m.observed() == state::operation_enabled && m.outcome() == master_outcome::reached) {
+          now = phase::write_after;
+          next_job = 0;
+        }
+        break;
+      case phase::write_after:
+        if (next_job < after_enable.size()) {
+          run_job(after_enable[next_job++]);
+        } else {
+          m.set_mode_bits(static_cast<std::uint16_t>(0x10 | 0x20 | relative));  // new set-point / start
+          event({{"event", a.command == "move" ? "setpoint" : "homing_started"}},
+                a.command == "move" ? "set-point " + std::to_string(target) + (a.relative ? " (relative)" : "")
+                                    : std::string("homing started"));
+          now = a.command == "move" ? phase::wait_ack : phase::wait_done;
+        }
+        break;
+      case phase::offer: break;
+      case phase::wait_ack:
+        if (sw & bit12) {
+          m.set_mode_bits(relative);  // bit 4 down: the handshake is done
+          now = phase::wait_done;
+        }
+        break;
+      case phase::wait_done:
+        if (a.command == "home" && (sw & bit13)) {
+          err << "cia402 master: node " << a.node << ": homing error (statusword " << word(sw) << ")\n";
+          done = true;
+          break;
+        }
+        if (!(sw & bit10)) seen_busy = true;
+        if (a.command == "move" ? (seen_busy && (sw & bit10) && !(sw & bit12))
+                                : ((sw & (bit10 | bit12)) == (bit10 | bit12))) {
+          m.set_mode_bits(0);
+          now = phase::read_position;
+        }
+        break;
+      case phase::read_position:
+        read_job(0x6064, true, [&](std::int64_t v) {
+          position = v;
+          event({{"event", a.command == "move" ? "reached" : "homed"}, {"position", position}},
+                (a.command == "move" ? "target reached, position " : "homing attained, position ") +
+                    std::to_string(position));
+          status = 0;
+          done = true;
+        });
+        break;
+    }
+  }
+  return status;
+}
+
 }  // namespace
 
 CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
@@ -285,12 +502,14 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
       ->default_str("virtual");
   cmd->add_option("--node", args.node, "the drive's node-ID")->check(CLI::Range(1, 127))->default_str("1");
   cmd->add_option("COMMAND", args.command,
-                  "state, enable, disable, quick-stop, reset, watch, velocity; sdo, nmt (no set-up)")
+                  "state, enable, disable, quick-stop, reset, watch, velocity, mode, move, home; sdo, nmt "
+                  "(no set-up)")
       ->required()
-      ->check(CLI::IsMember(
-          {"state", "enable", "disable", "quick-stop", "reset", "watch", "velocity", "sdo", "nmt"}));
+      ->check(CLI::IsMember({"state", "enable", "disable", "quick-stop", "reset", "watch", "velocity", "mode",
+                             "move", "home", "sdo", "nmt"}));
   cmd->add_option("OPERANDS", args.operands,
-                  "velocity RPM | sdo read INDEX[:SUB] | sdo write INDEX[:SUB] VALUE | "
+                  "velocity RPM | mode pp|pv|tq|hm|csp|csv|cst | move POSITION | sdo read INDEX[:SUB] | "
+                  "sdo write INDEX[:SUB] VALUE | "
                   "nmt start|stop|preop|reset");
   cmd->add_flag("--json", args.json,
                 "one JSON object a line: state and sdo print one, the others one per event");
@@ -304,6 +523,11 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
                   "send the master's heartbeat at this period in ms and have the drive watch it, so "
                   "0x6007 acts if the master stops (0 = off)")
       ->default_str("0");
+  cmd->add_flag("--relative", args.relative, "move: POSITION adds to the last target (control-word bit 6)");
+  cmd->add_option("--velocity", args.profile_velocity, "move: the profile velocity 0x6081 in rpm")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--method", args.homing_method, "home: the homing method 0x6098 (3, 33, 34, 35, 37)");
+  cmd->add_option("--offset", args.home_offset, "home: the home offset 0x607C, in increments");
   cmd->add_flag("--hold", args.hold, "after reaching the target, keep the drive there until SIGINT");
   return cmd;
 }
@@ -317,6 +541,9 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
   if (a.command == "state") return read_state(session, a, p, out, err);
   if (a.command == "sdo") return run_sdo(session, a, out, err);
   if (a.command == "nmt") return run_nmt(session, a, out, err);
+  if (a.command == "mode" || a.command == "move" || a.command == "home") {
+    return run_motion(session, a, p, out, err);
+  }
   const bool velocity_command = a.command == "velocity";
   std::int32_t rpm = 0;
   if (velocity_command) {

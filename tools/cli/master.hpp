@@ -2,12 +2,15 @@
 // virtual bus: NMT start, PDO set-up over SDO, then the core's master step over PDOs with SYNC
 // (canopen/drive_master.hpp). COMMAND: state (read 0x6041 over SDO and print), enable, disable,
 // quick-stop, reset (fault reset), watch (print state changes, velocity and EMCYs), velocity RPM
-// (enable, write 0x60FF, wait until the shaft turns at it); for test benches, without
+// (enable, write 0x60FF, wait until the shaft turns at it), mode MODE (0x6060, confirmed by 0x6061),
+// move POSITION (profile position: enable, 0x607A, the set-point handshake, wait for target
+// reached), home (homing with --method / --offset, wait for homing attained); for test benches, without
 // any set-up: sdo read INDEX[:SUB], sdo write INDEX[:SUB] VALUE, nmt start|stop|preop|reset.
 #pragma once
 
 #include <cstdint>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +33,10 @@ struct master_args {
   std::uint16_t heartbeat_ms = 100;  ///< the drive's heartbeat, watched by the master
   std::uint16_t guard_ms = 0;        ///< the master's heartbeat, watched by the drive (0x6007)
   bool hold = false;                 ///< after reaching the target, keep cycling until a signal
+  bool relative = false;             ///< move: the position adds to the last target
+  std::optional<std::int64_t> profile_velocity;  ///< move: 0x6081
+  std::optional<std::int64_t> homing_method;     ///< home: 0x6098
+  std::optional<std::int64_t> home_offset;       ///< home: 0x607C
 };
 
 CLI::App* add_master_subcommand(CLI::App& app, master_args& args);

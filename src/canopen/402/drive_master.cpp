@@ -291,7 +291,7 @@ void drive_master::note_status(std::uint16_t sw) {
   switch (mode_) {
     case mode::idle:
     case mode::word: break;
-    case mode::target: send_word(master_.step(sw, now_us_, error_code_)); break;
+    case mode::target: send_word(master_.step(sw, now_us_, error_code_) | mode_bits_); break;
     case mode::command: {
       std::uint16_t cw = 0;
       if (encode_command(*profile_, command_, 0, cw)) send_word(cw);
@@ -350,6 +350,17 @@ void drive_master::set_target(state target) {
   outbox_.clear();
   policy_ = master_policy::make(*profile_, options_, target);
   master_.set_target(policy_, now_us_, config_.transition_timeout_us);
+}
+
+void drive_master::set_mode_bits(std::uint16_t bits) {
+  // Only the bits a mode defines: the state machine's own (0..3, 7) stay the master step's.
+  constexpr std::uint16_t mode_specific = 0x0370;
+  bits &= mode_specific;
+  if (bits == mode_bits_) return;
+  mode_bits_ = bits;
+  if (phase_ == master_phase::running && mode_ == mode::target) {
+    send_word(static_cast<std::uint16_t>((last_sent_ & ~mode_specific) | bits));
+  }
 }
 
 void drive_master::set_command(command c) {

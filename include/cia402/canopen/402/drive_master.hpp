@@ -118,6 +118,11 @@ class drive_master {
   void send_control_word(std::uint16_t word, bool fault_reset_edge = false);
   /// Stop steering: RPDO1 is no longer sent (words still queued are dropped).
   void clear_target();
+  /// Operation-mode bits (4, 5, 6, 8, 9: new set-point, change immediately, relative, halt, change
+  /// on set-point; homing start) ORed into every word the master step sends; sent at once when
+  /// they change while steering.
+  void set_mode_bits(std::uint16_t bits);
+  std::uint16_t mode_bits() const noexcept { return mode_bits_; }
 
   /// Queue an SDO transfer for when the master is running; `done` is called in process() or
   /// on_frame() when it ends (or is cancelled). False, and nothing queued, while not running.
@@ -256,6 +261,7 @@ class drive_master {
   command command_ = command::disable_voltage;
   std::deque<std::pair<std::uint16_t, std::uint64_t>> outbox_;  // word, not before (us)
   std::uint16_t last_sent_ = 0;
+  std::uint16_t mode_bits_ = 0;
 
   bool status_known_ = false;
   std::uint16_t status_word_ = 0;
