@@ -146,7 +146,7 @@ def test_tpdo_timing_a_standard_master_can_rely_on(client):
     send(client, 0x000, [0x01, NODE])
     for n in range(4):
         if n == 2:
-            continue  # PDO 3 maps nothing in a velocity drive (COB-ID invalid)
+            continue  # PDO 3 is synchronous: it goes out on SYNC, not by its event timer
         assert sdo_upload_expedited(client, NODE, 0x1800 + n, 5) == 1000, "TPDO%d event timer" % (n + 1)
     assert sdo_upload_expedited(client, NODE, 0x1803, 3) == 100  # 10 ms
     # Idle: every TPDO still comes, from the event timer.

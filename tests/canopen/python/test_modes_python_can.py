@@ -1,0 +1,112 @@
+"""The operation modes of `cia402 bus` driven by a third-party CANopen client (python-can over
+socketcand): modes switched by SDO and by RPDO2, a profile position move with the set-point
+handshake, a homing run, and a cyclic synchronous position stream on SYNC with RPDO3 / TPDO3.
+Object numbers, bits and PDO layouts are CiA 402-2's, written out here."""
+import time
+
+from test_bus_python_can import NODE, send, wait_for, sdo_upload_expedited, sdo_download, status_state
+
+SYNC = 0x080
+RPDO1, RPDO2, RPDO3 = 0x200 + NODE, 0x300 + NODE, 0x400 + NODE
+TPDO1, TPDO2, TPDO3 = 0x180 + NODE, 0x280 + NODE, 0x380 + NODE
+
+
+def status_frames(m):
+    return m.arbitration_id == TPDO1 and len(m.data) == 2
+
+
+def wait_status(bus, predicate, timeout=5.0):
+    """The first status word (TPDO1) for which predicate(word) holds, or None."""
+    msg = wait_for(bus, lambda m: status_frames(m) and predicate(int.from_bytes(m.data, "little")), timeout)
+    return None if msg is None else int.from_bytes(msg.data, "little")
+
+
+def enable(bus):
+    send(bus, 0x000, [0x01, NODE])  # NMT start
+    for control_word in (0x06, 0x0F):
+        send(bus, RPDO1, [control_word, 0x00])
+        time.sleep(0.05)
+    word = wait_status(bus, lambda w: status_state(w) == "OPERATION_ENABLED")
+    assert word is not None, "not enabled"
+    time.sleep(0.1)  # the holding brake opens (30 ms)
+
+
+def position_on_sync(bus):
+    """Sends SYNC and returns 0x6064 from TPDO3 (0x6041 + 0x6064), sent on every SYNC."""
+    while bus.recv(timeout=0) is not None:
+        pass
+    send(bus, SYNC, [])
+    msg = wait_for(bus, lambda m: m.arbitration_id == TPDO3 and len(m.data) == 6, timeout=2)
+    assert msg is not None, "no TPDO3 after SYNC"
+    return int.from_bytes(msg.data[2:6], "little", signed=True)
+
+
+def test_modes_switch_by_sdo_and_by_rpdo2(client):
+    send(client, 0x000, [0x01, NODE])
+    assert sdo_upload_expedited(client, NODE, 0x6502, 0) == 0x3AD  # pp, pv, tq, hm, csp, csv, cst
+    assert sdo_download(client, NODE, 0x6060, 0, 1, 1).data[0] == 0x60
+    assert sdo_upload_expedited(client, NODE, 0x6061, 0) in (1, 3)  # switched by the next cycle
+    time.sleep(0.05)
+    assert sdo_upload_expedited(client, NODE, 0x6061, 0) == 1
+    # RPDO2 = 0x6040 + 0x6060; TPDO2 = 0x6041 + 0x6061 shows the switch.
+    send(client, RPDO2, [0x00, 0x00, 8])
+    shown = wait_for(client, lambda m: m.arbitration_id == TPDO2 and len(m.data) == 3 and m.data[2] == 8, 2)
+    assert shown is not None, "0x6061 did not show csp"
+    refused = sdo_download(client, NODE, 0x6060, 0, 2, 1)
+    assert refused.data[0] == 0x80 and int.from_bytes(refused.data[4:8], "little") == 0x06090030
+
+
+def test_profile_position_move(client):
+    send(client, 0x000, [0x01, NODE])
+    assert sdo_download(client, NODE, 0x6060, 0, 1, 1).data[0] == 0x60
+    assert sdo_download(client, NODE, 0x6081, 0, 600, 4).data[0] == 0x60  # profile velocity, rpm
+    enable(client)
+    assert sdo_download(client, NODE, 0x607A, 0, 20000, 4).data[0] == 0x60  # 2 revolutions
+    send(client, RPDO1, [0x1F, 0x00])  # bit 4: new set-point
+    assert wait_status(client, lambda w: w & 0x1000) is not None, "no set-point acknowledge (bit 12)"
+    send(client, RPDO1, [0x0F, 0x00])
+    assert wait_status(client, lambda w: (w & 0x1400) == 0x0400, timeout=5) is not None, "no target reached"
+    assert position_on_sync(client) == 20000
+    # Relative (bit 6): adds to the last target.
+    assert sdo_download(client, NODE, 0x607A, 0, (-5000) & 0xFFFFFFFF, 4).data[0] == 0x60
+    send(client, RPDO1, [0x5F, 0x00])
+    assert wait_status(client, lambda w: w & 0x1000) is not None
+    send(client, RPDO1, [0x4F, 0x00])
+    assert wait_status(client, lambda w: (w & 0x1400) == 0x0400, timeout=5) is not None
+    assert position_on_sync(client) == 15000
+
+
+def test_homing_run(client):
+    send(client, 0x000, [0x01, NODE])
+    assert sdo_download(client, NODE, 0x6060, 0, 6, 1).data[0] == 0x60
+    assert sdo_download(client, NODE, 0x6098, 0, 37, 1).data[0] == 0x60  # home on the current position
+    assert sdo_download(client, NODE, 0x607C, 0, 4321, 4).data[0] == 0x60
+    enable(client)
+    send(client, RPDO1, [0x1F, 0x00])  # bit 4: homing operation start
+    assert wait_status(client, lambda w: (w & 0x3400) == 0x1400) is not None, "homing not attained"
+    assert position_on_sync(client) == 4321
+    assert sdo_upload_expedited(client, NODE, 0x6064, 0) == 4321
+
+
+def test_cyclic_synchronous_position_stream(client):
+    send(client, 0x000, [0x01, NODE])
+    send(client, RPDO2, [0x00, 0x00, 8])  # mode 8 by PDO
+    time.sleep(0.05)
+    assert sdo_upload_expedited(client, NODE, 0x6061, 0) == 8
+    enable(client)
+    start = position_on_sync(client)
+    worst = 0
+    target = start
+    for k in range(1, 41):
+        target = start + 100 * k
+        # RPDO3 = 0x6040 + 0x607A, taken at the next SYNC; TPDO3 answers every SYNC.
+        send(client, RPDO3, [0x0F, 0x00] + list(target.to_bytes(4, "little", signed=True)))
+        actual = position_on_sync(client)
+        worst = max(worst, abs(target - actual))
+        time.sleep(0.005)
+    time.sleep(0.01)
+    assert position_on_sync(client) == target
+    assert worst <= 100, "lags more than one set-point: %d" % worst
+    status = sdo_upload_expedited(client, NODE, 0x6041, 0)
+    assert status & 0x1000, "bit 12: the drive follows the command value"
+    assert status & 0x2000 == 0, "no following error"
