@@ -111,6 +111,8 @@ double rpm(std::int64_t micro) { return static_cast<double>(micro) / 1e6; }
 
 void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const trace_info& info) {
   const double height = 600;
+  const bool positions =
+      std::any_of(rows.begin(), rows.end(), [](const trace_row& r) { return r.mode != 3; });
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(width) << "\" height=\""
       << num(height) << "\" viewBox=\"0 0 " << num(width) << " " << num(height)
       << "\" font-family=\"DejaVu Sans, Arial, sans-serif\" font-size=\"11\">\n"
@@ -119,6 +121,7 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
       << escape(info.title) << "</text>\n";
   out << "<text x=\"" << num(left) << "\" y=\"42\" fill=\"#444\">profile " << escape(info.profile_name)
       << ", cycle " << info.cycle_us << " us; velocity 0x606C (solid), target 0x60FF (dashed); "
+      << (positions ? "position 0x6064 (magenta, right scale); " : "")
       << "bands: state; marks: transitions</text>\n";
   if (rows.empty()) {
     out << "<text x=\"" << num(left) << "\" y=\"120\">(empty trace)</text>\n</svg>\n";
@@ -272,6 +275,40 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
     std::string label;
   };
   std::vector<mark> groups;
+  // Position 0x6064 on a scale of its own (labels at the right edge, in its colour), when the trace
+  // ran a mode other than profile velocity: a pv plot stays as it was.
+  if (positions) {
+    double pmin = static_cast<double>(rows.front().position);
+    double pmax = pmin;
+    for (const trace_row& r : rows) {
+      pmin = std::min(pmin, static_cast<double>(r.position));
+      pmax = std::max(pmax, static_cast<double>(r.position));
+    }
+    if (pmax - pmin < 1) pmax = pmin + 1;
+    const double pstep = nice_step(pmax - pmin, 5);
+    const double p0 = std::floor(pmin / pstep) * pstep;
+    const double p1 = std::ceil(pmax / pstep) * pstep;
+    const auto yp = [&](double p) { return plot_bottom - (p - p0) / (p1 - p0) * (plot_bottom - plot_top); };
+    out << "<g id=\"position-axis\" fill=\"#b5179e\">\n";
+    for (double p = p0; p <= p1 + pstep * 1e-6; p += pstep) {
+      out << "<text x=\"" << num(right - 4) << "\" y=\"" << num(yp(p) - 3) << "\" text-anchor=\"end\">"
+          << fixed(p, 0) << "</text>\n";
+    }
+    out << "<text transform=\"translate(" << num(width - 8) << "," << num((plot_top + plot_bottom) / 2)
+        << ") rotate(90)\" text-anchor=\"middle\">position 0x6064 [increments]</text>\n</g>\n";
+    // One point a pixel column at most: the position is smooth.
+    out << "<polyline id=\"position\" fill=\"none\" stroke=\"#b5179e\" stroke-width=\"1.6\" "
+           "stroke-linejoin=\"round\" points=\"";
+    const std::size_t every = std::max<std::size_t>(1, rows.size() / 900);
+    for (std::size_t i = 0; i < rows.size(); i += every) {
+      out << (i ? " " : "") << num(s.x(static_cast<double>(rows[i].time_us))) << ","
+          << num(yp(static_cast<double>(rows[i].position)));
+    }
+    out << " " << num(s.x(static_cast<double>(rows.back().time_us))) << ","
+        << num(yp(static_cast<double>(rows.back().position)));
+    out << "\"/>\n";
+  }
+
   out << "<g id=\"transitions\">\n";
   for (const trace_row& r : rows) {
     if (r.transition == no_transition) continue;

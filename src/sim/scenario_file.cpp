@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "cia402/profile_file.hpp"
+#include "cia402/objects.hpp"
 #include "cia402/sim/scenario.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 #include "cia402/support/text.hpp"
@@ -49,7 +50,16 @@ void check_keys(const toml::table& t, std::initializer_list<std::string_view> al
 
 
 // A decimal or 0x-hexadecimal integer written as a key ("0x605A").
-bool parse_index(std::string_view text, std::uint16_t& out) {
+// "0x605A", or "0x607D:2" for a sub-index (a quoted key: TOML keys cannot hold the colon bare).
+bool parse_index(std::string_view text, std::uint16_t& out, std::uint8_t& sub) {
+  sub = 0;
+  const std::size_t colon = text.find(':');
+  if (colon != std::string_view::npos) {
+    const std::optional<std::int64_t> s = support::parse_integer(text.substr(colon + 1), 0, 0xFF);
+    if (!s) return false;
+    sub = static_cast<std::uint8_t>(*s);
+    text = text.substr(0, colon);
+  }
   const std::optional<std::int64_t> v = support::parse_integer(text, 0, 0xFFFF);
   if (v) out = static_cast<std::uint16_t>(*v);
   return v.has_value();
@@ -201,7 +211,8 @@ struct loader {
     check_keys(t,
                {"brake", "brake_engage_delay", "brake_release_delay", "brake_deceleration",
                 "coast_deceleration", "standstill_window", "target_window",
-                "current_limit_percent", "voltage_limit_percent", "voltage", "sto"},
+                "current_limit_percent", "voltage_limit_percent", "voltage", "sto", "max_velocity",
+                "max_acceleration", "torque_acceleration", "friction", "load", "home_switch", "index_position"},
                "[plant]");
     plant_config& c = s.plant;
     if (const auto* n = t.get("brake")) c.brake_fitted = get_bool(*n, "brake");
@@ -237,6 +248,20 @@ struct loader {
       c.voltage_limit_percent =
           static_cast<std::uint32_t>(get_int(*n, "voltage_limit_percent", 1, 1000));
     }
+    if (const auto* n = t.get("max_velocity")) {
+      c.max_velocity_rpm = static_cast<std::uint32_t>(get_int(*n, "max_velocity", 1, 100000));
+    }
+    if (const auto* n = t.get("max_acceleration")) {
+      c.max_acceleration_rpm_s = static_cast<std::uint32_t>(get_int(*n, "max_acceleration", 1, 100000000));
+    }
+    if (const auto* n = t.get("torque_acceleration")) {
+      c.torque_acceleration_rpm_s = static_cast<std::uint32_t>(get_int(*n, "torque_acceleration", 1, 100000000));
+    }
+    if (const auto* n = t.get("friction")) c.friction_permille = static_cast<std::uint32_t>(get_int(*n, "friction", 0, 1000));
+    if (const auto* n = t.get("load")) c.load_permille = static_cast<std::int32_t>(get_int(*n, "load", -1000, 1000));
+    constexpr std::int64_t reach = std::int64_t{1} << 40;
+    if (const auto* n = t.get("home_switch")) c.home_switch_position = get_int(*n, "home_switch", -reach, reach);
+    if (const auto* n = t.get("index_position")) c.index_position = get_int(*n, "index_position", -reach, reach);
     if (const auto* n = t.get("voltage")) s.dc_link_at_start = get_bool(*n, "voltage");
     if (const auto* n = t.get("sto")) s.sto_at_start = get_bool(*n, "sto");
     if (const char* why = check_plant_config(c)) refuse(t, std::string("[plant]: ") + why);
@@ -247,7 +272,8 @@ struct loader {
     axis_state scratch = make_axis_state(s.drive_profile.get());
     for (auto&& [key, value] : t) {
       std::uint16_t index = 0;
-      if (!parse_index(key.str(), index)) {
+      std::uint8_t sub = 0;
+      if (!parse_index(key.str(), index, sub)) {
         std::string hint;
         for (std::string_view root_key : {"events", "expect", "name", "duration", "cycle", "plant"}) {
           if (key.str() == root_key) {
@@ -255,25 +281,27 @@ struct loader {
                    "' before [objects], or as objects.0x605A = ... dotted keys)";
           }
         }
-        refuse(key, "object key " + toml_reading::quoted(key.str()) + " is not an index such as 0x605A" + hint);
+        refuse(key, "object key " + toml_reading::quoted(key.str()) +
+                        " is not an index such as 0x605A (or \"0x607D:2\" with a sub-index)" + hint);
       }
       const std::int64_t v = get_int(value, "object " + hex(index, 4),
                                      std::numeric_limits<std::int64_t>::min(),
                                      std::numeric_limits<std::int64_t>::max());
-      const sdo_abort r = write_object(s.drive_profile.get(), scratch, index, 0, v);
+      const sdo_abort r = write_object(s.drive_profile.get(), scratch, index, sub, v);
       if (r != sdo_abort::none) {
-        refuse(value, "writing " + hex(index, 4) + " = " + std::to_string(v) + " is refused: SDO abort " +
-                          hex(static_cast<std::uint32_t>(r), 8) + " (" + sdo_abort_text(r) + ")");
+        refuse(value, "writing " + hex(index, 4) + (sub ? ":" + std::to_string(sub) : std::string()) + " = " +
+                          std::to_string(v) + " is refused: SDO abort " + hex(static_cast<std::uint32_t>(r), 8) +
+                          " (" + sdo_abort_text(r) + ")");
       }
-      s.initial_writes.emplace_back(index, v);
+      s.initial_writes.push_back({index, sub, v});
     }
   }
 
   void load_event(const toml::table& t) {
     check_keys(t,
                {"at", "write", "acceleration", "deceleration", "quick_stop_deceleration",
-                "target_velocity", "cw", "abort", "voltage", "sto", "connection_lost",
-                "clear_fault", "fault", "fault_class"},
+                "target_velocity", "target_position", "target_torque", "mode", "cw", "abort", "voltage",
+                "sto", "connection_lost", "clear_fault", "fault", "fault_class"},
                "an event");
     const toml::node* at = t.get("at");
     if (at == nullptr) refuse(t, "an event needs 'at', the time it happens (e.g. at = \"10ms\")");
@@ -282,10 +310,11 @@ struct loader {
     base.line = static_cast<int>(t.source().begin.line);
     std::vector<scenario_event> actions;
 
-    auto add_write = [&](std::uint16_t index, const toml::node& n, std::string_view what) {
+    auto add_write = [&](std::uint16_t index, const toml::node& n, std::string_view what, std::uint8_t sub = 0) {
       scenario_event e = base;
       e.what = scenario_event::kind::write;
       e.index = index;
+      e.sub = sub;
       e.value = get_int(n, what, std::numeric_limits<std::int64_t>::min(),
                         std::numeric_limits<std::int64_t>::max());
       actions.push_back(e);
@@ -293,10 +322,12 @@ struct loader {
     if (const auto* n = t.get("write")) {
       for (auto&& [key, value] : get_table(*n, "'write'")) {
         std::uint16_t index = 0;
-        if (!parse_index(key.str(), index)) {
-          refuse(key, "object key " + toml_reading::quoted(key.str()) + " is not an index such as 0x605A");
+        std::uint8_t sub = 0;
+        if (!parse_index(key.str(), index, sub)) {
+          refuse(key, "object key " + toml_reading::quoted(key.str()) +
+                          " is not an index such as 0x605A (or \"0x607D:2\" with a sub-index)");
         }
-        add_write(index, value, "object " + hex(index, 4));
+        add_write(index, value, "object " + hex(index, 4), sub);
       }
     }
     if (const auto* n = t.get("acceleration")) add_write(object::profile_acceleration, *n, "acceleration");
@@ -305,6 +336,19 @@ struct loader {
       add_write(object::quick_stop_deceleration, *n, "quick_stop_deceleration");
     }
     if (const auto* n = t.get("target_velocity")) add_write(object::target_velocity, *n, "target_velocity");
+    if (const auto* n = t.get("target_position")) add_write(object::target_position, *n, "target_position");
+    if (const auto* n = t.get("target_torque")) add_write(object::target_torque, *n, "target_torque");
+    if (const auto* n = t.get("mode")) {
+      std::int8_t m = 0;
+      const std::string text = n->is_string() ? std::string(get_string(*n, "mode"))
+                                              : std::to_string(get_int(*n, "mode", -128, 127));
+      if (!mode::parse(text, m)) refuse(*n, "mode must be pp, pv, tq, hm, csp, csv, cst or a number");
+      scenario_event e = base;
+      e.what = scenario_event::kind::write;
+      e.index = object::modes_of_operation;
+      e.value = m;
+      actions.push_back(e);
+    }
     if (const auto* n = t.get("cw")) add_write(object::control_word, *n, "cw");
     const std::size_t writes = actions.size();
     if (const auto* n = t.get("abort")) {
@@ -353,9 +397,9 @@ struct loader {
       refuse(*fault_class, "fault_class needs a fault in the same event");
     }
     if (actions.empty()) {
-      refuse(t, "an event needs an action: cw, target_velocity, acceleration, deceleration, "
-                "quick_stop_deceleration, write, fault, clear_fault, voltage, sto or "
-                "connection_lost");
+      refuse(t, "an event needs an action: cw, mode, target_velocity, target_position, target_torque, "
+                "acceleration, deceleration, quick_stop_deceleration, write, fault, clear_fault, voltage, "
+                "sto or connection_lost");
     }
     s.events.insert(s.events.end(), actions.begin(), actions.end());
   }
@@ -363,7 +407,7 @@ struct loader {
   void load_expectation(const toml::table& t) {
     check_keys(t,
                {"at", "between", "state", "velocity", "statusword", "torque", "brake",
-                "error_code", "transition", "always"},
+                "error_code", "transition", "always", "position", "mode"},
                "an expectation");
     expectation base;
     base.line = static_cast<int>(t.source().begin.line);
@@ -485,6 +529,36 @@ struct loader {
       const std::string_view v = get_string(*n, "brake");
       if (v != "engaged" && v != "released") refuse(*n, "brake must be \"engaged\" or \"released\"");
       e.flag = v == "engaged";
+      s.expectations.push_back(e);
+    }
+    if (const auto* n = t.get("position")) {
+      expectation e = base;
+      e.what = expectation::kind::position;
+      constexpr std::int64_t reach = std::int64_t{1} << 40;
+      if (const auto* cmp = n->as_table()) {
+        check_keys(*cmp, {"within"}, "a position comparison");
+        const toml::node* w = cmp->get("within");
+        if (w == nullptr) refuse(*n, "position takes an increment count or { within = [LOW, HIGH] }");
+        const toml::array& range = get_array(*w, "within");
+        if (range.size() != 2) refuse(*w, "within takes [LOW, HIGH]");
+        e.how = expectation::compare::within;
+        e.low = get_int(*range.get(0), "the low end of within", -reach, reach);
+        e.high = get_int(*range.get(1), "the high end of within", -reach, reach);
+        if (e.high < e.low) refuse(*w, "within [LOW, HIGH] needs LOW <= HIGH");
+      } else {
+        e.how = expectation::compare::equal;
+        e.low = get_int(*n, "position", -reach, reach);
+      }
+      s.expectations.push_back(e);
+    }
+    if (const auto* n = t.get("mode")) {
+      expectation e = base;
+      e.what = expectation::kind::mode;
+      std::int8_t m = 0;
+      const std::string text = n->is_string() ? std::string(get_string(*n, "mode"))
+                                              : std::to_string(get_int(*n, "mode", -128, 127));
+      if (!mode::parse(text, m)) refuse(*n, "mode must be pp, pv, tq, hm, csp, csv, cst or a number");
+      e.low = m;
       s.expectations.push_back(e);
     }
     if (const auto* n = t.get("error_code")) {

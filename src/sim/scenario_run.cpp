@@ -2,6 +2,7 @@
 // cycle, every expectation checked against the cycle it names, and a log a person can read.
 #include <string>
 
+#include "cia402/objects.hpp"
 #include "cia402/sim/scenario.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 #include "cia402/support/text.hpp"
@@ -35,6 +36,10 @@ std::string describe_write(const profile& p, std::uint16_t index, std::int64_t v
                  ? describe_control_word(p, static_cast<std::uint16_t>(value))
                  : "cw " + std::to_string(value);
     case object::target_velocity: return "target velocity 0x60FF = " + std::to_string(value) + " rpm";
+    case object::target_position: return "target position 0x607A = " + std::to_string(value);
+    case object::target_torque: return "target torque 0x6071 = " + std::to_string(value) + " permille";
+    case object::modes_of_operation:
+      return "mode 0x6060 = " + std::to_string(value) + " (" + mode::short_name(value) + ")";
     case object::profile_acceleration:
       return "acceleration 0x6083 = " + std::to_string(value) + " rpm/s";
     case object::profile_deceleration:
@@ -76,6 +81,11 @@ std::string claim(const expectation& e) {
     case expectation::kind::error_code:
       return "error code " + hex(static_cast<std::uint32_t>(e.low), 4);
     case expectation::kind::transition: return "transition T" + std::to_string(e.transition);
+    case expectation::kind::position:
+      return e.how == expectation::compare::within
+                 ? "position within [" + std::to_string(e.low) + ", " + std::to_string(e.high) + "]"
+                 : "position " + std::to_string(e.low);
+    case expectation::kind::mode: return "mode " + std::to_string(e.low) + " (" + mode::short_name(e.low) + ")";
     case expectation::kind::always: return std::string("always ") + invariant_name(e.rule);
   }
   return "?";
@@ -109,6 +119,13 @@ bool holds(const expectation& e, const trace_row& r, std::string& actual) {
     case expectation::kind::error_code:
       actual = "error code is " + hex(r.error_code, 4);
       return r.error_code == e.low;
+    case expectation::kind::position:
+      actual = "position is " + std::to_string(r.position);
+      return e.how == expectation::compare::within ? r.position >= e.low && r.position <= e.high
+                                                   : r.position == e.low;
+    case expectation::kind::mode:
+      actual = "mode is " + std::to_string(r.mode);
+      return r.mode == e.low;
     case expectation::kind::transition:
     case expectation::kind::always: break;
   }
@@ -167,7 +184,7 @@ class runner {
 
   run_result run() {
     drive_view v = drive_.view();
-    for (const auto& [index, value] : s_.initial_writes) v.write(index, 0, value);
+    for (const scenario::object_write& w : s_.initial_writes) v.write(w.index, w.sub, w.value);
     v.set_dc_link(s_.dc_link_at_start);
     v.set_sto(s_.sto_at_start);
     if (options_.record_trace) result_.trace.reserve(static_cast<std::size_t>(s_.cycles));
@@ -208,7 +225,7 @@ class runner {
     const std::string at_line = " (line " + std::to_string(e.line) + ")";
     switch (e.what) {
       case scenario_event::kind::write: {
-        const sdo_abort r = v.write(e.index, 0, e.value);
+        const sdo_abort r = v.write(e.index, e.sub, e.value);
         std::string text = describe_write(p_, e.index, e.value);
         bool failed = false;
         if (e.expected_abort != sdo_abort::none) {

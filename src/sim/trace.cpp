@@ -24,7 +24,7 @@ bool same_but_velocity(const trace_row& a, const trace_row& b) {
          a.fault_cause == b.fault_cause && a.current == b.current &&
          b.transition == no_transition && a.ramp == b.ramp && a.torque == b.torque &&
          a.brake_released == b.brake_released && a.brake_engaged == b.brake_engaged &&
-         a.dc_link == b.dc_link && a.sto == b.sto;
+         a.dc_link == b.dc_link && a.sto == b.sto && a.mode == b.mode;
 }
 
 // Control-word and status-word bits as VCD signal names (cia402-reference.md §1.2, §2.1; bits 12
@@ -73,6 +73,10 @@ trace_row begin_row(std::uint64_t time_us, const plant_constants& k, const axis_
   r.brake_engaged = in.brake_engaged;
   r.dc_link = in.dc_link;
   r.sto = in.sto;
+  r.position = a.position;
+  r.position_demand = a.demand;
+  r.torque_permille = a.torque;
+  r.mode = a.operation_mode;
   return r;
 }
 
@@ -120,7 +124,8 @@ std::vector<std::size_t> kept_rows(const std::vector<trace_row>& rows, std::size
 
 void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_t every) {
   out << "time_us,controlword,statusword,state,transition,velocity_rpm,target_rpm,torque,"
-         "brake_released,brake_engaged,ramp,error_code,fault_cause,dc_link,sto\n";
+         "brake_released,brake_engaged,ramp,error_code,fault_cause,dc_link,sto,position,position_demand,"
+         "torque_permille,mode\n";
   for (std::size_t i : kept_rows(rows, every)) {
     const trace_row& r = rows[i];
     out << r.time_us << ',' << hex(r.control_word, 4) << ',' << hex(r.status_word, 4) << ','
@@ -129,7 +134,8 @@ void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_
         << format_rpm(r.velocity) << ',' << r.target_velocity << ',' << int{r.torque} << ','
         << int{r.brake_released} << ',' << int{r.brake_engaged} << ',' << stop_ramp_name(r.ramp)
         << ',' << hex(r.error_code, 4) << ',' << hex(r.fault_cause, 4) << ',' << int{r.dc_link} << ','
-        << int{r.sto} << '\n';
+        << int{r.sto} << ',' << r.position << ',' << r.position_demand << ',' << r.torque_permille << ','
+        << int{r.mode} << '\n';
   }
 }
 
@@ -147,7 +153,9 @@ void write_jsonl(std::ostream& out, const std::vector<trace_row>& rows, std::siz
         << ",\"brake_engaged\":" << b(r.brake_engaged) << ",\"ramp\":\""
         << stop_ramp_name(r.ramp) << "\",\"error_code\":\"" << hex(r.error_code, 4)
         << "\",\"fault_cause\":\"" << hex(r.fault_cause, 4) << "\",\"dc_link\":" << b(r.dc_link)
-        << ",\"sto\":" << b(r.sto) << "}\n";
+        << ",\"sto\":" << b(r.sto) << ",\"position\":" << r.position << ",\"position_demand\":"
+        << r.position_demand << ",\"torque_permille\":" << r.torque_permille << ",\"mode\":" << int{r.mode}
+        << "}\n";
   }
 }
 
@@ -203,6 +211,14 @@ void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trac
        [](const trace_row& r, int) { return binary(r.error_code, 16); }, 0},
       {"", "fault_cause", type::vector, 16,
        [](const trace_row& r, int) { return binary(r.fault_cause, 16); }, 0},
+      {"", "position", type::vector, 32,
+       [](const trace_row& r, int) { return binary(static_cast<std::uint32_t>(r.position), 32); }, 0},
+      {"", "position_demand", type::vector, 32,
+       [](const trace_row& r, int) { return binary(static_cast<std::uint32_t>(r.position_demand), 32); }, 0},
+      {"", "torque_permille", type::vector, 16,
+       [](const trace_row& r, int) { return binary(static_cast<std::uint16_t>(r.torque_permille), 16); }, 0},
+      {"", "mode", type::vector, 8,
+       [](const trace_row& r, int) { return binary(static_cast<std::uint8_t>(r.mode), 8); }, 0},
   };
   for (int b = 0; b < 16; ++b) signals.push_back({"cw", control_bit_names[b], type::wire, 1, cw_bit, b});
   for (int b = 0; b < 16; ++b) signals.push_back({"sw", status_bit_names[b], type::wire, 1, sw_bit, b});

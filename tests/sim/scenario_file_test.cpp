@@ -58,7 +58,8 @@ TEST(scenario_file, a_complete_file_loads_with_times_in_cycles_and_events_in_tim
   EXPECT_EQ(s.cycles, 101u);  // 0, 1 ms, ..., 100 ms
   EXPECT_FALSE(s.plant.brake_fitted);
   ASSERT_EQ(s.initial_writes.size(), 1u);
-  EXPECT_EQ(s.initial_writes[0].first, 0x605A);
+  EXPECT_EQ(s.initial_writes[0].index, 0x605A);
+  EXPECT_EQ(s.initial_writes[0].sub, 0);
   ASSERT_EQ(s.events.size(), 4u);
   EXPECT_EQ(s.events[0].cycle, 10u);
   EXPECT_EQ(s.events[0].index, 0x60FF);  // within one event: writes of 0x60FF before cw

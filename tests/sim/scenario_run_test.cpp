@@ -209,8 +209,8 @@ TEST(examples, quick_stop_examples_cover_every_0x605A_code_of_the_standard_profi
     const scenario& s = std::get<scenario>(r);
     if (f.filename().string().rfind("quick-stop-", 0) != 0) continue;
     EXPECT_EQ(std::string(s.drive_profile.get().name), "cia402");
-    for (const auto& [index, value] : s.initial_writes) {
-      if (index == 0x605A) codes.insert(value);
+    for (const scenario::object_write& w : s.initial_writes) {
+      if (w.index == 0x605A) codes.insert(w.value);
     }
   }
   EXPECT_EQ(codes, (std::set<std::int64_t>{0, 1, 2, 3, 4, 5, 6, 7, 8}));

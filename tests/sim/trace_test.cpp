@@ -2,6 +2,8 @@
 // claim, read back by independent parsers (nlohmann::json for JSONL, a small VCD reader here).
 #include <gtest/gtest.h>
 
+#include <bitset>
+
 #include <algorithm>
 #include <limits>
 #include <map>
@@ -69,7 +71,8 @@ TEST(csv, one_row_per_cycle_under_a_header_and_decimation_keeps_every_change) {
   std::getline(in, line);
   EXPECT_EQ(line,
             "time_us,controlword,statusword,state,transition,velocity_rpm,target_rpm,torque,"
-            "brake_released,brake_engaged,ramp,error_code,fault_cause,dc_link,sto");
+            "brake_released,brake_engaged,ramp,error_code,fault_cause,dc_link,sto,position,"
+            "position_demand,torque_permille,mode");
   std::size_t rows = 0;
   std::string t11;
   while (std::getline(in, line)) {
@@ -77,8 +80,15 @@ TEST(csv, one_row_per_cycle_under_a_header_and_decimation_keeps_every_change) {
     if (line.find(",QUICK_STOP_ACTIVE,11,") != std::string::npos) t11 = line;
   }
   EXPECT_EQ(rows, s.cycles);
-  EXPECT_EQ(t11, "600000,0x000B,0x0217,QUICK_STOP_ACTIVE,11,1500,1500,1,1,0,quick_stop,0x0000,"
-                 "0x0000,1,0");
+  const std::string first15 = "600000,0x000B,0x0217,QUICK_STOP_ACTIVE,11,1500,1500,1,1,0,quick_stop,0x0000,"
+                             "0x0000,1,0,";
+  ASSERT_EQ(t11.substr(0, first15.size()), first15);
+  // The operation-mode columns: that cycle's position, demand, torque (friction at a steady 1500
+  // rpm) and mode 3.
+  const trace_row& row = r.trace[600];
+  EXPECT_EQ(t11.substr(first15.size()), std::to_string(row.position) + "," + std::to_string(row.position_demand) +
+                                            ",20,3");
+  EXPECT_GT(row.position, 0);
   const std::string d = every50.str();
   EXPECT_LT(d.size(), full.str().size() / 5);
   for (const char* kept : {"\n0,", "\n21000,", "\n600000,", "\n745000,", "\n1000000,"}) {
@@ -186,7 +196,8 @@ TEST(vcd, signals_are_named_per_bit_and_their_values_follow_the_trace) {
   EXPECT_EQ(v.type_of.at("drive.cw.8_halt"), "wire");
   EXPECT_EQ(v.type_of.at("drive.sw.10_target_reached"), "wire");
   EXPECT_EQ(v.type_of.at("drive.sw.4_voltage_enabled"), "wire");
-  EXPECT_EQ(v.type_of.size(), 15u + 16u + 16u);
+  EXPECT_EQ(v.type_of.at("drive.position"), "wire");
+  EXPECT_EQ(v.type_of.size(), 15u + 4u + 16u + 16u) << "15 drive signals, 4 of the operation modes, 32 bits";
   for (const trace_row& row : r.trace) {
     const std::uint64_t t = row.time_us;
     ASSERT_EQ(v.value_at("drive.state", t), state_name(row.current)) << t;
@@ -194,6 +205,8 @@ TEST(vcd, signals_are_named_per_bit_and_their_values_follow_the_trace) {
     ASSERT_EQ(v.value_at("drive.sw.2_operation_enabled", t), (row.status_word & 4) ? "1" : "0") << t;
     ASSERT_EQ(v.value_at("drive.cw.2_quick_stop", t), (row.control_word & 4) ? "1" : "0") << t;
     ASSERT_EQ(v.value_at("drive.velocity_rpm", t), format_rpm(row.velocity)) << t;
+    ASSERT_EQ(v.value_at("drive.position", t), std::bitset<32>(static_cast<std::uint32_t>(row.position)).to_string())
+        << t;
   }
   EXPECT_EQ(v.value_at("drive.last_transition", 700000), "00001011");  // T11
   EXPECT_EQ(v.value_at("drive.last_transition", 800000), "00001100");  // T12
@@ -213,12 +226,15 @@ TEST(vcd, the_standard_form_has_no_string_variables_and_names_its_codes) {
   const vcd_file v = read_vcd(out.str());
   EXPECT_EQ(v.type_of.at("drive.state"), "integer");
   EXPECT_EQ(v.type_of.at("drive.ramp"), "integer");
-  EXPECT_EQ(v.type_of.size(), 15u + 16u + 16u);
+  EXPECT_EQ(v.type_of.at("drive.position"), "wire");
+  EXPECT_EQ(v.type_of.size(), 15u + 4u + 16u + 16u) << "15 drive signals, 4 of the operation modes, 32 bits";
   for (const trace_row& row : r.trace) {
     const std::uint64_t t = row.time_us;
     ASSERT_EQ(std::stoul(v.value_at("drive.state", t), nullptr, 2), static_cast<unsigned>(row.current)) << t;
     ASSERT_EQ(std::stoul(v.value_at("drive.ramp", t), nullptr, 2), static_cast<unsigned>(row.ramp)) << t;
     ASSERT_EQ(v.value_at("drive.velocity_rpm", t), format_rpm(row.velocity)) << t;
+    ASSERT_EQ(v.value_at("drive.position", t), std::bitset<32>(static_cast<std::uint32_t>(row.position)).to_string())
+        << t;
   }
 }
 

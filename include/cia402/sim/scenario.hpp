@@ -44,6 +44,7 @@ struct scenario_event {
   int line = 0;
   kind what = kind::write;
   std::uint16_t index = 0;
+  std::uint8_t sub = 0;
   std::int64_t value = 0;
   std::uint16_t code = 0;
   std::uint8_t fault_class = 2;
@@ -74,7 +75,7 @@ bool invariant_holds(invariant rule, const profile& p, const trace_row* previous
 /// One checked claim about the run.
 struct expectation {
   enum class kind : std::uint8_t {
-    state, velocity, statusword, torque, brake, error_code, transition, always
+    state, velocity, statusword, torque, brake, error_code, transition, always, position, mode
   };
   enum class compare : std::uint8_t { equal, below, above, within };
   int line = 0;
@@ -87,7 +88,7 @@ struct expectation {
   bool window = false;
   state expected_state = state::start;
   compare how = compare::equal;
-  std::int64_t low = 0;     ///< micro-rpm (velocity), or the value (statusword, error_code)
+  std::int64_t low = 0;     ///< micro-rpm (velocity), increments (position), or the value
   std::int64_t high = 0;    ///< micro-rpm (velocity within), or the mask (statusword)
   bool flag = false;        ///< torque on / brake engaged
   std::uint8_t transition = 0;
@@ -103,7 +104,12 @@ struct scenario {
   bool dc_link_at_start = true;
   bool sto_at_start = false;
   /// Objects written before power-up (option codes, ramps, 0x60FF), already known to succeed.
-  std::vector<std::pair<std::uint16_t, std::int64_t>> initial_writes;
+  struct object_write {
+    std::uint16_t index = 0;
+    std::uint8_t sub = 0;
+    std::int64_t value = 0;
+  };
+  std::vector<object_write> initial_writes;
   /// Cycles run: times 0, cycle, ..., duration.
   std::uint64_t cycles = 0;
   std::vector<scenario_event> events;  ///< sorted by cycle, then file order

@@ -33,6 +33,11 @@ struct trace_row {
   bool brake_engaged = true;          ///< the brake holds (as the drive read it)
   bool dc_link = true;
   bool sto = false;
+  // The operation modes, as sampled at time_us.
+  std::int64_t position = 0;          ///< 0x6064, increments
+  std::int64_t position_demand = 0;   ///< 0x6062
+  std::int32_t torque_permille = 0;   ///< 0x6077, permille of rated torque
+  std::int8_t mode = 3;               ///< 0x6061
 };
 
 /// The row for the cycle about to run at time_us: call before step_axis() with the axis, then
@@ -61,7 +66,9 @@ struct trace_info {
 };
 
 /// CSV with a header line: time_us, controlword, statusword, state, transition, velocity_rpm,
-/// target_rpm, torque, brake_released, brake_engaged, ramp, error_code, fault_cause, dc_link, sto.
+/// target_rpm, torque, brake_released, brake_engaged, ramp, error_code, fault_cause, dc_link, sto,
+/// then (added with the operation modes, so tools that read the first fifteen keep working)
+/// position, position_demand, torque_permille, mode.
 void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_t every = 1);
 /// One JSON object per line with the same fields (transition null when none was taken).
 void write_jsonl(std::ostream& out, const std::vector<trace_row>& rows, std::size_t every = 1);
@@ -69,7 +76,8 @@ void write_jsonl(std::ostream& out, const std::vector<trace_row>& rows, std::siz
 /// velocity_rpm and target_rpm (real), state and ramp (GTKWave's string type: `$var string`, or
 /// with info.vcd_standard 8-bit integer codes the header's $comment names),
 /// last_transition (integer) with a transition_taken pulse in the cycle one is taken, torque,
-/// brake_released, brake_engaged, dc_link, sto (wires), error_code;
+/// brake_released, brake_engaged, dc_link, sto (wires), error_code, position and position_demand
+/// (32-bit vectors, two's complement as 0x6064 travels), torque_permille (16), mode (8);
 /// sub-scopes `cw` and `sw` with one wire per control-word and status-word bit, named by number and
 /// meaning (cw.0_switch_on ... sw.10_target_reached). Only changes are written.
 void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trace_info& info);
