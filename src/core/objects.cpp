@@ -126,8 +126,19 @@ std::size_t drive_object_count() noexcept { return count; }
 const object_description& drive_object(std::size_t i) noexcept { return objects[i < count ? i : 0]; }
 
 const object_description* find_drive_object(std::uint16_t index, std::uint8_t sub) noexcept {
-  for (const object_description& o : objects) {
-    if (o.index == index && o.sub == sub) return &o;
+  // Binary search: a master writes set-points of many axes every cycle through this.
+  const std::uint32_t key = (std::uint32_t{index} << 8) | sub;
+  std::size_t lo = 0;
+  std::size_t hi = count;
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    const std::uint32_t at = (std::uint32_t{objects[mid].index} << 8) | objects[mid].sub;
+    if (at == key) return &objects[mid];
+    if (at < key) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
   }
   return nullptr;
 }

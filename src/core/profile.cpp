@@ -32,6 +32,8 @@ const profile* find_builtin_profile(std::string_view name) noexcept {
 const profile& standard_profile() noexcept { return detail::cia402_profile; }
 
 bool option_of_index(std::uint16_t index, option& out) noexcept {
+  // Most indices asked about are not option codes (every set-point write asks): one range test.
+  if (index != 0x6007 && (index < 0x605A || index > 0x605E)) return false;
   for (int i = 0; i < option_count; ++i) {
     if (option_index(static_cast<option>(i)) == index) {
       out = static_cast<option>(i);

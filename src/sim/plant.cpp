@@ -242,16 +242,21 @@ std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_
         demand = cut;
       }
       a.demand = demand;
-      const wide per_cycle = static_cast<wide>(k.max_velocity) * o.increments_per_rev * k.cycle_us /
-                             static_cast<wide>(60'000'000'000'000LL);
-      const std::int64_t reach = static_cast<std::int64_t>(per_cycle);
+      // Top speed [rpm] x increments a revolution x cycle [us] stays below 2^61 (1e5 x 2^24 x 1e6):
+      // 64-bit arithmetic, no 128-bit division in the cycle of a thousand axes.
+      const std::uint64_t per_rev_us = std::uint64_t{o.increments_per_rev} * k.cycle_us;
+      const auto reach = static_cast<std::int64_t>(static_cast<std::uint64_t>(k.max_velocity / micro) *
+                                                   per_rev_us / 60'000'000u);
       const std::int64_t step = clamp(demand - s.position, -reach, reach);
-      const std::int64_t before = s.position;
       s.position += step;
       s.fraction = 0;
-      s.velocity = static_cast<std::int64_t>(static_cast<wide>(s.position - before) *
-                                             60'000'000'000'000LL /
-                                             (static_cast<wide>(o.increments_per_rev) * k.cycle_us));
+      // micro-rpm = step x 60e12 / (increments a revolution x cycle), exact in 64 bits while
+      // |step| <= 153,000; beyond, in 128.
+      constexpr std::int64_t scale = 60'000'000'000'000LL;
+      constexpr std::int64_t exact_64 = INT64_MAX / scale;
+      s.velocity = (step <= exact_64 && step >= -exact_64)
+                       ? step * scale / static_cast<std::int64_t>(per_rev_us)
+                       : static_cast<std::int64_t>(static_cast<wide>(step) * scale / static_cast<wide>(per_rev_us));
       status |= 1u << 12;  // the drive follows the command value
       if (following_error_check(k, a)) status |= 1u << 13;
       break;
