@@ -189,6 +189,12 @@ struct instrument::impl {
     j["dc_link"] = v.dc_link();
     j["sto"] = v.sto();
     j["fault_cause"] = hex(v.fault_cause(), 4);
+    // The operation mode and its actual values (docs/modes.md).
+    j["mode"] = v.operation_mode();
+    j["position"] = v.position();
+    j["position_demand"] = v.position_demand();
+    j["following_error"] = v.following_error();
+    j["torque_actual"] = v.torque();
     json objects = json::object();
     for (const object_name& o : object_names(*table)) {
       std::int64_t value = 0;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cia402/master.hpp"
+#include "cia402/motion/homing.hpp"
 #include "page_names.hpp"
 #include "vocabulary.hpp"
 
@@ -117,6 +118,18 @@ json profile_info(const profile& p) {
         if (p.spec(opt).allows(v)) values.push_back(v);
       }
     }
+    // The modes 0x6502 announces, the homing methods the drive runs: a choice, not a number.
+    if (o.index == object_index::modes_of_operation) {
+      const object_description* supported = find_drive_object(object_index::supported_drive_modes);
+      for (int m = 1; m <= 10 && supported != nullptr; ++m) {
+        if (mode::supported_bit(m) & static_cast<std::uint32_t>(supported->default_value)) values.push_back(m);
+      }
+    }
+    if (o.index == object_index::homing_method) {
+      for (int m = 0; m <= 37; ++m) {
+        if (motion::homing::supports(m)) values.push_back(m);
+      }
+    }
     json entry = {{"index", hex(o.index, 4)}, {"name", o.name}, {"values", values}};
     // The range the object table allows, so the page refuses an impossible value without a request.
     if (const object_description* d = find_drive_object(o.index)) {
@@ -126,6 +139,11 @@ json profile_info(const profile& p) {
     objects.push_back(std::move(entry));
   }
   j["objects"] = std::move(objects);
+  json modes = json::object();
+  for (int m = 1; m <= 10; ++m) {
+    if (mode::short_name(m)[0] != '\0') modes[std::to_string(m)] = mode::short_name(m);
+  }
+  j["modes"] = std::move(modes);
   j.update(vocabulary_json(p));
   return j;
 }

@@ -21,10 +21,14 @@ bit_names bit_names_for(const profile& p) {
   return out;
 }
 
-// The objects the page lists for writing: the option codes the profile has and the ramps, named
-// from the one object table ("Quick stop option code" -> "quick stop option code (rpm/s)").
+// The objects the page lists for writing: the mode and its set-points first, then the option codes
+// the profile has and the ramps, named from the one object table ("Quick stop option code" ->
+// "quick stop option code (rpm/s)").
 std::vector<object_name> object_names(const profile& p) {
-  constexpr std::uint16_t listed[] = {0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007,
+  constexpr std::uint16_t listed[] = {object_index::modes_of_operation, object_index::target_position,
+                                      object_index::profile_velocity, object_index::target_torque,
+                                      object_index::homing_method, object_index::home_offset,
+                                      0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007,
                                       object_index::profile_acceleration, object_index::profile_deceleration,
                                       object_index::quick_stop_deceleration};
   std::vector<object_name> out;

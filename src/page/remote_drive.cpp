@@ -460,6 +460,13 @@ struct remote_drive::impl {
                                         : json(nullptr);
     j["sto"] = nullptr;
     j["fault_cause"] = remote.fault_injection() ? json(hex(injected_fault, 4)) : json(nullptr);
+    // The mode as read at start or written since (0x6060); the actual values are not mapped.
+    const auto mode = objects.find(object_index::modes_of_operation);
+    j["mode"] = mode != objects.end() ? json(mode->second) : json(nullptr);
+    j["position"] = nullptr;
+    j["position_demand"] = nullptr;
+    j["following_error"] = nullptr;
+    j["torque_actual"] = nullptr;
     json objs = json::object();
     for (const auto& [index, value] : objects) objs[hex(index, 4)] = value;
     j["objects"] = std::move(objs);

@@ -376,3 +376,41 @@ TEST(instrument, wait_for_update_returns_after_close_without_an_update) {
 }
 
 }  // namespace
+
+namespace {
+
+// The page offers the modes 0x6502 announces and the homing methods the drive runs as choices, and
+// the snapshot carries the mode and its actual values.
+TEST(instrument, modes_are_a_choice_and_the_snapshot_shows_mode_position_and_torque) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  const json info = json::parse(inst.info_json(true, false));
+  json modes, methods;
+  for (const json& o : info["objects"]) {
+    if (o["index"] == "0x6060") modes = o["values"];
+    if (o["index"] == "0x6098") methods = o["values"];
+  }
+  EXPECT_EQ(modes, json::parse("[1, 3, 4, 6, 8, 9, 10]"));
+  EXPECT_EQ(methods, json::parse("[3, 33, 34, 35, 37]"));
+  EXPECT_EQ(info["modes"]["8"], "csp");
+
+  EXPECT_EQ(snapshot(inst)["mode"], 3);
+  id_of(inst.write_object(0x6060, 6));
+  id_of(inst.write_object(0x607C, 1234));
+  for (const cia402::page::page_command c : {cia402::page::page_command::shutdown, cia402::page::page_command::switch_on,
+                                             cia402::page::page_command::enable_operation}) {
+    id_of(inst.command(c));
+    run(inst, 100);
+  }
+  id_of(inst.toggle_control_bit(4));  // homing operation start
+  run(inst, 20);
+  const json s = snapshot(inst);
+  EXPECT_EQ(s["mode"], 6);
+  EXPECT_EQ(s["position"], 1234);
+  EXPECT_EQ(s["following_error"], 0);
+  EXPECT_TRUE(s["torque_actual"].is_number());
+  EXPECT_EQ(s["objects"]["0x6060"], 6);
+  EXPECT_EQ(hex_value(s["status_word"]) & 0x1400, 0x1400) << "homing attained, target reached";
+}
+
+}  // namespace

@@ -301,6 +301,46 @@ function updateDiagram(s) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Operation modes: the mode-specific bits by the names CiA 402-2 gives them in each mode
+
+const MODE_NAMES = {
+  1: 'Profile position', 3: 'Profile velocity', 4: 'Profile torque', 6: 'Homing',
+  8: 'Cyclic synchronous position', 9: 'Cyclic synchronous velocity', 10: 'Cyclic synchronous torque',
+};
+const MODE_CONTROL_BITS = {
+  1: { 4: 'New set-point', 5: 'Change set immediately', 6: 'Relative', 9: 'Change on set-point' },
+  6: { 4: 'Homing operation start' },
+};
+const MODE_STATUS_BITS = {
+  1: { 12: 'Set-point acknowledge', 13: 'Following error' },
+  3: { 12: 'Speed = 0', 13: 'Max slippage error' },
+  6: { 12: 'Homing attained', 13: 'Homing error' },
+  8: { 12: 'Drive follows command value', 13: 'Following error' },
+  9: { 12: 'Drive follows command value' },
+  10: { 12: 'Drive follows command value' },
+};
+
+function modeLabel(mode) {
+  if (mode === null || mode === undefined) return '–';
+  const short = info.modes && info.modes[mode];
+  return MODE_NAMES[mode] ? `${mode} ${MODE_NAMES[mode]} (${short})` : String(mode);
+}
+
+// Only where the profile leaves a bit to the mode ("Operation mode specific"): the DRIVECOM
+// profiles name their bits themselves.
+function nameModeBits(mode) {
+  const rename = (selector, bits, overrides) => {
+    for (const b of bits) {
+      const node = document.querySelector(`${selector}[data-bit="${b.bit}"] .name`);
+      if (!node || !/mode specific/i.test(b.name)) continue;
+      node.textContent = (overrides && overrides[b.bit]) || b.name;
+    }
+  };
+  rename('#control-bits button', info.control_bits, MODE_CONTROL_BITS[mode]);
+  rename('#status-bits li', info.status_bits, MODE_STATUS_BITS[mode]);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Words, commands, plant
 
 function buildBits() {
@@ -374,6 +414,22 @@ function buildCommands() {
     b.addEventListener('click', () => post('/api/command', { command: c.key }));
     box.appendChild(b);
   }
+}
+
+// The mode select writes 0x6060; its choices are the modes 0x6502 announces.
+function buildModes() {
+  const sel = el('mode-select');
+  sel.textContent = '';
+  const entry = info.objects.find((o) => o.index === '0x6060');
+  sel.hidden = !entry;
+  if (!entry) return;
+  for (const m of entry.values) {
+    const opt = document.createElement('option');
+    opt.value = String(m);
+    opt.textContent = MODE_NAMES[m] ? `${MODE_NAMES[m]} (${info.modes[m]})` : String(m);
+    sel.appendChild(opt);
+  }
+  sel.addEventListener('change', () => post('/api/object', { index: '0x6060', value: Number(sel.value) }));
 }
 
 function buildObjects() {
@@ -546,6 +602,15 @@ function update(s) {
   if (halt) halt.setAttribute('aria-pressed', ((cw >> 8) & 1) ? 'true' : 'false');
 
   el('velocity').textContent = s.velocity === null ? '–' : s.velocity;
+  el('mode').textContent = modeLabel(s.mode);
+  el('position').textContent = s.position === null || s.position === undefined ? '–' : s.position;
+  el('following-note').textContent = s.following_error ? `(following error ${s.following_error})` : '';
+  el('torque-actual').textContent =
+    s.torque_actual === null || s.torque_actual === undefined ? '–' : s.torque_actual;
+  nameModeBits(s.mode);
+  const modeSelect = el('mode-select');
+  const requested = s.objects && s.objects['0x6060'];
+  if (requested !== undefined && document.activeElement !== modeSelect) modeSelect.value = String(requested);
   el('target').textContent = s.target_velocity;
   el('setpoint-note').textContent = s.effective_target !== s.target_velocity
     ? `(set-points cleared: following ${s.effective_target})` : '';
@@ -1005,6 +1070,7 @@ async function main() {
   buildBits();
   buildCommands();
   buildObjects();
+  buildModes();
   buildPlant();
   setControl(info.control);
   applyCapabilities(info.capabilities);

@@ -412,6 +412,48 @@ async function main() {
     await waitResult(page, 'WRITE 0x6083 = -5: refused: outside');
   });
 
+  await check('operation modes: pp from the page moves to 0x607A on bit 4, homing 37 sets the home offset', async () => {
+    await page.selectOption('#mode-select', '1');
+    await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('1 '),
+      null, { timeout: 8000 });
+    expect(await page.textContent('#control-bits button[data-bit="4"] .name') === 'New set-point',
+      'control bit 4 named for pp');
+    expect(await page.textContent('#status-bits li[data-bit="12"] .name') === 'Set-point acknowledge',
+      'status bit 12 named for pp');
+    await click(page, 'shutdown');
+    await expectPresentState(page, 'READY_TO_SWITCH_ON');
+    await click(page, 'switch_on');
+    await expectPresentState(page, 'SWITCHED_ON');
+    await click(page, 'enable_operation');
+    await expectPresentState(page, 'OPERATION_ENABLED');
+    await page.selectOption('#object-index', '0x607A');
+    await page.fill('#object-value', '20000');
+    await page.click('#object-form button');
+    await waitResult(page, 'WRITE 0x607A = 20000');
+    const bit4 = '#control-bits button[data-bit="4"]';
+    await page.click(bit4);
+    await page.waitForFunction(() => document.querySelector('#status-bits li[data-bit="12"]').classList.contains('on'),
+      null, { timeout: 8000 });
+    await page.click(bit4);
+    await page.waitForFunction(() => document.getElementById('position').textContent === '20000',
+      null, { timeout: 10000 });
+    await page.selectOption('#mode-select', '6');
+    await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('6 '),
+      null, { timeout: 8000 });
+    expect(await page.textContent('#status-bits li[data-bit="12"] .name') === 'Homing attained',
+      'status bit 12 named for homing');
+    await page.selectOption('#object-index', '0x607C');
+    await page.fill('#object-value', '777');
+    await page.click('#object-form button');
+    await waitResult(page, 'WRITE 0x607C = 777');
+    await page.click(bit4);
+    await page.waitForFunction(() => document.getElementById('position').textContent === '777',
+      null, { timeout: 8000 });
+    await page.click(bit4);
+    await click(page, 'disable_voltage');
+    await expectPresentState(page, 'SWITCH_ON_DISABLED');
+  });
+
   await check('phone width 390x844: one column, diagram first, nothing wider than the screen', async () => {
     await page.setViewportSize({ width: 390, height: 844 });
     await page.waitForTimeout(300);
