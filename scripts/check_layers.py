@@ -30,6 +30,8 @@ LAYERS = [
     ("canopen/transport", "src/canopen/transport/"),
     ("canopen/301", "include/cia402/canopen/301/"),
     ("canopen/301", "src/canopen/301/"),
+    ("ethercat/esc", "include/cia402/ethercat/esc/"),
+    ("ethercat/esc", "src/ethercat/esc/"),
     ("ethercat/sii", "include/cia402/ethercat/sii/"),
     ("ethercat/sii", "src/ethercat/sii/"),
     ("ethercat/coe", "include/cia402/ethercat/coe/"),
@@ -62,16 +64,17 @@ ALLOWED = {
     "canopen/306": {"core", "support", "canopen/can", "canopen/301"},
     "canopen/transport": {"core", "canopen/can"},
     "canopen/402": {"core", "support", "canopen/can", "canopen/301", "canopen/306", "sim"},
+    "ethercat/esc": set(),
     "ethercat/sii": set(),
     "ethercat/coe": {"core", "canopen/301", "canopen/can"},
     "ethercat/402": {"core", "support", "sim", "motion", "canopen/can", "canopen/301", "canopen/306",
-                     "canopen/402", "ethercat/sii", "ethercat/coe"},
+                     "canopen/402", "ethercat/esc", "ethercat/sii", "ethercat/coe"},
     "apps": {"core", "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402"},
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
              "canopen/301", "canopen/306", "canopen/transport", "canopen/402"},
     "tools": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
               "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "apps", "page",
-              "ethercat/sii", "ethercat/coe", "ethercat/402"},
+              "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/402"},
 }
 
 # Where a quoted include is looked for, after the including file's own folder.

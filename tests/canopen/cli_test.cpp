@@ -212,5 +212,18 @@ TEST(cli_bus, node_lists_parse_ranges_and_singles) {
   EXPECT_NE(why.find("node 2 is listed twice"), std::string::npos);
 }
 
+// `cia402 esi`: the EtherCAT ESI of the virtual drive, from the description its SII is built from.
+TEST(cli_esi, prints_the_drives_esi_with_its_identity_and_pdos) {
+  const result r = run_tool({"esi"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("<?xml", 0), 0u);
+  EXPECT_NE(r.out.find("ProductCode=\"#x00000402\""), std::string::npos);
+  EXPECT_NE(r.out.find("<RxPdo Sm=\"2\""), std::string::npos);
+  EXPECT_NE(r.out.find("<Index>#x607A</Index>"), std::string::npos) << "target position for csp";
+  EXPECT_NE(r.out.find("<Index>#x6064</Index>"), std::string::npos);
+  EXPECT_NE(r.out.find("<ProfileNo>402</ProfileNo>"), std::string::npos);
+  EXPECT_EQ(run_tool({"esi", "-o", "/nonexistent/dir/x.xml"}).status, 2);
+}
+
 }  // namespace
 }  // namespace cia402::cli
