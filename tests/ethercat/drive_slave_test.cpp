@@ -1,0 +1,212 @@
+// The virtual drive as an EtherCAT slave, driven through frames on the in-process wire as a master
+// drives it: SII identity, the AL state machine and its refusals, CoE SDO through the mailbox, the
+// process data in OP (enable the drive, read its status word), the watchdog, emergencies.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "cia402/ethercat/402/drive_description.hpp"
+#include "cia402/ethercat/402/drive_slave.hpp"
+
+namespace cia402::ethercat {
+namespace {
+
+constexpr std::array<std::uint8_t, 6> broadcast{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
+constexpr std::array<std::uint8_t, 6> master_mac{0x02, 0, 0, 0, 0, 1};
+constexpr std::uint16_t station = 0x1001;
+
+struct bench {
+  drive_slave slave{standard_profile(), 7};
+  chain wire;
+  std::uint8_t counter = 0;
+  bench() { wire.add(slave.controller()); }
+
+  struct answer {
+    std::vector<std::uint8_t> data;
+    std::uint16_t wkc = 0;
+  };
+  answer send(command c, std::uint32_t address, std::vector<std::uint8_t> data) {
+    frame_builder b(broadcast, master_mac);
+    const long at = b.add(c, 0, address, data, static_cast<std::uint16_t>(data.size()));
+    std::vector<std::uint8_t> f = b.finish();
+    EXPECT_EQ(wire.pass(f), frame_error::none);
+    answer a;
+    a.data.assign(f.begin() + at, f.begin() + at + static_cast<long>(data.size()));
+    a.wkc = static_cast<std::uint16_t>(f[static_cast<std::size_t>(at) + data.size()] |
+                                       (f[static_cast<std::size_t>(at) + data.size() + 1] << 8));
+    return a;
+  }
+  std::uint32_t fp(std::uint16_t offset) const { return station | (static_cast<std::uint32_t>(offset) << 16); }
+  std::uint16_t read16(std::uint16_t offset) {
+    const answer a = send(command::fprd, fp(offset), {0, 0});
+    return static_cast<std::uint16_t>(a.data[0] | (a.data[1] << 8));
+  }
+  void write16(std::uint16_t offset, std::uint16_t v) {
+    EXPECT_EQ(send(command::fpwr, fp(offset), {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8)}).wkc, 1);
+  }
+  void run(int cycles) {
+    for (int i = 0; i < cycles; ++i) slave.step(1000);
+  }
+  // Requests an AL state and returns the AL status after the slave's next cycle.
+  std::uint16_t request(std::uint16_t state) {
+    write16(reg::al_control, state);
+    run(1);
+    return read16(reg::al_status);
+  }
+  void sync_manager(int n, const sync_manager_description& d) {
+    std::vector<std::uint8_t> s{static_cast<std::uint8_t>(d.start), static_cast<std::uint8_t>(d.start >> 8),
+                                static_cast<std::uint8_t>(d.length), static_cast<std::uint8_t>(d.length >> 8),
+                                d.control, 0, 1, 0};
+    EXPECT_EQ(send(command::fpwr, fp(static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n)), s).wkc, 1);
+  }
+  void to_pre_op() {
+    EXPECT_EQ(send(command::apwr, 0 | (static_cast<std::uint32_t>(reg::station_address) << 16), {0x01, 0x10}).wkc, 1);
+    sync_manager(0, slave.description().sync_managers[0]);
+    sync_manager(1, slave.description().sync_managers[1]);
+    EXPECT_EQ(request(2), 2);
+  }
+  // A CoE SDO request through the mailbox; the slave's reply mailbox.
+  std::vector<std::uint8_t> sdo(std::vector<std::uint8_t> body) {
+    std::vector<std::uint8_t> m(mailbox_size, 0);
+    mailbox_header h;
+    h.length = static_cast<std::uint16_t>(2 + body.size());
+    h.type = mailbox_type::coe;
+    h.counter = static_cast<std::uint8_t>(++counter % 7 + 1);
+    write_mailbox_header(h, m.data());
+    m[7] = 0x20;  // SDO request
+    std::copy(body.begin(), body.end(), m.begin() + 8);
+    EXPECT_EQ(send(command::fpwr, fp(mailbox_out_start), m).wkc, 1);
+    run(1);
+    const answer a = send(command::fprd, fp(mailbox_in_start), std::vector<std::uint8_t>(mailbox_size, 0));
+    EXPECT_EQ(a.wkc, 1) << "a reply is waiting";
+    return a.data;
+  }
+  std::int64_t upload(std::uint16_t index, std::uint8_t sub) {
+    const std::vector<std::uint8_t> r = sdo({0x40, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8), sub, 0, 0, 0, 0});
+    EXPECT_EQ(r[8] & 0xE0, 0x40) << "SDO abort " << std::hex << (r[12] | (r[13] << 8) | (r[14] << 16) | (r[15] << 24));
+    return r[12] | (r[13] << 8) | (r[14] << 16) | (static_cast<std::int64_t>(r[15]) << 24);
+  }
+  std::uint32_t download(std::uint16_t index, std::uint8_t sub, std::uint32_t v, int bytes) {
+    const std::uint8_t cmd = bytes == 1 ? 0x2F : bytes == 2 ? 0x2B : 0x23;
+    const std::vector<std::uint8_t> r = sdo({cmd, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8), sub,
+                                             static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8),
+                                             static_cast<std::uint8_t>(v >> 16), static_cast<std::uint8_t>(v >> 24)});
+    return r[8] == 0x60 ? 0 : static_cast<std::uint32_t>(r[12] | (r[13] << 8) | (r[14] << 16) | (r[15] << 24));
+  }
+  void fmmu(int i, std::uint32_t log, std::uint16_t len, std::uint16_t phys, std::uint8_t type) {
+    std::vector<std::uint8_t> f(16, 0);
+    for (int k = 0; k < 4; ++k) f[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(log >> (8 * k));
+    f[4] = static_cast<std::uint8_t>(len);
+    f[5] = static_cast<std::uint8_t>(len >> 8);
+    f[7] = 7;
+    f[8] = static_cast<std::uint8_t>(phys);
+    f[9] = static_cast<std::uint8_t>(phys >> 8);
+    f[11] = type;
+    f[12] = 1;
+    EXPECT_EQ(send(command::fpwr, fp(static_cast<std::uint16_t>(reg::fmmu0 + 16 * i)), f).wkc, 1);
+  }
+  void to_op() {
+    to_pre_op();
+    const slave_description& d = slave.description();
+    sync_manager(2, d.sync_managers[2]);
+    sync_manager(3, d.sync_managers[3]);
+    fmmu(0, 0x10000, d.sync_managers[2].length, d.sync_managers[2].start, 2);
+    fmmu(1, 0x10100, d.sync_managers[3].length, d.sync_managers[3].start, 1);
+    EXPECT_EQ(request(4), 4);
+    EXPECT_EQ(request(8), 8);
+  }
+  // One process data cycle: the control word out, the status word back.
+  std::uint16_t cycle(std::uint16_t control_word) {
+    std::vector<std::uint8_t> out(slave.output_bytes(), 0);
+    out[0] = static_cast<std::uint8_t>(control_word);
+    out[1] = static_cast<std::uint8_t>(control_word >> 8);
+    EXPECT_EQ(send(command::lwr, 0x10000, out).wkc, 1);
+    run(1);
+    const answer in = send(command::lrd, 0x10100, std::vector<std::uint8_t>(slave.input_bytes(), 0));
+    EXPECT_EQ(in.wkc, 1);
+    return static_cast<std::uint16_t>(in.data[0] | (in.data[1] << 8));
+  }
+};
+
+TEST(drive_slave, powers_up_in_init_and_its_sii_names_the_drive) {
+  bench b;
+  b.run(5);
+  EXPECT_EQ(b.send(command::aprd, static_cast<std::uint32_t>(reg::al_status) << 16, {0, 0}).data[0], 1);
+  std::vector<std::uint8_t> words;
+  for (std::uint32_t w = 8; w < 16; w += 4) {
+    b.send(command::apwr, static_cast<std::uint32_t>(reg::eeprom_address) << 16,
+           {static_cast<std::uint8_t>(w), 0, 0, 0});
+    b.send(command::apwr, static_cast<std::uint32_t>(reg::eeprom_control) << 16, {0x00, 0x01});
+    const auto a = b.send(command::aprd, static_cast<std::uint32_t>(reg::eeprom_data) << 16, std::vector<std::uint8_t>(8, 0));
+    words.insert(words.end(), a.data.begin(), a.data.end());
+  }
+  EXPECT_EQ(words[4] | (words[5] << 8), 0x0402) << "product code";
+  EXPECT_EQ(words[12], 7) << "serial";
+}
+
+TEST(drive_slave, the_al_state_machine_refuses_what_its_configuration_cannot_run) {
+  bench b;
+  EXPECT_EQ(b.send(command::apwr, static_cast<std::uint32_t>(reg::station_address) << 16, {0x01, 0x10}).wkc, 1);
+  EXPECT_EQ(b.request(2), 0x11) << "no mailbox sync managers yet: PRE-OP refused, INIT kept, error flag";
+  EXPECT_EQ(b.read16(reg::al_status_code), al_code::invalid_mailbox_configuration);
+  EXPECT_EQ(b.request(0x11), 1) << "INIT with the acknowledge clears the error";
+  EXPECT_EQ(b.read16(reg::al_status_code), 0);
+  b.sync_manager(0, b.slave.description().sync_managers[0]);
+  b.sync_manager(1, b.slave.description().sync_managers[1]);
+  EXPECT_EQ(b.request(3), 0x11) << "BOOT is refused";
+  EXPECT_EQ(b.read16(reg::al_status_code), al_code::bootstrap_not_supported);
+  EXPECT_EQ(b.request(0x12), 2);
+  EXPECT_EQ(b.request(8), 0x12) << "OP from PRE-OP skips SAFE-OP";
+  EXPECT_EQ(b.read16(reg::al_status_code), al_code::invalid_state_change);
+  EXPECT_EQ(b.request(0x14), 0x12) << "SAFE-OP without process data sync managers";
+  EXPECT_EQ(b.read16(reg::al_status_code), al_code::invalid_output_configuration);
+}
+
+TEST(drive_slave, coe_reads_and_writes_the_drive_and_guards_the_pdo_configuration) {
+  bench b;
+  b.to_pre_op();
+  EXPECT_EQ(b.upload(0x1018, 2), 0x402);
+  EXPECT_EQ(b.upload(0x1018, 4), 7);
+  EXPECT_EQ(b.upload(0x6502, 0), 0x3AD);
+  EXPECT_EQ(b.download(0x6060, 0, 8, 1), 0u);
+  EXPECT_EQ(b.upload(0x6060, 0), 8);
+  EXPECT_EQ(b.download(0x6060, 0, 2, 1), 0x06090030u) << "a mode the drive does not announce";
+  EXPECT_EQ(b.download(0x1A00, 1, 0x60400010, 4), 0x06040041u) << "the control word is no input";
+  EXPECT_EQ(b.download(0x1C12, 1, 0x1A00, 2), 0x06090030u) << "only RxPDOs go to 0x1C12";
+  EXPECT_EQ(b.download(0x1601, 1, 0x60710010, 4), 0u) << "target torque into RxPDO 2";
+  b.to_op();
+  EXPECT_EQ(b.download(0x1601, 1, 0x60FF0020, 4), 0x08000022u) << "mappings are written in PRE-OP only";
+}
+
+TEST(drive_slave, in_op_the_process_data_enable_the_drive) {
+  bench b;
+  b.to_op();
+  std::uint16_t sw = 0;
+  for (std::uint16_t cw : {0x0006, 0x0007, 0x000F}) {
+    for (int i = 0; i < 40; ++i) sw = b.cycle(cw);
+  }
+  EXPECT_EQ(sw & 0x6F, 0x27) << "OPERATION ENABLED";
+  EXPECT_EQ(b.slave.device().drive().view().current(), state::operation_enabled);
+}
+
+TEST(drive_slave, a_silent_master_trips_the_watchdog_and_0x6007_acts) {
+  bench b;
+  b.to_op();
+  for (std::uint16_t cw : {0x0006, 0x0007, 0x000F}) {
+    for (int i = 0; i < 40; ++i) b.cycle(cw);
+  }
+  b.run(150);  // no outputs for 150 ms; the watchdog is 100 ms
+  EXPECT_EQ(b.read16(reg::al_status), 0x14) << "SAFE-OP with the error flag";
+  EXPECT_EQ(b.read16(reg::al_status_code), al_code::sync_manager_watchdog);
+  b.run(10);
+  // 0x6007 = 1 by default: a lost connection is a fault (S10), and the master hears an emergency.
+  EXPECT_EQ(b.slave.device().drive().view().outputs().error_code, 0x8130);
+  const auto mbx = b.send(command::fprd, b.fp(mailbox_in_start), std::vector<std::uint8_t>(mailbox_size, 0));
+  ASSERT_EQ(mbx.wkc, 1);
+  EXPECT_EQ(mbx.data[7] >> 4, 1) << "CoE emergency";
+  EXPECT_EQ(mbx.data[8] | (mbx.data[9] << 8), 0x8130);
+}
+
+}  // namespace
+}  // namespace cia402::ethercat
