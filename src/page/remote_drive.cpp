@@ -79,7 +79,15 @@ co::drive_master_config master_config(const profile& p, const remote_config& c) 
   m.timing = co::pdo_timing::on_change;
   m.map_velocity = true;
   m.velocity_inhibit_100us = c.velocity_inhibit_100us;
-  for (const object_name& o : object_names(p)) m.read_at_start.push_back(o.index);
+  // The set-points of the position and torque modes are not read at start (each read is a round
+  // trip before the page runs): they show once written. The mode is, for the mode select.
+  for (const object_name& o : object_names(p)) {
+    const std::uint16_t i = o.index;
+    const bool setpoint = i == object_index::target_position || i == object_index::target_torque ||
+                          i == object_index::profile_velocity || i == object_index::homing_method ||
+                          i == object_index::home_offset;
+    if (!setpoint) m.read_at_start.push_back(i);
+  }
   m.read_at_start.push_back(0x60FF);
   m.poll_us = c.poll_us;
   m.retry_us = c.retry_us;

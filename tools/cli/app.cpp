@@ -12,6 +12,7 @@
 #include "cli/bus.hpp"
 #include "cli/diagram.hpp"
 #include "cli/eds.hpp"
+#include "cli/ecat_slave.hpp"
 #include "cli/esi.hpp"
 #include "cli/master.hpp"
 #include "cli/path.hpp"
@@ -114,6 +115,8 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   auto* eds = add_eds_subcommand(app, eds_options);
   esi_args esi_options;
   auto* esi = add_esi_subcommand(app, esi_options);
+  ecat_slave_args ecat_slave_options;
+  auto* ecat_slave = add_ecat_slave_subcommand(app, ecat_slave_options);
 
   // A word that is not a command gets the list of commands, not CLI11's "subcommand required".
   const std::string first = args.empty() ? std::string() : args.front();
@@ -140,6 +143,7 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   if (master->parsed()) return run_master(master_options, out, err);
   if (eds->parsed()) return run_eds(eds_options, out, err);
   if (esi->parsed()) return run_esi(esi_options, out, err);
+  if (ecat_slave->parsed()) return run_ecat_slave(ecat_slave_options, out, err);
   if (profiles->parsed()) {
     if (dump_name.empty()) return list_profiles(out);
     const profile* p = find_builtin_profile(dump_name);

@@ -1,0 +1,98 @@
+#include "cia402/apps/ethercat_host.hpp"
+
+#include <arpa/inet.h>
+#include <linux/if_packet.h>
+#include <net/ethernet.h>
+#include <net/if.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "cia402/apps/elapsed_clock.hpp"
+
+namespace cia402::apps {
+
+ethercat_host::ethercat_host(const profile& p, int nodes, std::uint32_t cycle_us) : cycle_us_(cycle_us) {
+  for (int i = 0; i < nodes; ++i) {
+    drives_.push_back(std::make_unique<ethercat::drive_slave>(p, static_cast<std::uint32_t>(i + 1)));
+    wire_.add(drives_.back()->controller());
+  }
+}
+
+ethercat_host::~ethercat_host() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+std::error_code ethercat_host::open(const std::string& interface) {
+  const unsigned index = ::if_nametoindex(interface.c_str());
+  if (index == 0) return {errno != 0 ? errno : ENODEV, std::generic_category()};
+  const int fd = ::socket(AF_PACKET, SOCK_RAW | SOCK_CLOEXEC, htons(ethercat::ethertype));
+  if (fd < 0) return {errno, std::generic_category()};
+  sockaddr_ll address{};
+  address.sll_family = AF_PACKET;
+  address.sll_protocol = htons(ethercat::ethertype);
+  address.sll_ifindex = static_cast<int>(index);
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
+    const int e = errno;
+    ::close(fd);
+    return {e, std::generic_category()};
+  }
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = fd;
+  ifindex_ = static_cast<int>(index);
+  return {};
+}
+
+bool ethercat_host::pass(std::vector<std::uint8_t>& frame) {
+  if (wire_.pass(frame) != ethercat::frame_error::none) return false;
+  // As an ESC's port 0 does on the way back: the source address marked locally administered, so a
+  // master tells its own outgoing frame from the answer.
+  frame[6] |= 0x02;
+  return true;
+}
+
+void ethercat_host::cycle(std::uint32_t elapsed_us) {
+  for (auto& d : drives_) d->step(elapsed_us);
+}
+
+void ethercat_host::run(const volatile std::sig_atomic_t& stop) {
+  elapsed_clock clock;
+  std::uint32_t pending_us = 0;
+  std::vector<std::uint8_t> frame(ethercat::maximum_frame_size + 4);
+  while (stop == 0) {
+    pollfd p{fd_, POLLIN, 0};
+    const int timeout_ms = static_cast<int>(cycle_us_ > pending_us ? (cycle_us_ - pending_us) / 1000 : 0);
+    (void)::poll(&p, 1, timeout_ms);
+    // Every frame waiting, answered at once: a master's cycle is a frame and its answer.
+    for (int burst = 0; burst < 64 && fd_ >= 0; ++burst) {
+      sockaddr_ll from{};
+      socklen_t from_len = sizeof from;
+      frame.resize(ethercat::maximum_frame_size + 4);
+      const ssize_t n = ::recvfrom(fd_, frame.data(), frame.size(), MSG_DONTWAIT,
+                                   reinterpret_cast<sockaddr*>(&from), &from_len);
+      if (n <= 0) break;
+      if (from.sll_pkttype == PACKET_OUTGOING) continue;  // our own answer, seen going out
+      frame.resize(static_cast<std::size_t>(n));
+      if (!pass(frame)) continue;
+      sockaddr_ll to{};
+      to.sll_family = AF_PACKET;
+      to.sll_protocol = htons(ethercat::ethertype);
+      to.sll_ifindex = ifindex_;
+      to.sll_halen = 6;
+      std::memcpy(to.sll_addr, frame.data(), 6);
+      (void)::sendto(fd_, frame.data(), frame.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+    }
+    pending_us += clock.take();
+    // Catch up at most a few cycles: a stalled host does not replay a second of drive time at once.
+    if (pending_us > cycle_us_ * 10) pending_us = cycle_us_ * 10;
+    while (pending_us >= cycle_us_) {
+      cycle(cycle_us_);
+      pending_us -= cycle_us_;
+    }
+  }
+}
+
+}  // namespace cia402::apps

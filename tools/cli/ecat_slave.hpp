@@ -1,0 +1,27 @@
+// `cia402 ecat-slave --iface IF [--nodes N] [--profile NAME]`: N virtual CiA 402 drives as a chain
+// of EtherCAT CoE slaves on a network interface (apps/ethercat_host.hpp), until SIGINT or SIGTERM.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+namespace CLI {
+class App;
+}
+
+namespace cia402::cli {
+
+struct ecat_slave_args {
+  std::string iface;
+  int nodes = 1;
+  std::string profile = "cia402";
+  std::string profile_file;
+  std::uint32_t cycle_us = 1000;
+};
+
+CLI::App* add_ecat_slave_subcommand(CLI::App& app, ecat_slave_args& args);
+/// Exit status 0 after a signal; 1 when the interface cannot be opened; 2 for a refused option.
+int run_ecat_slave(const ecat_slave_args& args, std::ostream& out, std::ostream& err);
+
+}  // namespace cia402::cli
