@@ -1,12 +1,14 @@
-// The simulator's plant: a motor in profile velocity mode with a holding brake, a DC link and an STO
-// input, stepped on a fixed cycle of virtual time. The state machine is the core's: each cycle the
+// The simulator's plant: a motor in the operation modes of docs/modes.md (profile velocity, profile
+// position, homing, cyclic synchronous position / velocity / torque, profile torque) with a holding
+// brake, a DC link and an STO input, stepped on a fixed cycle of virtual time. The state machine is the core's: each cycle the
 // plant's feedback goes into cia402::step() and the plant then follows its drive_outputs. Nothing
 // here reads a clock, draws a random number or uses floating point, so the same inputs give the
 // same trajectory bit for bit on every machine.
 //
-// Units: velocities in rpm (0x60FF, 0x606C), ramps in rpm/s (0x6083..0x6085), time in
-// microseconds. Inside, the velocity is kept in micro-rpm (1e-6 rpm) so that a ramp's change per
-// cycle, rate [rpm/s] x cycle [us], is an exact integer.
+// Units: velocities in rpm (0x60FF, 0x606C), ramps in rpm/s (0x6083..0x6085), positions in
+// increments (0x608F), torque in permille of rated torque, time in microseconds. Inside, the
+// velocity is kept in micro-rpm (1e-6 rpm) so that a ramp's change per cycle, rate [rpm/s] x cycle
+// [us], is an exact integer, and the position with an exact fraction of an increment.
 #pragma once
 
 #include <cstdint>
