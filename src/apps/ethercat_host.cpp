@@ -10,6 +10,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <ctime>
 
 #include "cia402/apps/elapsed_clock.hpp"
 
@@ -63,9 +64,11 @@ void ethercat_host::run(const volatile std::sig_atomic_t& stop) {
   std::uint32_t pending_us = 0;
   std::vector<std::uint8_t> frame(ethercat::maximum_frame_size + 4);
   while (stop == 0) {
+    // Sleep until a frame comes or the next cycle is due, to the microsecond: no busy loop.
     pollfd p{fd_, POLLIN, 0};
-    const int timeout_ms = static_cast<int>(cycle_us_ > pending_us ? (cycle_us_ - pending_us) / 1000 : 0);
-    (void)::poll(&p, 1, timeout_ms);
+    const std::uint32_t wait_us = cycle_us_ > pending_us ? cycle_us_ - pending_us : 0;
+    const timespec wait{0, static_cast<long>(wait_us) * 1000};
+    (void)::ppoll(&p, 1, &wait, nullptr);
     // Every frame waiting, answered at once: a master's cycle is a frame and its answer.
     for (int burst = 0; burst < 64 && fd_ >= 0; ++burst) {
       sockaddr_ll from{};
