@@ -7,7 +7,7 @@
 // Default process data, enough for a cyclic synchronous position master and every other mode:
 //   RxPDO 0x1600 (SM2, outputs, 13 bytes): 0x6040 controlword, 0x607A target position, 0x60FF target
 //     velocity, 0x6071 target torque, 0x6060 modes of operation;
-//   TxPDO 0x1A00 (SM3, inputs, 17 bytes): 0x6041 statusword, 0x6064 position actual value, 0x606C
+//   TxPDO 0x1A00 (SM3, inputs, 19 bytes): 0x6041 statusword, 0x6064 position actual value, 0x606C
 //     velocity actual value, 0x6077 torque actual value, 0x6061 modes of operation display, 0x603F
 //     error code, 0x60F4 following error actual value (a master sees a following error growing).
 // Both mappings and both assignments are writable in PRE-OP (a master may map what it wants); a

@@ -75,8 +75,7 @@ class esc {
   // ---- the EtherCAT side ---------------------------------------------------------------------
 
   /// One datagram passing this controller: data read or written, the working counter raised for
-  /// what it did, ADP incremented for auto-increment commands. `last_in_chain` tells the DL status
-  /// whether port 1 is closed.
+  /// what it did, ADP incremented for auto-increment and broadcast commands.
   void process(datagram& d) noexcept;
   /// Every datagram of a parsed frame, in order.
   void process(parsed_frame& f) noexcept {
@@ -156,7 +155,7 @@ class chain {
  public:
   void add(esc& e);
   std::size_t size() const noexcept { return escs_.size(); }
-  /// Passes a frame through every controller; false (and the frame untouched) when it is not a
+  /// Passes a frame through every controller; an error (and the frame untouched) when it is not a
   /// sound EtherCAT frame.
   frame_error pass(std::vector<std::uint8_t>& frame) noexcept;
   std::uint64_t frames() const noexcept { return frames_; }
