@@ -831,12 +831,22 @@ function buildAxes() {
 const recorder = { rowsSeen: 0, transitionsSeen: 0, rows: [], transitions: 0, dropped: 0 };
 const TIMELINE_MS = 30000;
 
+// One request at a time: under load a poll can outlast the 500 ms interval, and two polls asking
+// from the same counts would both append what is new (the history listed transitions twice).
+let recordingInFlight = false;
+
 async function pollRecording() {
+  if (recordingInFlight) return;
+  recordingInFlight = true;
   try {
+    const askedRows = recorder.rowsSeen;
+    const askedTransitions = recorder.transitionsSeen;
     const res = await fetch(api(
-      `/api/recording?rows_seen=${recorder.rowsSeen}&transitions_seen=${recorder.transitionsSeen}`));
+      `/api/recording?rows_seen=${askedRows}&transitions_seen=${askedTransitions}`));
     if (!res.ok) return;
     const r = await res.json();
+    // An answer to counts that are no longer ours (the recording started over meanwhile) is dropped.
+    if (recorder.rowsSeen !== askedRows || recorder.transitionsSeen !== askedTransitions) return;
     if (r.rows_seen < recorder.rowsSeen || r.transitions_seen < recorder.transitionsSeen) {
       // A new recording (the server restarted; a profile switch reloads the page): start over.
       recorder.rowsSeen = 0;
@@ -863,6 +873,8 @@ async function pollRecording() {
     addHistory(r.transitions);
   } catch (e) {
     // The event stream's stale marking says the server is gone; nothing to add here.
+  } finally {
+    recordingInFlight = false;
   }
 }
 
