@@ -95,13 +95,18 @@ constexpr bool stop_running(const axis& a) noexcept { return a.pending_row != no
 /// 5 device profile (0x83xx..0x8Fxx, e.g. 0x8611 following error), 7 manufacturer (0xFFxx).
 /// Inline, so a step whose caller ignores the register does not compute it.
 constexpr std::uint8_t error_register_of(std::uint16_t error_code) noexcept {
+  if (error_code == 0) return 0;
   const unsigned group = error_code >> 12;
   const unsigned high = error_code >> 8;
-  return static_cast<std::uint8_t>(
-      error_code == 0 ? 0u
-                      : 0x01u | (group == 0x2 ? 0x02u : 0u) | (group == 0x3 ? 0x04u : 0u) |
-                            (group == 0x4 ? 0x08u : 0u) | (high == 0x81 || high == 0x82 ? 0x10u : 0u) |
-                            (group == 0x8 && high >= 0x83 ? 0x20u : 0u) | (high == 0xFF ? 0x80u : 0u));
+  unsigned r = 0x01u;
+  if (group - 2u < 3u) {
+    r |= 0x02u << (group - 2u);  // 0x2xxx current, 0x3xxx voltage, 0x4xxx temperature
+  } else if (group == 0x8) {
+    r |= high >= 0x83 ? 0x20u : high >= 0x81 ? 0x10u : 0u;
+  } else if (high == 0xFF) {
+    r |= 0x80u;
+  }
+  return static_cast<std::uint8_t>(r);
 }
 
 /// Error codes the drive raises itself.

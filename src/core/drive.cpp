@@ -26,110 +26,120 @@ stop_ramp ramp_of_code(int code) noexcept {
   return static_cast<stop_ramp>(((code - 1) & 3) + 1);
 }
 
-// The option code a row's stop depends on, read when the stop starts (S16).
-std::int8_t stop_code_of_row(const axis& a, row_stop stop) noexcept {
-  switch (stop) {
-    case row_stop::shutdown_option:
-    case row_stop::shutdown_option_halt: return option_value(a, option::shutdown);
-    case row_stop::disable_operation_option: return option_value(a, option::disable_operation);
-    case row_stop::immediate:
-    case row_stop::slow_down_ramp:
-    case row_stop::quick_stop_ramp:
-    case row_stop::halt_ramp: break;
+// What a row's stop does, as a few bits, so the drive reads a table rather than a switch: the ramp
+// (none, slow-down or quick-stop as stop_ramp numbers them, or `halt_ramp_live`: the one 0x605D
+// picks, read live because 0x605D acts at once, S16), whether it only runs when the option code
+// read as the stop starts is 1 (else the change is immediate), and which code that is.
+namespace stop_bits {
+constexpr unsigned halt_ramp_live = 3;  ///< bits 0..1: the ramp; 3 = as 0x605D says
+constexpr unsigned ramp = 3;
+constexpr unsigned if_code_is_1 = 1u << 2;  ///< ramp only if the code read at the start is 1
+constexpr unsigned code_605c = 1u << 3;     ///< that code is 0x605C, else 0x605B
+}  // namespace stop_bits
+
+constexpr unsigned stop_nibble(row_stop s) noexcept {
+  switch (s) {
+    case row_stop::immediate: break;
+    case row_stop::shutdown_option: return stop_bits::if_code_is_1 | 1u;
+    case row_stop::disable_operation_option:
+      return stop_bits::if_code_is_1 | stop_bits::code_605c | 1u;
+    case row_stop::slow_down_ramp: return static_cast<unsigned>(stop_ramp::slow_down);
+    case row_stop::quick_stop_ramp: return static_cast<unsigned>(stop_ramp::quick_stop);
+    case row_stop::halt_ramp: return stop_bits::halt_ramp_live;
+    case row_stop::shutdown_option_halt: return stop_bits::if_code_is_1 | stop_bits::halt_ramp_live;
   }
   return 0;
 }
 
+constexpr std::uint32_t stop_table = [] {
+  std::uint32_t t = 0;
+  for (int s = 0; s < row_stop_count; ++s) t |= stop_nibble(static_cast<row_stop>(s)) << (4 * s);
+  return t;
+}();
+static_assert(row_stop_count <= 8, "a nibble per row_stop in 32 bits");
+static_assert(static_cast<int>(stop_ramp::slow_down) == 1 && static_cast<int>(stop_ramp::quick_stop) == 2);
+
+unsigned stop_of(row_stop s) noexcept {
+  const unsigned i = static_cast<unsigned>(s);
+  return i < row_stop_count ? (stop_table >> (4 * i)) & 0xFu : 0u;
+}
+
+// The option code a row's stop depends on, read when the stop starts (S16).
+std::int8_t stop_code_of_row(const axis& a, unsigned stop) noexcept {
+  if (!(stop & stop_bits::if_code_is_1)) return 0;
+  return option_value(a, (stop & stop_bits::code_605c) ? option::disable_operation : option::shutdown);
+}
+
 // The ramp a row's stop runs before its state change, given the code read when it started; none
-// means the change is immediate. 0x605D acts at once (S16), so a stop "with Halt" reads it live.
-stop_ramp ramp_of_row(const axis& a, row_stop stop, int code) noexcept {
-  switch (stop) {
-    case row_stop::shutdown_option:
-    case row_stop::disable_operation_option:
-      return code == 1 ? stop_ramp::slow_down : stop_ramp::none;
-    case row_stop::slow_down_ramp: return stop_ramp::slow_down;
-    case row_stop::quick_stop_ramp: return stop_ramp::quick_stop;
-    case row_stop::halt_ramp: return ramp_of_code(option_value(a, option::halt));
-    case row_stop::shutdown_option_halt:
-      return code == 1 ? ramp_of_code(option_value(a, option::halt)) : stop_ramp::none;
-    case row_stop::immediate: break;
-  }
-  return stop_ramp::none;
+// means the change is immediate.
+stop_ramp ramp_of_row(const axis& a, unsigned stop, int code) noexcept {
+  if ((stop & stop_bits::if_code_is_1) && code != 1) return stop_ramp::none;
+  const unsigned ramp = stop & stop_bits::ramp;
+  return ramp == stop_bits::halt_ramp_live ? ramp_of_code(option_value(a, option::halt))
+                                           : static_cast<stop_ramp>(ramp);
 }
 
 // What the present state (or the pending row's stop) asks of the motion side, and whether that stop
-// ends with torque off (so the brake closes at standstill first, S12).
-struct activity_now {
-  stop_ramp ramp = stop_ramp::none;
-  bool torque_wanted = false;
-  bool stop_ends_torque = false;
-};
+// ends with torque off (so the brake closes at standstill first, S12). Packed in one register: the
+// ramp in bits 0..7, then the two flags.
+namespace activity {
+constexpr unsigned torque_wanted = 1u << 8;
+constexpr unsigned stop_ends_torque = 1u << 9;
+constexpr unsigned ramp = 0xFFu;
+}  // namespace activity
 
-activity_now activity_of(const profile& p, const axis& a, bool halt) noexcept {
-  activity_now now;
+unsigned activity_of(const profile& p, const axis& a, bool halt) noexcept {
   if (a.pending_row != no_row) {
     const transition_row& r = p.rows[a.pending_row];
-    now.ramp = ramp_of_row(a, r.stop, a.stop_code);
-    now.torque_wanted = true;
     // A stop into a state that holds torque (SWITCHED ON of seeds 003/004) keeps the brake open.
-    now.stop_ends_torque = !p.torque_allowed(r.to);
-    return now;
+    return static_cast<unsigned>(ramp_of_row(a, stop_of(r.stop), a.stop_code)) |
+           activity::torque_wanted | (p.torque_allowed(r.to) ? 0u : activity::stop_ends_torque);
   }
-  switch (p.info(a.current).activity) {
-    case state_activity::idle: break;
-    case state_activity::hold: now.torque_wanted = true; break;
-    case state_activity::run:
-      now.torque_wanted = true;
-      if (halt) now.ramp = ramp_of_code(option_value(a, option::halt));
-      break;
-    case state_activity::quick_stop: {
-      const int code = a.stop_code;  // 0x605A as it was when the quick stop started (S16)
-      now.ramp = ramp_of_code(code);
-      now.torque_wanted = now.ramp != stop_ramp::coast;
-      now.stop_ends_torque = code >= 1 && code <= 4;
-      break;
-    }
-    case state_activity::fault_reaction:
-      now.ramp = (a.flags & axis_flag::coast_reaction)
-                     ? stop_ramp::coast
-                     : ramp_of_code(a.stop_code);  // 0x605E as at T13 (S16)
-      now.torque_wanted = now.ramp != stop_ramp::coast;
-      now.stop_ends_torque = true;
-      break;
+  const state_activity act = p.info(a.current).activity;
+  if (act == state_activity::hold || act == state_activity::run) {
+    return activity::torque_wanted |
+           (halt && act == state_activity::run
+                ? static_cast<unsigned>(ramp_of_code(option_value(a, option::halt)))
+                : 0u);
   }
-  return now;
-}
-
-// The fault the drive acts on this cycle: a cause from outside, a lost connection with 0x6007 = 1,
-// or an event of its own (STO or undervoltage while torque was on, S13/S14).
-struct fault_now {
-  std::uint16_t code = 0;
-  std::uint8_t error_class = 0;
-  bool internal = false;
-};
-
-fault_now fault_of(const profile& p, const axis& a, const drive_inputs& in) noexcept {
-  const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
-  if (torque_was_on && in.sto) return {error_code::safe_torque_off, 3, true};
-  if (torque_was_on && !in.dc_link) return {error_code::dc_link_undervoltage, 3, true};
-  const std::uint8_t input_class = p.error_classes ? in.fault_class : std::uint8_t{2};
-  if (in.fault_code != 0 && input_class >= 2) return {in.fault_code, input_class, false};
-  // A lost connection with 0x6007 = 1 is a fault even beside a mere warning (class 0 or 1).
-  if (in.connection_lost && option_value(a, option::abort_connection) == 1) {
-    return {error_code::heartbeat, 2, false};
+  if (act == state_activity::quick_stop || act == state_activity::fault_reaction) {
+    // The code of 0x605A or 0x605E as it was when the stop started (S16); a fault reaction the
+    // drive turned into a coast coasts.
+    const int code = a.stop_code;
+    const bool fault_reaction = act == state_activity::fault_reaction;
+    const stop_ramp ramp = fault_reaction && (a.flags & axis_flag::coast_reaction)
+                               ? stop_ramp::coast
+                               : ramp_of_code(code);
+    return static_cast<unsigned>(ramp) | (ramp != stop_ramp::coast ? activity::torque_wanted : 0u) |
+           (fault_reaction || (code >= 1 && code <= 4) ? activity::stop_ends_torque : 0u);
   }
-  if (in.fault_code != 0) return {in.fault_code, input_class, false};
-  return {};
+  return 0;
 }
 
 bool raised_by_drive(std::uint16_t code) noexcept {
-  return code == error_code::safe_torque_off || code == error_code::dc_link_undervoltage ||
-         code == error_code::heartbeat;
+  return (code == error_code::safe_torque_off) | (code == error_code::dc_link_undervoltage) |
+         (code == error_code::heartbeat);
 }
 
 void set_flag(axis& a, std::uint8_t flag, bool on) noexcept {
   a.flags = static_cast<std::uint8_t>(on ? (a.flags | flag) : (a.flags & ~flag));
 }
+
+// The fault facts an error class raises (fault, fault_quick_stop, fault_present, fault_immediate:
+// bits 8..11), a nibble per class 0..5 (5 stands for any class above 4). Without error classes a
+// fault has class 2, or 3 when the drive raised it itself, so the table serves both.
+constexpr std::uint32_t fault_facts_of_class = [] {
+  std::uint32_t t = 0;
+  for (unsigned c = 0; c <= 5; ++c) {
+    const std::uint32_t facts = (c >= 2 ? bits(fact::fault) : 0u) |
+                                (c == 1 ? bits(fact::fault_quick_stop) : 0u) |
+                                (c >= 1 ? bits(fact::fault_present) : 0u) |
+                                (c >= 3 ? bits(fact::fault_immediate) : 0u);
+    t |= (facts >> 8) << (4 * c);
+  }
+  return t;
+}();
+static_assert((fault_facts | bits(fact::fault_present) | bits(fact::fault_immediate)) == 0xF00u);
 
 }  // namespace
 
@@ -139,20 +149,17 @@ axis make_axis(const profile& p) noexcept {
   return a;
 }
 
-namespace {
-
 // Everything but the quiet cycle (detail/quiet_step.hpp): facts, the first matching row, pending
 // stops (S7), outputs.
-}  // namespace
-
 drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& in) noexcept {
   drive_outputs out;
-  // Facts of this cycle. The common cycle (remote, no fault, voltage, no STO, no stop pending)
-  // takes no branch here but the one on the fault code.
+  // Facts of this cycle.
   const std::uint16_t cw = in.control_word;
   const std::uint32_t reset_bit = (cw >> 7) & 1u;
   const std::uint32_t reset_edge = reset_bit & ~static_cast<std::uint32_t>(a.flags);
   a.flags = static_cast<std::uint8_t>((a.flags & ~axis_flag::fault_reset_bit) | reset_bit);  // S2
+  const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
+  const state_activity act_before = p.info(a.current).activity;
 
   std::uint32_t f = bits(fact::automatic) |
                     (in.dc_link ? bits(fact::dc_link) : bits(fact::undervoltage)) |
@@ -162,7 +169,7 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
                     (static_cast<std::uint32_t>(in.local_enable && !in.remote) << 19) |
                     (static_cast<std::uint32_t>(in.local_disable) << 20) |
                     // S16: in QUICK STOP ACTIVE the code read when the quick stop started.
-                    quick_stop_facts(p.info(a.current).activity == state_activity::quick_stop
+                    quick_stop_facts(act_before == state_activity::quick_stop
                                          ? a.stop_code
                                          : a.options[static_cast<int>(option::quick_stop)]) |
                     ((static_cast<std::uint32_t>(a.flags) & axis_flag::entered_by_fault) << 16) |
@@ -171,52 +178,67 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   static_assert(axis_flag::fault_latched << 17 == static_cast<std::uint32_t>(fact::fault_latched));
 
   const int abort_code = option_value(a, option::abort_connection);
-  if (!in.connection_lost || abort_code < 2) {
-    if (in.remote) f |= (1u << p.command_of_bits[cw & 0x1Fu]) | (reset_edge << 6);
-  } else {
+  const bool link_fault = in.connection_lost && abort_code == 1;
+  if (in.connection_lost && abort_code >= 2) {
     f |= abort_code == 2 ? bits(fact::disable_voltage) : bits(fact::quick_stop);  // S10
+  } else if (in.remote) {
+    f |= (1u << p.command_of_bits[cw & 0x1Fu]) | (reset_edge << 6);
   }
   const bool halt = in.remote && (cw & control_bit::halt) && p.spec(option::halt).exists();
   if (halt) f |= bits(fact::halt);
 
-  fault_now fault;
-  if (in.fault_code != 0 || in.connection_lost || (a.flags & axis_flag::torque_on)) {
-    fault = fault_of(p, a, in);
-    if (fault.code != 0) {
-      if (!p.error_classes || fault.error_class >= 2) f |= bits(fact::fault);
-      if (p.error_classes && fault.error_class == 1) f |= bits(fact::fault_quick_stop);
-      if (!p.error_classes || fault.error_class >= 1) f |= bits(fact::fault_present);
-      if (fault.error_class >= 3) f |= bits(fact::fault_immediate);
-      if (p.error_classes && fault.error_class == 4) {
-        a.flags |= axis_flag::fault_latched;
-        f |= bits(fact::fault_latched);
-      }
-    }
+  // The fault the drive acts on: an event of its own (STO or undervoltage while torque was on,
+  // S13/S14), a cause from outside, or a lost connection with 0x6007 = 1, which is a fault even
+  // beside a mere warning (class 0 or 1).
+  std::uint16_t fault_code = 0;
+  unsigned fault_class = 0;
+  bool internal = false;
+  const unsigned input_class = p.error_classes ? in.fault_class : 2u;
+  if (torque_was_on && (in.sto || !in.dc_link)) {
+    fault_code = in.sto ? error_code::safe_torque_off : error_code::dc_link_undervoltage;
+    fault_class = 3;
+    internal = true;
+  } else if (in.fault_code != 0 && (input_class >= 2 || !link_fault)) {
+    fault_code = in.fault_code;
+    fault_class = input_class;
+  } else if (link_fault) {
+    fault_code = error_code::heartbeat;
+    fault_class = 2;
+  }
+  f |= ((fault_facts_of_class >> (4 * (fault_class < 5 ? fault_class : 5u))) & 0xFu) << 8;
+  if (fault_class == 4) {  // only with error classes
+    a.flags |= axis_flag::fault_latched;
+    f |= bits(fact::fault_latched);
   }
   // S4: a fault that calls for a coast turns a ramped fault reaction into a coast at once, so the
   // stop completes (T14) in this same step with torque off and the brake closed.
-  const state_activity act_before = p.info(a.current).activity;
   if (act_before == state_activity::fault_reaction &&
-      (in.sto || !in.dc_link || (fault.code != 0 && fault.error_class >= 3))) {
+      (f & (bits(fact::sto) | bits(fact::undervoltage) | bits(fact::fault_immediate)))) {
     a.flags |= axis_flag::coast_reaction;
   }
   // Seed 001: T2 needs "< 1000 RPM", T7 fires on "> 1000 RPM"; exactly 1000 does neither.
   const std::int32_t limit = p.speed_limit_rpm;
   const std::int32_t speed = in.actual_speed_rpm;
-  if (limit > 0 && (speed > limit || speed < -limit)) f |= bits(fact::overspeed);
-  if (limit <= 0 || (speed < limit && speed > -limit)) f |= bits(fact::below_speed_limit);
+  const std::uint32_t magnitude = speed < 0 ? 0u - static_cast<std::uint32_t>(speed)
+                                            : static_cast<std::uint32_t>(speed);
+  if (limit <= 0) {
+    f |= bits(fact::below_speed_limit);
+  } else if (magnitude > static_cast<std::uint32_t>(limit)) {
+    f |= bits(fact::overspeed);
+  } else if (magnitude < static_cast<std::uint32_t>(limit)) {
+    f |= bits(fact::below_speed_limit);
+  }
 
   // A stop is complete at standstill with the brake engaged (when it ends with torque off), or at
   // once when it coasts.
   // Only a pending row, QUICK STOP ACTIVE and FAULT REACTION ACTIVE run stops that can coast or
   // end with torque off; elsewhere standstill is enough.
-  const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
   bool complete = in.sto || in.standstill;
   if (a.pending_row != no_row || act_before == state_activity::quick_stop ||
       act_before == state_activity::fault_reaction) {
-    const activity_now before = activity_of(p, a, halt);
-    complete = before.ramp == stop_ramp::coast || in.sto ||
-               (in.standstill && (in.brake_engaged || !before.stop_ends_torque));
+    const unsigned before = activity_of(p, a, halt);
+    complete = (before & activity::ramp) == static_cast<unsigned>(stop_ramp::coast) || in.sto ||
+               (in.standstill && (in.brake_engaged || !(before & activity::stop_ends_torque)));
   }
   if (complete) f |= bits(fact::stop_complete);
 
@@ -238,22 +260,18 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   // pending row completes when its stop does. A row with a ramp of its own runs it first, also
   // when it takes over from another stop (T17 during T5 still stops on the quick-stop ramp).
   std::uint8_t commit = no_row;
-  std::uint8_t take = no_row;
+  std::uint8_t take = match;
   if (a.pending_row != no_row) {
-    if (match != no_row && match != a.pending_row &&
-        (p.rows[match].flags & row_flag::interrupts_stop)) {
-      take = match;
-    } else if (f & bits(fact::stop_complete)) {
-      commit = a.pending_row;
+    if (match == no_row || match == a.pending_row ||
+        !(p.rows[match].flags & row_flag::interrupts_stop)) {
+      take = no_row;
+      if (complete) commit = a.pending_row;
     }
-  } else {
-    take = match;
   }
   if (take != no_row) {
-    const row_stop stop = p.rows[take].stop;
+    const unsigned stop = stop_of(p.rows[take].stop);
     const std::int8_t code = stop_code_of_row(a, stop);  // read as the stop starts (S16)
-    const bool ramp_first = torque_was_on && !in.sto && ramp_of_row(a, stop, code) != stop_ramp::none;
-    if (ramp_first) {
+    if (torque_was_on && !in.sto && ramp_of_row(a, stop, code) != stop_ramp::none) {
       a.pending_row = take;
       a.stop_code = code;
     } else {
@@ -264,9 +282,9 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   // the drive raised itself (STO or undervoltage under torque, a lost link) came after the outside
   // cause that is still present, so that cause does not write over it.
   if ((f & bits(fact::fault)) &&
-      (a.current == state::fault_reaction_active || a.current == state::fault) &&
-      (fault.internal || !raised_by_drive(a.error_code))) {
-    a.error_code = fault.code;
+      ((a.current == state::fault_reaction_active) | (a.current == state::fault)) &&
+      (internal || !raised_by_drive(a.error_code))) {
+    a.error_code = fault_code;
   }
 
   if (commit != no_row) {
@@ -275,37 +293,36 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
     a.current = r.to;
     a.pending_row = no_row;
     // S16: the quick stop and the fault reaction run by the code they find as they start.
-    switch (p.info(r.to).activity) {
-      case state_activity::quick_stop: a.stop_code = option_value(a, option::quick_stop); break;
-      case state_activity::fault_reaction:
-        a.stop_code = option_value(a, option::fault_reaction);
-        break;
-      default: a.stop_code = 0; break;
-    }
+    const state_activity act = p.info(r.to).activity;
+    a.stop_code = act == state_activity::quick_stop       ? option_value(a, option::quick_stop)
+                  : act == state_activity::fault_reaction ? option_value(a, option::fault_reaction)
+                                                          : std::int8_t{0};
     a.last_transition = r.number;
     out.transition = r.number;
     out.clear_setpoints = (r.flags & row_flag::clears_setpoints) != 0;
     set_flag(a, axis_flag::entered_by_fault, (why & fault_facts) && !(why & command_facts));
-    if (why & fault_facts) a.error_code = fault.code;
+    if (why & fault_facts) a.error_code = fault_code;
     if (why & bits(fact::fault)) {
-      // A fault reaction has nothing to ramp when torque is already off, or cannot (S14).
-      set_flag(a, axis_flag::coast_reaction, fault.internal || fault.error_class >= 3 ||
-                                                 !torque_was_on || in.sto);
+      // A fault reaction has nothing to ramp when torque is already off, or cannot (S14). The
+      // drive's own faults have class 3.
+      set_flag(a, axis_flag::coast_reaction, fault_class >= 3 || !torque_was_on || in.sto);
     }
     if (why & bits(fact::fault_reset)) {
       a.error_code = 0;
       set_flag(a, axis_flag::coast_reaction, false);
     }
   }
-  const activity_now now = activity_of(p, a, halt);
+  const unsigned now = activity_of(p, a, halt);
 
   // Outputs of the state the drive is in now.
   const state s = a.current;
   out.current = s;
-  const bool torque = now.torque_wanted && !in.sto && now.ramp != stop_ramp::coast;
-  out.ramp = in.sto && now.torque_wanted ? stop_ramp::coast : now.ramp;
+  const bool torque_wanted = (now & activity::torque_wanted) != 0;
+  const auto ramp = static_cast<stop_ramp>(now & activity::ramp);
+  const bool torque = torque_wanted && !in.sto && ramp != stop_ramp::coast;
+  out.ramp = in.sto && torque_wanted ? stop_ramp::coast : ramp;
   out.torque = torque;
-  out.brake_released = torque && !(now.stop_ends_torque && in.standstill);
+  out.brake_released = torque && !((now & activity::stop_ends_torque) && in.standstill);
   a.flags = static_cast<std::uint8_t>((a.flags & ~axis_flag::torque_on) |
                                       (torque ? axis_flag::torque_on : 0u));
 
@@ -314,7 +331,8 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
                      (static_cast<std::uint32_t>(in.sto) << 7) |
                      (static_cast<std::uint32_t>(in.remote) << 9) |
                      (in.status_bits & (status_bit::reported & ~status_bit::target_reached));
-  if (p.error_classes && in.fault_code != 0 && in.fault_class <= 1) sw |= status_bit::warning;
+  sw |= static_cast<std::uint32_t>(p.error_classes & (in.fault_code != 0) & (in.fault_class <= 1))
+        << 7;  // status_bit::warning
   bool target;
   if (info.activity == state_activity::run) {
     target = halt ? in.standstill : (in.status_bits & status_bit::target_reached) != 0;
@@ -326,7 +344,7 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   if (target && a.pending_row == no_row) sw |= status_bit::target_reached;
   out.status_word = static_cast<std::uint16_t>(sw);
   out.error_code = a.error_code;
-  out.error_register = a.error_code ? error_register_of(a.error_code) : std::uint8_t{0};
+  out.error_register = error_register_of(a.error_code);
   return out;
 }
 
