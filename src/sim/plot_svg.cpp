@@ -19,12 +19,17 @@ constexpr double left = 84;
 constexpr double right = 970;
 constexpr double plot_top = 96;
 constexpr double plot_bottom = 376;
-constexpr double torque_top = 390;
-constexpr double brake_top = 410;
-constexpr double inputs_top = 430;
+// The lanes, the time axis and the legend below the plot; a trace of the operation modes gets the
+// torque 0x6077 lane between the plot and them, which moves them down by `torque_lane_room`.
+constexpr double torque_on_top_pv = 390;
+constexpr double brake_top_pv = 410;
+constexpr double inputs_top_pv = 430;
 constexpr double lane_height = 14;
-constexpr double axis_y = 452;
-constexpr double legend_top = 508;
+constexpr double axis_y_pv = 452;
+constexpr double legend_top_pv = 508;
+constexpr double torque_lane_top = 392;
+constexpr double torque_lane_height = 56;
+constexpr double torque_lane_room = 70;
 constexpr double char_width = 7.4;  // a generous width of one upper-case character at 11 px
 
 struct state_style {
@@ -110,9 +115,17 @@ double rpm(std::int64_t micro) { return static_cast<double>(micro) / 1e6; }
 }  // namespace
 
 void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const trace_info& info) {
-  const double height = 600;
+  // A trace that ran a mode other than profile velocity gets the position 0x6064 (on its own scale
+  // in the plot) and a torque 0x6077 lane; a pv-only trace's plot stays as it was.
   const bool positions =
       std::any_of(rows.begin(), rows.end(), [](const trace_row& r) { return r.mode != 3; });
+  const double shift = positions ? torque_lane_room : 0;
+  const double height = 600 + shift;
+  const double torque_top = torque_on_top_pv + shift;
+  const double brake_top = brake_top_pv + shift;
+  const double inputs_top = inputs_top_pv + shift;
+  const double axis_y = axis_y_pv + shift;
+  const double legend_top = legend_top_pv + shift;
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(width) << "\" height=\""
       << num(height) << "\" viewBox=\"0 0 " << num(width) << " " << num(height)
       << "\" font-family=\"DejaVu Sans, Arial, sans-serif\" font-size=\"11\">\n"
@@ -121,7 +134,7 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
       << escape(info.title) << "</text>\n";
   out << "<text x=\"" << num(left) << "\" y=\"42\" fill=\"#444\">profile " << escape(info.profile_name)
       << ", cycle " << info.cycle_us << " us; velocity 0x606C (solid), target 0x60FF (dashed); "
-      << (positions ? "position 0x6064 (magenta, right scale); " : "")
+      << (positions ? "position 0x6064 (magenta, right scale); torque 0x6077 below; " : "")
       << "bands: state; marks: transitions</text>\n";
   if (rows.empty()) {
     out << "<text x=\"" << num(left) << "\" y=\"120\">(empty trace)</text>\n</svg>\n";
@@ -340,6 +353,61 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
   }
   out << "</g>\n";
 
+  // Torque 0x6077 (permille of rated torque) in a lane of its own, zero line and its extremes
+  // labelled; per pixel column the first, lowest, highest and last sample, so no step is lost.
+  if (positions) {
+    double tmin = 0;
+    double tmax = 0;
+    for (const trace_row& r : rows) {
+      tmin = std::min(tmin, static_cast<double>(r.torque_permille));
+      tmax = std::max(tmax, static_cast<double>(r.torque_permille));
+    }
+    if (tmax - tmin < 1) tmax = tmin + 1;
+    const double lane_bottom = torque_lane_top + torque_lane_height;
+    const auto yt = [&](double t) {
+      return lane_bottom - 3 - (t - tmin) / (tmax - tmin) * (torque_lane_height - 6);
+    };
+    out << "<g id=\"torque-lane\">\n";
+    out << "<rect x=\"" << num(left) << "\" y=\"" << num(torque_lane_top) << "\" width=\""
+        << num(right - left) << "\" height=\"" << num(torque_lane_height)
+        << "\" fill=\"#fbfbfb\" stroke=\"#999\" stroke-width=\"0.5\"/>\n";
+    out << "<line x1=\"" << num(left) << "\" y1=\"" << num(yt(0)) << "\" x2=\"" << num(right)
+        << "\" y2=\"" << num(yt(0)) << "\" stroke=\"#bbb\" stroke-width=\"0.5\"/>\n";
+    out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(torque_lane_top + 11)
+        << "\" text-anchor=\"end\">torque 0x6077</text>\n";
+    out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(torque_lane_top + 24)
+        << "\" text-anchor=\"end\" font-size=\"10\" fill=\"#444\">[permille]</text>\n";
+    for (const double t : {tmin, 0.0, tmax}) {
+      if (t != 0.0 && std::fabs(t) < 1) continue;
+      if (t == 0.0 && (tmin == 0.0 || tmax == 0.0)) continue;  // labelled as an extreme
+      out << "<text x=\"" << num(right - 4) << "\" y=\"" << num(yt(t) + 4)
+          << "\" text-anchor=\"end\" font-size=\"10\" fill=\"#2a7f62\">" << fixed(t, 0) << "</text>\n";
+    }
+    out << "<polyline id=\"torque\" fill=\"none\" stroke=\"#2a7f62\" stroke-width=\"1.4\" "
+           "stroke-linejoin=\"round\" points=\"";
+    bool first = true;
+    auto point = [&](const trace_row& r) {
+      out << (first ? "" : " ") << num(s.x(static_cast<double>(r.time_us))) << ","
+          << num(yt(static_cast<double>(r.torque_permille)));
+      first = false;
+    };
+    for (std::size_t i = 0; i < rows.size();) {
+      const long column = std::lround(std::floor(s.x(static_cast<double>(rows[i].time_us))));
+      std::size_t j = i, lo = i, hi = i;
+      while (j < rows.size() && std::lround(std::floor(s.x(static_cast<double>(rows[j].time_us)))) == column) {
+        if (rows[j].torque_permille < rows[lo].torque_permille) lo = j;
+        if (rows[j].torque_permille > rows[hi].torque_permille) hi = j;
+        ++j;
+      }
+      std::vector<std::size_t> picks = {i, lo, hi, j - 1};
+      std::sort(picks.begin(), picks.end());
+      picks.erase(std::unique(picks.begin(), picks.end()), picks.end());
+      for (std::size_t k : picks) point(rows[k]);
+      i = j;
+    }
+    out << "\"/>\n</g>\n";
+  }
+
   // Lanes: torque on; brake released (solid) and changing over (light).
   out << "<g id=\"lanes\">\n";
   out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(torque_top + 11)
@@ -463,6 +531,16 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
       << "<text x=\"" << num(x + 30) << "\" y=\"" << num(y)
       << "\">brake engaging / releasing (its delay)</text>\n";
   y += 20;
+  if (positions) {
+    out << "<line x1=\"" << num(left) << "\" y1=\"" << num(y - 4) << "\" x2=\"" << num(left + 24)
+        << "\" y2=\"" << num(y - 4) << "\" stroke=\"#b5179e\" stroke-width=\"1.6\"/>\n"
+        << "<text x=\"" << num(left + 30) << "\" y=\"" << num(y) << "\">position 0x6064 (right scale)</text>\n";
+    out << "<line x1=\"" << num(left + 290) << "\" y1=\"" << num(y - 4) << "\" x2=\"" << num(left + 314)
+        << "\" y2=\"" << num(y - 4) << "\" stroke=\"#2a7f62\" stroke-width=\"1.4\"/>\n"
+        << "<text x=\"" << num(left + 320) << "\" y=\"" << num(y)
+        << "\">torque 0x6077 (permille of rated torque)</text>\n";
+    y += 20;
+  }
   out << "<rect x=\"" << num(left) << "\" y=\"" << num(y - 10) << "\" width=\"24\" height=\"12\" "
       << "fill=\"#e8a09a\"/>\n"
       << "<text x=\"" << num(left + 30) << "\" y=\"" << num(y)

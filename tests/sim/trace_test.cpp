@@ -285,6 +285,39 @@ TEST(svg, a_long_trace_is_thinned_to_the_plot_width_without_losing_peaks) {
   EXPECT_EQ(std::count(ys.begin(), ys.end(), top), 1);
 }
 
+TEST(svg, a_trace_of_another_mode_gets_a_torque_lane_that_keeps_its_extremes) {
+  std::vector<trace_row> rows(20000);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    rows[i].time_us = i * 1000;
+    rows[i].current = state::operation_enabled;
+    rows[i].mode = 10;  // cyclic synchronous torque
+    rows[i].torque_permille = (i == 12345) ? -700 : 250;  // one negative spike
+  }
+  std::ostringstream out;
+  write_svg_plot(out, rows, trace_info{"cst", "cia402", 1000, true});
+  const std::string svg = out.str();
+  EXPECT_NE(svg.find("height=\"670\""), std::string::npos) << "the lane adds its room";
+  const std::size_t at = svg.find("id=\"torque\"");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_NE(svg.find(">-700<"), std::string::npos) << "the lowest torque is labelled";
+  EXPECT_NE(svg.find(">250<"), std::string::npos) << "the highest torque is labelled";
+  const std::string line = svg.substr(at, svg.find("/>", at) - at);
+  std::vector<double> ys;
+  for (std::size_t c = line.find(','); c != std::string::npos; c = line.find(',', c + 1)) {
+    ys.push_back(std::stod(line.substr(c + 1)));
+  }
+  EXPECT_LT(ys.size(), 4000u) << "thinned to the plot width";
+  ASSERT_FALSE(ys.empty());
+  const double lowest = *std::max_element(ys.begin(), ys.end());  // SVG y grows downwards
+  EXPECT_EQ(std::count(ys.begin(), ys.end(), lowest), 1) << "the one-cycle spike survives thinning";
+
+  for (trace_row& r : rows) r.mode = 3;  // profile velocity only: the plot stays as it was
+  std::ostringstream pv;
+  write_svg_plot(pv, rows, trace_info{"pv", "cia402", 1000, true});
+  EXPECT_EQ(pv.str().find("torque-lane"), std::string::npos);
+  EXPECT_NE(pv.str().find("height=\"600\""), std::string::npos);
+}
+
 TEST(format, rpm_prints_exact_decimals_and_seconds_six_places) {
   EXPECT_EQ(format_rpm(0), "0");
   EXPECT_EQ(format_rpm(1500000000), "1500");
