@@ -83,6 +83,33 @@ TEST(cli_master, home_sets_the_position_to_the_home_offset) {
   EXPECT_EQ(refused.status, 1) << "method 1 needs a limit switch the virtual drive lacks";
 }
 
+TEST(cli_master, csp_stream_ramps_0x607A_by_rpdo3_and_follows_by_tpdo3) {
+  const result r = run_tool({"master", "--can", "virtual", "csp-stream", "--to", "20000", "--velocity", "600"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("node 1: mode 8 (csp)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("node 1: streaming 0x607A from 0 to 20000 at 600 rpm by RPDO3, SYNC every 1000 us"),
+            std::string::npos)
+      << r.out;
+  // 600 rpm x 10,000 increments a revolution = 100 increments a 1 ms SYNC: 200 set-points, each
+  // reached within its cycle.
+  EXPECT_NE(r.out.find("node 1: reached 20000 after 200 set-points, max following error 0 increments"),
+            std::string::npos)
+      << r.out;
+  const result json = run_tool({"master", "--can", "virtual", "--json", "csp-stream", "--to", "-3000",
+                                "--velocity", "300", "--sync-us", "2000"});
+  ASSERT_EQ(json.status, 0) << json.err;
+  EXPECT_NE(json.out.find(R"({"node":1,"event":"streamed","position":-3000,"set_points":30,)"), std::string::npos)
+      << json.out;
+  // Faster than the motor can follow: the following error fault, exit 1.
+  const result lost = run_tool({"master", "--can", "virtual", "csp-stream", "--to", "200000000", "--velocity", "100000"});
+  EXPECT_EQ(lost.status, 1);
+  EXPECT_NE(lost.err.find("following error"), std::string::npos) << lost.err;
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "csp-stream", "--to", "100"}).status, 2) << "no --velocity";
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "csp-stream", "--velocity", "100"}).status, 2) << "no --to";
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "csp-stream", "--to", "3000000000", "--velocity", "1"}).status, 2);
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "csp-stream", "--to", "1", "--velocity", "1", "--sync-us", "10"}).status, 2);
+}
+
 TEST(cli_master, watch_json_prints_one_object_per_event) {
   const result r = run_tool({"master", "--can", "virtual", "--json", "--timeout", "300", "watch"});
   ASSERT_EQ(r.status, 0) << r.err;

@@ -3,6 +3,10 @@
 // and event timer). The node runs on the test double, so the status word comes from the core.
 #include <gtest/gtest.h>
 
+#include <memory>
+#include <string>
+#include <vector>
+
 #include "network.hpp"
 
 namespace cia402::canopen::test {
@@ -326,6 +330,125 @@ TEST_F(pdo_test, rpdo_shorter_than_its_mapping_is_dropped_with_emcy_0x8210) {
   const auto after = net.with_id(0x83);
   ASSERT_EQ(after.size(), 2u);
   EXPECT_EQ(get_le(after[1].data.data(), 2), 0x0000u) << "error reset";
+}
+
+// Objects with sub-indices map as (index, sub): a device that holds an array (as the virtual drive
+// holds 0x607D, 0x6099) is read and written with the sub-index the mapping entry names.
+class array_device final : public device {
+ public:
+  static constexpr std::uint16_t index = 0x2100;
+  sdo_abort read(std::uint16_t i, std::uint8_t sub, std::int64_t& v) noexcept override {
+    if (i != index) return sdo_abort::object_does_not_exist;
+    if (sub < 1 || sub > 2) return sdo_abort::sub_index_does_not_exist;
+    v = values[sub - 1];
+    return sdo_abort::none;
+  }
+  sdo_abort write(std::uint16_t i, std::uint8_t sub, std::int64_t v) noexcept override {
+    if (i != index) return sdo_abort::object_does_not_exist;
+    if (sub < 1 || sub > 2) return sdo_abort::sub_index_does_not_exist;
+    values[sub - 1] = v;
+    return sdo_abort::none;
+  }
+  std::uint32_t step(std::uint32_t) noexcept override { return 1000; }
+  void set_connection_lost(bool) noexcept override {}
+  void reset() noexcept override {}
+  void report(std::uint8_t sub) noexcept { changed(index, sub); }
+  std::int64_t values[2] = {0, 0};
+};
+
+class pdo_sub_index_test : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    slave_config c;
+    c.node_id = id;
+    c.objects = drive_objects();
+    object_entry pair;
+    pair.index = array_device::index;
+    pair.name = "Pair";
+    pair.code = object_code::array;
+    sub_entry count;
+    count.name = "Highest sub-index supported";
+    count.default_value = 2;
+    pair.subs.push_back(count);
+    for (std::uint8_t sub = 1; sub <= 2; ++sub) {
+      sub_entry e;
+      e.sub = sub;
+      e.name = "Value " + std::to_string(sub);
+      e.type = data_type::integer32;
+      e.acc = access::rw;
+      e.pdo_mappable = true;
+      e.where = backing::device;
+      pair.subs.push_back(e);
+    }
+    c.objects.push_back(pair);
+    ch = bus.attach();
+    tester = bus.attach();
+    node = std::make_unique<slave>(dev, *ch, c);
+    settle();
+  }
+  void settle() {
+    for (int i = 0; i < 4; ++i) node->poll(*ch, 0);
+    frame f;
+    while (tester->receive(f)) received.push_back(f);
+  }
+  std::uint32_t write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, unsigned bytes) {
+    static constexpr std::uint8_t commands[5] = {0, 0x2F, 0x2B, 0x27, 0x23};
+    received.clear();
+    EXPECT_FALSE(tester->send(sdo_request(id, commands[bytes], index, sub, value)));
+    settle();
+    for (const frame& f : received) {
+      if (f.id == cob::sdo_tx + id) return abort_code_of(f);
+    }
+    return 0xFFFFFFFFu;
+  }
+  std::vector<frame> with_id(std::uint32_t can_id) const {
+    std::vector<frame> out;
+    for (const frame& f : received) {
+      if (f.id == can_id) out.push_back(f);
+    }
+    return out;
+  }
+
+  virtual_bus bus;
+  array_device dev;
+  std::unique_ptr<virtual_channel> ch;
+  std::unique_ptr<virtual_channel> tester;
+  std::unique_ptr<slave> node;
+  std::vector<frame> received;
+};
+
+TEST_F(pdo_sub_index_test, a_mapped_sub_index_is_sampled_and_written_with_its_sub) {
+  // TPDO4 = 0x2100 sub 2, synchronous; RPDO4 = 0x2100 sub 1, on receipt.
+  ASSERT_EQ(write(0x1803, 1, 0x80000483, 4), 0u);
+  ASSERT_EQ(write(0x1A03, 0, 0, 1), 0u);
+  ASSERT_EQ(write(0x1A03, 1, 0x21000220, 4), 0u);
+  ASSERT_EQ(write(0x1A03, 0, 1, 1), 0u);
+  ASSERT_EQ(write(0x1803, 2, 1, 1), 0u);
+  ASSERT_EQ(write(0x1803, 1, 0x483, 4), 0u);
+  ASSERT_EQ(write(0x1403, 1, 0x80000503, 4), 0u);
+  ASSERT_EQ(write(0x1603, 0, 0, 1), 0u);
+  EXPECT_EQ(write(0x1603, 1, 0x21000320, 4), 0x06090011u) << "no sub-index 3";
+  ASSERT_EQ(write(0x1603, 1, 0x21000120, 4), 0u);
+  ASSERT_EQ(write(0x1603, 0, 1, 1), 0u);
+  ASSERT_EQ(write(0x1403, 1, 0x503, 4), 0u);
+  EXPECT_EQ(node->tpdo(3).map[0].sub, 2);
+  EXPECT_EQ(node->rpdo(3).map[0].sub, 1);
+
+  EXPECT_FALSE(tester->send(nmt_frame(nmt_command::start, id)));
+  settle();
+  dev.values[1] = -123456;
+  received.clear();
+  EXPECT_FALSE(tester->send(make_frame(cob::sync, {})));
+  settle();
+  const auto sent = with_id(0x483);
+  ASSERT_EQ(sent.size(), 1u);
+  EXPECT_EQ(sent[0].len, 4);
+  EXPECT_EQ(static_cast<std::int32_t>(get_le(sent[0].data.data(), 4)), -123456);
+
+  EXPECT_FALSE(tester->send(make_frame(0x503, {0x39, 0x30, 0x00, 0x00})));  // 12345
+  settle();
+  EXPECT_EQ(dev.values[0], 12345);
+  EXPECT_EQ(dev.values[1], -123456) << "sub 2 untouched";
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "cli/master.hpp"
 
 #include <poll.h>
+#include <time.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -67,14 +68,26 @@ class bus_session {
   /// Waits for the next thing to do (at most `wait_us`) and returns the microseconds that passed.
   std::uint32_t wait(std::uint32_t wait_us) {
     if (virtual_) {
-      const std::uint32_t step = 1000;
-      drive_->poll(step);
-      return step;
+      drive_->poll(virtual_step_us_);
+      return virtual_step_us_;
     }
     pollfd p{channel_->native_handle(), POLLIN, 0};
+    if (precise_) {
+      // A SYNC period that a millisecond's rounding would stretch: wait to the microsecond.
+      const std::uint32_t us = std::clamp<std::uint32_t>(wait_us, 50, 10000);
+      const timespec ts{0, static_cast<long>(us) * 1000};
+      if (p.fd >= 0) ::ppoll(&p, 1, &ts, nullptr);
+      return clock_.take();
+    }
     const int ms = static_cast<int>(std::min<std::uint32_t>(wait_us / 1000 + 1, 10));
     if (p.fd >= 0) ::poll(&p, 1, ms);
     return clock_.take();
+  }
+  /// For a SYNC period of `us` kept to the microsecond (csp-stream): on the virtual bus one wait()
+  /// passes at most that long (1000 us otherwise), on a real one it waits to the microsecond.
+  void set_sync_period(std::uint32_t us) {
+    virtual_step_us_ = std::clamp<std::uint32_t>(us, 1, 1000);
+    precise_ = true;
   }
   /// One pass of a master: waits for the next thing to do, hands it the frames and the time that
   /// passed, lets a virtual drive answer at once. Returns the microseconds that passed; `next` is
@@ -115,6 +128,8 @@ class bus_session {
 
  private:
   bool virtual_ = false;
+  std::uint32_t virtual_step_us_ = 1000;
+  bool precise_ = false;
   canopen::virtual_bus bus_;
   std::unique_ptr<canopen::virtual_drive_node> drive_;
   std::unique_ptr<canopen::virtual_channel> master_ch_;
@@ -448,7 +463,9 @@ int run_motion(bus_session& session, const master_args& a, const profile& p, std
         if (next_job < after_enable.size()) {
           run_job(after_enable[next_job++]);
         } else {
-          m.set_mode_bits(static_cast<std::uint16_t>(0x10 | 0x20 | relative));  // new set-point / start
+          // pp: bit 4 new set-point, 5 change immediately, 6 relative; homing: bit 4 start (5 and 6
+          // are reserved there).
+          m.set_mode_bits(static_cast<std::uint16_t>(a.command == "move" ? 0x10 | 0x20 | relative : 0x10));
           event({{"event", a.command == "move" ? "setpoint" : "homing_started"}},
                 a.command == "move" ? "set-point " + std::to_string(target) + (a.relative ? " (relative)" : "")
                                     : std::string("homing started"));
@@ -490,6 +507,232 @@ int run_motion(bus_session& session, const master_args& a, const profile& p, std
   return status;
 }
 
+// `csp-stream`: cyclic synchronous position (mode 8) over PDO 3 with SYNC, for tests. Switches the
+// mode by SDO (confirmed by 0x6061), reads the encoder resolution (0x608F) and the position (0x6064),
+// writes 0x607A = that position so enabling moves nothing, enables with the core's master step, then
+// before every SYNC moves the set-point RPDO3 carries on by one cycle of a ramp at --velocity until
+// --to. TPDO3 brings 0x6064 at every SYNC: the following error is how far it is from the set-point of
+// the SYNC before (the one the drive has had a cycle to reach). Done when the position is the target.
+int run_csp_stream(bus_session& session, const master_args& a, const profile& p, std::ostream& out,
+                   std::ostream& err) {
+  if (!a.operands.empty() || !a.stream_to || !a.profile_velocity) {
+    err << "cia402 master: csp-stream --to POSITION --velocity RPM [--sync-us US]: no operands, and "
+           "both --to and --velocity\n";
+    return usage_error;
+  }
+  if (*a.stream_to < type_low(object_type::integer32) || *a.stream_to > type_high(object_type::integer32)) {
+    err << "cia402 master: --to " << *a.stream_to << " does not fit 0x607A (INTEGER32)\n";
+    return usage_error;
+  }
+  const auto to = static_cast<std::int32_t>(*a.stream_to);
+  const std::int64_t rpm = *a.profile_velocity;
+
+  canopen::drive_master_config mc;
+  mc.node_id = static_cast<std::uint8_t>(a.node);
+  mc.cycle_us = a.sync_us;
+  mc.drive_heartbeat_ms = a.heartbeat_ms;
+  mc.master_heartbeat_ms = a.guard_ms;
+  mc.drive_profile = &p;
+  mc.map_position = true;
+  canopen::drive_master m(session.channel(), mc);
+  session.set_sync_period(a.sync_us);
+  const auto event = [&](nlohmann::ordered_json j, const std::string& text) {
+    if (a.json) {
+      nlohmann::ordered_json line{{"node", a.node}};
+      line.update(j);
+      out << line.dump() << "\n";
+    } else {
+      out << "node " << a.node << ": " << text << "\n";
+    }
+  };
+  m.on_state = [&](state, state to_state, std::uint16_t sw) {
+    event({{"event", "state"}, {"state", state_name(to_state)}, {"statusword", word(sw)}},
+          std::string(state_name(to_state)) + " (statusword " + word(sw) + ")");
+  };
+
+  enum class phase { write_mode, confirm_mode, resolution, start_position, hold_position, enable, stream, done };
+  phase now = phase::write_mode;
+  bool job_busy = false;
+  bool failed_job = false;
+  const auto on_refusal = [&](const std::string& what, const canopen::sdo_result& r) {
+    failed_job = true;
+    err << "cia402 master: node " << a.node << ": " << what;
+    if (r.cancelled) {
+      err << " was cancelled (the link to the drive was lost)\n";
+    } else {
+      err << " refused: SDO abort " << hex(static_cast<std::uint32_t>(r.abort), 8) << " ("
+          << sdo_abort_text(r.abort) << ")\n";
+    }
+  };
+  const auto write_job = [&](std::uint16_t index, std::int64_t value, unsigned bytes, std::function<void()> then) {
+    job_busy = true;
+    const bool queued = m.write(index, 0, value, bytes, [&, index, value, then](const canopen::sdo_result& r) {
+      job_busy = false;
+      if (!r.ok()) return on_refusal("writing " + hex(index, 4) + " = " + std::to_string(value), r);
+      then();
+    });
+    if (!queued) {
+      job_busy = false;
+      failed_job = true;
+      err << "cia402 master: could not queue the write of " << hex(index, 4) << "\n";
+    }
+  };
+  const auto read_job = [&](std::uint16_t index, std::uint8_t sub, bool is_signed, bool optional,
+                            std::function<void(std::optional<std::int64_t>)> use) {
+    job_busy = true;
+    const bool queued = m.read(index, sub, is_signed, [&, index, sub, optional, use](const canopen::sdo_result& r) {
+      job_busy = false;
+      if (r.ok()) return use(r.value);
+      if (optional && !r.cancelled) return use(std::nullopt);
+      on_refusal("reading " + hex(index, 4) + ":" + std::to_string(sub), r);
+    });
+    if (!queued) {
+      job_busy = false;
+      failed_job = true;
+      err << "cia402 master: could not queue the read of " << hex(index, 4) << "\n";
+    }
+  };
+
+  // The ramp: set-point k = start + direction x k cycles of travel at rpm, exact in integers (no
+  // drift however long), until the target.
+  std::int64_t increments = 10000;  // 0x608F sub 1 over sub 2: increments a revolution
+  std::int64_t revolutions = 1;
+  std::int32_t start = 0;
+  std::uint64_t cycles = 0;
+  std::uint64_t set_points = 0;
+  std::optional<std::int32_t> previous_set_point;  // RPDO3 of the SYNC before the last
+  std::int64_t max_error = 0;
+  bool all_sent = false;
+  const auto ramp_at = [&](std::uint64_t k) {
+    const std::int64_t span = std::int64_t{to} - start;
+    const std::int64_t distance = span < 0 ? -span : span;
+    // rpm x increments x us x k / (60e6 x revolutions), as whole and remainder of one cycle's
+    // travel: rpm x increments x us < 2^61 (1e5 x 2^24 x 1e6), the remainder x k stays small
+    // because the ramp ends within |distance| / (one cycle's travel) cycles.
+    const auto per_cycle = static_cast<std::uint64_t>(rpm) * static_cast<std::uint64_t>(increments) * a.sync_us;
+    const std::uint64_t divisor = 60'000'000ull * static_cast<std::uint64_t>(revolutions);
+    const std::uint64_t whole = per_cycle / divisor * k;
+    if (whole >= static_cast<std::uint64_t>(distance)) return to;
+    const auto travel = static_cast<std::int64_t>(whole + per_cycle % divisor * k / divisor);
+    if (travel >= distance) return to;
+    return static_cast<std::int32_t>(start + (span < 0 ? -travel : travel));
+  };
+  m.before_sync = [&] {
+    previous_set_point = m.position_set_point();
+    if (now != phase::stream || all_sent) return;
+    const std::int32_t sp = ramp_at(++cycles);
+    m.set_position_set_point(sp);
+    ++set_points;
+    all_sent = sp == to;
+  };
+  m.on_position = [&](std::int32_t actual) {
+    if (now != phase::stream || !previous_set_point) return;
+    max_error = std::max<std::int64_t>(max_error, std::abs(std::int64_t{actual} - *previous_set_point));
+  };
+
+  constexpr std::uint16_t bit12 = 1u << 12, bit13 = 1u << 13;
+  stop_requested = 0;
+  int status = failed;
+  std::uint64_t elapsed = 0;
+  std::uint32_t next = 0;
+  while (now != phase::done) {
+    if (stop_requested != 0) {
+      err << "cia402 master: interrupted\n";
+      break;
+    }
+    if (const auto ec = session.failure()) {
+      err << "cia402 master: the bus connection failed: " << ec.message() << "\n";
+      break;
+    }
+    elapsed += session.pump(m, next);
+    if (m.phase() == canopen::master_phase::failed) {
+      err << "cia402 master: " << m.failure_text() << "\n";
+      break;
+    }
+    if (failed_job) break;
+    if (a.timeout_ms != 0 && elapsed >= a.timeout_ms * 1000ull) {
+      err << "cia402 master: node " << a.node << ": csp-stream did not finish within " << a.timeout_ms
+          << " ms (last statusword " << word(m.status_word());
+      if (m.position()) err << ", position " << *m.position();
+      if (m.position_set_point()) err << ", set-point " << *m.position_set_point();
+      err << ")\n";
+      break;
+    }
+    if (m.phase() != canopen::master_phase::running || job_busy) continue;
+    if (m.status_known() && m.observed() == state::fault && now >= phase::enable) {
+      err << "cia402 master: node " << a.node << " faulted, error code " << hex(m.error_code(), 4);
+      if (m.error_code() == 0x8611) err << " (following error: 0x6065 / 0x6066 exceeded)";
+      err << "; max following error seen " << max_error << " increments\n";
+      break;
+    }
+    switch (now) {
+      case phase::write_mode:
+        write_job(0x6060, mode::cyclic_synchronous_position, 1, [&] { now = phase::confirm_mode; });
+        break;
+      case phase::confirm_mode:
+        read_job(0x6061, 0, true, false, [&](std::optional<std::int64_t> shown) {
+          if (shown != mode::cyclic_synchronous_position) return;  // not switched yet: read again
+          event({{"event", "mode"}, {"mode", *shown}, {"name", mode::short_name(static_cast<std::int8_t>(*shown))}},
+                "mode " + std::to_string(*shown) + " (" + mode::short_name(static_cast<std::int8_t>(*shown)) + ")");
+          now = phase::resolution;
+        });
+        break;
+      case phase::resolution:
+        // 0x608F is optional: without it, 10,000 increments a revolution.
+        read_job(0x608F, 1, false, true, [&](std::optional<std::int64_t> v) {
+          if (v && *v > 0) increments = std::min<std::int64_t>(*v, std::int64_t{1} << 26);
+          read_job(0x608F, 2, false, true, [&](std::optional<std::int64_t> r) {
+            if (r && *r > 0) revolutions = *r;
+            now = phase::start_position;
+          });
+        });
+        break;
+      case phase::start_position:
+        read_job(0x6064, 0, true, false, [&](std::optional<std::int64_t> v) {
+          start = static_cast<std::int32_t>(*v);
+          now = phase::hold_position;
+        });
+        break;
+      case phase::hold_position:
+        // Where it stands, so enabling moves nothing; RPDO3 keeps saying so until the stream starts.
+        write_job(0x607A, start, 4, [&] {
+          m.set_position_set_point(start);
+          m.set_target(state::operation_enabled);
+          now = phase::enable;
+        });
+        break;
+      case phase::enable:
+        if (m.observed() == state::operation_enabled && m.outcome() == master_outcome::reached &&
+            (m.status_word() & bit12)) {
+          event({{"event", "stream_started"}, {"from", start}, {"to", to}, {"velocity_rpm", rpm},
+                 {"sync_us", a.sync_us}},
+                "streaming 0x607A from " + std::to_string(start) + " to " + std::to_string(to) + " at " +
+                    std::to_string(rpm) + " rpm by RPDO3, SYNC every " + std::to_string(a.sync_us) + " us");
+          now = phase::stream;
+        }
+        break;
+      case phase::stream:
+        if (m.status_word() & bit13) {
+          err << "cia402 master: node " << a.node << ": following error (statusword " << word(m.status_word())
+              << ", max following error seen " << max_error << " increments)\n";
+          now = phase::done;
+          break;
+        }
+        if (all_sent && m.position() == to) {
+          event({{"event", "streamed"}, {"position", *m.position()}, {"set_points", set_points},
+                 {"max_following_error", max_error}},
+                "reached " + std::to_string(*m.position()) + " after " + std::to_string(set_points) +
+                    " set-points, max following error " + std::to_string(max_error) + " increments");
+          status = 0;
+          now = phase::done;
+        }
+        break;
+      case phase::done: break;
+    }
+  }
+  return status;
+}
+
 }  // namespace
 
 CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
@@ -502,11 +745,11 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
       ->default_str("virtual");
   cmd->add_option("--node", args.node, "the drive's node-ID")->check(CLI::Range(1, 127))->default_str("1");
   cmd->add_option("COMMAND", args.command,
-                  "state, enable, disable, quick-stop, reset, watch, velocity, mode, move, home; sdo, nmt "
-                  "(no set-up)")
+                  "state, enable, disable, quick-stop, reset, watch, velocity, mode, move, home, csp-stream; "
+                  "sdo, nmt (no set-up)")
       ->required()
       ->check(CLI::IsMember({"state", "enable", "disable", "quick-stop", "reset", "watch", "velocity", "mode",
-                             "move", "home", "sdo", "nmt"}));
+                             "move", "home", "csp-stream", "sdo", "nmt"}));
   cmd->add_option("OPERANDS", args.operands,
                   "velocity RPM | mode pp|pv|tq|hm|csp|csv|cst | move POSITION | sdo read INDEX[:SUB] | "
                   "sdo write INDEX[:SUB] VALUE | "
@@ -524,8 +767,13 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
                   "0x6007 acts if the master stops (0 = off)")
       ->default_str("0");
   cmd->add_flag("--relative", args.relative, "move: POSITION adds to the last target (control-word bit 6)");
-  cmd->add_option("--velocity", args.profile_velocity, "move: the profile velocity 0x6081 in rpm")
+  cmd->add_option("--velocity", args.profile_velocity,
+                  "move: the profile velocity 0x6081 in rpm; csp-stream: the ramp's speed in rpm")
       ->check(CLI::Range(1, 100000));
+  cmd->add_option("--to", args.stream_to, "csp-stream: the position the ramp of 0x607A ends at, in increments");
+  cmd->add_option("--sync-us", args.sync_us, "csp-stream: SYNC period in microseconds (one set-point each)")
+      ->check(CLI::Range(100, 1000000))
+      ->default_str("1000");
   cmd->add_option("--method", args.homing_method, "home: the homing method 0x6098 (3, 33, 34, 35, 37)");
   cmd->add_option("--offset", args.home_offset, "home: the home offset 0x607C, in increments");
   cmd->add_flag("--hold", args.hold, "after reaching the target, keep the drive there until SIGINT");
@@ -544,6 +792,7 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
   if (a.command == "mode" || a.command == "move" || a.command == "home") {
     return run_motion(session, a, p, out, err);
   }
+  if (a.command == "csp-stream") return run_csp_stream(session, a, p, out, err);
   const bool velocity_command = a.command == "velocity";
   std::int32_t rpm = 0;
   if (velocity_command) {

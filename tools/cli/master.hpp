@@ -4,7 +4,9 @@
 // quick-stop, reset (fault reset), watch (print state changes, velocity and EMCYs), velocity RPM
 // (enable, write 0x60FF, wait until the shaft turns at it), mode MODE (0x6060, confirmed by 0x6061),
 // move POSITION (profile position: enable, 0x607A, the set-point handshake, wait for target
-// reached), home (homing with --method / --offset, wait for homing attained); for test benches, without
+// reached), home (homing with --method / --offset, wait for homing attained), csp-stream --to POSITION
+// --velocity RPM (cyclic synchronous position: a ramp of 0x607A in RPDO3 before every SYNC, 0x6064
+// from TPDO3, the largest following error reported); for test benches, without
 // any set-up: sdo read INDEX[:SUB], sdo write INDEX[:SUB] VALUE, nmt start|stop|preop|reset.
 #pragma once
 
@@ -34,7 +36,9 @@ struct master_args {
   std::uint16_t guard_ms = 0;        ///< the master's heartbeat, watched by the drive (0x6007)
   bool hold = false;                 ///< after reaching the target, keep cycling until a signal
   bool relative = false;             ///< move: the position adds to the last target
-  std::optional<std::int64_t> profile_velocity;  ///< move: 0x6081
+  std::optional<std::int64_t> profile_velocity;  ///< move: 0x6081; csp-stream: the ramp's speed
+  std::optional<std::int64_t> stream_to;         ///< csp-stream: where the ramp ends
+  std::uint32_t sync_us = 1000;                  ///< csp-stream: SYNC period
   std::optional<std::int64_t> homing_method;     ///< home: 0x6098
   std::optional<std::int64_t> home_offset;       ///< home: 0x607C
 };

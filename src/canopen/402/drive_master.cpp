@@ -63,6 +63,8 @@ void drive_master::restart(phase_reason why, std::string text) {
   heartbeat_watched_ = false;
   error_code_mapped_ = false;
   velocity_mapped_ = false;
+  position_mapped_ = false;
+  position_.reset();
   stale_guard_ = false;
   consumer_.configure({});
   heartbeat_lost_ = false;
@@ -77,10 +79,11 @@ void drive_master::go_running() {
                                                3u * config_.drive_heartbeat_ms, 0xFFFF))}});
   }
   next_poll_us_ = now_us_ + config_.poll_us;
+  word_sent_ = false;
   set_phase(master_phase::running, phase_reason::running);
   if (config_.timing == pdo_timing::sync) {
     sync_timer_.start(config_.cycle_us);
-    (void)out_->send(make_frame(cob::sync, {}));
+    send_sync();
   }
   if (mode_ == mode::target) master_.set_target(policy_, now_us_, config_.transition_timeout_us);
 }
@@ -340,6 +343,12 @@ void drive_master::on_frame(const frame& f) {
   }
   if (velocity_mapped_ && f.id == cob::tpdo1 + 0x100 + node && f.len >= 4) {
     note_velocity(static_cast<std::int32_t>(static_cast<std::uint32_t>(get_le(f.data.data(), 4))));
+    return;
+  }
+  // TPDO3: the status word (TPDO1 has it too, and steers) and the position actual value.
+  if (position_mapped_ && f.id == cob::tpdo1 + 0x200 + node && f.len >= 6) {
+    position_ = static_cast<std::int32_t>(static_cast<std::uint32_t>(get_le(f.data.data() + 2, 4)));
+    if (on_position) on_position(*position_);
   }
 }
 
@@ -397,8 +406,24 @@ void drive_master::send_word(std::uint16_t cw) {
   f.len = 2;
   put_le(f.data.data(), cw, 2);
   last_sent_ = cw;
+  word_sent_ = true;
   (void)out_->send(f);
   if (on_sent) on_sent(cw);
+}
+
+void drive_master::send_sync() {
+  if (before_sync) before_sync();
+  if (position_mapped_ && position_set_point_ && word_sent_) {
+    // RPDO3 takes effect at the SYNC that follows it: the control word it carries is the one the
+    // drive already has (RPDO1 acts at once), the set-point is this cycle's.
+    frame f;
+    f.id = cob::rpdo1 + 0x200 + config_.node_id;
+    f.len = 6;
+    put_le(f.data.data(), last_sent_, 2);
+    put_le(f.data.data() + 2, static_cast<std::uint32_t>(*position_set_point_), 4);
+    (void)out_->send(f);
+  }
+  (void)out_->send(make_frame(cob::sync, {}));
 }
 
 // --- time ---------------------------------------------------------------------------------------
@@ -442,7 +467,7 @@ std::uint32_t drive_master::process(std::uint32_t elapsed_us) {
     }
     if (config_.timing == pdo_timing::sync) {
       // The SYNC that started the running phase counts as this cycle's.
-      if (was_running && sync_timer_.expired(elapsed_us)) (void)out_->send(make_frame(cob::sync, {}));
+      if (was_running && sync_timer_.expired(elapsed_us)) send_sync();
       next = earliest(next, sync_timer_.left());
     }
     if (config_.poll_us != 0 && !current_) {

@@ -170,6 +170,31 @@ void drive_master::build_script() {
   script_.push_back(write(0x1400, 2, 255, 1));
   script_.push_back(write(0x1400, 1, rpdo1, 4));
 
+  // PDO 3 for a cyclic synchronous position master: RPDO3 = 0x6040 + 0x607A taken at the next
+  // SYNC, TPDO3 = 0x6041 + 0x6064 sent on every SYNC. The drive's defaults, written all the same: a
+  // drive set up otherwise before (or by another master) gets them back. Required: a csp master has
+  // nothing without them.
+  if (config_.map_position) {
+    const std::int64_t rpdo3 = cob::rpdo1 + 0x200 + node;
+    script_.push_back(write(0x1402, 1, pdo_cob_invalid | rpdo3, 4));
+    script_.push_back(write(0x1602, 0, 0, 1));
+    script_.push_back(write(0x1602, 1, 0x60400010, 4));
+    script_.push_back(write(0x1602, 2, 0x607A0020, 4));
+    script_.push_back(write(0x1602, 0, 2, 1));
+    script_.push_back(write(0x1402, 2, 1, 1));
+    script_.push_back(write(0x1402, 1, rpdo3, 4));
+    const std::int64_t tpdo3 = cob::tpdo1 + 0x200 + node;
+    script_.push_back(write(0x1802, 1, pdo_cob_invalid | tpdo3, 4));
+    script_.push_back(write(0x1A02, 0, 0, 1));
+    script_.push_back(write(0x1A02, 1, 0x60410010, 4));
+    script_.push_back(write(0x1A02, 2, 0x60640020, 4));
+    script_.push_back(write(0x1A02, 0, 2, 1));
+    script_.push_back(write(0x1802, 2, 1, 1));
+    sdo_job enable3 = write(0x1802, 1, tpdo3, 4);
+    enable3.then = note_done(position_mapped_);
+    script_.push_back(enable3);
+  }
+
   if (on_change) {
     // The drive's present values last, just before NMT start, so the master starts from them:
     // no TPDO says them until they change.

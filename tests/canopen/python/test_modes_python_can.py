@@ -2,7 +2,12 @@
 socketcand): modes switched by SDO and by RPDO2, a profile position move with the set-point
 handshake, a homing run, and a cyclic synchronous position stream on SYNC with RPDO3 / TPDO3.
 Object numbers, bits and PDO layouts are CiA 402-2's, written out here."""
+import json
+import os
+import subprocess
 import time
+
+import pytest
 
 from test_bus_python_can import NODE, send, wait_for, sdo_upload_expedited, sdo_download, status_state
 
@@ -44,6 +49,11 @@ def position_on_sync(bus):
 def test_modes_switch_by_sdo_and_by_rpdo2(client):
     send(client, 0x000, [0x01, NODE])
     assert sdo_upload_expedited(client, NODE, 0x6502, 0) == 0x3AD  # pp, pv, tq, hm, csp, csv, cst
+    # PDO 3 is synchronous (transmission type 1): RPDO3 at the next SYNC, TPDO3 on every SYNC.
+    assert sdo_upload_expedited(client, NODE, 0x1402, 2) == 1
+    assert sdo_upload_expedited(client, NODE, 0x1802, 2) == 1
+    assert sdo_upload_expedited(client, NODE, 0x1602, 2) == 0x607A0020
+    assert sdo_upload_expedited(client, NODE, 0x1A02, 2) == 0x60640020
     assert sdo_download(client, NODE, 0x6060, 0, 1, 1).data[0] == 0x60
     assert sdo_upload_expedited(client, NODE, 0x6061, 0) in (1, 3)  # switched by the next cycle
     time.sleep(0.05)
@@ -76,14 +86,18 @@ def test_profile_position_move(client):
     assert position_on_sync(client) == 15000
 
 
-def test_homing_run(client):
+@pytest.mark.parametrize("method", [37, 3])
+def test_homing_run(client, method):
+    """37: home on the current position; 3: the home switch (positive side), then the index pulse."""
     send(client, 0x000, [0x01, NODE])
     assert sdo_download(client, NODE, 0x6060, 0, 6, 1).data[0] == 0x60
-    assert sdo_download(client, NODE, 0x6098, 0, 37, 1).data[0] == 0x60  # home on the current position
+    assert sdo_download(client, NODE, 0x6098, 0, method, 1).data[0] == 0x60
     assert sdo_download(client, NODE, 0x607C, 0, 4321, 4).data[0] == 0x60
     enable(client)
     send(client, RPDO1, [0x1F, 0x00])  # bit 4: homing operation start
-    assert wait_status(client, lambda w: (w & 0x3400) == 0x1400) is not None, "homing not attained"
+    ended = wait_status(client, lambda w: (w & 0x2000) or (w & 0x1400) == 0x1400, timeout=20)
+    assert ended is not None, "homing did not end"
+    assert ended & 0x3400 == 0x1400, "homing error (bit 13): 0x%04X" % ended
     assert position_on_sync(client) == 4321
     assert sdo_upload_expedited(client, NODE, 0x6064, 0) == 4321
 
@@ -110,3 +124,28 @@ def test_cyclic_synchronous_position_stream(client):
     status = sdo_upload_expedited(client, NODE, 0x6041, 0)
     assert status & 0x1000, "bit 12: the drive follows the command value"
     assert status & 0x2000 == 0, "no following error"
+
+
+def run_master(bus_server, *args):
+    """`cia402 master` on the same bus, through socketcand: our master against our node, in real time."""
+    url = "socketcand://127.0.0.1:%d/can0" % bus_server["port"]
+    return subprocess.run([os.environ["CIA402_BIN"], "master", "--can", url, "--node", str(NODE)] + list(args),
+                          capture_output=True, text=True, timeout=60)
+
+
+def test_cia402_master_runs_the_modes_over_socketcand(bus_server):
+    done = run_master(bus_server, "--json", "move", "12000", "--velocity", "900")
+    assert done.returncode == 0, done.stderr
+    events = [json.loads(line) for line in done.stdout.splitlines()]
+    assert {"node": NODE, "event": "reached", "position": 12000} in events
+    done = run_master(bus_server, "home", "--method", "37", "--offset", "-250")
+    assert done.returncode == 0, done.stderr
+    assert "homing attained, position -250" in done.stdout
+    # csp: a ramp of 0x607A in RPDO3 before every 2 ms SYNC, 0x6064 back in TPDO3.
+    done = run_master(bus_server, "--json", "csp-stream", "--to", "5000", "--velocity", "300", "--sync-us", "2000")
+    assert done.returncode == 0, done.stderr
+    streamed = [e for e in (json.loads(line) for line in done.stdout.splitlines()) if e["event"] == "streamed"]
+    assert len(streamed) == 1 and streamed[0]["position"] == 5000
+    # Each set-point is reached within the SYNC period it had (300 rpm: 100 increments a 2 ms SYNC);
+    # on wall time a late SYNC may show up to one more step.
+    assert streamed[0]["max_following_error"] <= 200, streamed[0]

@@ -19,11 +19,17 @@
 //   6. TPDO1 = 0x6041 + 0x603F (0x6041 alone if the drive cannot map 0x603F): synchronous (type 1)
 //      with `pdo_timing::sync`, else on change (255) with no inhibit time, so every state arrives;
 //      TPDO2 = 0x606C on change with `map_velocity` (optional as a whole); RPDO1 = 0x6040 on receipt;
-//      each PDO: disable, clear, map, count, type, enable;
+//      with `map_position` (a cyclic synchronous position master, pdo_timing::sync): RPDO3 = 0x6040 +
+//      0x607A taken at the next SYNC and TPDO3 = 0x6041 + 0x6064 on every SYNC (both type 1, the
+//      drive's defaults, written all the same: required); each PDO: disable, clear, map, count, type,
+//      enable;
 //   7. on change only: the present 0x6040, 0x6041, 0x603F, 0x606C, so the master starts from them;
 //   8. NMT start.
 // Running: with `pdo_timing::sync` one SYNC per cycle; the drive answers with TPDO1 and, when a
-// target or a command is set, the master answers with RPDO1 at once. Words set with
+// target or a command is set, the master answers with RPDO1 at once. With `map_position` and a
+// set-point given (set_position_set_point), RPDO3 (the last control word sent and the set-point) goes
+// out just before each SYNC, after `before_sync` has had the chance to move the set-point on; TPDO3's
+// position is kept (position()) and reported (on_position). Words set with
 // `send_control_word` go out when given (a fault-reset edge as bit 7 high for `reset_pulse_us`).
 // Nothing is sent in RPDO1 until a target, command or word is given, so watching a drive never
 // commands it. Requests (`read`, `write`) run one at a time between polls of what no PDO carries
@@ -68,6 +74,7 @@ struct drive_master_config {
   pdo_timing timing = pdo_timing::sync;
   bool map_velocity = false;               ///< TPDO2 = 0x606C, on change
   std::uint16_t velocity_inhibit_100us = 200;  ///< TPDO2's inhibit time
+  bool map_position = false;               ///< RPDO3 = 0x6040 + 0x607A, TPDO3 = 0x6041 + 0x6064, on SYNC
   std::vector<std::uint16_t> read_at_start;    ///< sub 0 of each, read during set-up (optional)
   std::uint32_t poll_us = 0;               ///< SDO polling of what no PDO carries; 0 = none
   std::uint32_t retry_us = 0;              ///< set-up starts again this long after a failure; 0 = never
@@ -123,6 +130,10 @@ class drive_master {
   /// they change while steering.
   void set_mode_bits(std::uint16_t bits);
   std::uint16_t mode_bits() const noexcept { return mode_bits_; }
+  /// With `map_position`: the target position RPDO3 carries before every SYNC (with the last control
+  /// word sent), once a control word has been sent; nullopt stops RPDO3.
+  void set_position_set_point(std::optional<std::int32_t> position) noexcept { position_set_point_ = position; }
+  std::optional<std::int32_t> position_set_point() const noexcept { return position_set_point_; }
 
   /// Queue an SDO transfer for when the master is running; `done` is called in process() or
   /// on_frame() when it ends (or is cancelled). False, and nothing queued, while not running.
@@ -150,6 +161,8 @@ class drive_master {
   std::uint16_t error_code() const noexcept { return error_code_; }
   std::uint8_t error_register() const noexcept { return error_register_; }
   std::optional<std::int32_t> velocity() const noexcept { return velocity_; }
+  /// 0x6064 from the last TPDO3 (with `map_position`); nullopt before the first.
+  std::optional<std::int32_t> position() const noexcept { return position_; }
   std::optional<std::uint16_t> last_emcy() const noexcept { return last_emcy_; }
   /// The NMT state of the drive's last heartbeat.
   std::optional<std::uint8_t> nmt_seen() const noexcept { return nmt_seen_; }
@@ -172,6 +185,7 @@ class drive_master {
   bool heartbeat_watched() const noexcept { return heartbeat_watched_; }
   bool error_code_mapped() const noexcept { return error_code_mapped_; }
   bool velocity_mapped() const noexcept { return velocity_mapped_; }
+  bool position_mapped() const noexcept { return position_mapped_; }
   /// What set-up read (the option codes and `read_at_start`): only what the drive answered.
   const std::map<std::uint16_t, std::int64_t>& start_values() const noexcept { return start_values_; }
 
@@ -183,6 +197,11 @@ class drive_master {
   std::function<void(std::uint16_t status_word)> on_status;
   /// Called for every velocity received.
   std::function<void(std::int32_t velocity)> on_velocity;
+  /// Called for every position received (TPDO3, with `map_position`).
+  std::function<void(std::int32_t position)> on_position;
+  /// Called just before each SYNC goes out (and RPDO3 before it): the moment to set the next cyclic
+  /// set-point.
+  std::function<void()> before_sync;
   /// Called for every word sent in RPDO1.
   std::function<void(std::uint16_t word)> on_sent;
   /// Called when the phase changes, with why; phase_text() says it in words.
@@ -218,6 +237,7 @@ class drive_master {
   void note_status(std::uint16_t sw);
   void note_velocity(std::int32_t v);
   void send_word(std::uint16_t cw);
+  void send_sync();
   void set_phase(master_phase p, phase_reason why);
   std::string node_text() const;
 
@@ -251,6 +271,7 @@ class drive_master {
   bool heartbeat_watched_ = false;
   bool error_code_mapped_ = false;
   bool velocity_mapped_ = false;
+  bool position_mapped_ = false;
   bool stale_guard_ = false;  // 0x1016 watches this master's node-ID, left by an earlier run
   std::map<std::uint16_t, std::int64_t> start_values_;
 
@@ -262,12 +283,15 @@ class drive_master {
   std::deque<std::pair<std::uint16_t, std::uint64_t>> outbox_;  // word, not before (us)
   std::uint16_t last_sent_ = 0;
   std::uint16_t mode_bits_ = 0;
+  bool word_sent_ = false;  // a control word went out since running: RPDO3 may carry it
+  std::optional<std::int32_t> position_set_point_;
 
   bool status_known_ = false;
   std::uint16_t status_word_ = 0;
   std::uint16_t error_code_ = 0;
   std::uint8_t error_register_ = 0;
   std::optional<std::int32_t> velocity_;
+  std::optional<std::int32_t> position_;
   std::optional<std::uint16_t> last_emcy_;
   std::optional<std::uint8_t> nmt_seen_;
   state observed_ = state::start;
