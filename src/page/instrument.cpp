@@ -57,6 +57,9 @@ struct instrument::impl {
 
   std::uint16_t control_word = 0;
   std::deque<std::uint16_t> scripted;  // words for the next cycles, one each (a fault-reset edge)
+  // The set-point handshake of profile position: bit 4 is up (once `scripted` ran out) until status
+  // bit 12 acknowledges it or the cycle `handshake_until` passes.
+  std::optional<std::uint64_t> handshake_until;
   detail::action_log log;
 
   struct transition_seen {
@@ -79,6 +82,7 @@ struct instrument::impl {
 
   // Logs a command or bit toggle and gives its word to the drive from the next cycle on.
   std::uint64_t change_word(const detail::word_change& w) {
+    handshake_until.reset();  // a word given by hand ends the handshake: bit 4 as the word has it
     const std::uint64_t id =
         w.tracked ? track(w.action, true, w.expect_in(*table, control_word, drive->view().current()))
                   : log.report_now(w.action, "done", w.text);
@@ -142,10 +146,27 @@ struct instrument::impl {
       recording.note_transition({0, row.time_us, int{out.transition}, before, out.current,
                                  row.control_word, out.status_word, false});
     }
+    if (handshake_until && scripted.empty()) end_handshake(out, now);
     if (log.pending()) settle(out, now);
     if (now % config.publish_every == 0) {
       board.publish([this](bool with_time) { return snapshot(with_time); });
     }
+  }
+
+  // Bit 4 falls once the drive acknowledged the set-point (status bit 12 in a cycle that read bit 4
+  // set), or unacknowledged after new_setpoint_wait_us.
+  void end_handshake(const drive_outputs& out, std::uint64_t now) {
+    constexpr std::uint16_t bit4 = 1u << 4;
+    const bool acknowledged = (control_word & bit4) != 0 && (out.status_word & (1u << 12)) != 0;
+    if (!acknowledged && now < *handshake_until) return;
+    handshake_until.reset();
+    if (!acknowledged) {
+      log.report_now("NEW_SET-POINT", "refused",
+                     "refused: no set-point acknowledge (status bit 12) within " +
+                         std::to_string(detail::new_setpoint_wait_us / 1000) +
+                         " ms; bit 4 cleared" + blocking_conditions());
+    }
+    apply_word(static_cast<std::uint16_t>(control_word & ~bit4));
   }
 
   // Settled: no scripted word left, no transition and no stop running for settle_quiet cycles.
@@ -191,6 +212,7 @@ struct instrument::impl {
     j["fault_cause"] = hex(v.fault_cause(), 4);
     // The operation mode and its actual values (docs/modes.md).
     j["mode"] = v.operation_mode();
+    j["requested_mode"] = v.requested_mode();
     j["position"] = v.position();
     j["position_demand"] = v.position_demand();
     j["following_error"] = v.following_error();
@@ -239,6 +261,29 @@ reply instrument::toggle_control_bit(int bit) {
   return accepted{impl_->change_word(detail::flip_bit(*impl_->table, impl_->control_word, bit))};
 }
 
+reply instrument::new_setpoint() {
+  std::lock_guard lock(impl_->mutex);
+  impl& m = *impl_;
+  if (auto no = detail::new_setpoint_refusal(*m.table, m.drive->view().operation_mode())) return *no;
+  constexpr std::uint16_t bit4 = 1u << 4;
+  const std::uint16_t word = m.control_word;
+  m.scripted.clear();
+  // A rising edge: bit 4 low for a cycle first if it was up.
+  if ((word & bit4) != 0) m.scripted.push_back(static_cast<std::uint16_t>(word & ~bit4));
+  m.scripted.push_back(static_cast<std::uint16_t>(word | bit4));
+  const std::uint64_t cycle_us = m.drive->constants().cycle_us;
+  m.handshake_until = m.drive->cycle() + m.scripted.size() +
+                      detail::new_setpoint_wait_us / (cycle_us ? cycle_us : 1);
+  std::string options;
+  if ((word & (1u << 5)) != 0) options += ", change set immediately";
+  if ((word & (1u << 6)) != 0) options += ", relative";
+  if ((word & (1u << 9)) != 0) options += ", change on set-point";
+  return accepted{m.log.report_now(
+      "NEW_SET-POINT", "done",
+      "done: 0x607A = " + std::to_string(m.drive->view().state_of_axis().objects.target_position) + options +
+          "; bit 4 up until the drive acknowledges (status bit 12), then down")};
+}
+
 reply instrument::select_profile(std::string_view name) {
   std::lock_guard lock(impl_->mutex);
   impl& m = *impl_;
@@ -256,6 +301,7 @@ reply instrument::select_profile(std::string_view name) {
   m.table = chosen;
   m.control_word = 0;
   m.scripted.clear();
+  m.handshake_until.reset();
   m.last_transition.reset();
   m.recording.clear();
   return accepted{m.log.report_now("PROFILE " + std::string(chosen->name), "done",

@@ -139,11 +139,31 @@ json profile_info(const profile& p) {
     objects.push_back(std::move(entry));
   }
   j["objects"] = std::move(objects);
+  // The modes by number: short names ("pp"), CiA 402-2's names ("Profile position"), and the names
+  // of the bits the profile leaves to the mode as each mode gives them (the page renames those bits
+  // when 0x6061 changes; a DRIVECOM profile keeps the names it gives its bits).
   json modes = json::object();
+  json titles = json::object();
+  json mode_bits = json::object();
   for (int m = 1; m <= 10; ++m) {
-    if (mode::short_name(m)[0] != '\0') modes[std::to_string(m)] = mode::short_name(m);
+    if (mode::short_name(m)[0] == '\0') continue;
+    const std::string key = std::to_string(m);
+    modes[key] = mode::short_name(m);
+    titles[key] = mode_title(m);
+    json control = json::object();
+    json status = json::object();
+    for (int b = 0; b < 16; ++b) {
+      if (const char* n = mode_bit_name(p, true, b, m)) control[std::to_string(b)] = n;
+      if (const char* n = mode_bit_name(p, false, b, m)) status[std::to_string(b)] = n;
+    }
+    mode_bits[key] = {{"control", std::move(control)}, {"status", std::move(status)}};
   }
   j["modes"] = std::move(modes);
+  j["mode_names"] = std::move(titles);
+  j["mode_bits"] = std::move(mode_bits);
+  // The set-point handshake of profile position (POST /api/command "new_setpoint") needs bit 4 left
+  // to the mode.
+  j["new_setpoint"] = left_to_mode(p, true, 4);
   j.update(vocabulary_json(p));
   return j;
 }

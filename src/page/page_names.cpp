@@ -45,4 +45,84 @@ std::vector<object_name> object_names(const profile& p) {
   return out;
 }
 
+namespace {
+
+struct mode_words {
+  std::int64_t mode;
+  const char* title;
+  const char* control[4];  // bits 4, 5, 6, 9
+  const char* status[2];   // bits 12, 13
+};
+
+// CiA 402-2 (IEC 61800-7-201), the mode-specific bits of 0x6040 and 0x6041 per mode (docs/modes.md).
+// A bit a mode does not use is "Reserved in <mode>".
+constexpr mode_words mode_table[] = {
+    {mode::profile_position, "Profile position",
+     {"New set-point", "Change set immediately", "Relative (0 absolute)", "Change on set-point"},
+     {"Set-point acknowledge", "Following error"}},
+    {mode::profile_velocity, "Profile velocity", {nullptr, nullptr, nullptr, nullptr},
+     {"Speed = 0", "Max slippage error"}},
+    {mode::profile_torque, "Profile torque", {nullptr, nullptr, nullptr, nullptr}, {nullptr, nullptr}},
+    {mode::homing, "Homing", {"Homing operation start", nullptr, nullptr, nullptr},
+     {"Homing attained", "Homing error"}},
+    {mode::cyclic_synchronous_position, "Cyclic synchronous position",
+     {nullptr, nullptr, nullptr, nullptr}, {"Drive follows the command value", "Following error"}},
+    {mode::cyclic_synchronous_velocity, "Cyclic synchronous velocity",
+     {nullptr, nullptr, nullptr, nullptr}, {"Drive follows the command value", nullptr}},
+    {mode::cyclic_synchronous_torque, "Cyclic synchronous torque",
+     {nullptr, nullptr, nullptr, nullptr}, {"Drive follows the command value", nullptr}},
+};
+
+const mode_words* words_of(std::int64_t m) noexcept {
+  for (const mode_words& w : mode_table) {
+    if (w.mode == m) return &w;
+  }
+  return nullptr;
+}
+
+// "Reserved in pv": a bit the mode does not use (the short names of cia402::mode::short_name).
+const char* reserved_in(std::int64_t m) noexcept {
+  constexpr const char* names[] = {nullptr,          "Reserved in pp",  nullptr,
+                                   "Reserved in pv", "Reserved in tq",  nullptr,
+                                   "Reserved in hm", nullptr,           "Reserved in csp",
+                                   "Reserved in csv", "Reserved in cst"};
+  return m >= 0 && m <= 10 ? names[m] : nullptr;
+}
+
+}  // namespace
+
+const char* mode_title(std::int64_t m) noexcept {
+  const mode_words* w = words_of(m);
+  return w != nullptr ? w->title : "";
+}
+
+bool left_to_mode(const profile& p, bool control_word, int bit) noexcept {
+  if (bit < 0 || bit > 15) return false;
+  const word_bit_names& n = bit_names_of(p);
+  const std::string_view name = control_word ? n.control[bit] : n.status[bit];
+  return name == "Operation mode specific" || name == "Mode specific";
+}
+
+const char* mode_bit_name(const profile& p, bool control_word, int bit, std::int64_t m) noexcept {
+  const mode_words* w = words_of(m);
+  if (w == nullptr || !left_to_mode(p, control_word, bit)) return nullptr;
+  const char* name = nullptr;
+  if (control_word) {
+    switch (bit) {
+      case 4: name = w->control[0]; break;
+      case 5: name = w->control[1]; break;
+      case 6: name = w->control[2]; break;
+      case 9: name = w->control[3]; break;
+      default: return nullptr;
+    }
+  } else {
+    switch (bit) {
+      case 12: name = w->status[0]; break;
+      case 13: name = w->status[1]; break;
+      default: return nullptr;
+    }
+  }
+  return name != nullptr ? name : reserved_in(m);
+}
+
 }  // namespace cia402::page

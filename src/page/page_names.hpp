@@ -27,7 +27,21 @@ struct object_name {
   std::string name;
 };
 
-/// The objects the page offers to write: the profile's option codes, then the ramps.
+/// The objects the page offers to write: the mode and its set-points, the profile's option codes,
+/// then the ramps.
 std::vector<object_name> object_names(const profile& p);
+
+/// The name CiA 402-2 gives an operation mode ("Profile position", ...), "" for any other value.
+const char* mode_title(std::int64_t m) noexcept;
+
+/// A bit's name in operation mode `m` where the profile leaves the bit to the mode (CiA 402's
+/// "Operation mode specific", DRIVECOM's "Mode specific"): control bits 4, 5, 6, 9 and status bits
+/// 12, 13 as CiA 402-2 names them in that mode ("New set-point", "Homing attained", "Reserved in
+/// csv", ...). nullptr where the profile's own name stands: a bit the profile names itself
+/// (DRIVECOM's STW bit 4 "Fast stop / inhibit ramp function generator"), or a value that is no mode.
+const char* mode_bit_name(const profile& p, bool control_word, int bit, std::int64_t m) noexcept;
+
+/// Whether the profile leaves this bit of the word to the operation mode.
+bool left_to_mode(const profile& p, bool control_word, int bit) noexcept;
 
 }  // namespace cia402::page

@@ -10,13 +10,21 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-// Everything but the time, the velocity and the set-point (which moves with a ramp's input).
+// Everything but the time and the sampled values (velocity, position, torque: they move with a
+// ramp or a move).
 bool same_but_velocity(const sim::trace_row& a, const sim::trace_row& b) {
   return a.control_word == b.control_word && a.status_word == b.status_word &&
          a.error_code == b.error_code && a.fault_cause == b.fault_cause && a.current == b.current &&
          a.transition == b.transition && a.ramp == b.ramp && a.torque == b.torque &&
          a.brake_released == b.brake_released && a.brake_engaged == b.brake_engaged &&
-         a.dc_link == b.dc_link && a.sto == b.sto && a.target_velocity == b.target_velocity;
+         a.dc_link == b.dc_link && a.sto == b.sto && a.target_velocity == b.target_velocity &&
+         a.mode == b.mode;
+}
+
+// The sampled values: kept at most once per velocity_every_us while they move.
+bool same_samples(const sim::trace_row& a, const sim::trace_row& b) {
+  return a.velocity == b.velocity && a.position == b.position &&
+         a.position_demand == b.position_demand && a.torque_permille == b.torque_permille;
 }
 
 // micro-rpm to whole rpm, rounded half away from zero.
@@ -31,11 +39,11 @@ void recorder::record(const sim::trace_row& row) {
   if (!keep) {
     const sim::trace_row& prev = rows_.back();
     keep = !same_but_velocity(prev, row) ||
-           (row.velocity != prev.velocity && row.time_us >= prev.time_us + limits_.velocity_every_us);
+           (!same_samples(row, prev) && row.time_us >= prev.time_us + limits_.velocity_every_us);
   }
-  // A velocity that settled after the last kept sample: keep the cycle before the first unchanged
-  // one, so the file shows where the ramp ended.
-  if (!keep && last_ && last_->velocity != rows_.back().velocity && row.velocity == last_->velocity) {
+  // Samples that settled after the last kept one: keep the cycle before the first unchanged one,
+  // so the file shows where the ramp or the move ended.
+  if (!keep && last_ && !same_samples(*last_, rows_.back()) && same_samples(row, *last_)) {
     rows_.push_back(*last_);
   }
   last_ = row;
@@ -69,7 +77,7 @@ json recorder::since_json(std::uint64_t row_since, std::uint64_t transition_sinc
     if (seq++ <= row_since) continue;
     rows.push_back({r.time_us / 1000, r.control_word, r.status_word, state_name(r.current),
                     r.transition == no_transition ? json(nullptr) : json(int{r.transition}),
-                    whole_rpm(r.velocity)});
+                    whole_rpm(r.velocity), r.position, r.torque_permille});
   }
   json list = json::array();
   for (const transition& t : transitions_) {

@@ -2,9 +2,9 @@
 // page's transition history and timeline and for export as CSV and VCD (the simulator's own trace
 // formats, sim/trace.hpp, so a recording opens wherever a `cia402 simulate` trace does).
 //
-// A cycle is kept when anything but the velocity changed (every transition, word and input), and
-// otherwise at most once per `velocity_every_us` while the velocity moves: a drive standing still
-// costs nothing, a ramp about 50 rows a second. The oldest rows go first when the bound is reached;
+// A cycle is kept when anything but the sampled values changed (every transition, word, input and
+// mode), and otherwise at most once per `velocity_every_us` while the velocity, the position or the
+// torque moves: a drive standing still costs nothing, a ramp or a move about 50 rows a second. The oldest rows go first when the bound is reached;
 // the recording says how many went.
 #pragma once
 
@@ -48,8 +48,8 @@ class recorder {
   recorder() : recorder(limits{}) {}
   explicit recorder(limits l) : limits_(l) {}
 
-  /// One cycle. Kept when it differs from the last kept row in anything but the velocity, or the
-  /// velocity changed and velocity_every_us passed.
+  /// One cycle. Kept when it differs from the last kept row in anything but the sampled values, or
+  /// one of them (velocity, position, demand, torque) changed and velocity_every_us passed.
   void record(const sim::trace_row& row);
   /// A transition for the history (the row that showed it goes through record()).
   void note_transition(transition t);
@@ -58,14 +58,15 @@ class recorder {
 
   /// What came after a previous answer's `rows_seen` and `transitions_seen` (0, 0: everything):
   /// {"rows_seen": R, "transitions_seen": T, "dropped_rows": D,
-  ///  "rows": [[time_ms, cw, sw, state, transition|null, rpm], ...],
+  ///  "rows": [[time_ms, cw, sw, state, transition|null, rpm, position, torque_permille], ...],
   ///  "transitions": [{"seq", "time_ms", "number", "from", "to", "control_word", "status_word",
   ///  "inferred"}, ...]}.
   nlohmann::ordered_json since_json(std::uint64_t row_since, std::uint64_t transition_since) const;
   std::size_t rows() const { return rows_.size(); }
   std::size_t transitions() const { return transitions_.size(); }
 
-  /// The kept rows, with the last cycle recorded at its time so the file ends at "now".
+  /// The kept rows, with the last cycle recorded at its time so the file ends at "now" (the
+  /// simulator's CSV: position, position_demand, torque_permille and mode are its last columns).
   void write_csv(std::ostream& out) const;
   /// IEEE 1364 VCD (state and ramp as integer codes named in a $comment), or with `gtkwave` the
   /// GTKWave form with `$var string`.

@@ -1,5 +1,6 @@
 #include "cia402/page/remote_drive.hpp"
 
+#include <array>
 #include <condition_variable>
 #include <functional>
 #include <map>
@@ -89,6 +90,7 @@ co::drive_master_config master_config(const profile& p, const remote_config& c) 
     if (!setpoint) m.read_at_start.push_back(i);
   }
   m.read_at_start.push_back(0x60FF);
+  m.read_at_start.push_back(object_index::supported_drive_modes);  // the mode select's choices
   m.poll_us = c.poll_us;
   m.retry_us = c.retry_us;
   m.reset_pulse_us = c.reset_pulse_us;
@@ -161,6 +163,72 @@ struct remote_drive::impl {
   detail::recorder recording;
   std::uint8_t transition_this_poll = no_transition;  // for the recorder's row
 
+  // The mode display and actual values no PDO of the page carries, read by SDO in rounds.
+  struct actual_value {
+    std::uint16_t index;
+    std::optional<std::int64_t> value;
+    bool absent = false;  // the drive refused the read: not asked again until set-up runs again
+  };
+  std::array<actual_value, 4> actuals{{{object_index::modes_of_operation_display, {}, false},
+                                       {object_index::position_actual_value, {}, false},
+                                       {object_index::torque_actual_value, {}, false},
+                                       {object_index::following_error_actual_value, {}, false}}};
+  std::size_t next_actual = 0;
+  bool actual_in_flight = false;
+  std::uint64_t next_round_us = 0;
+  int user_transfers = 0;  // the page's own SDO requests queued or running
+
+  // The set-point handshake: bit 4 goes up at raise_at_us (after a cycle low if it was up), and
+  // down with the first status word showing bit 12 after that, or at give_up_us.
+  struct handshake_run {
+    bool raised = false;
+    std::uint64_t raise_at_us = 0;
+    std::uint64_t give_up_us = 0;
+    bool acknowledged = false;
+  };
+  std::optional<handshake_run> handshake;
+
+  std::optional<std::int64_t> actual(std::uint16_t index) const {
+    for (const actual_value& a : actuals) {
+      if (a.index == index) return a.value;
+    }
+    return std::nullopt;
+  }
+
+  void forget_actuals() {
+    for (actual_value& a : actuals) {
+      a.value.reset();
+      a.absent = false;
+    }
+    next_actual = 0;
+    next_round_us = now_us;
+  }
+
+  // One read at a time, and none while the page's own requests wait: they go first.
+  void read_actuals() {
+    if (config.actual_poll_us == 0 || actual_in_flight || user_transfers > 0 ||
+        remote.phase() != co::master_phase::running || remote.request_pending() ||
+        now_us < next_round_us) {
+      return;
+    }
+    while (next_actual < actuals.size() && actuals[next_actual].absent) ++next_actual;
+    if (next_actual >= actuals.size()) {
+      next_actual = 0;
+      next_round_us = now_us + config.actual_poll_us;
+      return;
+    }
+    const std::size_t k = next_actual++;
+    actual_in_flight = remote.read(actuals[k].index, 0, true, [this, k](const co::sdo_result& r) {
+      actual_in_flight = false;
+      if (r.ok()) {
+        actuals[k].value = r.value;
+      } else if (!r.cancelled && r.abort != sdo_abort::sdo_protocol_timed_out) {
+        actuals[k].absent = true;  // the drive has no such object (or will not say)
+        actuals[k].value.reset();
+      }
+    });
+  }
+
   std::string node_text() const { return "node " + std::to_string(config.node_id); }
 
   remote_status status() const {
@@ -182,11 +250,14 @@ struct remote_drive::impl {
       case co::phase_reason::node_restarted:
         injected_fault = 0;
         state_known = false;
+        forget_actuals();
+        handshake.reset();
         break;
       case co::phase_reason::failed:
         // The node went silent (or its set-up failed): nothing is known until set-up ran again.
         state_known = false;
         log.finish_pending(remote.phase_text().c_str());
+        handshake.reset();
         break;
       case co::phase_reason::running: {
         // Start from the drive's present values, so connecting changes nothing.
@@ -201,6 +272,8 @@ struct remote_drive::impl {
         }
         control_word = remote.last_sent();
         sent_before = control_word;
+        forget_actuals();
+        actual_in_flight = false;
         break;
       }
       default: break;
@@ -244,6 +317,7 @@ struct remote_drive::impl {
     }
     observed = s;
     state_known = true;
+    if (handshake && handshake->raised && (sw & (1u << 12)) != 0) handshake->acknowledged = true;
   }
 
   void on_velocity(std::int32_t v) {
@@ -255,12 +329,37 @@ struct remote_drive::impl {
     now_us += elapsed_us;
     transition_this_poll = no_transition;
     (void)remote.poll(bus, elapsed_us);
+    if (handshake) run_handshake();
+    read_actuals();
     if (state_known) record_row();
     if (log.pending()) settle();
     if (now_us >= next_publish_us) {
       next_publish_us = now_us + config.publish_us;
       board.publish([this](bool with_time) { return snapshot(with_time); });
     }
+  }
+
+  void run_handshake() {
+    constexpr std::uint16_t bit4 = 1u << 4;
+    handshake_run& h = *handshake;
+    if (!h.raised) {
+      if (now_us < h.raise_at_us || remote.words_queued()) return;
+      control_word = static_cast<std::uint16_t>(control_word | bit4);
+      remote.send_control_word(control_word);
+      h.raised = true;
+      h.give_up_us = now_us + detail::new_setpoint_wait_us;
+      return;
+    }
+    if (!h.acknowledged && now_us < h.give_up_us) return;
+    if (!h.acknowledged) {
+      log.report_now("NEW_SET-POINT", "refused",
+                     "refused: no set-point acknowledge (status bit 12) within " +
+                         std::to_string(detail::new_setpoint_wait_us / 1000) + " ms; bit 4 cleared" +
+                         conditions());
+    }
+    control_word = static_cast<std::uint16_t>(control_word & ~bit4);
+    remote.send_control_word(control_word);
+    handshake.reset();
   }
 
   // The recorder's row for this poll. The bus shows the words, the state, the velocity and the
@@ -281,6 +380,11 @@ struct remote_drive::impl {
     row.brake_released = row.torque;
     row.brake_engaged = !row.torque;
     row.dc_link = (row.status_word & status_bit::voltage_enabled) != 0;
+    // The SDO-read actual values as last read (0 while unknown; mode 0: none known).
+    row.position = actual(object_index::position_actual_value).value_or(0);
+    row.position_demand = row.position;
+    row.torque_permille = static_cast<std::int32_t>(actual(object_index::torque_actual_value).value_or(0));
+    row.mode = static_cast<std::int8_t>(actual(object_index::modes_of_operation_display).value_or(0));
     recording.record(row);
   }
 
@@ -333,11 +437,13 @@ struct remote_drive::impl {
         state_known && velocity && *velocity != 0 &&
         (table.info(observed).activity == state_activity::quick_stop ||
          table.info(observed).activity == state_activity::fault_reaction);
-    log.settle(now_us, remote.words_queued() || stopping || remote.request_pending());
+    // The actual values' reads are not the action's business: only the page's own requests count.
+    log.settle(now_us, remote.words_queued() || stopping || user_transfers > 0);
   }
 
   // Logs a command or bit toggle and queues its word for RPDO1.
   std::uint64_t change_word(const detail::word_change& w) {
+    handshake.reset();  // a word given by hand ends the handshake: bit 4 as the word has it
     const std::uint64_t id =
         w.tracked
             ? track(w.action, true,
@@ -363,6 +469,7 @@ struct remote_drive::impl {
     auto w = std::make_shared<user_wait>();
     w->track_action = std::move(track_action);
     const bool queued = remote.write(index, 0, value, bytes, [this, w, on_done](const co::sdo_result& r) {
+      --user_transfers;
       w->done = true;
       w->cancelled = r.cancelled;
       w->abort = r.abort;
@@ -372,7 +479,11 @@ struct remote_drive::impl {
       }
       job_done.notify_all();
     });
-    if (!queued) w->done = w->cancelled = true;
+    if (queued) {
+      ++user_transfers;
+    } else {
+      w->done = w->cancelled = true;
+    }
     job_done.wait_for(lock, config.request_timeout, [&] { return w->done || board.closed(); });
     return w;
   }
@@ -468,13 +579,16 @@ struct remote_drive::impl {
                                         : json(nullptr);
     j["sto"] = nullptr;
     j["fault_cause"] = remote.fault_injection() ? json(hex(injected_fault, 4)) : json(nullptr);
-    // The mode as read at start or written since (0x6060); the actual values are not mapped.
-    const auto mode = objects.find(object_index::modes_of_operation);
-    j["mode"] = mode != objects.end() ? json(mode->second) : json(nullptr);
-    j["position"] = nullptr;
+    // The mode display and the actual values as last read by SDO (null: not read yet, the drive
+    // lacks the object, or the node is silent); the mode requested as read at start or written.
+    const auto shown = [live](std::optional<std::int64_t> v) { return live && v ? json(*v) : json(nullptr); };
+    j["mode"] = shown(actual(object_index::modes_of_operation_display));
+    const auto requested = objects.find(object_index::modes_of_operation);
+    j["requested_mode"] = requested != objects.end() ? json(requested->second) : json(nullptr);
+    j["position"] = shown(actual(object_index::position_actual_value));
     j["position_demand"] = nullptr;
-    j["following_error"] = nullptr;
-    j["torque_actual"] = nullptr;
+    j["following_error"] = shown(actual(object_index::following_error_actual_value));
+    j["torque_actual"] = shown(actual(object_index::torque_actual_value));
     json objs = json::object();
     for (const auto& [index, value] : objects) objs[hex(index, 4)] = value;
     j["objects"] = std::move(objs);
@@ -514,6 +628,36 @@ reply remote_drive::toggle_control_bit(int bit) {
   std::lock_guard lock(impl_->mutex);
   if (auto no = impl_->not_running()) return *no;
   return accepted{impl_->change_word(detail::flip_bit(impl_->table, impl_->control_word, bit))};
+}
+
+reply remote_drive::new_setpoint() {
+  std::lock_guard lock(impl_->mutex);
+  impl& m = *impl_;
+  if (auto no = m.not_running()) return *no;
+  // The mode the drive shows; before the first read of 0x6061, the one asked for.
+  std::optional<std::int64_t> mode = m.actual(object_index::modes_of_operation_display);
+  if (!mode) {
+    const auto requested = m.objects.find(object_index::modes_of_operation);
+    if (requested != m.objects.end()) mode = requested->second;
+  }
+  if (auto no = detail::new_setpoint_refusal(m.table, mode)) return *no;
+  constexpr std::uint16_t bit4 = 1u << 4;
+  impl::handshake_run h;
+  h.raise_at_us = m.now_us;
+  if ((m.control_word & bit4) != 0) {
+    // A rising edge: bit 4 low for a moment first.
+    m.control_word = static_cast<std::uint16_t>(m.control_word & ~bit4);
+    m.remote.send_control_word(m.control_word);
+    h.raise_at_us = m.now_us + m.config.reset_pulse_us;
+  }
+  m.handshake = h;
+  std::string options;
+  if ((m.control_word & (1u << 5)) != 0) options += ", change set immediately";
+  if ((m.control_word & (1u << 6)) != 0) options += ", relative";
+  if ((m.control_word & (1u << 9)) != 0) options += ", change on set-point";
+  return accepted{m.log.report_now(
+      "NEW_SET-POINT", "done",
+      "done" + options + ": bit 4 up until the drive acknowledges (status bit 12), then down")};
 }
 
 reply remote_drive::write_object(std::uint16_t index, std::int64_t value) {
@@ -598,6 +742,18 @@ std::string remote_drive::info_json(bool control, bool token_required) const {
   j["cycle_us"] = m.config.cycle_us;
   j["publish_ms"] = m.config.publish_us / 1000.0;
   j["capabilities"] = m.capabilities();
+  // The modes the drive's own 0x6502 announces, where it was read.
+  const auto supported = m.remote.start_values().find(object_index::supported_drive_modes);
+  if (supported != m.remote.start_values().end()) {
+    for (json& o : j["objects"]) {
+      if (o["index"] != hex(object_index::modes_of_operation, 4)) continue;
+      json values = json::array();
+      for (int k = 1; k <= 10; ++k) {
+        if ((mode::supported_bit(k) & static_cast<std::uint32_t>(supported->second)) != 0) values.push_back(k);
+      }
+      o["values"] = std::move(values);
+    }
+  }
   return j.dump();
 }
 

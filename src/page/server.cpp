@@ -412,11 +412,13 @@ struct server::impl {
       return inst.toggle_control_bit(static_cast<int>(*bit));
     }
     if (body.contains("bit")) return request_error{400, "'bit' belongs to toggle_bit only"};
+    if (name == "new_setpoint") return inst.new_setpoint();
     page_command c{};
     if (!parse_page_command(name, c)) {
       return request_error{400, "unknown command '" + name +
                                     "' (shutdown, switch_on, enable_operation, disable_operation, "
-                                    "disable_voltage, quick_stop, fault_reset, halt, toggle_bit)"};
+                                    "disable_voltage, quick_stop, fault_reset, halt, toggle_bit, "
+                                    "new_setpoint)"};
     }
     return inst.command(c);
   }

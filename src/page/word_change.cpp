@@ -1,8 +1,10 @@
 #include "word_change.hpp"
 
 #include "cia402/master.hpp"
+#include "cia402/objects.hpp"
 #include "cia402/words.hpp"
 #include "page_json.hpp"
+#include "page_names.hpp"
 
 namespace cia402::page::detail {
 
@@ -70,6 +72,20 @@ word_change flip_bit(const profile& p, std::uint16_t control_word, int bit) {
   w.text = owned ? std::string("done: still decodes to ") + command_name(now)
                  : std::string("done: the state machine does not read bit ") + std::to_string(bit);
   return w;
+}
+
+std::optional<refused> new_setpoint_refusal(const profile& p, std::optional<std::int64_t> m) {
+  if (!left_to_mode(p, true, 4)) {
+    return refused{409, std::string("profile ") + p.name + " names control bit 4 \"" +
+                            bit_names_of(p).control[4] + "\": no set-point handshake on it"};
+  }
+  if (m && *m != mode::profile_position) {
+    const char* name = mode::short_name(*m);
+    return refused{409, "the new set-point handshake is profile position's (0x6060 = 1); the drive "
+                        "runs mode " + std::to_string(*m) +
+                        (name[0] != '\0' ? std::string(" (") + name + ")" : std::string())};
+  }
+  return std::nullopt;
 }
 
 }  // namespace cia402::page::detail

@@ -36,4 +36,12 @@ std::variant<word_change, refused> press_button(const profile& p, page_command c
 /// sets bit 7 (a fault-reset edge); else it changed nothing the state machine reads.
 word_change flip_bit(const profile& p, std::uint16_t control_word, int bit);
 
+/// Why the set-point handshake of profile position (bit 4 up until status bit 12, then down) cannot
+/// run, or nothing: the profile gives bit 4 a meaning of its own (409), or the drive shows another
+/// mode in 0x6061 (`mode`, when known; 409).
+std::optional<refused> new_setpoint_refusal(const profile& p, std::optional<std::int64_t> mode);
+
+/// How long the handshake waits for status bit 12 before it lets bit 4 fall unacknowledged.
+inline constexpr std::uint64_t new_setpoint_wait_us = 1000000;
+
 }  // namespace cia402::page::detail

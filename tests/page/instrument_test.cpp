@@ -414,3 +414,120 @@ TEST(instrument, modes_are_a_choice_and_the_snapshot_shows_mode_position_and_tor
 }
 
 }  // namespace
+
+namespace {
+
+void enable(instrument& inst) {
+  for (const page_command c :
+       {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
+    id_of(inst.command(c));
+    run(inst, 100);
+  }
+}
+
+// Steps until the snapshot shows status bit `bit` set (or `limit` cycles passed).
+json run_until_status_bit(instrument& inst, int bit, int limit) {
+  json s = snapshot(inst);
+  for (int i = 0; i < limit && ((hex_value(s["status_word"]) >> bit) & 1) == 0; i += 10) {
+    run(inst, 10);
+    s = snapshot(inst);
+  }
+  return s;
+}
+
+// Profile position from the page: 0x6060 = 1, 0x607A, the new set-point handshake (bit 4 up until
+// status bit 12, then down: CiA 402-2's set-point handshake), the move to the target (bit 10), a
+// relative move adding to it (bit 6).
+TEST(instrument, the_new_setpoint_handshake_moves_in_profile_position) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  id_of(inst.write_object(0x6060, 1));
+  EXPECT_EQ(snapshot(inst)["requested_mode"], 1);
+  enable(inst);
+  ASSERT_EQ(snapshot(inst)["mode"], 1);
+  id_of(inst.write_object(0x607A, 5000));
+  id_of(inst.new_setpoint());
+  json s = snapshot(inst);
+  EXPECT_EQ(s["results"][0]["action"], "NEW_SET-POINT");
+  EXPECT_EQ(s["results"][0]["outcome"], "done");
+  run(inst, 20);  // target reached (bit 10) falls as the move starts
+  s = run_until_status_bit(inst, 10, 20000);
+  EXPECT_EQ(s["position"], 5000);
+  EXPECT_EQ(hex_value(s["control_word"]) & 0x0010, 0) << "bit 4 is down after the acknowledge";
+  EXPECT_EQ(hex_value(s["status_word"]) & 0x1000, 0) << "bit 12 follows bit 4 down";
+  // The recording holds the handshake: a cycle with bit 4 up and bit 12 acknowledging it.
+  const json rec = json::parse(inst.recording_json(0, 0));
+  bool handshake = false;
+  for (const json& row : rec["rows"]) {
+    if ((row[1].get<int>() & 0x0010) != 0 && (row[2].get<int>() & 0x1000) != 0) handshake = true;
+  }
+  EXPECT_TRUE(handshake);
+  EXPECT_EQ(rec["rows"].back()[6], 5000) << "the position is the recording's 7th column";
+
+  id_of(inst.toggle_control_bit(6));  // relative
+  id_of(inst.write_object(0x607A, 1000));
+  id_of(inst.new_setpoint());
+  run(inst, 20);
+  s = run_until_status_bit(inst, 10, 20000);
+  EXPECT_EQ(s["position"], 6000);
+  EXPECT_NE(std::string(s["results"][0]["text"]).find("relative"), std::string::npos) << s["results"];
+
+  // Another mode: the handshake is refused, nothing changes.
+  id_of(inst.write_object(0x6060, 3));
+  run(inst, 5);
+  const auto r = inst.new_setpoint();
+  const auto* no = std::get_if<refused>(&r);
+  ASSERT_NE(no, nullptr);
+  EXPECT_EQ(no->http_status, 409);
+  EXPECT_NE(no->reason.find("(pv)"), std::string::npos) << no->reason;
+}
+
+// A set-point the drive does not acknowledge (not enabled): bit 4 falls after a second, reported.
+TEST(instrument, an_unacknowledged_setpoint_lets_bit_4_fall_and_says_so) {
+  instrument inst(cia402::standard_profile());
+  run(inst, 10);
+  id_of(inst.write_object(0x6060, 1));
+  run(inst, 5);
+  id_of(inst.new_setpoint());
+  run(inst, 5);
+  EXPECT_EQ(hex_value(snapshot(inst)["control_word"]) & 0x0010, 0x0010);
+  run(inst, 1100);
+  const json s = snapshot(inst);
+  EXPECT_EQ(hex_value(s["control_word"]) & 0x0010, 0);
+  EXPECT_EQ(s["results"][0]["outcome"], "refused");
+  EXPECT_NE(std::string(s["results"][0]["text"]).find("status bit 12"), std::string::npos);
+}
+
+// The names of the mode-specific bits per mode, as CiA 402-2 gives them; a DRIVECOM profile keeps
+// the names it gives its control bits, and has no set-point handshake on bit 4.
+TEST(instrument, info_names_the_mode_specific_bits_per_mode) {
+  instrument inst(cia402::standard_profile());
+  const json info = json::parse(inst.info_json(true, false));
+  EXPECT_EQ(info["mode_names"]["1"], "Profile position");
+  EXPECT_EQ(info["mode_names"]["8"], "Cyclic synchronous position");
+  EXPECT_EQ(info["mode_bits"]["1"]["control"]["4"], "New set-point");
+  EXPECT_EQ(info["mode_bits"]["1"]["control"]["5"], "Change set immediately");
+  EXPECT_EQ(info["mode_bits"]["1"]["control"]["9"], "Change on set-point");
+  EXPECT_EQ(info["mode_bits"]["1"]["status"]["12"], "Set-point acknowledge");
+  EXPECT_EQ(info["mode_bits"]["1"]["status"]["13"], "Following error");
+  EXPECT_EQ(info["mode_bits"]["6"]["control"]["4"], "Homing operation start");
+  EXPECT_EQ(info["mode_bits"]["6"]["status"]["12"], "Homing attained");
+  EXPECT_EQ(info["mode_bits"]["6"]["status"]["13"], "Homing error");
+  EXPECT_EQ(info["mode_bits"]["3"]["status"]["12"], "Speed = 0");
+  EXPECT_EQ(info["mode_bits"]["3"]["control"]["4"], "Reserved in pv");
+  EXPECT_EQ(info["mode_bits"]["8"]["status"]["12"], "Drive follows the command value");
+  EXPECT_FALSE(info["mode_bits"]["1"]["control"].contains("8")) << "halt is the profile's";
+  EXPECT_TRUE(info["new_setpoint"]);
+
+  instrument s300(by_name("s300-profibus"));
+  const json d = json::parse(s300.info_json(true, false));
+  EXPECT_TRUE(d["mode_bits"]["1"]["control"].empty()) << "STW bits 4, 5, 6 and 9 have names";
+  EXPECT_EQ(d["mode_bits"]["6"]["status"]["12"], "Homing attained") << "ZSW 12 is \"Mode specific\"";
+  EXPECT_FALSE(d["new_setpoint"]);
+  const auto r = s300.new_setpoint();
+  const auto* no = std::get_if<refused>(&r);
+  ASSERT_NE(no, nullptr);
+  EXPECT_NE(no->reason.find("Fast stop / inhibit ramp function generator"), std::string::npos) << no->reason;
+}
+
+}  // namespace

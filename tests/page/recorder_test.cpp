@@ -60,4 +60,43 @@ TEST(page_recorder, the_oldest_rows_and_transitions_go_first_and_are_counted) {
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 11);  // header + 10 rows
 }
 
+// The operation modes: a move at constant velocity is sampled by its position, a mode change is
+// kept at once, and the timeline rows and the CSV end with the position and the torque.
+TEST(page_recorder, position_and_torque_are_sampled_and_exported_at_the_end_of_each_row) {
+  recorder rec;
+  for (std::uint64_t c = 0; c <= 1000; ++c) {
+    trace_row r = at(c * 1000, 600);  // constant velocity: only the position moves
+    r.position = static_cast<std::int64_t>(c) * 100;
+    r.position_demand = r.position;
+    r.torque_permille = 25;
+    r.mode = 1;
+    rec.record(r);
+  }
+  EXPECT_EQ(rec.rows(), 51u);
+  trace_row homing = at(1001000, 600);
+  homing.position = 100100;
+  homing.position_demand = 100100;
+  homing.torque_permille = -7;
+  homing.mode = 6;  // a mode change is kept at once
+  rec.record(homing);
+  EXPECT_EQ(rec.rows(), 52u);
+  const auto j = rec.since_json(51, 0);
+  ASSERT_EQ(j["rows"].size(), 1u);
+  ASSERT_EQ(j["rows"][0].size(), 8u);
+  EXPECT_EQ(j["rows"][0][5], 600);
+  EXPECT_EQ(j["rows"][0][6], 100100);
+  EXPECT_EQ(j["rows"][0][7], -7);
+
+  std::ostringstream csv;
+  rec.write_csv(csv);
+  const std::string text = csv.str();
+  const auto ends_with = [](const std::string& line, const std::string& tail) {
+    return line.size() >= tail.size() && line.compare(line.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  const std::string header = text.substr(0, text.find('\n'));
+  EXPECT_TRUE(ends_with(header, ",position,position_demand,torque_permille,mode")) << header;
+  const std::string last = text.substr(text.rfind('\n', text.size() - 2) + 1);
+  EXPECT_TRUE(ends_with(last, ",100100,100100,-7,6\n")) << last;
+}
+
 }  // namespace

@@ -345,3 +345,56 @@ TEST(remote_drive, node_that_is_not_on_the_bus_does_not_answer_set_up) {
 }
 
 }  // namespace
+
+namespace {
+
+// The operation modes on a remote drive: 0x6061, 0x6064, 0x6077 and 0x60F4 read by SDO in rounds
+// (every 100 ms), the mode select's choices from the drive's own 0x6502, a pp move by the
+// new set-point handshake in RPDO1 (bit 4 up until status bit 12, then down), and the position in
+// the recording.
+TEST(remote_drive, reads_mode_and_actual_values_and_moves_by_the_setpoint_handshake) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  b.run_ms(300);
+  json s = b.snapshot();
+  EXPECT_EQ(s["mode"], 3);
+  EXPECT_EQ(s["requested_mode"], 3);
+  EXPECT_EQ(s["position"], 0);
+  EXPECT_TRUE(s["torque_actual"].is_number());
+  EXPECT_EQ(s["following_error"], 0);
+  const json info = json::parse(b.remote().info_json(true, false));
+  for (const json& o : info["objects"]) {
+    if (o["index"] == "0x6060") {
+      EXPECT_EQ(o["values"], json::parse("[1, 3, 4, 6, 8, 9, 10]"));
+    }
+  }
+
+  ASSERT_TRUE(is_accepted(b.blocking([&] { return b.remote().write_object(0x6060, 1); })));
+  enable(b);
+  ASSERT_TRUE(is_accepted(b.blocking([&] { return b.remote().write_object(0x607A, 4000); })));
+  b.run_ms(300);
+  EXPECT_EQ(b.snapshot()["mode"], 1);
+  ASSERT_TRUE(is_accepted(b.remote().new_setpoint()));
+  b.run_ms(2000);
+  s = b.snapshot();
+  EXPECT_EQ(s["position"], 4000);
+  EXPECT_EQ(b.drive().view().position(), 4000);
+  EXPECT_EQ(s["control_word"], "0x000F") << "bit 4 down again after the acknowledge";
+  EXPECT_EQ(s["results"][0]["action"], "NEW_SET-POINT") << s["results"];
+  EXPECT_EQ(s["results"][0]["outcome"], "done") << s["results"];
+  const json rec = json::parse(b.remote().recording_json(0, 0));
+  bool bit4 = false;
+  for (const json& row : rec["rows"]) bit4 = bit4 || (row[1].get<int>() & 0x0010) != 0;
+  EXPECT_TRUE(bit4) << "the recording shows bit 4 up";
+  EXPECT_EQ(rec["rows"].back()[6], 4000);
+
+  // Homing: the page's mode select writes 0x6060; the handshake is refused in that mode.
+  ASSERT_TRUE(is_accepted(b.blocking([&] { return b.remote().write_object(0x6060, 6); })));
+  b.run_ms(300);
+  EXPECT_EQ(b.snapshot()["mode"], 6);
+  const reply r = b.remote().new_setpoint();
+  ASSERT_TRUE(std::holds_alternative<refused>(r));
+  EXPECT_EQ(std::get<refused>(r).http_status, 409);
+}
+
+}  // namespace

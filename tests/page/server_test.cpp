@@ -125,6 +125,22 @@ TEST_F(page_server, a_valid_command_is_obeyed) {
 
 // The recorder keeps every transition with its time and words, gives the page only what it has not
 // seen, and exports the same cycles as CSV and as IEEE 1364 VCD (or GTKWave's form on request).
+// The new set-point handshake of profile position over HTTP: refused (409) in profile velocity,
+// obeyed in pp.
+TEST_F(page_server, new_setpoint_is_a_command_of_profile_position) {
+  start(false);
+  expect_refused(post("/api/command", R"({"command":"new_setpoint"})"), 409, "profile position");
+  auto r = post("/api/object", R"({"index":"0x6060","value":1})");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200) << r->body;
+  step(5);
+  r = post("/api/command", R"({"command":"new_setpoint"})");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200) << r->body;
+  const json s = json::parse(inst.snapshot_json());
+  EXPECT_EQ(s["results"][0]["action"], "NEW_SET-POINT");
+}
+
 TEST_F(page_server, recorder_keeps_every_transition_and_exports_csv_and_vcd) {
   start(false);
   for (const char* c : {"shutdown", "switch_on", "enable_operation", "disable_voltage"}) {

@@ -301,43 +301,151 @@ function updateDiagram(s) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Operation modes: the mode-specific bits by the names CiA 402-2 gives them in each mode
+// Operation modes: the mode-specific bits by the names CiA 402-2 gives them in each mode. The server
+// says which bits the profile leaves to the mode and their names per mode (info.mode_bits); a
+// DRIVECOM profile keeps the names it gives its bits.
 
-const MODE_NAMES = {
-  1: 'Profile position', 3: 'Profile velocity', 4: 'Profile torque', 6: 'Homing',
-  8: 'Cyclic synchronous position', 9: 'Cyclic synchronous velocity', 10: 'Cyclic synchronous torque',
-};
-const MODE_CONTROL_BITS = {
-  1: { 4: 'New set-point', 5: 'Change set immediately', 6: 'Relative', 9: 'Change on set-point' },
-  6: { 4: 'Homing operation start' },
-};
-const MODE_STATUS_BITS = {
-  1: { 12: 'Set-point acknowledge', 13: 'Following error' },
-  3: { 12: 'Speed = 0', 13: 'Max slippage error' },
-  6: { 12: 'Homing attained', 13: 'Homing error' },
-  8: { 12: 'Drive follows command value', 13: 'Following error' },
-  9: { 12: 'Drive follows command value' },
-  10: { 12: 'Drive follows command value' },
-};
+function modeTitle(mode) {
+  const title = info.mode_names && info.mode_names[mode];
+  const short = info.modes && info.modes[mode];
+  return title ? `${title} (${short})` : String(mode);
+}
 
 function modeLabel(mode) {
   if (mode === null || mode === undefined) return '–';
-  const short = info.modes && info.modes[mode];
-  return MODE_NAMES[mode] ? `${mode} ${MODE_NAMES[mode]} (${short})` : String(mode);
+  return info.mode_names && info.mode_names[mode] ? `${mode} ${modeTitle(mode)}` : String(mode);
 }
 
-// Only where the profile leaves a bit to the mode ("Operation mode specific"): the DRIVECOM
-// profiles name their bits themselves.
+let namedForMode = null;
 function nameModeBits(mode) {
-  const rename = (selector, bits, overrides) => {
+  if (mode === namedForMode) return;
+  namedForMode = mode;
+  const overlay = (info.mode_bits && info.mode_bits[mode]) || { control: {}, status: {} };
+  const rename = (selector, bits, names) => {
     for (const b of bits) {
       const node = document.querySelector(`${selector}[data-bit="${b.bit}"] .name`);
-      if (!node || !/mode specific/i.test(b.name)) continue;
-      node.textContent = (overrides && overrides[b.bit]) || b.name;
+      if (!node) continue;
+      const name = names[b.bit] || b.name;
+      node.textContent = name;
+      node.parentElement.title = name === b.name ? '' : `${b.name}: in ${modeTitle(mode)}, ${name}`;
     }
   };
-  rename('#control-bits button', info.control_bits, MODE_CONTROL_BITS[mode]);
-  rename('#status-bits li', info.status_bits, MODE_STATUS_BITS[mode]);
+  rename('#control-bits button', info.control_bits, overlay.control);
+  rename('#status-bits li', info.status_bits, overlay.status);
+}
+
+// The set-point inputs of the mode the drive runs: velocity 0x60FF (pv, csv; and when the mode is
+// not known), position 0x607A (pp with the new set-point handshake, csp), torque 0x6071 (tq, cst),
+// homing method 0x6098 and homing start (hm).
+const SETPOINT_FORMS = {
+  velocity: ['target-form'],
+  position: ['position-form'],
+  pp: ['position-form', 'pp-options'],
+  torque: ['torque-form'],
+  homing: ['homing-form'],
+};
+function setpointKind(mode) {
+  switch (mode) {
+    case 1: return 'pp';
+    case 8: return 'position';
+    case 4: case 10: return 'torque';
+    case 6: return 'homing';
+    default: return 'velocity';
+  }
+}
+
+// A set-point checked against the object table's range before it is written, as the object form does.
+function setpointValue(inputId, index) {
+  const v = el(inputId).value.trim();
+  const what = `WRITE ${index} = ${v}: refused`;
+  if (!/^-?\d+$/.test(v)) {
+    showResult('refused', `${what}: the value must be an integer`);
+    return null;
+  }
+  const n = Number(v);
+  const o = info.objects.find((x) => x.index === index);
+  if (o && o.min !== undefined && (n < o.min || n > o.max)) {
+    showResult('refused', `${what}: outside ${o.min}..${o.max}`);
+    return null;
+  }
+  return n;
+}
+
+function controlBit(bit) {
+  return snapshot ? ((hexBits(snapshot.control_word) >> bit) & 1) === 1 : false;
+}
+
+function buildSetpoints() {
+  const handshake = info.new_setpoint === true;
+  el('position-form').addEventListener('submit', async (e) => {
+    e.preventDefault();
+    const n = setpointValue('position-input', '0x607A');
+    if (n === null) return;
+    const written = await post('/api/object', { index: '0x607A', value: n });
+    // Profile position takes the set-point with the handshake on bit 4; csp follows 0x607A as is.
+    if (written && handshake && snapshot && snapshot.mode === 1) {
+      post('/api/command', { command: 'new_setpoint' });
+    }
+  });
+  for (const [id, bit] of [['pp-relative', 6], ['pp-immediate', 5]]) {
+    el(id).addEventListener('change', (e) => {
+      touched[id] = performance.now();
+      if (e.target.checked !== controlBit(bit)) post('/api/command', { command: 'toggle_bit', bit });
+    });
+  }
+  el('torque-form').addEventListener('submit', (e) => {
+    e.preventDefault();
+    const n = setpointValue('torque-input', '0x6071');
+    if (n !== null) post('/api/object', { index: '0x6071', value: n });
+  });
+  const methods = el('homing-method');
+  const entry = info.objects.find((o) => o.index === '0x6098');
+  for (const m of entry ? entry.values : []) {
+    const opt = document.createElement('option');
+    opt.value = String(m);
+    opt.textContent = String(m);
+    methods.appendChild(opt);
+  }
+  methods.addEventListener('change', () => { touched['homing-method'] = performance.now(); });
+  // Homing operation start is bit 4 held up (CiA 402-2); taking it down interrupts the run.
+  el('homing-start').hidden = !handshake;
+  el('homing-form').addEventListener('submit', async (e) => {
+    e.preventDefault();
+    if (controlBit(4)) {
+      post('/api/command', { command: 'toggle_bit', bit: 4 });
+      return;
+    }
+    const method = Number(methods.value);
+    if (snapshot && snapshot.objects['0x6098'] !== method) {
+      if (!(await post('/api/object', { index: '0x6098', value: method }))) return;
+    }
+    if (handshake) post('/api/command', { command: 'toggle_bit', bit: 4 });
+  });
+}
+
+function showSetpoints(s) {
+  const mode = s.mode !== null && s.mode !== undefined ? s.mode : s.requested_mode;
+  const kind = setpointKind(mode);
+  const shown = new Set(SETPOINT_FORMS[kind]);
+  for (const ids of Object.values(SETPOINT_FORMS)) {
+    for (const id of ids) el(id).hidden = !shown.has(id);
+  }
+  el('position-go').textContent = kind === 'pp' && info.new_setpoint ? 'Move' : 'Set';
+  el('position-go').title = kind === 'pp' && info.new_setpoint
+    ? 'writes 0x607A, then bit 4 (new set-point) up until the drive acknowledges with status bit 12'
+    : 'writes 0x607A';
+  const cw = hexBits(s.control_word);
+  syncSwitch('pp-relative', ((cw >> 6) & 1) === 1);
+  syncSwitch('pp-immediate', ((cw >> 5) & 1) === 1);
+  const homing = el('homing-start');
+  const running = mode === 6 && ((cw >> 4) & 1) === 1;
+  homing.setAttribute('aria-pressed', running ? 'true' : 'false');
+  homing.textContent = running ? 'Stop homing' : 'Start homing';
+  const method = s.objects && s.objects['0x6098'];
+  if (method !== undefined && document.activeElement !== el('homing-method') &&
+      performance.now() - (touched['homing-method'] || 0) > 3000) {
+    el('homing-method').value = String(method);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -426,7 +534,7 @@ function buildModes() {
   for (const m of entry.values) {
     const opt = document.createElement('option');
     opt.value = String(m);
-    opt.textContent = MODE_NAMES[m] ? `${MODE_NAMES[m]} (${info.modes[m]})` : String(m);
+    opt.textContent = modeTitle(m);
     sel.appendChild(opt);
   }
   sel.addEventListener('change', () => post('/api/object', { index: '0x6060', value: Number(sel.value) }));
@@ -608,8 +716,10 @@ function update(s) {
   el('torque-actual').textContent =
     s.torque_actual === null || s.torque_actual === undefined ? '–' : s.torque_actual;
   nameModeBits(s.mode);
+  showSetpoints(s);
   const modeSelect = el('mode-select');
-  const requested = s.objects && s.objects['0x6060'];
+  const requested = s.requested_mode !== undefined && s.requested_mode !== null
+    ? s.requested_mode : s.objects && s.objects['0x6060'];
   if (requested !== undefined && document.activeElement !== modeSelect) modeSelect.value = String(requested);
   el('target').textContent = s.target_velocity;
   el('setpoint-note').textContent = s.effective_target !== s.target_velocity
@@ -861,7 +971,7 @@ async function pollRecording() {
     recorder.dropped = r.dropped_rows;
     for (const row of r.rows) {
       recorder.rows.push({ t: row[0], cw: row[1], sw: row[2], state: row[3], transition: row[4],
-        v: row[5] });
+        v: row[5], pos: row[6], tq: row[7] });
     }
     const newest = recorder.rows.length ? recorder.rows[recorder.rows.length - 1].t : 0;
     // Keep one row from before the window, so the lanes start at its left edge with a value.
@@ -975,6 +1085,28 @@ function drawTimeline() {
   });
   g.stroke();
 
+  // The position 0x6064, dashed on a scale of its own, where it moved in the window.
+  const positions = visible.map(([, , r]) => r.pos).filter((p) => p !== undefined && p !== null);
+  if (positions.length) {
+    let plo = Math.min(...positions), phi = Math.max(...positions);
+    if (phi > plo) {
+      const py = (p) => velTop + 3 + (1 - (p - plo) / (phi - plo)) * (velH - 6);
+      g.save();
+      g.setLineDash([5, 3]);
+      g.lineWidth = 1.5;
+      g.beginPath();
+      visible.forEach(([a, b, r], i) => {
+        if (i === 0) g.moveTo(x(a), py(r.pos)); else g.lineTo(x(a), py(r.pos));
+        if (i === visible.length - 1) g.lineTo(x(b), py(r.pos));
+      });
+      g.stroke();
+      g.restore();
+      g.fillStyle = ink;
+      g.textAlign = 'right';
+      g.fillText(`- - pos ${plo}..${phi}`, left - 6, velTop + velH / 2);
+    }
+  }
+
   const lane = (label, top, word, bit) => {
     g.fillStyle = ink;
     g.textAlign = 'right';
@@ -1083,6 +1215,7 @@ async function main() {
   buildCommands();
   buildObjects();
   buildModes();
+  buildSetpoints();
   buildPlant();
   setControl(info.control);
   applyCapabilities(info.capabilities);

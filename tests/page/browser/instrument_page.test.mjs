@@ -412,46 +412,113 @@ async function main() {
     await waitResult(page, 'WRITE 0x6083 = -5: refused: outside');
   });
 
-  await check('operation modes: pp from the page moves to 0x607A on bit 4, homing 37 sets the home offset', async () => {
+  const visible = (id) => page.evaluate((i) => {
+    const n = document.getElementById(i);
+    return !!n && !n.hidden && n.getBoundingClientRect().height > 0;
+  }, id);
+  const statusBitOn = (bit) => page.waitForFunction(
+    (b) => document.querySelector(`#status-bits li[data-bit="${b}"]`).classList.contains('on'), bit,
+    { timeout: 10000 });
+  const positionIs = (value) => page.waitForFunction(
+    (v) => document.getElementById('position').textContent === v, value, { timeout: 10000 });
+
+  await check('operation modes: the select offers the modes 0x6502 announces, by name', async () => {
+    const options = await page.$$eval('#mode-select option', (os) => os.map((o) => `${o.value} ${o.textContent}`));
+    expect(options.join('|') === '1 Profile position (pp)|3 Profile velocity (pv)|4 Profile torque (tq)|' +
+      '6 Homing (hm)|8 Cyclic synchronous position (csp)|9 Cyclic synchronous velocity (csv)|' +
+      '10 Cyclic synchronous torque (cst)', `modes offered: ${options.join('|')}`);
+    expect(await page.textContent('#mode') === '3 Profile velocity (pv)', 'pv at power-up');
+    expect(await visible('target-form') && !(await visible('position-form')), 'pv: the target velocity');
+    expect(await page.textContent('#status-bits li[data-bit="12"] .name') === 'Speed = 0', 'status bit 12 in pv');
+  });
+
+  await check('pp: a target and the new set-point handshake move the drive; the bits take pp names', async () => {
     await page.selectOption('#mode-select', '1');
     await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('1 '),
       null, { timeout: 8000 });
     expect(await page.textContent('#control-bits button[data-bit="4"] .name') === 'New set-point',
       'control bit 4 named for pp');
+    expect(await page.textContent('#control-bits button[data-bit="5"] .name') === 'Change set immediately',
+      'control bit 5 named for pp');
+    expect(await page.textContent('#control-bits button[data-bit="6"] .name') === 'Relative (0 absolute)',
+      'control bit 6 named for pp');
     expect(await page.textContent('#status-bits li[data-bit="12"] .name') === 'Set-point acknowledge',
       'status bit 12 named for pp');
+    expect(await page.textContent('#status-bits li[data-bit="10"] .name') === 'Target reached', 'status bit 10');
+    expect(await visible('position-form') && await visible('pp-options') && !(await visible('target-form')),
+      'pp: target position, relative and immediate instead of the target velocity');
     await click(page, 'shutdown');
     await expectPresentState(page, 'READY_TO_SWITCH_ON');
     await click(page, 'switch_on');
     await expectPresentState(page, 'SWITCHED_ON');
     await click(page, 'enable_operation');
     await expectPresentState(page, 'OPERATION_ENABLED');
-    await page.selectOption('#object-index', '0x607A');
-    await page.fill('#object-value', '20000');
-    await page.click('#object-form button');
-    await waitResult(page, 'WRITE 0x607A = 20000');
-    const bit4 = '#control-bits button[data-bit="4"]';
-    await page.click(bit4);
-    await page.waitForFunction(() => document.querySelector('#status-bits li[data-bit="12"]').classList.contains('on'),
+    await page.fill('#position-input', '20000');
+    await page.click('#position-go');
+    await waitResult(page, 'NEW SET-POINT: done: 0x607A = 20000');
+    await positionIs('20000');
+    await statusBitOn(10);
+    const cw = parseInt(await page.textContent('#cw-hex'), 16);
+    expect((cw & 0x10) === 0, `bit 4 down after the handshake, control word 0x${cw.toString(16)}`);
+    await page.click('label:has(#pp-relative)');
+    await page.waitForFunction(() => (parseInt(document.getElementById('cw-hex').textContent, 16) & 0x40) !== 0,
       null, { timeout: 8000 });
-    await page.click(bit4);
-    await page.waitForFunction(() => document.getElementById('position').textContent === '20000',
-      null, { timeout: 10000 });
+    await page.fill('#position-input', '-5000');
+    await page.click('#position-go');
+    await waitResult(page, 'relative');
+    await positionIs('15000');
+    await page.screenshot({ path: path.join(outDir, 'pp-1280x800.png'), fullPage: true });
+    await page.click('label:has(#pp-relative)');
+    await page.waitForFunction(() => (parseInt(document.getElementById('cw-hex').textContent, 16) & 0x40) === 0,
+      null, { timeout: 8000 });
+    expect(await diagramTop() === diagramAtStart, `diagram moved from ${diagramAtStart} to ${await diagramTop()}`);
+  });
+
+  await check('hm: homing method 37 and homing start set the position to the home offset', async () => {
     await page.selectOption('#mode-select', '6');
     await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('6 '),
       null, { timeout: 8000 });
     expect(await page.textContent('#status-bits li[data-bit="12"] .name') === 'Homing attained',
       'status bit 12 named for homing');
+    expect(await page.textContent('#status-bits li[data-bit="13"] .name') === 'Homing error',
+      'status bit 13 named for homing');
+    expect(await page.textContent('#control-bits button[data-bit="4"] .name') === 'Homing operation start',
+      'control bit 4 named for homing');
+    expect(await visible('homing-form') && !(await visible('position-form')), 'hm: the homing inputs');
     await page.selectOption('#object-index', '0x607C');
     await page.fill('#object-value', '777');
     await page.click('#object-form button');
     await waitResult(page, 'WRITE 0x607C = 777');
-    await page.click(bit4);
-    await page.waitForFunction(() => document.getElementById('position').textContent === '777',
+    await page.selectOption('#homing-method', '37');
+    await page.click('#homing-start');
+    await positionIs('777');
+    await statusBitOn(12);
+    await page.waitForFunction(() => document.getElementById('homing-start').textContent === 'Stop homing',
       null, { timeout: 8000 });
-    await page.click(bit4);
+    const method = await page.$eval('#object-values', (t) => [...t.querySelectorAll('tr')]
+      .find((r) => r.querySelector('th').textContent.startsWith('0x6098')).querySelector('td').textContent);
+    expect(method === '37', `0x6098 reads ${method}`);
+    await page.click('#homing-start');
+    await page.waitForFunction(() => document.getElementById('homing-start').textContent === 'Start homing',
+      null, { timeout: 8000 });
     await click(page, 'disable_voltage');
     await expectPresentState(page, 'SWITCH_ON_DISABLED');
+    await page.selectOption('#mode-select', '3');
+    await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('3 '),
+      null, { timeout: 8000 });
+    expect(await page.textContent('#control-bits button[data-bit="4"] .name') === 'Reserved in pv',
+      'control bit 4 back to pv');
+  });
+
+  await check('the recording exports position and torque as its last columns', async () => {
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#export-csv')]);
+    const file = path.join(outDir, 'modes-recording.csv');
+    await download.saveAs(file);
+    const lines = fs.readFileSync(file, 'utf8').trim().split('\n');
+    expect(lines[0].endsWith(',position,position_demand,torque_permille,mode'), `header ${lines[0]}`);
+    const positions = lines.slice(1).map((l) => l.split(',')).map((c) => Number(c[c.length - 4]));
+    expect(positions.includes(20000) && positions.includes(15000) && positions.includes(777),
+      'the recording holds the positions reached');
   });
 
   await check('phone width 390x844: one column, diagram first, nothing wider than the screen', async () => {

@@ -39,10 +39,11 @@ export CIA402_NODE_MODULES="$work/node_modules"
 export CIA402_CHROMIUM="$chromium"
 node "$here/instrument_page.test.mjs" "$cia402" "$work/output" "$screenshot"
 # With CIA402_UPDATE_SCREENSHOT=1 the docs' other pictures follow: phone width, several axes, the
-# recorder (the whole page at 1280 px).
+# recorder (the whole page at 1280 px), profile position after a move.
 if [ "${CIA402_UPDATE_SCREENSHOT:-0}" = 1 ]; then
   images=$(dirname "$screenshot")
   cp "$work/output/phone-390x844.png" "$images/instrument-page-phone.png"
   cp "$work/output/axes-1280x800.png" "$images/axes.png"
   cp "$work/output/full-1280.png" "$images/instrument-page-full.png"
+  cp "$work/output/pp-1280x800.png" "$images/instrument-page-pp.png"
 fi

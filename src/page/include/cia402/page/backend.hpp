@@ -78,6 +78,13 @@ class backend {
   virtual reply command(page_command c) = 0;
   /// Flips one bit (0..15) of the control word.
   virtual reply toggle_control_bit(int bit) = 0;
+  /// Profile position's set-point handshake (CiA 402-2): control bit 4 (new set-point) rises and
+  /// stays set until the drive acknowledges with status bit 12, then falls; bits 5, 6 and 9 are
+  /// sent as they stand. Refused (409) where the profile gives bit 4 a meaning of its own or the
+  /// drive runs another mode.
+  virtual reply new_setpoint() {
+    return refused{409, "this drive offers no new set-point handshake"};
+  }
   /// Writes an object (option codes, ramps, 0x60FF, ...). A write the drive refuses gives its SDO
   /// abort code and changes nothing.
   virtual reply write_object(std::uint16_t index, std::int64_t value) = 0;

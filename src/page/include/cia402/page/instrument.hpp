@@ -61,6 +61,8 @@ class instrument final : public backend {
   reply command(page_command c) override;
   /// Flips one bit (0..15) of the control word.
   reply toggle_control_bit(int bit) override;
+  /// Profile position's set-point handshake: bit 4 up until status bit 12, then down (backend.hpp).
+  reply new_setpoint() override;
   /// Starts again from power-up under another of the selectable profiles; the recording and the
   /// control word start over, the results say so.
   reply select_profile(std::string_view name) override;

@@ -14,7 +14,8 @@
 // Commands go out in RPDO1 (the word from cia402::encode_command, other bits kept; a fault reset is
 // bit 7 high for reset_pulse_us, then low); writes of objects and 0x60FF are SDO downloads through
 // the master and their refusals carry the drive's abort code; what no TPDO carries is polled every
-// poll_us. The transition numbers are inferred from the observed states (transition_inference.hpp)
+// poll_us, and the mode display and the actual position, torque and following error every
+// actual_poll_us (objects the drive lacks show as null). The transition numbers are inferred from the observed states (transition_inference.hpp)
 // and marked "inferred" in the snapshots.
 //
 // A lost heartbeat or any SDO timeout shows as status "no_answer" with "node N does not answer
@@ -48,6 +49,9 @@ struct remote_config {
   std::uint16_t guard_ms = 100;
   std::uint32_t retry_us = 1000000;       ///< set-up starts again this long after a failure
   std::uint32_t poll_us = 100000;         ///< SDO polling of what no TPDO carries
+  /// The mode display 0x6061 and the actual values 0x6064, 0x6077, 0x60F4 are read by SDO one after
+  /// the other, a round this often (0: never). An object the drive lacks is read no more (null).
+  std::uint32_t actual_poll_us = 100000;
   std::uint32_t publish_us = 40000;       ///< at most one snapshot this often, only on change
   std::uint32_t settle_quiet_us = 150000; ///< an action settles after this long without change
   std::uint32_t settle_limit_us = 15000000;
@@ -85,6 +89,9 @@ class remote_drive final : public backend {
 
   reply command(page_command c) override;
   reply toggle_control_bit(int bit) override;
+  /// Profile position's set-point handshake in RPDO1: bit 4 up until the drive's status bit 12, then
+  /// down (backend.hpp). The mode is checked against 0x6061 as last read.
+  reply new_setpoint() override;
   /// Blocks until the drive answered the SDO download (or it timed out).
   reply write_object(std::uint16_t index, std::int64_t value) override;
   /// Target velocity (SDO 0x60FF) or a fault (SDO 0x2001, on a `cia402 bus` node only), one per
