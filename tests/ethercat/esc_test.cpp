@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "cia402/ethercat/esc/esc.hpp"
@@ -302,6 +303,387 @@ TEST(frames, random_bytes_never_crash_and_never_touch_a_refused_frame) {
   }
   EXPECT_GT(sound, 0);
   EXPECT_EQ(b.wire.frames() + b.wire.refused_frames(), 20000u);
+}
+
+// ---- every command, its working counter, and what it does to the data --------------------------
+
+// One slave at station 0x1001 with a 4-byte output FMMU at logical 0x8000 onto 0x1100 and a 4-byte
+// input FMMU at the same logical address from 0x1180 (an LRW there writes the one and reads the other).
+bus one_configured_slave() {
+  bus b(1);
+  b.write16(command::apwr, ap(0, reg::station_address), 0x1001);
+  fmmu(b, 0, 0, 0x8000, 4, 0, 7, 0x1100, 0, 2);
+  fmmu(b, 0, 1, 0x8000, 4, 0, 7, 0x1180, 0, 1);
+  return b;
+}
+
+TEST(esc_commands, each_command_counts_as_etg_1000_4_says) {
+  struct row {
+    command cmd;
+    std::uint32_t address;
+    std::uint16_t wkc;
+    bool reads;  // the datagram comes back with the slave's data
+  };
+  const row rows[] = {
+      {command::nop, ap(0, 0x1000), 0, false},
+      {command::aprd, ap(0, 0x1000), 1, true},   {command::apwr, ap(0, 0x1000), 1, false},
+      {command::aprw, ap(0, 0x1000), 3, true},   {command::fprd, fp(0x1001, 0x1000), 1, true},
+      {command::fpwr, fp(0x1001, 0x1000), 1, false}, {command::fprw, fp(0x1001, 0x1000), 3, true},
+      {command::brd, 0x1000u << 16, 1, true},     {command::bwr, 0x1000u << 16, 1, false},
+      {command::brw, 0x1000u << 16, 3, true},     {command::lrd, 0x8000, 1, true},
+      {command::lwr, 0x8000, 1, false},           {command::lrw, 0x8000, 3, true},
+      {command::armw, ap(0, 0x1000), 1, true},    {command::frmw, fp(0x1001, 0x1000), 1, true},
+  };
+  for (const row& r : rows) {
+    bus b = one_configured_slave();
+    b.escs[0].write16(0x1000, 0xBEEF);
+    b.escs[0].write16(0x1180, 0xBEEF);
+    const result got = b.send(r.cmd, r.address, {0x11, 0x22, 0, 0});
+    SCOPED_TRACE(command_name(r.cmd));
+    EXPECT_EQ(got.wkc, r.wkc);
+    if (r.reads) {
+      // BRW/BRD OR the slave's data into what came: 0x11 | 0xEF, 0x22 | 0xBE.
+      const bool ors = r.cmd == command::brd || r.cmd == command::brw;
+      EXPECT_EQ(got.data[0], ors ? 0xFF : 0xEF);
+      EXPECT_EQ(got.data[1], ors ? 0xBE : 0xBE);
+    } else {
+      EXPECT_EQ(got.data[0], 0x11) << "a write leaves the data as it came";
+    }
+    const bool writes = r.cmd == command::apwr || r.cmd == command::aprw || r.cmd == command::fpwr ||
+                        r.cmd == command::fprw || r.cmd == command::bwr || r.cmd == command::brw;
+    EXPECT_EQ(b.escs[0].read16(0x1000), writes ? 0x2211 : 0xBEEF) << "read-write: the old value back, the new one in";
+    const bool logical_writes = r.cmd == command::lwr || r.cmd == command::lrw;
+    EXPECT_EQ(b.escs[0].read16(0x1100), logical_writes ? 0x2211 : 0);
+    EXPECT_EQ(b.escs[0].refused_accesses(), 0u);
+  }
+}
+
+TEST(esc_commands, a_chain_of_three_multiplies_the_broadcast_and_logical_counters) {
+  bus b(3);
+  for (int s = 0; s < 3; ++s) fmmu(b, s, 0, 0x100u + 2u * static_cast<std::uint32_t>(s), 2, 0, 7, 0x1100, 0, 3);
+  EXPECT_EQ(b.send(command::brd, reg::type << 16, {0}).wkc, 3);
+  EXPECT_EQ(b.send(command::bwr, 0x1000u << 16, {1}).wkc, 3);
+  EXPECT_EQ(b.send(command::brw, 0x1000u << 16, {1}).wkc, 9);
+  EXPECT_EQ(b.send(command::lrd, 0x100, std::vector<std::uint8_t>(6, 0)).wkc, 3);
+  EXPECT_EQ(b.send(command::lwr, 0x100, std::vector<std::uint8_t>(6, 0)).wkc, 3);
+  EXPECT_EQ(b.send(command::lrw, 0x100, std::vector<std::uint8_t>(6, 0)).wkc, 9) << "read-write FMMUs";
+  EXPECT_EQ(b.send(command::lrw, 0x102, {0, 0}).wkc, 3) << "only the second slave's part";
+}
+
+TEST(esc_commands, nop_and_unknown_commands_pass_untouched) {
+  bus b(2);
+  const result nop = b.send(command::nop, ap(0, reg::type), {7, 7});
+  EXPECT_EQ(nop.wkc, 0);
+  EXPECT_EQ(nop.adp, 0) << "NOP leaves ADP";
+  EXPECT_EQ(nop.data, (std::vector<std::uint8_t>{7, 7}));
+  const result unknown = b.send(static_cast<command>(0x0F), ap(0, reg::type), {7, 7});
+  EXPECT_EQ(unknown.wkc, 0);
+  EXPECT_EQ(unknown.data, (std::vector<std::uint8_t>{7, 7}));
+  for (const esc& e : b.escs) EXPECT_EQ(e.errors().unknown_command, 1u);
+}
+
+TEST(esc_commands, frmw_reads_at_the_station_and_writes_the_others) {
+  bus b(3);
+  for (std::uint16_t i = 0; i < 3; ++i) b.write16(command::apwr, ap(i, reg::station_address), 0x1001 + i);
+  b.escs[1].write16(reg::dc_receive_time, 0x5150);
+  const result r = b.send(command::frmw, fp(0x1002, reg::dc_receive_time), {0, 0});
+  EXPECT_EQ(r.wkc, 3);
+  EXPECT_EQ(b.value16(r), 0x5150);
+  EXPECT_EQ(b.escs[0].read16(reg::dc_receive_time), 0) << "before the reader: the master's data";
+  EXPECT_EQ(b.escs[2].read16(reg::dc_receive_time), 0x5150);
+}
+
+TEST(esc_commands, a_write_past_the_memory_changes_nothing_and_is_counted_by_kind) {
+  bus b = one_configured_slave();
+  b.escs[0].write8(0x1FFF, 0x42);
+  EXPECT_EQ(b.send(command::fpwr, fp(0x1001, 0x1FFF), {1, 2}).wkc, 0);
+  EXPECT_EQ(b.send(command::bwr, 0xFFF0u << 16, {1, 2}).wkc, 0);
+  EXPECT_EQ(b.escs[0].read8(0x1FFF), 0x42);
+  // An FMMU whose physical end lies past the memory.
+  fmmu(b, 0, 2, 0x9000, 4, 0, 7, 0x1FFE, 0, 2);
+  EXPECT_EQ(b.send(command::lwr, 0x9000, {1, 2, 3, 4}).wkc, 0);
+  EXPECT_EQ(b.escs[0].read8(0x1FFF), 0x42);
+  EXPECT_EQ(b.escs[0].errors().past_memory, 3u);
+  EXPECT_EQ(b.escs[0].errors().sync_manager, 0u);
+}
+
+TEST(esc_commands, an_fmmu_cannot_write_what_the_master_may_not) {
+  bus b(1);
+  const std::uint16_t status = b.escs[0].read16(reg::al_status);
+  fmmu(b, 0, 0, 0x4000, 2, 0, 7, reg::al_status, 0, 2);
+  EXPECT_EQ(b.send(command::lwr, 0x4000, {0x08, 0}).wkc, 1);
+  EXPECT_EQ(b.escs[0].read16(reg::al_status), status);
+  // A read FMMU on the status of sync manager 1 (the "mailbox full" bit), as masters map it.
+  sync_manager(b, 1, 0x1080, 16, 0x22);
+  fmmu(b, 0, 1, 0x4010, 1, 3, 3, reg::sync_manager0 + 8 + reg::sm_status, 3, 1);
+  EXPECT_EQ(b.send(command::lrd, 0x4010, {0}).data[0], 0);
+  ASSERT_TRUE(b.escs[0].write_mailbox(1, {1, 2, 3}));
+  EXPECT_EQ(b.send(command::lrd, 0x4010, {0}).data[0], 0x08);
+  // Nor can a datagram write a sync manager's status or PDI control bytes.
+  EXPECT_EQ(b.send(command::apwr, ap(0, reg::sync_manager0 + 8 + reg::sm_status), {0}).wkc, 1);
+  EXPECT_TRUE(b.escs[0].mailbox_full(1));
+  EXPECT_NE(b.escs[0].read8(reg::sync_manager0 + 8 + reg::sm_status) & 0x08, 0);
+}
+
+TEST(esc_commands, al_control_and_sync_manager_events_show_in_the_al_event_register) {
+  bus b(1);
+  sync_manager(b, 0, 0x1000, 8, 0x26);
+  b.write16(command::apwr, ap(0, reg::al_control), 2);
+  EXPECT_EQ(b.escs[0].read16(reg::al_event_request) & 0x0001, 1);
+  EXPECT_TRUE(b.escs[0].take_al_control_event());
+  EXPECT_EQ(b.escs[0].read16(reg::al_event_request) & 0x0001, 0);
+  b.send(command::apwr, ap(0, 0x1000), std::vector<std::uint8_t>(8, 1));
+  EXPECT_EQ(b.escs[0].read16(reg::al_event_request), 0x0100) << "SM 0";
+  EXPECT_TRUE(b.escs[0].take_sync_manager_event(0));
+  EXPECT_EQ(b.escs[0].read16(reg::al_event_request), 0);
+}
+
+TEST(esc_commands, the_application_may_deactivate_a_sync_manager) {
+  bus b(1);
+  sync_manager(b, 0, 0x1000, 8, 0x26);
+  EXPECT_TRUE(b.escs[0].sm(0).enabled);
+  b.escs[0].write8(reg::sync_manager0 + reg::sm_pdi_control, 1);
+  EXPECT_FALSE(b.escs[0].sm(0).enabled);
+  b.escs[0].write8(reg::sync_manager0 + reg::sm_pdi_control, 0);
+  EXPECT_TRUE(b.escs[0].sm(0).enabled);
+}
+
+TEST(esc, the_watchdog_counts_in_units_of_40_ns_times_divider_plus_2) {
+  bus b(1);
+  b.escs[0].write16(reg::watchdog_divider, 98);               // (98 + 2) x 40 ns = 4 us
+  b.escs[0].write16(reg::watchdog_time_process_data, 250);    // 1 ms
+  sync_manager(b, 2, 0x1100, 2, 0x64);
+  b.send(command::apwr, ap(0, 0x1100), {1, 2});
+  b.escs[0].advance(999'000);
+  EXPECT_FALSE(b.escs[0].take_watchdog_event());
+  b.escs[0].advance(2'000);
+  EXPECT_TRUE(b.escs[0].take_watchdog_event());
+  EXPECT_EQ(b.escs[0].read16(reg::watchdog_status_process_data) & 1, 0);
+  b.escs[0].advance(10'000'000);
+  EXPECT_FALSE(b.escs[0].take_watchdog_event()) << "expired once, until outputs come again";
+  b.escs[0].write16(reg::watchdog_time_process_data, 0);     // 0: the watchdog is off
+  b.send(command::apwr, ap(0, 0x1100), {1, 2});
+  b.escs[0].advance(1'000'000'000);
+  EXPECT_FALSE(b.escs[0].take_watchdog_event());
+}
+
+// ---- three-buffer process data ------------------------------------------------------------------
+
+std::vector<std::uint8_t> pdi_bytes(const esc& e, std::uint16_t at, std::size_t n) {
+  std::vector<std::uint8_t> v(n);
+  for (std::size_t i = 0; i < n; ++i) v[i] = e.read8(static_cast<std::uint16_t>(at + i));
+  return v;
+}
+
+TEST(three_buffers, the_application_sees_whole_output_buffers_only) {
+  bus b(1);
+  sync_manager(b, 2, 0x1100, 4, 0x64);
+  esc& e = b.escs[0];
+  EXPECT_EQ(e.read8(reg::sync_manager0 + 16 + reg::sm_status) >> 4, 3) << "no buffer written yet";
+  EXPECT_EQ(b.send(command::apwr, ap(0, 0x1100), {1, 2, 3, 4}).wkc, 1);
+  EXPECT_TRUE(e.take_sync_manager_event(2));
+  EXPECT_EQ(pdi_bytes(e, 0x1100, 4), (std::vector<std::uint8_t>{1, 2, 3, 4}));
+  EXPECT_NE(e.read8(reg::sync_manager0 + 16 + reg::sm_status) >> 4, 3);
+  // The master writes a second buffer whole and begins a third: the application, taking the event,
+  // gets the second, never half of the third.
+  b.send(command::apwr, ap(0, 0x1100), {5, 6, 7, 8});
+  b.send(command::apwr, ap(0, 0x1100), {9, 9});
+  EXPECT_EQ(pdi_bytes(e, 0x1100, 4), (std::vector<std::uint8_t>{1, 2, 3, 4})) << "held until taken";
+  EXPECT_TRUE(e.take_sync_manager_event(2));
+  EXPECT_EQ(pdi_bytes(e, 0x1100, 4), (std::vector<std::uint8_t>{5, 6, 7, 8}));
+  b.send(command::apwr, ap(0, 0x1102), {10, 11});  // the third buffer's last byte: complete
+  std::vector<std::uint8_t> got(4);
+  ASSERT_TRUE(e.read_buffer(2, got));
+  EXPECT_EQ(got, (std::vector<std::uint8_t>{9, 9, 10, 11}));
+  EXPECT_FALSE(e.read_buffer(3, got)) << "no such sync manager";
+  std::vector<std::uint8_t> wrong(3);
+  EXPECT_FALSE(e.read_buffer(2, wrong)) << "not its length";
+}
+
+TEST(three_buffers, the_master_reads_one_whole_input_buffer_across_datagrams) {
+  bus b(1);
+  sync_manager(b, 3, 0x1180, 4, 0x20);
+  esc& e = b.escs[0];
+  ASSERT_TRUE(e.write_buffer(3, std::vector<std::uint8_t>{1, 2, 3, 4}));
+  const result first = b.send(command::aprd, ap(0, 0x1180), {0, 0});
+  EXPECT_EQ(first.data, (std::vector<std::uint8_t>{1, 2}));
+  ASSERT_TRUE(e.write_buffer(3, std::vector<std::uint8_t>{5, 6, 7, 8}));
+  const result second = b.send(command::aprd, ap(0, 0x1182), {0, 0});
+  EXPECT_EQ(second.data, (std::vector<std::uint8_t>{3, 4})) << "the buffer it opened, not the newer one";
+  EXPECT_EQ(b.send(command::aprd, ap(0, 0x1180), {0, 0, 0, 0}).data, (std::vector<std::uint8_t>{5, 6, 7, 8}));
+  // Bytes the application writes one by one reach the master at its next read, and the bytes it
+  // did not write keep their values.
+  e.write8(0x1181, 0x66);
+  EXPECT_EQ(e.read8(0x1181), 0x66) << "the application reads back what it wrote";
+  EXPECT_EQ(b.send(command::aprd, ap(0, 0x1180), {0, 0, 0, 0}).data, (std::vector<std::uint8_t>{5, 0x66, 7, 8}));
+  // The master does not write the slave's inputs.
+  EXPECT_EQ(b.send(command::apwr, ap(0, 0x1180), {0, 0, 0, 0}).wkc, 0);
+  EXPECT_EQ(e.errors().sync_manager, 1u);
+  std::vector<std::uint8_t> out(4);
+  EXPECT_FALSE(e.read_buffer(3, out)) << "inputs are written, not read, by the application";
+  EXPECT_FALSE(e.write_buffer(3, std::vector<std::uint8_t>{1})) << "not its length";
+}
+
+TEST(three_buffers, sync_managers_packed_without_room_for_three_buffers_work) {
+  bus b(1);
+  // A master placing SM3 right after SM2's length (a real ESC would need 3 x 4 bytes for SM2).
+  sync_manager(b, 2, 0x1100, 4, 0x64);
+  sync_manager(b, 3, 0x1104, 4, 0x20);
+  fmmu(b, 0, 0, 0x10000, 4, 0, 7, 0x1100, 0, 2);
+  fmmu(b, 0, 1, 0x10004, 4, 0, 7, 0x1104, 0, 1);
+  esc& e = b.escs[0];
+  for (std::uint8_t cycle = 1; cycle <= 3; ++cycle) {
+    ASSERT_TRUE(e.write_buffer(3, std::vector<std::uint8_t>{cycle, 0, 0, 0xAA}));
+    const result r = b.send(command::lrw, 0x10000, {cycle, 1, 2, 3, 0, 0, 0, 0});
+    EXPECT_EQ(r.wkc, 3);
+    EXPECT_EQ(r.data[4], cycle);
+    EXPECT_EQ(r.data[7], 0xAA);
+    EXPECT_TRUE(e.take_sync_manager_event(2));
+    EXPECT_EQ(pdi_bytes(e, 0x1100, 4), (std::vector<std::uint8_t>{cycle, 1, 2, 3}));
+  }
+}
+
+TEST(three_buffers, outputs_at_bit_offsets_through_an_fmmu_land_in_the_buffer) {
+  bus b(1);
+  sync_manager(b, 2, 0x1100, 1, 0x64);
+  // A 3-bit field at logical bit 5 to physical bits 2..4 of the output buffer (its only byte).
+  fmmu(b, 0, 0, 0x3000, 1, 5, 7, 0x1100, 2, 2);
+  EXPECT_EQ(b.send(command::lwr, 0x3000, {0xA0}).wkc, 1);  // bits 5..7 = 101
+  EXPECT_TRUE(b.escs[0].take_sync_manager_event(2));
+  EXPECT_EQ(b.escs[0].read8(0x1100), 0x14);
+}
+
+// ---- frames ---------------------------------------------------------------------------------------
+
+TEST(frames, vlan_tags_and_a_broken_more_follows_chain_are_refused_by_kind) {
+  bus b(1);
+  frame_builder fb(broadcast, master_mac);
+  fb.add(command::bwr, 0, reg::dl_control << 16, std::vector<std::uint8_t>{9, 9}, 2);
+  const std::vector<std::uint8_t> good = fb.finish();
+  std::vector<std::uint8_t> vlan = good;
+  vlan[12] = 0x81;
+  vlan[13] = 0x00;
+  EXPECT_EQ(b.wire.pass(vlan), frame_error::vlan_tagged);
+  std::vector<std::uint8_t> more = good;
+  more[ethernet_header_size + ethercat_header_size + 7] |= 0x80;  // "more follows", and nothing does
+  EXPECT_EQ(b.wire.pass(more), frame_error::more_follows_past_end);
+  EXPECT_EQ(more[ethernet_header_size + ethercat_header_size + 10], 9) << "untouched";
+  std::vector<std::uint8_t> empty = good;
+  empty[14] = 0;
+  empty[15] = 0x10;  // length 0: not even one datagram
+  EXPECT_EQ(b.wire.pass(empty), frame_error::datagram_truncated);
+  std::vector<std::uint8_t> data_too_long = good;
+  data_too_long[ethernet_header_size + ethercat_header_size + 6] = 0x40;  // 64 data bytes in a 14-byte datagram
+  EXPECT_EQ(b.wire.pass(data_too_long), frame_error::datagram_truncated);
+  EXPECT_EQ(b.wire.refused_frames(frame_error::vlan_tagged), 1u);
+  EXPECT_EQ(b.wire.refused_frames(frame_error::more_follows_past_end), 1u);
+  EXPECT_EQ(b.wire.refused_frames(frame_error::datagram_truncated), 2u);
+  EXPECT_EQ(b.escs[0].read16(reg::dl_control), 0);
+  EXPECT_STRNE(frame_error_text(frame_error::more_follows_past_end), "?");
+  EXPECT_STRNE(frame_error_text(frame_error::vlan_tagged), "?");
+}
+
+TEST(frames, the_builder_chains_datagrams_and_pads_to_the_ethernet_minimum) {
+  frame_builder fb(broadcast, master_mac);
+  fb.add(command::aprd, 1, ap(0, reg::type), {}, 1);
+  fb.add(command::fprd, 2, fp(0x1001, reg::al_status), {}, 2);
+  std::vector<std::uint8_t> f = fb.finish();
+  EXPECT_EQ(f.size(), minimum_frame_size);
+  parsed_frame p;
+  ASSERT_EQ(parse_frame(f, p), frame_error::none);
+  ASSERT_EQ(p.count, 2u);
+  EXPECT_TRUE(p.datagrams[0].more);
+  EXPECT_FALSE(p.datagrams[1].more);
+  EXPECT_EQ(p.datagrams[1].cmd, command::fprd);
+  EXPECT_EQ(p.datagrams[1].index, 2);
+  EXPECT_EQ(p.datagrams[1].position(), 0x1001);
+  EXPECT_EQ(p.datagrams[1].offset(), reg::al_status);
+  EXPECT_EQ(p.datagrams[1].length, 2);
+  EXPECT_EQ(std::string(command_name(command::frmw)), "FRMW");
+  frame_builder big(broadcast, master_mac);
+  EXPECT_GE(big.add(command::lrw, 0, 0, {}, 1400), 0);
+  EXPECT_EQ(big.add(command::lrw, 0, 0, {}, 200), -1) << "past 1514 bytes";
+}
+
+// Snapshot of everything the application can see.
+std::vector<std::uint8_t> snapshot(const esc& e) { return pdi_bytes(e, 0, esc::memory_size); }
+
+TEST(frames, random_sound_frames_never_crash_and_refused_ones_change_nothing) {
+  bus b(3);
+  // Something for the datagrams to hit: station addresses, mailboxes, buffered SMs, FMMUs.
+  for (std::uint16_t i = 0; i < 3; ++i) {
+    b.write16(command::apwr, ap(i, reg::station_address), 0x1001 + i);
+    fmmu(b, i, 0, 0x10000u + 4u * i, 4, 3, 2, 0x1100, 1, 3);
+  }
+  const auto every_sync_manager = [&](int n, std::uint16_t start, std::uint16_t len, std::uint8_t control) {
+    std::vector<std::uint8_t> sm{static_cast<std::uint8_t>(start), static_cast<std::uint8_t>(start >> 8),
+                                 static_cast<std::uint8_t>(len), 0, control, 0, 1, 0};
+    EXPECT_EQ(b.send(command::bwr, static_cast<std::uint32_t>(reg::sync_manager0 + 8 * n) << 16, sm).wkc, 3);
+  };
+  every_sync_manager(0, 0x1000, 32, 0x26);
+  every_sync_manager(1, 0x1040, 32, 0x22);
+  every_sync_manager(2, 0x1100, 4, 0x64);
+  every_sync_manager(3, 0x1180, 4, 0x20);
+  std::mt19937 random(4020);
+  const auto pick = [&](std::uint32_t n) { return static_cast<std::uint32_t>(random() % n); };
+  const std::uint16_t addresses[] = {0x0000, 0x0010, 0x0120, 0x0500, 0x0502, 0x0600, 0x0800, 0x0806,
+                                     0x1000, 0x1040, 0x1100, 0x1180, 0x1FF0, 0x0FFE};
+  int refused = 0;
+  for (int i = 0; i < 4000; ++i) {
+    frame_builder fb(broadcast, master_mac);
+    const std::uint32_t n = 1 + pick(4);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const auto cmd = static_cast<command>(pick(16));
+      const std::uint16_t offset = static_cast<std::uint16_t>(addresses[pick(14)] + pick(8));
+      const std::uint16_t adp = pick(2) ? static_cast<std::uint16_t>(-static_cast<int>(pick(4)))
+                                        : static_cast<std::uint16_t>(0x1000 + pick(4));
+      const std::uint32_t address = pick(4) == 0 ? 0x10000u + pick(16) : adp | (std::uint32_t{offset} << 16);
+      std::vector<std::uint8_t> data(pick(40));
+      for (auto& byte : data) byte = static_cast<std::uint8_t>(random());
+      fb.add(cmd, 0, address, data, static_cast<std::uint16_t>(data.size()));
+    }
+    std::vector<std::uint8_t> f = fb.finish();
+    // One in four is damaged: a byte of its headers changed, or cut short.
+    const bool damage = pick(4) == 0;
+    if (damage) {
+      if (pick(2)) {
+        f[12 + pick(static_cast<std::uint32_t>(std::min<std::size_t>(f.size() - 12, 30)))] ^=
+            static_cast<std::uint8_t>(1u << pick(8));
+      } else {
+        f.resize(pick(static_cast<std::uint32_t>(f.size())));
+      }
+    }
+    std::array<std::vector<std::uint8_t>, 3> before;
+    const bool check = damage;
+    if (check) {
+      for (std::size_t s = 0; s < 3; ++s) before[s] = snapshot(b.escs[s]);
+    }
+    const std::vector<std::uint8_t> sent = f;
+    const frame_error e = b.wire.pass(f);
+    if (!damage) {
+      EXPECT_EQ(e, frame_error::none);
+    }
+    if (e != frame_error::none) {
+      ++refused;
+      EXPECT_EQ(f, sent) << "a refused frame comes back untouched";
+      for (std::size_t s = 0; s < 3; ++s) EXPECT_EQ(snapshot(b.escs[s]), before[s]) << "refused frame " << i;
+    }
+    // The application runs between frames.
+    for (esc& s : b.escs) {
+      std::vector<std::uint8_t> m;
+      if (s.read_mailbox(0, m) && !s.mailbox_full(1)) (void)s.write_mailbox(1, m);
+      (void)s.take_sync_manager_event(2);
+      (void)s.write_buffer(3, std::vector<std::uint8_t>{static_cast<std::uint8_t>(i), 0, 0, 0});
+      (void)s.take_al_control_event();
+      s.advance(pick(1'000'000));
+    }
+  }
+  EXPECT_GT(refused, 100);
+  for (const esc& s : b.escs) {
+    EXPECT_EQ(s.read8(reg::type), 0xC0) << "identity never written";
+    EXPECT_EQ(s.read8(reg::fmmus_supported), esc::fmmu_count);
+    EXPECT_GT(s.refused_accesses(), 0u) << "some datagrams hit the end of memory or a mailbox";
+  }
 }
 
 }  // namespace

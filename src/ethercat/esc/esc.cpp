@@ -22,8 +22,13 @@ constexpr std::uint16_t eeprom_error_command = 1u << 13;
 constexpr std::uint8_t sm_status_mailbox_full = 1u << 3;
 
 // The registers a master may write; everything else (identity, DL and AL status, watchdog status,
-// the EEPROM's status bits) keeps its value, while the datagram still counts as served.
+// the EEPROM's status bits, a sync manager's status and PDI control) keeps its value, while the
+// datagram still counts as served.
 bool master_writable(std::uint16_t a) noexcept {
+  if (a >= reg::sync_manager0 && a < reg::sync_manager0 + 8 * esc::sync_manager_count) {
+    const unsigned within = (a - reg::sync_manager0) % 8u;
+    return within != reg::sm_status && within != reg::sm_pdi_control;
+  }
   return (a >= 0x0010 && a <= 0x0013) || (a >= 0x0100 && a <= 0x0103) || (a >= 0x0120 && a <= 0x0121) ||
          (a >= 0x0200 && a <= 0x0203) || (a >= 0x0300 && a <= 0x030F) || (a >= 0x0400 && a <= 0x0401) ||
          (a >= 0x0410 && a <= 0x0421) || a == 0x0500 || a == 0x0502 || a == 0x0503 ||
@@ -62,15 +67,139 @@ esc::esc(std::vector<std::uint8_t> eeprom) : eeprom_(std::move(eeprom)) {
   write16(reg::eeprom_control, eeprom_read_8_bytes);
 }
 
-std::uint8_t esc::read8(std::uint16_t a) const noexcept { return a < memory_size ? memory_[a] : 0; }
+// ---- three buffers ---------------------------------------------------------------------------
+
+std::uint8_t* esc::buffer(const sm_state& s, std::uint8_t which) noexcept {
+  return which == 0 ? memory_.data() + s.config.start
+                    : shadow_[which - 1u].data() + (s.config.start - reg::process_ram);
+}
+const std::uint8_t* esc::buffer(const sm_state& s, std::uint8_t which) const noexcept {
+  return which == 0 ? memory_.data() + s.config.start
+                    : shadow_[which - 1u].data() + (s.config.start - reg::process_ram);
+}
+
+const esc::sm_state* esc::triple_at(std::uint16_t address) const noexcept {
+  if (address < reg::process_ram) return nullptr;
+  for (const sm_state& s : sms_) {
+    if (s.triple && address >= s.config.start && address - s.config.start < s.config.length) return &s;
+  }
+  return nullptr;
+}
+
+bool esc::any_triple_in(std::uint16_t address, std::uint16_t length) const noexcept {
+  for (const sm_state& s : sms_) {
+    if (s.triple && overlaps(address, length, s.config.start, s.config.length)) return true;
+  }
+  return false;
+}
+
+std::uint8_t* esc::ecat_byte(std::uint16_t address) noexcept {
+  const sm_state* s = triple_at(address);
+  if (s == nullptr) return memory_.data() + address;
+  // The master writes into the writer's buffer of its outputs and reads the buffer it opened of
+  // the inputs (and, reading its own outputs back, what it is writing).
+  const std::uint8_t which = s->config.ecat_writes() ? s->writer : s->reader;
+  return buffer(*s, which) + (address - s->config.start);
+}
+
+void esc::publish(int n) noexcept {
+  sm_state& s = sms_[static_cast<std::size_t>(n)];
+  std::swap(s.writer, s.ready);
+  s.fresh = true;
+  s.published = true;
+  s.written = false;
+  // The writer goes on from what it published, so bytes it does not write keep their values.
+  std::memcpy(buffer(s, s.writer), buffer(s, s.ready), s.config.length);
+  show_buffer_state(n);
+}
+
+void esc::take_newest(int n) noexcept {
+  sm_state& s = sms_[static_cast<std::size_t>(n)];
+  if (!s.fresh) return;
+  std::swap(s.reader, s.ready);
+  s.fresh = false;
+  show_buffer_state(n);
+}
+
+void esc::show_buffer_state(int n) noexcept {
+  const sm_state& s = sms_[static_cast<std::size_t>(n)];
+  // Status bits 4..5: the buffer last written (0..2), 3 when none was yet.
+  const std::uint8_t last = !s.published ? 3 : (s.fresh ? s.ready : s.reader);
+  std::uint8_t& status = memory_[static_cast<std::size_t>(reg::sync_manager0 + 8 * n + reg::sm_status)];
+  status = static_cast<std::uint8_t>((status & 0x0F) | (last << 4));
+}
+
+void esc::configure_sync_manager(int n, bool reset) noexcept {
+  sm_state& s = sms_[static_cast<std::size_t>(n)];
+  const auto base = static_cast<std::size_t>(reg::sync_manager0 + 8 * n);
+  sync_manager c;
+  c.start = static_cast<std::uint16_t>(memory_[base] | (memory_[base + 1] << 8));
+  c.length = static_cast<std::uint16_t>(memory_[base + 2] | (memory_[base + 3] << 8));
+  c.control = memory_[base + reg::sm_control];
+  // Enabled by the master (activate bit 0) and not deactivated by the application (PDI control bit 0).
+  c.enabled = (memory_[base + reg::sm_activate] & 1u) != 0 && (memory_[base + reg::sm_pdi_control] & 1u) == 0 &&
+              c.length != 0;
+  const bool changed = c.start != s.config.start || c.length != s.config.length || c.control != s.config.control ||
+                       c.enabled != s.config.enabled;
+  if (!reset && !changed) return;
+  s = sm_state{};
+  s.config = c;
+  s.triple = c.enabled && c.buffered() && c.start >= reg::process_ram &&
+             std::uint32_t{c.start} + c.length <= memory_size;
+  memory_[base + reg::sm_status] = 0;
+  memory_[reg::al_event_request + 1] = static_cast<std::uint8_t>(memory_[reg::al_event_request + 1] & ~(1u << n));
+  if (s.triple) {
+    // All three buffers start as process RAM holds it.
+    for (auto& shadow : shadow_) std::memcpy(shadow.data() + (c.start - reg::process_ram), memory_.data() + c.start, c.length);
+    show_buffer_state(n);
+  }
+}
+
+void esc::raise_sync_manager_event(int n) noexcept {
+  sms_[static_cast<std::size_t>(n)].event = true;
+  memory_[reg::al_event_request + 1] = static_cast<std::uint8_t>(memory_[reg::al_event_request + 1] | (1u << n));
+}
+
+// ---- the application (PDI) side --------------------------------------------------------------
+
+std::uint8_t esc::read8(std::uint16_t a) const noexcept {
+  if (a >= memory_size) return 0;
+  if (const sm_state* s = triple_at(a)) {
+    const std::uint8_t which = s->config.ecat_writes() ? s->reader : s->writer;
+    return buffer(*s, which)[a - s->config.start];
+  }
+  return memory_[a];
+}
 std::uint16_t esc::read16(std::uint16_t a) const noexcept {
   return static_cast<std::uint16_t>(read8(a) | (read8(static_cast<std::uint16_t>(a + 1)) << 8));
 }
 std::uint32_t esc::read32(std::uint16_t a) const noexcept {
   return read16(a) | (static_cast<std::uint32_t>(read16(static_cast<std::uint16_t>(a + 2))) << 16);
 }
+
 void esc::write8(std::uint16_t a, std::uint8_t v) noexcept {
-  if (a < memory_size) memory_[a] = v;
+  if (a >= memory_size) return;
+  if (a >= reg::process_ram) {
+    for (int n = 0; n < sync_manager_count; ++n) {
+      sm_state& s = sms_[static_cast<std::size_t>(n)];
+      if (!s.triple || a < s.config.start || a - s.config.start >= s.config.length) continue;
+      const auto at = static_cast<std::size_t>(a - s.config.start);
+      if (s.config.ecat_writes()) {
+        buffer(s, s.reader)[at] = v;  // the outputs it holds: its own copy to scribble on
+        return;
+      }
+      buffer(s, s.writer)[at] = v;
+      s.written = true;
+      if (at + 1 == s.config.length) publish(n);  // the last byte closes the buffer, as on an ESC
+      return;
+    }
+    memory_[a] = v;
+    return;
+  }
+  memory_[a] = v;
+  if (a >= reg::sync_manager0 && a < reg::sync_manager0 + 8 * sync_manager_count) {
+    configure_sync_manager((a - reg::sync_manager0) / 8, false);
+  }
 }
 void esc::write16(std::uint16_t a, std::uint16_t v) noexcept {
   write8(a, static_cast<std::uint8_t>(v));
@@ -89,22 +218,22 @@ void esc::set_next_port_open(bool open) noexcept {
   write16(reg::dl_status, dl);
 }
 
-bool esc::take_al_control_event() noexcept { return std::exchange(al_control_event_, false); }
+bool esc::take_al_control_event() noexcept {
+  memory_[reg::al_event_request] = static_cast<std::uint8_t>(memory_[reg::al_event_request] & ~1u);
+  return std::exchange(al_control_event_, false);
+}
 bool esc::take_watchdog_event() noexcept { return std::exchange(watchdog_event_, false); }
 bool esc::take_sync_manager_event(int n) noexcept {
   if (n < 0 || n >= sync_manager_count) return false;
-  return std::exchange(sms_[static_cast<std::size_t>(n)].event, false);
+  sm_state& s = sms_[static_cast<std::size_t>(n)];
+  memory_[reg::al_event_request + 1] = static_cast<std::uint8_t>(memory_[reg::al_event_request + 1] & ~(1u << n));
+  if (s.triple && s.config.ecat_writes()) take_newest(n);
+  return std::exchange(s.event, false);
 }
 
 esc::sync_manager esc::sm(int n) const noexcept {
-  sync_manager s;
-  if (n < 0 || n >= sync_manager_count) return s;
-  const auto base = static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n);
-  s.start = read16(base);
-  s.length = read16(static_cast<std::uint16_t>(base + 2));
-  s.control = read8(static_cast<std::uint16_t>(base + 4));
-  s.enabled = (read8(static_cast<std::uint16_t>(base + 6)) & 1u) != 0 && s.length != 0;
-  return s;
+  if (n < 0 || n >= sync_manager_count) return sync_manager{};
+  return sms_[static_cast<std::size_t>(n)].config;
 }
 
 bool esc::mailbox_full(int n) const noexcept {
@@ -113,78 +242,121 @@ bool esc::mailbox_full(int n) const noexcept {
 
 bool esc::read_mailbox(int n, std::vector<std::uint8_t>& out) noexcept {
   const sync_manager s = sm(n);
-  if (!s.enabled || !s.mailbox() || !s.ecat_writes() || !mailbox_full(n)) return false;
+  if (!s.enabled || !s.mailbox() || !s.ecat_writes() || !mailbox_full(n) ||
+      std::uint32_t{s.start} + s.length > memory_size) {
+    return false;
+  }
   out.assign(memory_.begin() + s.start, memory_.begin() + s.start + s.length);
   sms_[static_cast<std::size_t>(n)].full = false;
-  const auto status = static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n + 5);
-  write8(status, static_cast<std::uint8_t>(read8(status) & ~sm_status_mailbox_full));
+  auto& status = memory_[static_cast<std::size_t>(reg::sync_manager0 + 8 * n + reg::sm_status)];
+  status = static_cast<std::uint8_t>(status & ~sm_status_mailbox_full);
   return true;
 }
 
 bool esc::write_mailbox(int n, const std::vector<std::uint8_t>& data) noexcept {
   const sync_manager s = sm(n);
-  if (!s.enabled || !s.mailbox() || s.ecat_writes() || mailbox_full(n) || data.size() > s.length) return false;
+  if (!s.enabled || !s.mailbox() || s.ecat_writes() || mailbox_full(n) || data.size() > s.length ||
+      std::uint32_t{s.start} + s.length > memory_size) {
+    return false;
+  }
   std::fill(memory_.begin() + s.start, memory_.begin() + s.start + s.length, std::uint8_t{0});
   std::copy(data.begin(), data.end(), memory_.begin() + s.start);
   sms_[static_cast<std::size_t>(n)].full = true;
-  const auto status = static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n + 5);
-  write8(status, static_cast<std::uint8_t>(read8(status) | sm_status_mailbox_full));
+  auto& status = memory_[static_cast<std::size_t>(reg::sync_manager0 + 8 * n + reg::sm_status)];
+  status = static_cast<std::uint8_t>(status | sm_status_mailbox_full);
   return true;
 }
 
+bool esc::read_buffer(int n, std::span<std::uint8_t> out) noexcept {
+  if (n < 0 || n >= sync_manager_count) return false;
+  const sm_state& s = sms_[static_cast<std::size_t>(n)];
+  if (!s.triple || !s.config.ecat_writes() || out.size() != s.config.length) return false;
+  take_newest(n);
+  std::memcpy(out.data(), buffer(s, s.reader), out.size());
+  return true;
+}
+
+bool esc::write_buffer(int n, std::span<const std::uint8_t> in) noexcept {
+  if (n < 0 || n >= sync_manager_count) return false;
+  const sm_state& s = sms_[static_cast<std::size_t>(n)];
+  if (!s.triple || s.config.ecat_writes() || in.size() != s.config.length) return false;
+  std::memcpy(buffer(s, s.writer), in.data(), in.size());
+  publish(n);
+  return true;
+}
+
+// ---- the EtherCAT side -----------------------------------------------------------------------
+
 bool esc::sync_managers_allow(std::uint16_t address, std::uint16_t length, bool read, bool write) const noexcept {
-  for (int n = 0; n < sync_manager_count; ++n) {
-    const sync_manager s = sm(n);
+  for (const sm_state& st : sms_) {
+    const sync_manager& s = st.config;
     if (!s.enabled || !overlaps(address, length, s.start, s.length)) continue;
     if (s.ecat_writes()) {
       // The master's outputs or its mailbox: a full mailbox takes nothing until the slave read it.
-      if (write && s.mailbox() && sms_[static_cast<std::size_t>(n)].full) return false;
+      if (write && s.mailbox() && st.full) return false;
     } else {
       // The slave's inputs or mailbox: the master only reads, a mailbox only when it is full.
       if (write) return false;
-      if (read && s.mailbox() && !sms_[static_cast<std::size_t>(n)].full) return false;
+      if (read && s.mailbox() && !st.full) return false;
     }
   }
   return true;
 }
 
+void esc::before_ecat_access(std::uint16_t address, std::uint16_t length, bool read) noexcept {
+  if (!read) return;
+  for (int n = 0; n < sync_manager_count; ++n) {
+    sm_state& s = sms_[static_cast<std::size_t>(n)];
+    if (!s.triple || s.config.ecat_writes()) continue;
+    // Reading the first byte of the inputs opens the newest buffer; the master keeps it until it
+    // opens the next, however many datagrams it reads it in.
+    if (s.config.start < address || s.config.start - address >= length) continue;
+    if (s.written) publish(n);  // what the application wrote by now, even without its last byte
+    take_newest(n);
+  }
+}
+
 void esc::after_ecat_access(std::uint16_t address, std::uint16_t length, bool read, bool write) noexcept {
   for (int n = 0; n < sync_manager_count; ++n) {
-    const sync_manager s = sm(n);
+    sm_state& st = sms_[static_cast<std::size_t>(n)];
+    const sync_manager& s = st.config;
     if (!s.enabled || !overlaps(address, length, s.start, s.length)) continue;
     const std::uint32_t last = std::uint32_t{s.start} + s.length - 1u;
     const bool covers_last = address <= last && last < std::uint32_t{address} + length;
-    sm_state& st = sms_[static_cast<std::size_t>(n)];
-    const auto status = static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n + 5);
+    auto& status = memory_[static_cast<std::size_t>(reg::sync_manager0 + 8 * n + reg::sm_status)];
     if (s.ecat_writes() && write && covers_last) {
       // The buffer is complete when its last byte is written (mailbox full, new outputs).
       if (s.mailbox()) {
         st.full = true;
-        write8(status, static_cast<std::uint8_t>(read8(status) | sm_status_mailbox_full));
+        status = static_cast<std::uint8_t>(status | sm_status_mailbox_full);
       }
-      st.event = true;
+      if (st.triple) publish(n);
+      raise_sync_manager_event(n);
       if (s.watchdog_trigger()) {
         since_trigger_ns_ = 0;
-        write16(reg::watchdog_status_process_data, 1);
+        memory_[reg::watchdog_status_process_data] |= 1u;
       }
     }
     if (!s.ecat_writes() && read && covers_last && s.mailbox()) {
       st.full = false;  // read by the master: the slave may write the next one
-      write8(status, static_cast<std::uint8_t>(read8(status) & ~sm_status_mailbox_full));
-      st.event = true;
+      status = static_cast<std::uint8_t>(status & ~sm_status_mailbox_full);
+      raise_sync_manager_event(n);
     }
   }
 }
 
 void esc::register_written(std::uint16_t address, std::uint16_t length) noexcept {
   const auto touched = [&](std::uint16_t a, std::uint16_t n) { return overlaps(address, length, a, n); };
-  if (touched(reg::al_control, 2)) al_control_event_ = true;
-  for (int n = 0; n < sync_manager_count; ++n) {
-    // A sync manager configured (again) starts empty.
-    const auto base = static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n);
-    if (touched(base, 5) || touched(static_cast<std::uint16_t>(base + 6), 1)) {
-      sms_[static_cast<std::size_t>(n)] = sm_state{};
-      write8(static_cast<std::uint16_t>(base + 5), 0);
+  if (touched(reg::al_control, 2)) {
+    al_control_event_ = true;
+    memory_[reg::al_event_request] |= 1u;
+  }
+  if (touched(reg::sync_manager0, 8 * sync_manager_count)) {
+    for (int n = 0; n < sync_manager_count; ++n) {
+      // A sync manager configured (again), or its activation written, starts empty.
+      const auto base = static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n);
+      const bool reset = touched(base, 5) || touched(static_cast<std::uint16_t>(base + reg::sm_activate), 1);
+      if (reset) configure_sync_manager(n, true);
     }
   }
   if (touched(reg::eeprom_control + 1, 1)) {
@@ -195,7 +367,7 @@ void esc::register_written(std::uint16_t address, std::uint16_t length) noexcept
       const std::uint64_t word = read32(reg::eeprom_address);
       for (std::uint16_t i = 0; i < 8; ++i) {
         const std::uint64_t at = word * 2 + i;
-        write8(static_cast<std::uint16_t>(reg::eeprom_data + i), at < eeprom_.size() ? eeprom_[at] : 0xFF);
+        memory_[reg::eeprom_data + i] = at < eeprom_.size() ? eeprom_[at] : 0xFF;
       }
     } else if (cmd != 0 && cmd != 0x0400) {
       control |= eeprom_error_command;  // writes are not offered: the image is the drive's own
@@ -207,25 +379,42 @@ void esc::register_written(std::uint16_t address, std::uint16_t length) noexcept
 bool esc::ecat_access(std::uint16_t address, std::uint8_t* data, std::uint16_t length, bool read, bool write,
                       bool or_read) noexcept {
   if (std::uint32_t{address} + length > memory_size) {
-    ++refused_;
+    ++errors_.past_memory;
     return false;
   }
   if (!sync_managers_allow(address, length, read, write)) {
-    ++refused_;
+    ++errors_.sync_manager;
     return false;
   }
-  // Read before write, so a read-write returns what was there.
-  std::array<std::uint8_t, 2048> incoming{};
-  if (write) std::memcpy(incoming.data(), data, length);
+  before_ecat_access(address, length, read);
+  // Plain memory (no buffered sync manager in the range) is copied at once; otherwise byte by
+  // byte, each to the buffer it belongs to.
+  const bool plain = !any_triple_in(address, length);
+  // Read before write, so a read-write returns what was there and writes what came.
+  std::array<std::uint8_t, 2048> incoming;  // a datagram carries at most 2047 bytes
+  const std::uint8_t* source = data;
+  if (read && write) {
+    std::memcpy(incoming.data(), data, length);
+    source = incoming.data();
+  }
   if (read) {
-    for (std::uint16_t i = 0; i < length; ++i) {
-      data[i] = or_read ? static_cast<std::uint8_t>(data[i] | memory_[address + i]) : memory_[address + i];
+    if (plain && !or_read) {
+      std::memcpy(data, memory_.data() + address, length);
+    } else {
+      for (std::uint16_t i = 0; i < length; ++i) {
+        const std::uint8_t m = plain ? memory_[address + i] : *ecat_byte(static_cast<std::uint16_t>(address + i));
+        data[i] = or_read ? static_cast<std::uint8_t>(data[i] | m) : m;
+      }
     }
   }
   if (write) {
-    for (std::uint16_t i = 0; i < length; ++i) {
-      const auto a = static_cast<std::uint16_t>(address + i);
-      if (master_writable(a)) memory_[a] = incoming[i];
+    if (plain && address >= reg::process_ram) {
+      std::memcpy(memory_.data() + address, source, length);
+    } else {
+      for (std::uint16_t i = 0; i < length; ++i) {
+        const auto a = static_cast<std::uint16_t>(address + i);
+        if (master_writable(a)) *(plain ? memory_.data() + a : ecat_byte(a)) = source[i];
+      }
     }
     if (address < reg::process_ram) register_written(address, length);
   }
@@ -243,16 +432,17 @@ void esc::logical(datagram& d, bool read, bool write) noexcept {
     const bool writing = pass == 0;
     if (writing ? !write : !read) continue;
     for (int i = 0; i < fmmu_count; ++i) {
-      const auto base = static_cast<std::uint16_t>(reg::fmmu0 + 16 * i);
-      if ((read8(static_cast<std::uint16_t>(base + 12)) & 1u) == 0) continue;  // not active
-      const std::uint8_t type = read8(static_cast<std::uint16_t>(base + 11));
+      const auto base = static_cast<std::size_t>(reg::fmmu0 + 16 * i);
+      const std::uint8_t* f = memory_.data() + base;
+      if ((f[12] & 1u) == 0) continue;  // not active
+      const std::uint8_t type = f[11];
       if (writing ? (type & 2u) == 0 : (type & 1u) == 0) continue;
-      const std::uint32_t log_start = read32(base);
-      const std::uint16_t log_len = read16(static_cast<std::uint16_t>(base + 4));
-      const std::uint8_t start_bit = read8(static_cast<std::uint16_t>(base + 6)) & 7u;
-      const std::uint8_t end_bit = read8(static_cast<std::uint16_t>(base + 7)) & 7u;
-      const std::uint16_t phys = read16(static_cast<std::uint16_t>(base + 8));
-      const std::uint8_t phys_bit = read8(static_cast<std::uint16_t>(base + 10)) & 7u;
+      const std::uint32_t log_start = f[0] | (f[1] << 8) | (f[2] << 16) | (static_cast<std::uint32_t>(f[3]) << 24);
+      const auto log_len = static_cast<std::uint16_t>(f[4] | (f[5] << 8));
+      const std::uint8_t start_bit = f[6] & 7u;
+      const std::uint8_t end_bit = f[7] & 7u;
+      const auto phys = static_cast<std::uint16_t>(f[8] | (f[9] << 8));
+      const std::uint8_t phys_bit = f[10] & 7u;
       if (log_len == 0) continue;
       const std::uint64_t f_first = std::uint64_t{log_start} * 8 + start_bit;
       const std::uint64_t f_end = (std::uint64_t{log_start} + log_len - 1) * 8 + end_bit + 1;
@@ -263,17 +453,19 @@ void esc::logical(datagram& d, bool read, bool write) noexcept {
       const std::uint64_t bits = end - first;
       const std::uint64_t phys_end_byte = (phys_first + bits + 7) / 8;
       if (phys_end_byte > memory_size) {
-        ++refused_;
+        ++errors_.past_memory;
         continue;
       }
       const auto phys_byte = static_cast<std::uint16_t>(phys_first / 8);
       const auto phys_bytes = static_cast<std::uint16_t>(phys_end_byte - phys_byte);
       if (!sync_managers_allow(phys_byte, phys_bytes, !writing, writing)) {
-        ++refused_;
+        ++errors_.sync_manager;
         continue;
       }
+      before_ecat_access(phys_byte, phys_bytes, !writing);
+      const bool plain = phys_byte >= reg::process_ram && !any_triple_in(phys_byte, phys_bytes);
       const auto dg_bit = static_cast<std::uint32_t>(first - dg_first);
-      if ((first % 8) == 0 && (phys_first % 8) == 0 && (bits % 8) == 0) {
+      if (plain && (first % 8) == 0 && (phys_first % 8) == 0 && (bits % 8) == 0) {
         std::uint8_t* mem = memory_.data() + phys_first / 8;
         std::uint8_t* dat = d.data + dg_bit / 8;
         if (writing) {
@@ -282,13 +474,15 @@ void esc::logical(datagram& d, bool read, bool write) noexcept {
           std::memcpy(dat, mem, bits / 8);
         }
       } else {
+        // Bit by bit, each byte where it belongs (a buffer, or a register the master may write).
         for (std::uint64_t b = 0; b < bits; ++b) {
           const auto p = static_cast<std::uint32_t>(phys_first + b);
           const auto g = static_cast<std::uint32_t>(dg_bit + b);
+          const auto byte = static_cast<std::uint16_t>(p / 8);
           if (writing) {
-            set_bit(memory_.data(), p, get_bit(d.data, g));
+            if (master_writable(byte)) set_bit(ecat_byte(byte), p % 8, get_bit(d.data, g));
           } else {
-            set_bit(d.data, g, get_bit(memory_.data(), p));
+            set_bit(d.data, g, get_bit(ecat_byte(byte), p % 8));
           }
         }
       }
@@ -350,7 +544,7 @@ void esc::process(datagram& d) noexcept {
     case command::lrw:
       logical(d, c != command::lwr, c != command::lrd);
       return;
-    default: ++refused_; return;  // not a command: the datagram passes untouched
+    default: ++errors_.unknown_command; return;  // not a command: the datagram passes untouched
   }
   if (!addressed) return;
   if (!ecat_access(d.offset(), d.data, d.length, read, write, or_read)) return;
@@ -367,7 +561,7 @@ void esc::advance(std::uint64_t ns) noexcept {
   const std::uint64_t unit_ns = (std::uint64_t{read16(reg::watchdog_divider)} + 2) * 40;
   const std::uint64_t limit = std::uint64_t{read16(reg::watchdog_time_process_data)} * unit_ns;
   bool armed = false;
-  for (int n = 0; n < sync_manager_count; ++n) armed = armed || (sm(n).enabled && sm(n).watchdog_trigger());
+  for (const sm_state& s : sms_) armed = armed || (s.config.enabled && s.config.watchdog_trigger());
   if (!armed || limit == 0) {
     since_trigger_ns_ = 0;
     return;
@@ -391,6 +585,7 @@ frame_error chain::pass(std::vector<std::uint8_t>& frame) noexcept {
   const frame_error e = parse_frame(frame, parsed_);
   if (e != frame_error::none) {
     ++refused_frames_;
+    ++refused_by_[static_cast<std::size_t>(e)];
     return e;
   }
   for (esc* s : escs_) s->process(parsed_);

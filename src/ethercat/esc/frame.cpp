@@ -25,9 +25,11 @@ const char* frame_error_text(frame_error e) noexcept {
     case frame_error::none: return "no error";
     case frame_error::too_short: return "frame shorter than its headers";
     case frame_error::not_ethercat: return "not an EtherCAT frame (EtherType 0x88A4)";
+    case frame_error::vlan_tagged: return "VLAN-tagged frame (not supported)";
     case frame_error::not_commands: return "EtherCAT header type is not 1 (datagrams)";
     case frame_error::length_mismatch: return "EtherCAT length runs past the frame";
     case frame_error::datagram_truncated: return "a datagram runs past the EtherCAT length";
+    case frame_error::more_follows_past_end: return "a datagram says more follow, but the EtherCAT length ends";
     case frame_error::too_many_datagrams: return "more datagrams than a frame may carry";
   }
   return "?";
@@ -44,7 +46,9 @@ frame_error parse_frame(std::span<std::uint8_t> frame, parsed_frame& out) noexce
   out.count = 0;
   if (frame.size() < ethernet_header_size + ethercat_header_size) return frame_error::too_short;
   // The EtherType travels big-endian, unlike everything inside the frame.
-  if (frame[12] != (ethertype >> 8) || frame[13] != (ethertype & 0xFF)) return frame_error::not_ethercat;
+  const auto type = static_cast<std::uint16_t>((frame[12] << 8) | frame[13]);
+  if (type == 0x8100 || type == 0x88A8) return frame_error::vlan_tagged;
+  if (type != ethertype) return frame_error::not_ethercat;
   const std::uint16_t header = le16(frame.data() + ethernet_header_size);
   const std::size_t length = header & 0x07FFu;
   if ((header >> 12) != 1) return frame_error::not_commands;
@@ -59,8 +63,9 @@ frame_error parse_frame(std::span<std::uint8_t> frame, parsed_frame& out) noexce
       return frame_error::too_many_datagrams;
     }
     if (at + datagram_header_size > end) {
+      // The first datagram must fit; a later one is here only because the one before said so.
       out.count = 0;
-      return frame_error::datagram_truncated;
+      return at == start ? frame_error::datagram_truncated : frame_error::more_follows_past_end;
     }
     datagram& d = out.datagrams[out.count];
     std::uint8_t* h = frame.data() + at;

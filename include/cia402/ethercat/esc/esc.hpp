@@ -2,21 +2,33 @@
 // reads and writes with datagrams, as an ET1100-class controller has them, and the side a slave's
 // application (its "PDI") sees. What the controller does by itself lives here: addressing and
 // working counters, the configured station address, FMMUs mapping logical to physical memory at
-// bit granularity, sync managers (mailbox hand-over; buffered process data), the SII EEPROM
+// bit granularity, sync managers (mailbox hand-over; three-buffer process data), the SII EEPROM
 // interface, DL status, the process data watchdog. What a slave decides (the AL state machine, what
 // a mailbox means, process data contents) is the application's: it reads the events this
 // controller raises and answers through the PDI calls.
 //
 // Memory: registers 0x0000..0x0FFF, process RAM 0x1000..0x1FFF (4 KiB). No distributed clocks: the
-// ESC features register (0x0008) and the SII say so, so masters skip them. Buffered (three-buffer)
-// sync managers: frames and the application's cycle alternate in one thread here, so the master
-// always sees a whole buffer the application wrote, and the application a whole buffer a frame
-// wrote; the status register reports buffer changes as a real ESC does.
+// ESC features register (0x0008) and the SII say so, so masters skip them.
+//
+// Buffered (three-buffer) sync managers, as on a real ESC: the writer (the master for outputs, the
+// application for inputs) fills a buffer of its own, which is published whole when its last byte
+// is written; the reader keeps the buffer it opened until it opens the next (the master by reading
+// the first byte, the application by taking the sync manager's event or read_buffer()). So a master
+// reading or writing a buffer in several datagrams, and an application stepping between frames,
+// always see a whole buffer. Unlike a real ESC, the three buffers do not take 3 x length bytes of
+// process RAM: the second and third live beside it, so a master that places the next sync manager
+// right after the first length works too. And, because the application of this project writes
+// bytes in any order, what it wrote is also published when the master opens the buffer; a writer
+// goes on from the buffer it published (the bytes it does not write keep their values).
+//
+// Nothing on the per-frame path allocates or throws: bad input is refused, counted (errors()) and
+// leaves memory as it was.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "cia402/ethercat/esc/frame.hpp"
@@ -43,6 +55,7 @@ inline constexpr std::uint16_t al_status_code = 0x0134;
 inline constexpr std::uint16_t pdi_control = 0x0140;
 inline constexpr std::uint16_t event_mask = 0x0200;
 inline constexpr std::uint16_t event_request = 0x0210;
+inline constexpr std::uint16_t al_event_request = 0x0220;  ///< PDI side: bit 0 AL control, bit 8+n SM n
 inline constexpr std::uint16_t rx_errors = 0x0300;
 inline constexpr std::uint16_t watchdog_divider = 0x0400;
 inline constexpr std::uint16_t watchdog_time_pdi = 0x0410;
@@ -55,6 +68,11 @@ inline constexpr std::uint16_t eeprom_address = 0x0504;
 inline constexpr std::uint16_t eeprom_data = 0x0508;
 inline constexpr std::uint16_t fmmu0 = 0x0600;   ///< 16 bytes each
 inline constexpr std::uint16_t sync_manager0 = 0x0800;  ///< 8 bytes each
+/// Within a sync manager's 8 bytes: start (2), length (2), control, status, activate, PDI control.
+inline constexpr std::uint16_t sm_control = 4;
+inline constexpr std::uint16_t sm_status = 5;
+inline constexpr std::uint16_t sm_activate = 6;
+inline constexpr std::uint16_t sm_pdi_control = 7;
 inline constexpr std::uint16_t dc_receive_time = 0x0900;
 inline constexpr std::uint16_t process_ram = 0x1000;
 }  // namespace reg
@@ -65,6 +83,7 @@ enum class al_state : std::uint8_t { init = 1, pre_operational = 2, bootstrap = 
 class esc {
  public:
   static constexpr std::size_t memory_size = 0x2000;
+  static constexpr std::size_t process_ram_size = memory_size - reg::process_ram;
   static constexpr int fmmu_count = 8;
   static constexpr int sync_manager_count = 8;
 
@@ -90,6 +109,8 @@ class esc {
   std::uint16_t read16(std::uint16_t address) const noexcept;
   std::uint32_t read32(std::uint16_t address) const noexcept;
   /// PDI writes: any register the application owns (AL status and code, process RAM, ...).
+  /// Inside a buffered sync manager both go to the application's buffer: reads see the outputs it
+  /// took last, writes fill the inputs the master reads next (see the top of this file).
   void write8(std::uint16_t address, std::uint8_t v) noexcept;
   void write16(std::uint16_t address, std::uint16_t v) noexcept;
   /// The present AL status and code, as the application sets them.
@@ -98,7 +119,8 @@ class esc {
   /// What changed since the application last asked (each call clears it).
   bool take_al_control_event() noexcept;
   /// The master wrote the whole of this (ECAT-written) sync manager's buffer: a mailbox became full,
-  /// or new outputs arrived.
+  /// or new outputs arrived (then the application's reads in it see that newest buffer from now),
+  /// or it read the whole of the slave's mailbox.
   bool take_sync_manager_event(int n) noexcept;
   /// The process data watchdog expired (the master stopped writing outputs).
   bool take_watchdog_event() noexcept;
@@ -110,6 +132,7 @@ class esc {
     std::uint8_t control = 0;
     bool enabled = false;
     bool mailbox() const noexcept { return (control & 0x03) == 0x02; }
+    bool buffered() const noexcept { return (control & 0x03) == 0x00; }  ///< three buffers
     bool ecat_writes() const noexcept { return (control & 0x0C) == 0x04; }
     bool watchdog_trigger() const noexcept { return (control & 0x40) != 0; }
   };
@@ -119,35 +142,72 @@ class esc {
   /// Fills a mailbox the master reads (marks it full). False when it is still full or too short.
   bool write_mailbox(int n, const std::vector<std::uint8_t>& data) noexcept;
   bool mailbox_full(int n) const noexcept;
+  /// The newest whole buffer of outputs (a buffered sync manager the master writes) into `out`, of
+  /// the sync manager's length. False, and nothing copied, when n is not such a sync manager or the
+  /// size differs. Later reads (read8) see the same buffer.
+  bool read_buffer(int n, std::span<std::uint8_t> out) noexcept;
+  /// A whole buffer of inputs (a buffered sync manager the master reads), published at once.
+  bool write_buffer(int n, std::span<const std::uint8_t> in) noexcept;
 
-  /// Datagrams refused for a reason a master should hear about (past the memory, a mailbox the
-  /// master may not access now); the frame went on.
-  std::uint32_t refused_accesses() const noexcept { return refused_; }
+  /// Datagrams this controller refused, by reason; each left memory and the working counter as they
+  /// were, and the frame went on.
+  struct error_counters {
+    std::uint32_t past_memory = 0;      ///< a physical access (or an FMMU's target) beyond 0x1FFF
+    std::uint32_t sync_manager = 0;     ///< a full mailbox written, an empty one read, a read-only buffer written
+    std::uint32_t unknown_command = 0;  ///< a command byte no command has
+  };
+  const error_counters& errors() const noexcept { return errors_; }
+  std::uint32_t refused_accesses() const noexcept {
+    return errors_.past_memory + errors_.sync_manager + errors_.unknown_command;
+  }
   /// Tells the controller whether a slave follows it (the DL status shows port 1 open or closed).
   void set_next_port_open(bool open) noexcept;
 
  private:
   struct sm_state {
+    sync_manager config;      // decoded from 0x0800 + 8 n whenever those registers change
+    bool triple = false;      // buffered and inside process RAM: three buffers
     bool full = false;        // mailbox: written by one side, not yet read by the other
     bool event = false;
+    // Three buffers: 0 is process RAM at config.start, 1 and 2 lie beside it (shadow_). The writer
+    // fills `writer`, `ready` is the newest it published, the reader holds `reader`.
+    std::uint8_t writer = 0, ready = 1, reader = 2;
+    bool fresh = false;       // `ready` is newer than `reader`
+    bool written = false;     // the application wrote into its (input) buffer since publishing
+    bool published = false;   // any buffer was published since the configuration
   };
 
-  // An access of the master to physical memory: false when a sync manager refuses it (no change).
+  std::uint8_t* buffer(const sm_state& s, std::uint8_t which) noexcept;
+  const std::uint8_t* buffer(const sm_state& s, std::uint8_t which) const noexcept;
+  // The sync manager (three-buffer) whose area holds this byte, or nullptr.
+  const sm_state* triple_at(std::uint16_t address) const noexcept;
+  bool any_triple_in(std::uint16_t address, std::uint16_t length) const noexcept;
+  // Where the master's access of this byte lands (its own buffer inside a buffered sync manager).
+  std::uint8_t* ecat_byte(std::uint16_t address) noexcept;
+  void publish(int n) noexcept;        // the writer's buffer becomes the newest
+  void take_newest(int n) noexcept;    // the reader moves to the newest buffer
+  void show_buffer_state(int n) noexcept;
+  void configure_sync_manager(int n, bool reset) noexcept;
+  void raise_sync_manager_event(int n) noexcept;
+
+  // An access of the master to physical memory: false when refused (no change, counted).
   bool ecat_access(std::uint16_t address, std::uint8_t* data, std::uint16_t length, bool read, bool write,
                    bool or_read) noexcept;
   bool sync_managers_allow(std::uint16_t address, std::uint16_t length, bool read, bool write) const noexcept;
+  void before_ecat_access(std::uint16_t address, std::uint16_t length, bool read) noexcept;
   void after_ecat_access(std::uint16_t address, std::uint16_t length, bool read, bool write) noexcept;
   void register_written(std::uint16_t address, std::uint16_t length) noexcept;
   // Logical addressing through the FMMUs: how many FMMUs of each kind the datagram reached.
   void logical(datagram& d, bool read, bool write) noexcept;
 
   std::array<std::uint8_t, memory_size> memory_{};
+  std::array<std::array<std::uint8_t, process_ram_size>, 2> shadow_{};  // buffers 1 and 2
   std::vector<std::uint8_t> eeprom_;
   std::array<sm_state, sync_manager_count> sms_{};
   bool al_control_event_ = false;
   bool watchdog_event_ = false;
   std::uint64_t since_trigger_ns_ = 0;
-  std::uint32_t refused_ = 0;
+  error_counters errors_{};
 };
 
 /// The in-process wire: a chain of controllers a frame passes in order, and comes back from.
@@ -160,12 +220,18 @@ class chain {
   frame_error pass(std::vector<std::uint8_t>& frame) noexcept;
   std::uint64_t frames() const noexcept { return frames_; }
   std::uint64_t refused_frames() const noexcept { return refused_frames_; }
+  /// Refused frames of one kind.
+  std::uint64_t refused_frames(frame_error why) const noexcept {
+    const auto i = static_cast<std::size_t>(why);
+    return i < frame_error_count ? refused_by_[i] : 0;
+  }
 
  private:
   std::vector<esc*> escs_;
   parsed_frame parsed_;
   std::uint64_t frames_ = 0;
   std::uint64_t refused_frames_ = 0;
+  std::array<std::uint64_t, frame_error_count> refused_by_{};
 };
 
 }  // namespace cia402::ethercat

@@ -55,13 +55,17 @@ struct datagram {
 /// Why a frame was refused. Nothing in it is touched then.
 enum class frame_error : std::uint8_t {
   none,
-  too_short,            ///< shorter than the Ethernet and EtherCAT headers
-  not_ethercat,         ///< another EtherType (VLAN tags included: not supported)
-  not_commands,         ///< EtherCAT header type other than 1 (datagrams)
-  length_mismatch,      ///< the EtherCAT header's length runs past the frame
-  datagram_truncated,   ///< a datagram's data or working counter runs past the EtherCAT length
+  too_short,              ///< shorter than the Ethernet and EtherCAT headers
+  not_ethercat,           ///< another EtherType
+  vlan_tagged,            ///< an 802.1Q/802.1ad tag before the EtherType: not supported here
+  not_commands,           ///< EtherCAT header type other than 1 (datagrams)
+  length_mismatch,        ///< the EtherCAT header's length runs past the frame
+  datagram_truncated,     ///< a datagram's data or working counter runs past the EtherCAT length
+  more_follows_past_end,  ///< "more follows" set, but the EtherCAT length ends there
   too_many_datagrams,
 };
+/// How many kinds of frame_error there are (for counters indexed by it).
+inline constexpr std::size_t frame_error_count = static_cast<std::size_t>(frame_error::too_many_datagrams) + 1;
 const char* frame_error_text(frame_error e) noexcept;
 
 /// The datagrams of a frame, at most max_datagrams, pointing into `frame`.
@@ -71,7 +75,8 @@ struct parsed_frame {
 };
 
 /// Parses a whole Ethernet frame. The chain of datagrams ends at the first without "more follows";
-/// bytes after it (padding) are ignored.
+/// bytes after it, inside the EtherCAT length or not, are ignored (padding: a real ESC forwards
+/// them untouched too). On an error `out.count` is 0 and nothing was written.
 frame_error parse_frame(std::span<std::uint8_t> frame, parsed_frame& out) noexcept;
 
 /// Builds frames: datagrams are appended, then finish() writes the EtherCAT length and pads to the
