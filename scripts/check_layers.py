@@ -38,6 +38,8 @@ LAYERS = [
     ("ethercat/coe", "src/ethercat/coe/"),
     ("ethercat/402", "include/cia402/ethercat/402/"),
     ("ethercat/402", "src/ethercat/402/"),
+    ("ethercat/master", "include/cia402/ethercat/master/"),
+    ("ethercat/master", "src/ethercat/master/"),
     ("apps", "include/cia402/apps/"),
     ("apps", "src/apps/"),
     ("page", "src/page/"),
@@ -69,13 +71,14 @@ ALLOWED = {
     "ethercat/coe": {"core", "canopen/301", "canopen/can"},
     "ethercat/402": {"core", "support", "sim", "motion", "canopen/can", "canopen/301", "canopen/306",
                      "canopen/402", "ethercat/esc", "ethercat/sii", "ethercat/coe"},
-    "apps": {"ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/402", "sim", "motion", "support",
+    "ethercat/master": {"core", "ethercat/esc", "ethercat/sii"},
+    "apps": {"ethercat/master", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/402", "sim", "motion", "support",
              "core", "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402"},
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
              "canopen/301", "canopen/306", "canopen/transport", "canopen/402"},
     "tools": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
               "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "apps", "page",
-              "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/402"},
+              "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/402", "ethercat/master"},
 }
 
 # Where a quoted include is looked for, after the including file's own folder.

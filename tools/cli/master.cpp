@@ -738,11 +738,19 @@ int run_csp_stream(bus_session& session, const master_args& a, const profile& p,
 CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
   auto* cmd = app.add_subcommand(
       "master",
-      "Drive one CiA 402 drive over CANopen: NMT start, PDO set-up over SDO, then the master step over "
-      "PDOs with SYNC");
-  cmd->add_option("--can", args.can,
-                  "socketcand://HOST:PORT/BUS, socketcan://IFACE, or virtual (a virtual drive in-process)")
-      ->default_str("virtual");
+      "Drive one CiA 402 drive over CANopen (NMT start, PDO set-up over SDO, then the master step over "
+      "PDOs with SYNC), or the drives of an EtherCAT line with --ecat (scan, SII, OP, the master step over "
+      "a cyclic LRW)");
+  auto* can = cmd->add_option("--can", args.can,
+                              "socketcand://HOST:PORT/BUS, socketcan://IFACE, or virtual (a virtual drive in-process)")
+                   ->default_str("virtual");
+  cmd->add_option("--ecat", args.ecat,
+                  "a network interface: run our EtherCAT master there (raw socket, root) instead of CANopen; "
+                  "COMMAND OPERANDS are then steps run in order: state, enable, disable, quick-stop, reset, "
+                  "watch, wait MS, sdo read|write")
+      ->excludes(can);
+  cmd->add_option("--position", args.position, "--ecat: the drive's position on the line, 0 first (default: all)")
+      ->check(CLI::Range(0, 65535));
   cmd->add_option("--node", args.node, "the drive's node-ID")->check(CLI::Range(1, 127))->default_str("1");
   cmd->add_option("COMMAND", args.command,
                   "state, enable, disable, quick-stop, reset, watch, velocity, mode, move, home, csp-stream; "
@@ -771,7 +779,7 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
                   "move: the profile velocity 0x6081 in rpm; csp-stream: the ramp's speed in rpm")
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--to", args.stream_to, "csp-stream: the position the ramp of 0x607A ends at, in increments");
-  cmd->add_option("--sync-us", args.sync_us, "csp-stream: SYNC period in microseconds (one set-point each)")
+  cmd->add_option("--sync-us", args.sync_us, "csp-stream: SYNC period in microseconds (one set-point each); --ecat: the cycle (one LRW each)")
       ->check(CLI::Range(100, 1000000))
       ->default_str("1000");
   cmd->add_option("--method", args.homing_method, "home: the homing method 0x6098 (3, 33, 34, 35, 37)");
@@ -781,6 +789,7 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
 }
 
 int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
+  if (!a.ecat.empty()) return run_ecat_master(a, out, err);
   profile_choice choice;
   if (!choice.resolve(a.profile, a.profile_file, err)) return usage_error;
   const profile& p = choice.get();

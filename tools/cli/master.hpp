@@ -24,6 +24,8 @@ namespace cia402::cli {
 
 struct master_args {
   std::string can = "virtual";  ///< socketcand://HOST:PORT/BUS, socketcan://IFACE, or virtual
+  std::string ecat;             ///< a network interface: our EtherCAT master there instead of CANopen
+  std::optional<int> position;  ///< --ecat: the slave's position on the line (all when not given)
   int node = 1;
   std::string command;
   std::vector<std::string> operands;  ///< after sdo / nmt: what to read, write or send
@@ -48,5 +50,7 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args);
 /// Exit status: 0 done; 1 the drive or the bus failed (missing node, SDO abort, lost heartbeat,
 /// fault, timeout); 2 a refused option.
 int run_master(const master_args& args, std::ostream& out, std::ostream& err);
+/// `--ecat IF`: the EtherCAT master (master_ecat.cpp); COMMAND and OPERANDS are steps run in order.
+int run_ecat_master(const master_args& args, std::ostream& out, std::ostream& err);
 
 }  // namespace cia402::cli

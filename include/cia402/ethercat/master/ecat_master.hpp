@@ -1,0 +1,170 @@
+// An EtherCAT master for CiA 402 drives (ETG.1000.4/.6, ETG.6010): it finds the slaves on a line,
+// addresses them, reads their SII, sets up the mailbox, learns the PDO mapping over CoE (falling
+// back to the SII's default PDOs), maps the process data with FMMUs, brings the line to OP and then
+// runs a cyclic LRW in which the core's master step (`cia402::master`) turns each drive's status
+// word into its control word. SDO upload and download over the mailbox for everything else.
+//
+// It is written for real drives, not only ours: every layout comes from what a slave says about
+// itself (SII sync managers and mailbox, 0x1C12/0x1C13 and the PDOs they assign), 0x6040 and 0x6041
+// are found wherever the mapping puts them, AL status codes are read and reported, and a slave
+// that answers late is polled until a time limit rather than assumed ready. No distributed clocks:
+// drives that need DC synchronisation (csp on many real servos) are not served by this master.
+//
+// The master never reads a clock: time comes from the link (`now_us`, `wait_us`), so the same code
+// runs on a raw socket (src/apps) and on the in-process wire of the tests on virtual time.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cia402/ethercat/esc/frame.hpp"
+#include "cia402/ethercat/sii/slave_information.hpp"
+#include "cia402/master.hpp"
+#include "cia402/profile.hpp"
+#include "cia402/sdo_abort.hpp"
+
+namespace cia402::ethercat {
+
+/// What carries a master's frames to the line and back, and its sense of time.
+class master_link {
+ public:
+  virtual ~master_link() = default;
+  /// Sends `frame` and replaces it with the frame the line returned; false when none came back
+  /// within the link's time limit (the frame is then unchanged).
+  virtual bool exchange(std::vector<std::uint8_t>& frame) = 0;
+  /// Microseconds since a fixed start.
+  virtual std::uint64_t now_us() = 0;
+  /// Lets `us` microseconds pass: a sleep on a real line, the drives' time on an in-process one.
+  virtual void wait_us(std::uint32_t us) = 0;
+};
+
+/// AL states as register 0x0130 shows them (bits 0..3).
+enum class line_state : std::uint8_t { init = 1, pre_operational = 2, bootstrap = 3, safe_operational = 4, operational = 8 };
+const char* line_state_name(std::uint8_t al_state) noexcept;
+/// The text of an AL status code (0x0134), "unknown AL status code" for others.
+const char* al_status_code_text(std::uint16_t code) noexcept;
+
+/// Where an object sits in a slave's process data.
+struct pdo_place {
+  std::uint16_t bit_offset = 0;
+  std::uint8_t bits = 0;
+};
+
+/// One slave as the master found and configured it.
+struct ecat_slave {
+  std::uint16_t position = 0;   ///< 0 for the first slave after the master
+  std::uint16_t station = 0;    ///< the configured station address the master gave it
+  slave_description sii;        ///< identity, mailbox and sync managers, default PDOs, from its SII
+  bool mailbox = false;         ///< it has a CoE mailbox the master set up
+  std::uint8_t mailbox_counter = 0;
+  std::uint16_t output_bytes = 0;
+  std::uint16_t input_bytes = 0;
+  std::uint32_t logical_outputs = 0;  ///< its outputs' logical address in the LRW
+  std::uint32_t logical_inputs = 0;
+  std::optional<pdo_place> control_word, status_word, error_code, position_actual, velocity_actual, mode_display;
+  /// Every object of its outputs and inputs, in order (padding has index 0).
+  struct mapped_object {
+    std::uint16_t index = 0;
+    std::uint8_t sub = 0;
+    std::uint8_t bits = 0;
+    std::uint16_t bit_offset = 0;
+  };
+  std::vector<mapped_object> outputs, inputs;
+  std::string mapping_source;   ///< "CoE 0x1C12/0x1C13" or "SII default PDOs"
+  std::uint8_t al_state = 0;    ///< the last AL status read (bits 0..3; bit 4 = error)
+  std::uint16_t al_code = 0;
+  // The drive's CiA 402 machine, as the master drives it.
+  master steering;
+  master_policy policy;
+  bool steered = false;         ///< a target is set
+  std::optional<cia402::command> held_command;  ///< a command sent every cycle (quick stop), instead of a target
+  std::uint16_t last_status = 0;
+  std::uint16_t last_control = 0;
+  std::uint16_t last_error_code = 0;
+  std::vector<std::uint16_t> emergencies;  ///< error codes of the EMCYs the mailbox brought
+};
+
+/// An SDO transfer's result.
+struct ecat_sdo_result {
+  bool ok = false;
+  sdo_abort abort = sdo_abort::general_error;  ///< when the slave aborted
+  std::string error;                     ///< when there was no SDO answer at all (why)
+  std::vector<std::uint8_t> data;        ///< an upload's bytes
+  std::int64_t value(bool is_signed) const noexcept;
+};
+
+class ecat_master {
+ public:
+  /// `p` (outliving the master) is the profile the drives' status words are read with.
+  ecat_master(master_link& link, const profile& p, std::uint32_t cycle_us = 1000);
+
+  /// Counts the slaves (BRD), resets them to INIT, gives each the station address 0x1001 + position
+  /// and reads its SII. False, with error(), when no slave answers or a SII cannot be read.
+  bool scan();
+  /// PRE-OP: the mailbox sync managers as the SII says; SDO works from here (a tool may change the
+  /// PDO mapping now, before bring_to_operational reads it).
+  bool bring_to_pre_operational();
+  /// PRE-OP if not yet, the PDO mapping (CoE, else SII), process data
+  /// sync managers and FMMUs, SAFE-OP, then OP with the cyclic exchange running. False with error()
+  /// (including the slave's AL status code) when a slave refuses or does not get there in time.
+  bool bring_to_operational();
+  /// One cycle: the LRW of every slave's process data and each AL status; each drive's master step
+  /// runs on what came back. False when the frame did not come back or the working counter was
+  /// short (the cycle still counts; error() says which).
+  bool cycle();
+
+  /// Steer drive `i` (index into slaves()) to a state, or hold a command (quick stop).
+  void set_target(std::size_t i, state target);
+  void hold_command(std::size_t i, cia402::command c);
+  void release(std::size_t i);
+
+  ecat_sdo_result sdo_read(std::size_t i, std::uint16_t index, std::uint8_t sub);
+  ecat_sdo_result sdo_write(std::size_t i, std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes);
+
+  std::vector<ecat_slave>& slaves() noexcept { return slaves_; }
+  const std::string& error() const noexcept { return error_; }
+  std::uint16_t expected_working_counter() const noexcept { return expected_wkc_; }
+  std::uint16_t last_working_counter() const noexcept { return last_wkc_; }
+  std::uint64_t cycles() const noexcept { return cycles_; }
+  std::uint64_t lost_frames() const noexcept { return lost_frames_; }
+  std::uint32_t cycle_us() const noexcept { return cycle_us_; }
+  /// Called with every frame exchanged (sent, then answered), for captures.
+  std::function<void(const std::vector<std::uint8_t>& sent, const std::vector<std::uint8_t>& answered)> on_frame;
+
+ private:
+  struct single {
+    bool ok = false;
+    std::uint16_t wkc = 0;
+    std::vector<std::uint8_t> data;
+  };
+  single one(command cmd, std::uint32_t address, std::vector<std::uint8_t> data);
+  single read_register(const ecat_slave& s, std::uint16_t reg, std::uint16_t length);
+  bool write_register(const ecat_slave& s, std::uint16_t reg, const std::vector<std::uint8_t>& data);
+  bool read_sii(ecat_slave& s);
+  bool request_state(line_state target, bool cycling);
+  bool configure_mailbox(ecat_slave& s);
+  bool learn_mapping(ecat_slave& s);
+  bool configure_process_data(ecat_slave& s, std::uint32_t& logical);
+  bool mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe);
+  std::optional<std::vector<std::uint8_t>> mailbox_receive(ecat_slave& s);
+  ecat_sdo_result sdo(ecat_slave& s, const std::vector<std::uint8_t>& request, std::uint16_t index, std::uint8_t sub);
+  bool fail(std::string text);
+
+  master_link* link_;
+  const profile* profile_;
+  std::uint32_t cycle_us_;
+  std::vector<ecat_slave> slaves_;
+  std::vector<std::uint8_t> image_;  // the logical process image, outputs and inputs of every slave
+  std::uint16_t expected_wkc_ = 0;
+  std::uint16_t last_wkc_ = 0;
+  std::uint64_t cycles_ = 0;
+  std::uint64_t lost_frames_ = 0;
+  std::uint8_t index_ = 0;
+  bool pre_operational_ = false;
+  std::string error_;
+};
+
+}  // namespace cia402::ethercat

@@ -1,0 +1,700 @@
+#include "cia402/ethercat/master/ecat_master.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+
+namespace cia402::ethercat {
+namespace {
+
+// Registers (ETG.1000.4 table 29 ff.), written out here rather than taken from the emulated ESC:
+// the master is for any slave controller.
+constexpr std::uint16_t reg_type = 0x0000;
+constexpr std::uint16_t reg_station = 0x0010;
+constexpr std::uint16_t reg_al_control = 0x0120;
+constexpr std::uint16_t reg_al_status = 0x0130;
+constexpr std::uint16_t reg_eeprom_config = 0x0500;
+constexpr std::uint16_t reg_eeprom_control = 0x0502;
+constexpr std::uint16_t reg_fmmu0 = 0x0600;
+constexpr std::uint16_t reg_sm0 = 0x0800;
+constexpr std::uint16_t eeprom_busy = 0x8000;
+constexpr std::uint16_t eeprom_read_8 = 0x0040;
+constexpr std::uint16_t eeprom_errors = 0x6800;  // command error, checksum error, acknowledge error
+constexpr std::uint8_t al_error_bit = 0x10;
+constexpr std::uint16_t first_station = 0x1001;
+constexpr std::uint32_t logical_base = 0x00010000;
+
+// Limits in link time: a slave that has not done it by then will not.
+constexpr std::uint64_t state_change_us = 5'000'000;  // PRE-OP -> SAFE-OP may load a drive's parameters
+constexpr std::uint64_t eeprom_us = 100'000;
+constexpr std::uint64_t mailbox_us = 1'000'000;
+constexpr std::uint32_t poll_us = 200;
+constexpr std::size_t sii_max_bytes = 8192;
+
+const std::array<std::uint8_t, 6> broadcast{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
+const std::array<std::uint8_t, 6> master_mac{0x02, 0x00, 0x00, 0x00, 0x00, 0x01};
+
+std::uint16_t le16(const std::uint8_t* p) noexcept { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
+std::uint32_t le32(const std::uint8_t* p) noexcept {
+  return static_cast<std::uint32_t>(p[0] | (p[1] << 8) | (p[2] << 16)) | (static_cast<std::uint32_t>(p[3]) << 24);
+}
+void put_le(std::vector<std::uint8_t>& v, std::uint64_t value, unsigned bytes) {
+  for (unsigned i = 0; i < bytes; ++i) v.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
+}
+std::vector<std::uint8_t> le_bytes(std::uint64_t value, unsigned bytes) {
+  std::vector<std::uint8_t> v;
+  put_le(v, value, bytes);
+  return v;
+}
+
+std::string hex(std::uint32_t v, int digits) {
+  static const char* d = "0123456789ABCDEF";
+  std::string s = "0x";
+  for (int i = digits - 1; i >= 0; --i) s += d[(v >> (4 * i)) & 0xF];
+  return s;
+}
+
+// Bits of the process image, little-endian as EtherCAT carries them.
+std::uint64_t get_bits(const std::vector<std::uint8_t>& image, std::size_t bit, unsigned bits) {
+  std::uint64_t v = 0;
+  for (unsigned i = 0; i < bits; ++i) {
+    const std::size_t b = bit + i;
+    if ((image[b / 8] >> (b % 8)) & 1u) v |= std::uint64_t{1} << i;
+  }
+  return v;
+}
+void put_bits(std::vector<std::uint8_t>& image, std::size_t bit, unsigned bits, std::uint64_t v) {
+  for (unsigned i = 0; i < bits; ++i) {
+    const std::size_t b = bit + i;
+    const auto mask = static_cast<std::uint8_t>(1u << (b % 8));
+    image[b / 8] = static_cast<std::uint8_t>(((v >> i) & 1u) ? (image[b / 8] | mask) : (image[b / 8] & ~mask));
+  }
+}
+
+std::string slave_text(const ecat_slave& s) {
+  return "slave " + std::to_string(s.position) + " (station " + hex(s.station, 4) + ")";
+}
+
+}  // namespace
+
+const char* line_state_name(std::uint8_t al_state) noexcept {
+  switch (al_state & 0x0F) {
+    case 1: return "INIT";
+    case 2: return "PRE-OP";
+    case 3: return "BOOT";
+    case 4: return "SAFE-OP";
+    case 8: return "OP";
+    default: return "UNKNOWN";
+  }
+}
+
+const char* al_status_code_text(std::uint16_t code) noexcept {
+  switch (code) {
+    case 0x0000: return "no error";
+    case 0x0001: return "unspecified error";
+    case 0x0011: return "invalid requested state change";
+    case 0x0012: return "unknown requested state";
+    case 0x0013: return "bootstrap not supported";
+    case 0x0014: return "no valid firmware";
+    case 0x0015: return "invalid mailbox configuration (bootstrap)";
+    case 0x0016: return "invalid mailbox configuration";
+    case 0x0017: return "invalid sync manager configuration";
+    case 0x001A: return "synchronization error";
+    case 0x001B: return "sync manager watchdog";
+    case 0x001D: return "invalid output configuration";
+    case 0x001E: return "invalid input configuration";
+    case 0x0024: return "invalid input mapping";
+    case 0x0025: return "invalid output mapping";
+    case 0x0030: return "invalid DC sync configuration";
+    default: return "unknown AL status code";
+  }
+}
+
+std::int64_t ecat_sdo_result::value(bool is_signed) const noexcept {
+  std::uint64_t v = 0;
+  const std::size_t n = std::min<std::size_t>(data.size(), 8);
+  for (std::size_t i = 0; i < n; ++i) v |= static_cast<std::uint64_t>(data[i]) << (8 * i);
+  if (is_signed && n > 0 && n < 8 && (data[n - 1] & 0x80)) v |= ~std::uint64_t{0} << (8 * n);
+  return static_cast<std::int64_t>(v);
+}
+
+ecat_master::ecat_master(master_link& link, const profile& p, std::uint32_t cycle_us)
+    : link_(&link), profile_(&p), cycle_us_(cycle_us) {}
+
+bool ecat_master::fail(std::string text) {
+  error_ = std::move(text);
+  return false;
+}
+
+ecat_master::single ecat_master::one(command cmd, std::uint32_t address, std::vector<std::uint8_t> data) {
+  frame_builder b(broadcast, master_mac);
+  const auto length = static_cast<std::uint16_t>(data.size());
+  const long at = b.add(cmd, ++index_, address, data, length);
+  single r;
+  if (at < 0) return r;
+  std::vector<std::uint8_t> f = b.finish();
+  const std::vector<std::uint8_t> sent = f;
+  if (!link_->exchange(f) || f.size() < static_cast<std::size_t>(at) + length + 2) {
+    ++lost_frames_;
+    return r;
+  }
+  if (on_frame) on_frame(sent, f);
+  const auto* d = f.data() + at;
+  r.ok = true;
+  r.data.assign(d, d + length);
+  r.wkc = le16(d + length);
+  return r;
+}
+
+ecat_master::single ecat_master::read_register(const ecat_slave& s, std::uint16_t reg, std::uint16_t length) {
+  return one(command::fprd, s.station | (static_cast<std::uint32_t>(reg) << 16), std::vector<std::uint8_t>(length, 0));
+}
+
+bool ecat_master::write_register(const ecat_slave& s, std::uint16_t reg, const std::vector<std::uint8_t>& data) {
+  const single r = one(command::fpwr, s.station | (static_cast<std::uint32_t>(reg) << 16), data);
+  return r.ok && r.wkc == 1;
+}
+
+// --- finding the slaves ----------------------------------------------------------------------------
+
+bool ecat_master::scan() {
+  slaves_.clear();
+  pre_operational_ = false;
+  error_.clear();
+  const single count = one(command::brd, static_cast<std::uint32_t>(reg_type) << 16, {0, 0});
+  if (!count.ok) return fail("no frame came back: is the interface connected to an EtherCAT line?");
+  if (count.wkc == 0) return fail("no slave answered (BRD working counter 0)");
+  // Every slave to INIT (acknowledging any error), then its FMMUs and sync managers cleared, as a
+  // master starting afresh must: an earlier master may have left them set.
+  (void)one(command::bwr, static_cast<std::uint32_t>(reg_al_control) << 16, {0x11, 0x00});
+  (void)one(command::bwr, static_cast<std::uint32_t>(reg_fmmu0) << 16, std::vector<std::uint8_t>(16 * 8, 0));
+  (void)one(command::bwr, static_cast<std::uint32_t>(reg_sm0) << 16, std::vector<std::uint8_t>(8 * 8, 0));
+  for (std::uint16_t i = 0; i < count.wkc; ++i) {
+    ecat_slave s;
+    s.position = i;
+    s.station = static_cast<std::uint16_t>(first_station + i);
+    // Auto-increment addressing: the slave at position i is the one that sees ADP 0 after i others
+    // have counted it up from -i.
+    const single r = one(command::apwr, static_cast<std::uint16_t>(-static_cast<int>(i)) |
+                                            (static_cast<std::uint32_t>(reg_station) << 16),
+                         le_bytes(s.station, 2));
+    if (!r.ok || r.wkc != 1) return fail("slave " + std::to_string(i) + " did not take its station address");
+    slaves_.push_back(std::move(s));
+  }
+  for (ecat_slave& s : slaves_) {
+    if (!read_sii(s)) return false;
+  }
+  for (ecat_slave& s : slaves_) {
+    const single st = read_register(s, reg_al_status, 6);
+    if (st.ok && st.wkc == 1) {
+      s.al_state = st.data[0];
+      s.al_code = le16(st.data.data() + 4);
+    }
+  }
+  return true;
+}
+
+bool ecat_master::read_sii(ecat_slave& s) {
+  (void)write_register(s, reg_eeprom_config, {0x00, 0x00});  // the EEPROM to the EtherCAT side
+  std::vector<std::uint8_t> image;
+  // Words are read 4 or 8 bytes at a time, as the controller offers (0x0502 bit 6), until the
+  // category end marker: the image's fixed part is 64 words, then categories (type, size in words).
+  std::size_t category = 0x80;  // byte offset of the next category header
+  bool ended = false;
+  while (!ended && image.size() < sii_max_bytes) {
+    const auto word = static_cast<std::uint32_t>(image.size() / 2);
+    std::vector<std::uint8_t> request{0x00, 0x01};  // command: read
+    put_le(request, word, 4);
+    if (!write_register(s, reg_eeprom_control, request)) {
+      return fail(slave_text(s) + ": the SII EEPROM interface refused a read of word " + std::to_string(word));
+    }
+    std::vector<std::uint8_t> status;
+    for (const std::uint64_t start = link_->now_us();;) {
+      const single r = read_register(s, reg_eeprom_control, 14);  // control, address, data
+      if (r.ok && r.wkc == 1 && !(le16(r.data.data()) & eeprom_busy)) {
+        status = r.data;
+        break;
+      }
+      if (link_->now_us() - start > eeprom_us) return fail(slave_text(s) + ": the SII EEPROM stays busy");
+      link_->wait_us(poll_us);
+    }
+    const std::uint16_t control = le16(status.data());
+    if (control & eeprom_errors) {
+      return fail(slave_text(s) + ": SII read of word " + std::to_string(word) + " failed (EEPROM status " +
+                  hex(control, 4) + ")");
+    }
+    const std::size_t got = (control & eeprom_read_8) ? 8 : 4;
+    image.insert(image.end(), status.begin() + 6, status.begin() + 6 + static_cast<long>(got));
+    while (!ended && image.size() >= category + 4) {
+      const std::uint16_t type = le16(image.data() + category);
+      if (type == 0xFFFF) {
+        ended = true;
+      } else {
+        category += 4 + 2u * le16(image.data() + category + 2);
+      }
+    }
+  }
+  std::string why;
+  auto d = parse_sii(image, why);
+  if (!d) return fail(slave_text(s) + ": its SII does not read as one: " + why);
+  s.sii = std::move(*d);
+  return true;
+}
+
+// --- AL states ---------------------------------------------------------------------------------------
+
+bool ecat_master::request_state(line_state target, bool cycling) {
+  const auto want = static_cast<std::uint8_t>(target);
+  for (ecat_slave& s : slaves_) {
+    // An error left from before is acknowledged with the request (bit 4).
+    const std::uint8_t ack = (s.al_state & al_error_bit) ? al_error_bit : 0;
+    if (!write_register(s, reg_al_control, {static_cast<std::uint8_t>(want | ack), 0x00})) {
+      return fail(slave_text(s) + " did not take the request for " + line_state_name(want));
+    }
+  }
+  const std::uint64_t start = link_->now_us();
+  for (;;) {
+    bool all = true;
+    for (ecat_slave& s : slaves_) {
+      const single st = read_register(s, reg_al_status, 6);
+      if (!st.ok || st.wkc != 1) {
+        all = false;
+        continue;
+      }
+      s.al_state = st.data[0];
+      s.al_code = le16(st.data.data() + 4);
+      if (s.al_state & al_error_bit) {
+        return fail(slave_text(s) + " refused " + line_state_name(want) + ": AL status code " + hex(s.al_code, 4) +
+                    " (" + al_status_code_text(s.al_code) + "), stays in " + line_state_name(s.al_state));
+      }
+      if ((s.al_state & 0x0F) != want) all = false;
+    }
+    if (all) return true;
+    if (link_->now_us() - start > state_change_us) {
+      for (const ecat_slave& s : slaves_) {
+        if ((s.al_state & 0x0F) != want) {
+          return fail(slave_text(s) + " did not reach " + line_state_name(want) + " in time (still " +
+                      line_state_name(s.al_state) + ")");
+        }
+      }
+    }
+    if (cycling) {
+      (void)cycle();
+      link_->wait_us(cycle_us_);
+    } else {
+      link_->wait_us(poll_us);
+    }
+  }
+}
+
+bool ecat_master::configure_mailbox(ecat_slave& s) {
+  const slave_description& d = s.sii;
+  if (!d.coe || d.mailbox_out_size == 0 || d.mailbox_in_size == 0) return true;  // no CoE: SII only
+  const auto sm_control = [&](int n, std::uint8_t fallback) {
+    return n < static_cast<int>(d.sync_managers.size()) && d.sync_managers[static_cast<std::size_t>(n)].control != 0
+               ? d.sync_managers[static_cast<std::size_t>(n)].control
+               : fallback;
+  };
+  std::vector<std::uint8_t> sm;
+  put_le(sm, d.mailbox_out_start, 2);
+  put_le(sm, d.mailbox_out_size, 2);
+  sm.insert(sm.end(), {sm_control(0, 0x26), 0x00, 0x01, 0x00});
+  put_le(sm, d.mailbox_in_start, 2);
+  put_le(sm, d.mailbox_in_size, 2);
+  sm.insert(sm.end(), {sm_control(1, 0x22), 0x00, 0x01, 0x00});
+  if (!write_register(s, reg_sm0, sm)) return fail(slave_text(s) + " did not take its mailbox sync managers");
+  s.mailbox = true;
+  return true;
+}
+
+// --- mailbox and SDO ---------------------------------------------------------------------------------
+
+bool ecat_master::mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe) {
+  s.mailbox_counter = static_cast<std::uint8_t>(s.mailbox_counter % 7 + 1);  // 1..7, 0 is reserved
+  std::vector<std::uint8_t> m;
+  put_le(m, coe.size(), 2);
+  put_le(m, 0, 2);  // address
+  m.push_back(0);   // channel, priority
+  m.push_back(static_cast<std::uint8_t>(0x03 | (s.mailbox_counter << 4)));  // CoE
+  m.insert(m.end(), coe.begin(), coe.end());
+  if (m.size() > s.sii.mailbox_out_size) return false;
+  m.resize(s.sii.mailbox_out_size, 0);  // the whole mailbox: the last byte hands it over
+  for (const std::uint64_t start = link_->now_us();;) {
+    const single r = one(command::fpwr, s.station | (static_cast<std::uint32_t>(s.sii.mailbox_out_start) << 16), m);
+    if (r.ok && r.wkc == 1) return true;  // 0: the slave has not read the one before yet
+    if (link_->now_us() - start > mailbox_us) return false;
+    link_->wait_us(poll_us);
+  }
+}
+
+std::optional<std::vector<std::uint8_t>> ecat_master::mailbox_receive(ecat_slave& s) {
+  for (const std::uint64_t start = link_->now_us();;) {
+    const single r = one(command::fprd, s.station | (static_cast<std::uint32_t>(s.sii.mailbox_in_start) << 16),
+                         std::vector<std::uint8_t>(s.sii.mailbox_in_size, 0));
+    if (r.ok && r.wkc == 1) return r.data;  // 0: nothing in the mailbox yet
+    if (link_->now_us() - start > mailbox_us) return std::nullopt;
+    link_->wait_us(poll_us);
+  }
+}
+
+ecat_sdo_result ecat_master::sdo(ecat_slave& s, const std::vector<std::uint8_t>& request, std::uint16_t index,
+                                 std::uint8_t sub) {
+  ecat_sdo_result result;
+  if (!s.mailbox) {
+    result.error = slave_text(s) + " has no CoE mailbox";
+    return result;
+  }
+  std::vector<std::uint8_t> coe{0x00, 0x20};  // CoE header: SDO request
+  coe.insert(coe.end(), request.begin(), request.end());
+  if (!mailbox_send(s, coe)) {
+    result.error = slave_text(s) + ": its receive mailbox stays full";
+    return result;
+  }
+  for (;;) {
+    const auto reply = mailbox_receive(s);
+    if (!reply) {
+      result.error = slave_text(s) + ": no SDO answer for " + hex(index, 4) + ":" + std::to_string(sub);
+      return result;
+    }
+    const std::vector<std::uint8_t>& m = *reply;
+    const std::size_t length = le16(m.data());
+    if (m.size() < 8 || length < 2 || 6 + length > m.size()) continue;
+    const std::uint8_t type = m[5] & 0x0F;
+    const unsigned service = m[7] >> 4;
+    if (type == 0x03 && service == 1 && length >= 2 + 8) {  // an emergency on the way: note it, go on
+      s.emergencies.push_back(le16(m.data() + 8));
+      continue;
+    }
+    if (type == 0x00) {
+      result.error = slave_text(s) + " answered with a mailbox error " + hex(le16(m.data() + 8), 4);
+      return result;
+    }
+    if (type != 0x03 || service != 3 || length < 2 + 8) continue;  // not ours
+    const std::uint8_t* sdo = m.data() + 8;
+    if (le16(sdo + 1) != index || sdo[3] != sub) continue;
+    const std::uint8_t cmd = sdo[0];
+    if (cmd == 0x80) {
+      result.abort = static_cast<sdo_abort>(le32(sdo + 4));
+      result.error = slave_text(s) + " aborted " + hex(index, 4) + ":" + std::to_string(sub) + ": " +
+                     hex(le32(sdo + 4), 8) + " (" + sdo_abort_text(result.abort) + ")";
+      return result;
+    }
+    if ((cmd & 0xE0) == 0x60) {  // download response
+      result.ok = true;
+      return result;
+    }
+    if ((cmd & 0xE0) == 0x40) {  // upload response
+      if (cmd & 0x02) {          // expedited: 4 - n bytes of data, n in bits 2..3 when bit 0 says so
+        const std::size_t n = (cmd & 0x01) ? 4u - ((cmd >> 2) & 3u) : 4u;
+        result.data.assign(sdo + 4, sdo + 4 + n);
+      } else {
+        const std::size_t size = le32(sdo + 4);
+        const std::size_t have = length - 2 - 8;
+        if (size > have) {
+          result.error = slave_text(s) + ": " + hex(index, 4) + " needs a segmented upload (" + std::to_string(size) +
+                         " bytes), which this master does not do";
+          return result;
+        }
+        result.data.assign(sdo + 8, sdo + 8 + size);
+      }
+      result.ok = true;
+      return result;
+    }
+  }
+}
+
+ecat_sdo_result ecat_master::sdo_read(std::size_t i, std::uint16_t index, std::uint8_t sub) {
+  std::vector<std::uint8_t> r{0x40};
+  put_le(r, index, 2);
+  r.push_back(sub);
+  put_le(r, 0, 4);
+  return sdo(slaves_.at(i), r, index, sub);
+}
+
+ecat_sdo_result ecat_master::sdo_write(std::size_t i, std::uint16_t index, std::uint8_t sub, std::int64_t value,
+                                       unsigned bytes) {
+  bytes = std::clamp(bytes, 1u, 4u);
+  std::vector<std::uint8_t> r{static_cast<std::uint8_t>(0x23 | ((4 - bytes) << 2))};  // expedited, size given
+  put_le(r, index, 2);
+  r.push_back(sub);
+  put_le(r, static_cast<std::uint64_t>(value), bytes);
+  r.resize(8, 0);
+  return sdo(slaves_.at(i), r, index, sub);
+}
+
+// --- process data ------------------------------------------------------------------------------------
+
+bool ecat_master::learn_mapping(ecat_slave& s) {
+  struct entry {
+    std::uint16_t index;
+    std::uint8_t sub;
+    std::uint8_t bits;
+  };
+  std::vector<entry> outputs, inputs;
+  const std::size_t i = static_cast<std::size_t>(&s - slaves_.data());
+  bool from_coe = s.mailbox;
+  const auto read_assigned = [&](std::uint16_t assign, std::vector<entry>& out) {
+    const ecat_sdo_result count = sdo_read(i, assign, 0);
+    if (!count.ok) return false;
+    for (std::int64_t k = 1; k <= count.value(false); ++k) {
+      const ecat_sdo_result pdo = sdo_read(i, assign, static_cast<std::uint8_t>(k));
+      if (!pdo.ok) return false;
+      const auto pdo_index = static_cast<std::uint16_t>(pdo.value(false));
+      const ecat_sdo_result n = sdo_read(i, pdo_index, 0);
+      if (!n.ok) return false;
+      for (std::int64_t e = 1; e <= n.value(false); ++e) {
+        const ecat_sdo_result m = sdo_read(i, pdo_index, static_cast<std::uint8_t>(e));
+        if (!m.ok) return false;
+        const auto v = static_cast<std::uint32_t>(m.value(false));
+        out.push_back({static_cast<std::uint16_t>(v >> 16), static_cast<std::uint8_t>(v >> 8),
+                       static_cast<std::uint8_t>(v)});
+      }
+    }
+    return true;
+  };
+  if (from_coe && (!read_assigned(0x1C12, outputs) || !read_assigned(0x1C13, inputs))) {
+    // A slave without SDO access to its assignment: the SII's default PDOs are what it runs.
+    outputs.clear();
+    inputs.clear();
+    from_coe = false;
+  }
+  if (!from_coe) {
+    for (const pdo_description& p : s.sii.rx_pdos) {
+      if (!p.mandatory) continue;
+      for (const pdo_entry& e : p.entries) outputs.push_back({e.index, e.sub, e.bits});
+    }
+    for (const pdo_description& p : s.sii.tx_pdos) {
+      if (!p.mandatory) continue;
+      for (const pdo_entry& e : p.entries) inputs.push_back({e.index, e.sub, e.bits});
+    }
+  }
+  s.mapping_source = from_coe ? "CoE 0x1C12/0x1C13" : "SII default PDOs";
+  const auto keep = [](const std::vector<entry>& list, std::vector<ecat_slave::mapped_object>& out) {
+    out.clear();
+    unsigned at = 0;
+    for (const entry& e : list) {
+      out.push_back({e.index, e.sub, e.bits, static_cast<std::uint16_t>(at)});
+      at += e.bits;
+    }
+  };
+  keep(outputs, s.outputs);
+  keep(inputs, s.inputs);
+  const auto place = [](const std::vector<entry>& list, std::uint16_t index, std::uint8_t bits,
+                        unsigned& total) -> std::optional<pdo_place> {
+    std::optional<pdo_place> found;
+    unsigned at = 0;
+    for (const entry& e : list) {
+      if (e.index == index && e.sub == 0 && e.bits == bits && !found) {
+        found = pdo_place{static_cast<std::uint16_t>(at), e.bits};
+      }
+      at += e.bits;
+    }
+    total = at;
+    return found;
+  };
+  unsigned out_bits = 0, in_bits = 0;
+  s.control_word = place(outputs, 0x6040, 16, out_bits);
+  s.status_word = place(inputs, 0x6041, 16, in_bits);
+  s.error_code = place(inputs, 0x603F, 16, in_bits);
+  s.position_actual = place(inputs, 0x6064, 32, in_bits);
+  s.velocity_actual = place(inputs, 0x606C, 32, in_bits);
+  s.mode_display = place(inputs, 0x6061, 8, in_bits);
+  if (!s.control_word || !s.status_word) {
+    return fail(slave_text(s) + ": its process data (" + s.mapping_source + ") carries no " +
+                (s.control_word ? "0x6041 statusword" : "0x6040 controlword") +
+                ": not a CiA 402 drive as mapped");
+  }
+  s.output_bytes = static_cast<std::uint16_t>((out_bits + 7) / 8);
+  s.input_bytes = static_cast<std::uint16_t>((in_bits + 7) / 8);
+  return true;
+}
+
+bool ecat_master::configure_process_data(ecat_slave& s, std::uint32_t& logical) {
+  const slave_description& d = s.sii;
+  const auto sm_of = [&](sm_type t, int fallback_index, std::uint16_t fallback_start, std::uint8_t fallback_control) {
+    for (std::size_t n = 0; n < d.sync_managers.size(); ++n) {
+      if (d.sync_managers[n].type == t) {
+        return std::tuple{static_cast<int>(n), d.sync_managers[n].start, d.sync_managers[n].control};
+      }
+    }
+    return std::tuple{fallback_index, fallback_start, fallback_control};
+  };
+  const auto [out_sm, out_start, out_control] = sm_of(sm_type::outputs, 2, 0x1100, 0x64);
+  const auto [in_sm, in_start, in_control] = sm_of(sm_type::inputs, 3, 0x1180, 0x20);
+  const auto sm_bytes = [](std::uint16_t start, std::uint16_t length, std::uint8_t control) {
+    std::vector<std::uint8_t> v;
+    put_le(v, start, 2);
+    put_le(v, length, 2);
+    v.insert(v.end(), {control, 0x00, static_cast<std::uint8_t>(length > 0 ? 1 : 0), 0x00});
+    return v;
+  };
+  if (!write_register(s, static_cast<std::uint16_t>(reg_sm0 + 8 * out_sm), sm_bytes(out_start, s.output_bytes, out_control)) ||
+      !write_register(s, static_cast<std::uint16_t>(reg_sm0 + 8 * in_sm), sm_bytes(in_start, s.input_bytes, in_control))) {
+    return fail(slave_text(s) + " did not take its process data sync managers");
+  }
+  const auto fmmu_bytes = [](std::uint32_t log, std::uint16_t length, std::uint16_t physical, std::uint8_t type) {
+    std::vector<std::uint8_t> v;
+    put_le(v, log, 4);
+    put_le(v, length, 2);
+    v.insert(v.end(), {0x00, 0x07});  // logical start bit 0, end bit 7: whole bytes
+    put_le(v, physical, 2);
+    v.insert(v.end(), {0x00, type, static_cast<std::uint8_t>(length > 0 ? 1 : 0), 0, 0, 0});
+    return v;
+  };
+  // The FMMUs the SII names for outputs and inputs, else 0 and 1.
+  int out_fmmu = 0, in_fmmu = 1;
+  for (std::size_t n = 0; n < d.fmmus.size(); ++n) {
+    if (d.fmmus[n] == fmmu_use::outputs) out_fmmu = static_cast<int>(n);
+    if (d.fmmus[n] == fmmu_use::inputs) in_fmmu = static_cast<int>(n);
+  }
+  s.logical_outputs = logical;
+  s.logical_inputs = logical + s.output_bytes;
+  if (!write_register(s, static_cast<std::uint16_t>(reg_fmmu0 + 16 * out_fmmu),
+                      fmmu_bytes(s.logical_outputs, s.output_bytes, out_start, 0x02)) ||
+      !write_register(s, static_cast<std::uint16_t>(reg_fmmu0 + 16 * in_fmmu),
+                      fmmu_bytes(s.logical_inputs, s.input_bytes, in_start, 0x01))) {
+    return fail(slave_text(s) + " did not take its FMMUs");
+  }
+  logical += s.output_bytes + s.input_bytes;
+  return true;
+}
+
+bool ecat_master::bring_to_pre_operational() {
+  if (slaves_.empty()) return fail("no slaves: scan first");
+  for (ecat_slave& s : slaves_) {
+    if (!configure_mailbox(s)) return false;
+  }
+  pre_operational_ = request_state(line_state::pre_operational, false);
+  return pre_operational_;
+}
+
+bool ecat_master::bring_to_operational() {
+  if (!pre_operational_ && !bring_to_pre_operational()) return false;
+  pre_operational_ = false;
+  std::uint32_t logical = logical_base;
+  expected_wkc_ = 0;
+  for (ecat_slave& s : slaves_) {
+    if (!learn_mapping(s) || !configure_process_data(s, logical)) return false;
+    // ETG.1000.4: an LRW counts 1 for a slave's read FMMU and 2 for its write FMMU.
+    expected_wkc_ = static_cast<std::uint16_t>(expected_wkc_ + (s.output_bytes ? 2 : 0) + (s.input_bytes ? 1 : 0));
+  }
+  image_.assign(logical - logical_base, 0);
+  constexpr std::size_t room = maximum_frame_size - ethernet_header_size - ethercat_header_size -
+                               2 * (datagram_header_size + working_counter_size) - 2;
+  if (image_.size() > room) {
+    return fail("the process image (" + std::to_string(image_.size()) + " bytes) does not fit one frame; "
+                "this master sends one LRW a cycle");
+  }
+  // The outputs start as the drive has them, so running the line commands nothing by itself: the
+  // control word it last got, the set-points and mode it holds (a zero 0x6060 or 0x60FF would).
+  for (std::size_t i = 0; i < slaves_.size(); ++i) {
+    ecat_slave& s = slaves_[i];
+    for (const ecat_slave::mapped_object& o : s.outputs) {
+      if (o.index == 0 || !s.mailbox || o.bits == 0 || o.bits > 32) continue;
+      const ecat_sdo_result v = sdo_read(i, o.index, o.sub);
+      if (!v.ok) continue;
+      put_bits(image_, (s.logical_outputs - logical_base) * 8u + o.bit_offset, o.bits,
+               static_cast<std::uint64_t>(v.value(false)));
+    }
+    s.last_control = static_cast<std::uint16_t>(
+        get_bits(image_, (s.logical_outputs - logical_base) * 8u + s.control_word->bit_offset, 16));
+  }
+  // Outputs are valid before SAFE-OP -> OP: the drives get them from the first cycle on.
+  if (!request_state(line_state::safe_operational, true)) return false;
+  return request_state(line_state::operational, true);
+}
+
+void ecat_master::set_target(std::size_t i, state target) {
+  ecat_slave& s = slaves_.at(i);
+  s.policy = master_policy::make(*profile_, make_axis(*profile_), target);
+  s.steering.set_target(s.policy, link_->now_us(), 2'000'000);
+  s.steered = true;
+  s.held_command.reset();
+}
+
+void ecat_master::hold_command(std::size_t i, cia402::command c) {
+  ecat_slave& s = slaves_.at(i);
+  s.steering.clear_target();
+  s.steered = false;
+  s.held_command = c;
+}
+
+void ecat_master::release(std::size_t i) {
+  ecat_slave& s = slaves_.at(i);
+  s.steering.clear_target();
+  s.steered = false;
+  s.held_command.reset();
+}
+
+bool ecat_master::cycle() {
+  const std::uint64_t now = link_->now_us();
+  for (ecat_slave& s : slaves_) {
+    if (!s.control_word) continue;
+    std::uint16_t cw = s.last_control;
+    if (s.steered) {
+      cw = s.steering.step(s.last_status, now, s.last_error_code);
+    } else if (s.held_command) {
+      std::uint16_t word = 0;
+      if (encode_command(*profile_, *s.held_command, static_cast<std::uint16_t>(s.last_control & ~0x80u), word)) cw = word;
+    }
+    s.last_control = cw;
+    put_bits(image_, (s.logical_outputs - logical_base) * 8u + s.control_word->bit_offset, 16, cw);
+  }
+  frame_builder b(broadcast, master_mac);
+  const long lrw = b.add(command::lrw, ++index_, logical_base, image_, static_cast<std::uint16_t>(image_.size()));
+  const long al = b.add(command::brd, ++index_, static_cast<std::uint32_t>(reg_al_status) << 16, {}, 2);
+  // One slave a cycle, in turn: is its send mailbox full (SM1 status bit 3)? Then an emergency (or
+  // anything else it sent unasked) is fetched after the cycle.
+  ecat_slave* asked = slaves_.empty() ? nullptr : &slaves_[cycles_ % slaves_.size()];
+  if (asked != nullptr && !asked->mailbox) asked = nullptr;
+  const long sm1 = asked == nullptr ? -1
+                                    : b.add(command::fprd, ++index_,
+                                            asked->station | (static_cast<std::uint32_t>(reg_sm0 + 8 + 5) << 16), {}, 1);
+  std::vector<std::uint8_t> f = b.finish();
+  const std::vector<std::uint8_t> sent = f;
+  ++cycles_;
+  if (lrw < 0 || al < 0 || !link_->exchange(f) || f.size() < static_cast<std::size_t>(al) + 4) {
+    ++lost_frames_;
+    error_ = "a cycle's frame did not come back";
+    return false;
+  }
+  if (on_frame) on_frame(sent, f);
+  const std::uint8_t* data = f.data() + lrw;
+  last_wkc_ = le16(data + image_.size());
+  const std::uint8_t line = f[static_cast<std::size_t>(al)];  // every slave's AL status, ORed
+  if (sm1 >= 0 && static_cast<std::size_t>(sm1) + 3 <= f.size() && le16(f.data() + sm1 + 1) == 1 &&
+      (f[static_cast<std::size_t>(sm1)] & 0x08)) {
+    const single m = one(command::fprd, asked->station | (static_cast<std::uint32_t>(asked->sii.mailbox_in_start) << 16),
+                         std::vector<std::uint8_t>(asked->sii.mailbox_in_size, 0));
+    if (m.ok && m.wkc == 1 && m.data.size() >= 16 && (m.data[5] & 0x0F) == 0x03 && (m.data[7] >> 4) == 1) {
+      asked->emergencies.push_back(le16(m.data.data() + 8));
+    }
+  }
+  if (last_wkc_ != expected_wkc_) {
+    error_ = "working counter " + std::to_string(last_wkc_) + ", expected " + std::to_string(expected_wkc_);
+    return false;
+  }
+  std::vector<std::uint8_t> back(data, data + image_.size());
+  for (ecat_slave& s : slaves_) {
+    const std::size_t base = (s.logical_inputs - logical_base) * 8u;
+    s.last_status = static_cast<std::uint16_t>(get_bits(back, base + s.status_word->bit_offset, 16));
+    if (s.error_code) s.last_error_code = static_cast<std::uint16_t>(get_bits(back, base + s.error_code->bit_offset, 16));
+    // Inputs are read back into the image; outputs stay as the master wrote them.
+    std::copy(back.begin() + (s.logical_inputs - logical_base),
+              back.begin() + (s.logical_inputs - logical_base) + s.input_bytes,
+              image_.begin() + (s.logical_inputs - logical_base));
+  }
+  if (line != static_cast<std::uint8_t>(line_state::operational) && line != 0) {
+    // Somebody left OP (a watchdog, an error): read each one's state and code.
+    for (ecat_slave& s : slaves_) {
+      const single st = read_register(s, reg_al_status, 6);
+      if (st.ok && st.wkc == 1) {
+        s.al_state = st.data[0];
+        s.al_code = le16(st.data.data() + 4);
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace cia402::ethercat

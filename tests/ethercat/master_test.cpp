@@ -1,0 +1,252 @@
+// Our EtherCAT master against a line of virtual drives on the in-process wire, on virtual time:
+// scan and SII, bring-up to OP with the mapping learnt over CoE, the core's master step over the
+// process data (enable, quick stop, an injected fault and its reset), SDO with aborts, the
+// watchdog when the master stops, and a slave that refuses a state.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <tuple>
+#include <vector>
+
+#include "cia402/ethercat/402/drive_description.hpp"
+#include "cia402/ethercat/402/drive_slave.hpp"
+#include "cia402/ethercat/master/ecat_master.hpp"
+#include "cia402/master.hpp"
+#include "cia402/profile.hpp"
+
+namespace cia402::ethercat {
+namespace {
+
+// The line: frames pass every controller in order at once; waiting runs the drives' applications.
+class wire_link final : public master_link {
+ public:
+  explicit wire_link(int drives) {
+    for (int i = 0; i < drives; ++i) {
+      slaves.push_back(std::make_unique<drive_slave>(standard_profile(), static_cast<std::uint32_t>(i + 1)));
+      wire.add(slaves.back()->controller());
+    }
+  }
+  bool exchange(std::vector<std::uint8_t>& frame) override {
+    if (cut) return false;
+    ++frames;
+    return wire.pass(frame) == frame_error::none;
+  }
+  std::uint64_t now_us() override { return now; }
+  void wait_us(std::uint32_t us) override {
+    now += us;
+    for (auto& s : slaves) s->step(us);
+  }
+
+  std::vector<std::unique_ptr<drive_slave>> slaves;
+  chain wire;
+  std::uint64_t now = 0;
+  std::uint64_t frames = 0;
+  bool cut = false;
+};
+
+// Cycles (1 ms each) until `done` or the limit; the number of cycles, or -1.
+template <typename F>
+int run_until(ecat_master& m, wire_link& link, F done, int limit = 5000) {
+  for (int i = 1; i <= limit; ++i) {
+    (void)m.cycle();
+    link.wait_us(1000);
+    if (done()) return i;
+  }
+  return -1;
+}
+
+state shown(const ecat_slave& s) {
+  state st = state::start;
+  EXPECT_TRUE(decode_status(standard_profile(), s.last_status, st)) << s.last_status;
+  return st;
+}
+
+struct line {
+  wire_link link;
+  ecat_master master;
+  explicit line(int drives) : link(drives), master(link, standard_profile()) {}
+  void up() {
+    ASSERT_TRUE(master.scan()) << master.error();
+    ASSERT_TRUE(master.bring_to_operational()) << master.error();
+    // One cycle more: the first inputs of OP are in.
+    (void)master.cycle();
+    link.wait_us(1000);
+    (void)master.cycle();
+  }
+  bool all(state target) {
+    for (const ecat_slave& s : master.slaves()) {
+      if (shown(s) != target) return false;
+    }
+    return true;
+  }
+};
+
+TEST(ecat_master, scan_addresses_every_slave_and_reads_its_sii) {
+  line l(3);
+  ASSERT_TRUE(l.master.scan()) << l.master.error();
+  ASSERT_EQ(l.master.slaves().size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const ecat_slave& s = l.master.slaves()[i];
+    EXPECT_EQ(s.position, i);
+    EXPECT_EQ(s.station, 0x1001 + i);
+    EXPECT_EQ(l.link.slaves[i]->controller().read16(0x0010), 0x1001 + i) << "the station address is in the ESC";
+    const slave_description& own = l.link.slaves[i]->description();
+    EXPECT_EQ(s.sii.vendor_id, own.vendor_id);
+    EXPECT_EQ(s.sii.product_code, own.product_code);
+    EXPECT_EQ(s.sii.serial, i + 1) << "read from each slave's own EEPROM";
+    EXPECT_EQ(s.sii.device_name, own.device_name);
+    EXPECT_EQ(s.al_state & 0x0F, 1) << "INIT";
+  }
+}
+
+TEST(ecat_master, no_slave_and_no_line_are_errors_that_say_so) {
+  wire_link empty(0);
+  ecat_master m(empty, standard_profile());
+  EXPECT_FALSE(m.scan());
+  EXPECT_NE(m.error().find("no slave answered"), std::string::npos) << m.error();
+  wire_link cut(2);
+  cut.cut = true;
+  ecat_master m2(cut, standard_profile());
+  EXPECT_FALSE(m2.scan());
+  EXPECT_NE(m2.error().find("no frame came back"), std::string::npos) << m2.error();
+}
+
+TEST(ecat_master, brings_the_line_to_op_with_the_mapping_it_learnt_over_coe) {
+  line l(4);
+  l.up();
+  EXPECT_EQ(l.master.expected_working_counter(), 4 * 3) << "each slave: +2 write FMMU, +1 read FMMU";
+  EXPECT_EQ(l.master.last_working_counter(), 4 * 3);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const ecat_slave& s = l.master.slaves()[i];
+    EXPECT_EQ(l.link.slaves[i]->state(), al_state::operational);
+    EXPECT_EQ(s.mapping_source, "CoE 0x1C12/0x1C13");
+    EXPECT_EQ(s.output_bytes, l.link.slaves[i]->output_bytes());
+    EXPECT_EQ(s.input_bytes, l.link.slaves[i]->input_bytes());
+    ASSERT_TRUE(s.control_word && s.status_word && s.position_actual);
+    EXPECT_EQ(s.control_word->bit_offset, 0);
+    EXPECT_EQ(s.status_word->bit_offset, 0);
+    EXPECT_EQ(shown(s), state::switch_on_disabled);
+  }
+}
+
+TEST(ecat_master, a_changed_mapping_is_found_where_the_drive_puts_it) {
+  line l(1);
+  auto& m = l.master;
+  ASSERT_TRUE(m.scan());
+  ASSERT_TRUE(m.bring_to_pre_operational()) << m.error();
+  // TxPDO 0x1A00 = 0x6064, 0x6041: the status word second. A master that assumed the default
+  // layout would read the position's low half as the status word.
+  for (const auto& [index, sub, value, bytes] :
+       std::vector<std::tuple<std::uint16_t, std::uint8_t, std::int64_t, unsigned>>{
+           {0x1C13, 0, 0, 1}, {0x1A00, 0, 0, 1}, {0x1A00, 1, 0x60640020, 4}, {0x1A00, 2, 0x60410010, 4},
+           {0x1A00, 0, 2, 1}, {0x1C13, 0, 1, 1}}) {
+    const ecat_sdo_result r = m.sdo_write(0, index, sub, value, bytes);
+    ASSERT_TRUE(r.ok) << r.error;
+  }
+  ASSERT_TRUE(m.bring_to_operational()) << m.error();
+  const ecat_slave& s = m.slaves()[0];
+  EXPECT_EQ(s.input_bytes, 6);
+  EXPECT_EQ(s.position_actual->bit_offset, 0);
+  EXPECT_EQ(s.status_word->bit_offset, 32);
+  EXPECT_FALSE(s.error_code) << "0x603F is no longer mapped";
+  m.set_target(0, state::operation_enabled);
+  EXPECT_GT(run_until(m, l.link, [&] { return shown(m.slaves()[0]) == state::operation_enabled; }), 0);
+  EXPECT_EQ(m.sdo_write(0, 0x1C13, 0, 0, 1).ok, false) << "PDO assignment is refused outside PRE-OP";
+}
+
+TEST(ecat_master, enables_quick_stops_faults_and_resets_every_drive_over_process_data) {
+  line l(16);
+  l.up();
+  for (std::size_t i = 0; i < 16; ++i) l.master.set_target(i, state::operation_enabled);
+  EXPECT_GT(run_until(l.master, l.link, [&] { return l.all(state::operation_enabled); }), 0);
+  (void)l.master.cycle();  // the master's step sees the status word the cycle before brought
+  for (std::size_t i = 0; i < 16; ++i) {
+    EXPECT_EQ(l.master.slaves()[i].steering.outcome(), master_outcome::reached);
+    EXPECT_EQ(l.link.slaves[i]->device().drive().view().current(), state::operation_enabled);
+  }
+  // Quick stop on every drive: QUICK STOP ACTIVE, then (0x605A = 2) SWITCH ON DISABLED at standstill.
+  for (std::size_t i = 0; i < 16; ++i) l.master.hold_command(i, cia402::command::quick_stop);
+  bool passed_quick_stop = false;
+  EXPECT_GT(run_until(l.master, l.link, [&] {
+              passed_quick_stop = passed_quick_stop || shown(l.master.slaves()[0]) == state::quick_stop_active;
+              return l.all(state::switch_on_disabled);
+            }),
+            0);
+  EXPECT_TRUE(passed_quick_stop);
+  // A fault injected in drive 5 (0x2001 over the mailbox): FAULT there alone, its EMCY arrives.
+  for (std::size_t i = 0; i < 16; ++i) l.master.set_target(i, state::operation_enabled);
+  ASSERT_GT(run_until(l.master, l.link, [&] { return l.all(state::operation_enabled); }), 0);
+  ASSERT_TRUE(l.master.sdo_write(5, 0x2001, 0, 0x2310, 2).ok);
+  EXPECT_GT(run_until(l.master, l.link, [&] { return shown(l.master.slaves()[5]) == state::fault; }), 0);
+  (void)l.master.cycle();
+  EXPECT_EQ(l.master.slaves()[5].steering.outcome(), master_outcome::fault);
+  EXPECT_EQ(l.master.slaves()[5].last_error_code, 0x2310);
+  EXPECT_EQ(shown(l.master.slaves()[4]), state::operation_enabled) << "the others run on";
+  // Reset once the cause is gone: the fault-reset edge, then SWITCH ON DISABLED.
+  ASSERT_TRUE(l.master.sdo_write(5, 0x2001, 0, 0, 2).ok);
+  l.master.set_target(5, state::switch_on_disabled);
+  EXPECT_GT(run_until(l.master, l.link, [&] { return shown(l.master.slaves()[5]) == state::switch_on_disabled; }), 0);
+  EXPECT_EQ(l.master.slaves()[5].last_error_code, 0);
+  const auto& emcy = l.master.slaves()[5].emergencies;
+  EXPECT_NE(std::find(emcy.begin(), emcy.end(), 0x2310), emcy.end()) << "the EMCY came with the next SDO";
+  EXPECT_TRUE(l.master.slaves()[4].emergencies.empty());
+  EXPECT_EQ(l.master.last_working_counter(), 16 * 3);
+}
+
+TEST(ecat_master, the_outputs_start_as_the_drive_has_them) {
+  line l(1);
+  ASSERT_TRUE(l.master.scan());
+  // The drive holds mode 3 (pv) and a target velocity: running the line must not zero them.
+  auto& v = l.link.slaves[0]->device();
+  ASSERT_EQ(v.write(0x6060, 0, 3), sdo_abort::none);
+  ASSERT_EQ(v.write(0x60FF, 0, 700), sdo_abort::none);
+  l.up();
+  for (int i = 0; i < 20; ++i) {
+    (void)l.master.cycle();
+    l.link.wait_us(1000);
+  }
+  std::int64_t mode = 0, target = 0;
+  ASSERT_EQ(v.read(0x6060, 0, mode), sdo_abort::none);
+  ASSERT_EQ(v.read(0x60FF, 0, target), sdo_abort::none);
+  EXPECT_EQ(mode, 3);
+  EXPECT_EQ(target, 700);
+  EXPECT_EQ(shown(l.master.slaves()[0]), state::switch_on_disabled) << "watching commands nothing";
+}
+
+TEST(ecat_master, sdo_reads_writes_and_reports_aborts_in_words) {
+  line l(2);
+  l.up();
+  const ecat_sdo_result id = l.master.sdo_read(1, 0x1018, 4);
+  ASSERT_TRUE(id.ok) << id.error;
+  EXPECT_EQ(id.value(false), 2) << "serial of the second drive";
+  const ecat_sdo_result missing = l.master.sdo_read(0, 0x5555, 0);
+  EXPECT_FALSE(missing.ok);
+  EXPECT_EQ(missing.abort, sdo_abort::object_does_not_exist);
+  EXPECT_NE(missing.error.find("0x06020000"), std::string::npos) << missing.error;
+  ASSERT_TRUE(l.master.sdo_write(0, 0x6083, 0, 2500, 4).ok);
+  EXPECT_EQ(l.master.sdo_read(0, 0x6083, 0).value(false), 2500);
+  const ecat_sdo_result range = l.master.sdo_write(0, 0x605A, 0, 100, 2);
+  EXPECT_FALSE(range.ok) << "a quick stop option code out of range is refused, as on CAN";
+  EXPECT_NE(range.abort, sdo_abort::none);
+}
+
+TEST(ecat_master, a_master_that_stops_leaves_the_drives_to_their_watchdog) {
+  line l(2);
+  l.up();
+  l.master.set_target(0, state::operation_enabled);
+  ASSERT_GT(run_until(l.master, l.link, [&] { return shown(l.master.slaves()[0]) == state::operation_enabled; }), 0);
+  l.link.wait_us(200'000);  // no frames for 200 ms: past the 100 ms process data watchdog
+  EXPECT_EQ(l.link.slaves[0]->state(), al_state::safe_operational);
+  (void)l.master.cycle();
+  const ecat_slave& s = l.master.slaves()[0];
+  EXPECT_EQ(s.al_state, 0x14) << "SAFE-OP with the error bit";
+  EXPECT_EQ(s.al_code, 0x001B);
+  EXPECT_STREQ(al_status_code_text(s.al_code), "sync manager watchdog");
+  // The drive lost its master (0x6007 = 1 by default: a fault, 0x8130 heartbeat/connection error).
+  for (int i = 0; i < 50; ++i) l.link.wait_us(1000);
+  EXPECT_EQ(l.link.slaves[0]->device().drive().view().current(), state::fault);
+}
+
+}  // namespace
+}  // namespace cia402::ethercat
