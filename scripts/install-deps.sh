@@ -11,7 +11,7 @@ packages=(
   clang libclang-rt-14-dev
   gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib
   chromium python3-can python3-pytest
-  iproute2
+  iproute2 tshark
 )
 
 missing=()
