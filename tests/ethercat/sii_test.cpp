@@ -148,3 +148,28 @@ TEST(esi, names_identity_sync_managers_and_pdos_as_the_image_does) {
 
 }  // namespace
 }  // namespace cia402::ethercat
+
+namespace cia402::ethercat {
+namespace {
+
+TEST(sii, the_first_string_is_the_device_name_as_masters_that_show_string_1_expect) {
+  const std::vector<std::uint8_t> image = sii_image(sample());
+  // Categories from word 0x40: type, size in words, data. The strings category (10) starts with
+  // the count, then each string as a length byte and its characters.
+  for (std::size_t at = 0x80; at + 4 <= image.size();) {
+    const std::uint16_t type = static_cast<std::uint16_t>(image[at] | (image[at + 1] << 8));
+    const std::uint16_t size = static_cast<std::uint16_t>(image[at + 2] | (image[at + 3] << 8));
+    ASSERT_NE(type, 0xFFFF) << "no strings category";
+    if (type == 10) {
+      const std::size_t length = image[at + 5];
+      EXPECT_EQ(std::string(image.begin() + static_cast<long>(at) + 6, image.begin() + static_cast<long>(at + 6 + length)),
+                "cia402 virtual drive");
+      return;
+    }
+    at += 4 + 2u * size;
+  }
+  FAIL() << "no end marker";
+}
+
+}  // namespace
+}  // namespace cia402::ethercat

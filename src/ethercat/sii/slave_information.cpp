@@ -225,9 +225,11 @@ std::vector<std::uint8_t> sii_image(const slave_description& d) {
 
   string_table strings;
   std::vector<std::uint8_t> general(32, 0);
-  general[0] = strings.add(d.group_name);
+  // The device name is string 1: masters that show a slave's name without reading the general
+  // category (SOEM's slaveinfo, for one) take the first string.
   general[2] = strings.add(d.device_name);  // order number
   general[3] = strings.add(d.device_name);
+  general[0] = strings.add(d.group_name);
   general[5] = d.coe ? d.coe_details : 0;
   general[9] = d.profile_number == 402 ? 1 : 0;  // CiA 402 channels
   general[14] = general[0];
