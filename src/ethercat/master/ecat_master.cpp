@@ -350,7 +350,9 @@ ecat_sdo_result ecat_master::sdo(ecat_slave& s, const std::vector<std::uint8_t>&
     result.error = slave_text(s) + ": its receive mailbox stays full";
     return result;
   }
-  for (;;) {
+  // A slave that keeps sending what is not the answer (emergencies, stale replies) is given a
+  // bounded number of mailboxes, not the master's whole life.
+  for (int looked = 0; looked < 64; ++looked) {
     const auto reply = mailbox_receive(s);
     if (!reply) {
       result.error = slave_text(s) + ": no SDO answer for " + hex(index, 4) + ":" + std::to_string(sub);
@@ -401,6 +403,9 @@ ecat_sdo_result ecat_master::sdo(ecat_slave& s, const std::vector<std::uint8_t>&
       return result;
     }
   }
+  result.error = slave_text(s) + ": no answer to the SDO for " + hex(index, 4) + ":" + std::to_string(sub) +
+                 " among 64 mailboxes it sent";
+  return result;
 }
 
 ecat_sdo_result ecat_master::sdo_read(std::size_t i, std::uint16_t index, std::uint8_t sub) {
@@ -435,13 +440,13 @@ bool ecat_master::learn_mapping(ecat_slave& s) {
   bool from_coe = s.mailbox;
   const auto read_assigned = [&](std::uint16_t assign, std::vector<entry>& out) {
     const ecat_sdo_result count = sdo_read(i, assign, 0);
-    if (!count.ok) return false;
+    if (!count.ok || count.value(false) > 254) return false;  // sub-indices 1..254 at most
     for (std::int64_t k = 1; k <= count.value(false); ++k) {
       const ecat_sdo_result pdo = sdo_read(i, assign, static_cast<std::uint8_t>(k));
       if (!pdo.ok) return false;
       const auto pdo_index = static_cast<std::uint16_t>(pdo.value(false));
       const ecat_sdo_result n = sdo_read(i, pdo_index, 0);
-      if (!n.ok) return false;
+      if (!n.ok || n.value(false) > 254) return false;
       for (std::int64_t e = 1; e <= n.value(false); ++e) {
         const ecat_sdo_result m = sdo_read(i, pdo_index, static_cast<std::uint8_t>(e));
         if (!m.ok) return false;
@@ -493,6 +498,12 @@ bool ecat_master::learn_mapping(ecat_slave& s) {
     return found;
   };
   unsigned out_bits = 0, in_bits = 0;
+  for (const entry& e : outputs) out_bits += e.bits;
+  for (const entry& e : inputs) in_bits += e.bits;
+  if (out_bits + in_bits > 8u * (maximum_frame_size - 100)) {
+    return fail(slave_text(s) + ": its process data (" + std::to_string((out_bits + in_bits + 7) / 8) +
+                " bytes) does not fit one frame");
+  }
   s.control_word = place(outputs, 0x6040, 16, out_bits);
   s.status_word = place(inputs, 0x6041, 16, in_bits);
   s.error_code = place(inputs, 0x603F, 16, in_bits);
