@@ -17,6 +17,7 @@
 #include "action_log.hpp"
 #include "page_json.hpp"
 #include "page_names.hpp"
+#include "remote_link.hpp"
 #include "recorder.hpp"
 #include "snapshot_board.hpp"
 #include "word_change.hpp"
@@ -97,6 +98,92 @@ co::drive_master_config master_config(const profile& p, const remote_config& c) 
   return m;
 }
 
+// The link over CAN: the project's one CANopen 402 master, set up as master_config says.
+class canopen_link final : public detail::remote_link {
+ public:
+  canopen_link(const profile& p, co::channel& bus, const remote_config& c)
+      : bus_(bus), config_(c), m_(bus, master_config(p, c)) {
+    m_.on_status = [this](std::uint16_t sw) {
+      if (on_status) on_status(sw);
+    };
+    m_.on_velocity = [this](std::int32_t v) {
+      if (on_velocity) on_velocity(v);
+    };
+    m_.on_sent = [this](std::uint16_t w) {
+      if (on_sent) on_sent(w);
+    };
+    m_.on_phase = [this](co::master_phase, co::phase_reason why) {
+      if (!on_phase) return;
+      switch (why) {
+        case co::phase_reason::node_restarted: on_phase(detail::link_event::restarted); break;
+        case co::phase_reason::failed: on_phase(detail::link_event::failed); break;
+        case co::phase_reason::running: on_phase(detail::link_event::running); break;
+        default: break;
+      }
+    };
+  }
+
+  void poll(std::uint32_t elapsed_us) override { (void)m_.poll(bus_, elapsed_us); }
+  bool running() const override { return m_.phase() == co::master_phase::running; }
+  bool failed() const override { return m_.phase() == co::master_phase::failed; }
+  remote_status status() const override {
+    switch (m_.phase()) {
+      case co::master_phase::configuring: return remote_status::configuring;
+      case co::master_phase::running: return remote_status::running;
+      case co::master_phase::failed: break;
+    }
+    switch (m_.failure()) {
+      case co::master_failure::bus_failed: return remote_status::bus_failed;
+      case co::master_failure::sdo_refused:
+      case co::master_failure::not_a_drive: return remote_status::refused;
+      default: return remote_status::no_answer;
+    }
+  }
+  std::string phase_text() const override { return m_.phase_text(); }
+  std::string drive_text() const override { return "node " + std::to_string(config_.node_id); }
+  bool request_pending() const override { return m_.request_pending(); }
+  bool read(std::uint16_t index, bool is_signed, std::function<void(const detail::link_transfer&)> done) override {
+    return m_.read(index, 0, is_signed, [done](const co::sdo_result& r) { done(transfer(r)); });
+  }
+  bool write(std::uint16_t index, std::int64_t value, unsigned bytes,
+             std::function<void(const detail::link_transfer&)> done) override {
+    return m_.write(index, 0, value, bytes, [done](const co::sdo_result& r) { done(transfer(r)); });
+  }
+  const std::map<std::uint16_t, std::int64_t>& start_values() const override { return m_.start_values(); }
+  std::uint16_t last_sent() const override { return m_.last_sent(); }
+  void send_control_word(std::uint16_t word, bool fault_reset_edge) override {
+    m_.send_control_word(word, fault_reset_edge);
+  }
+  bool words_queued() const override { return m_.words_queued(); }
+  bool status_known() const override { return m_.status_known(); }
+  std::uint16_t status_word() const override { return m_.status_word(); }
+  std::uint16_t error_code() const override { return m_.error_code(); }
+  std::uint8_t error_register() const override { return m_.error_register(); }
+  bool fault_injection() const override { return m_.fault_injection(); }
+  json describe() const override {
+    json r;
+    r["node"] = config_.node_id;
+    r["bus"] = config_.bus_name;
+    r["status"] = remote_status_name(status());
+    r["text"] = m_.phase_text();
+    const auto nmt_seen = m_.nmt_seen();
+    r["nmt"] = nmt_seen ? json(co::nmt_state_name(static_cast<co::nmt_state>(*nmt_seen))) : json(nullptr);
+    r["device_name"] = m_.device_name();
+    r["heartbeat_watched"] = m_.heartbeat_watched();
+    r["error_code_in_pdo"] = m_.error_code_mapped();
+    r["velocity_in_pdo"] = m_.velocity_mapped();
+    const auto last_emcy = m_.last_emcy();
+    r["last_emcy"] = last_emcy ? json(hex(*last_emcy, 4)) : json(nullptr);
+    return r;
+  }
+  json where() const override { return {{"node", config_.node_id}, {"bus", config_.bus_name}}; }
+
+ private:
+  static detail::link_transfer transfer(const co::sdo_result& r) { return {r.ok(), r.cancelled, r.abort, r.value}; }
+  co::channel& bus_;
+  remote_config config_;
+  co::drive_master m_;
+};
 }  // namespace
 
 const char* remote_status_name(remote_status s) noexcept {
@@ -111,11 +198,11 @@ const char* remote_status_name(remote_status s) noexcept {
 }
 
 struct remote_drive::impl {
-  impl(const profile& p, co::channel& b, const remote_config& c)
+  impl(const profile& p, std::unique_ptr<detail::remote_link> l, const remote_config& c)
       : table(p),
-        bus(b),
         config(c),
-        remote(b, master_config(p, c)),
+        link(std::move(l)),
+        remote(*link),
         log({c.results_kept, c.settle_quiet_us, c.settle_limit_us,
              "still busy when the page stopped waiting", " (numbers inferred)"},
             [this] { return how_it_stands(); }) {
@@ -127,20 +214,19 @@ struct remote_drive::impl {
       if ((w & bit7) != 0 && (sent_before & bit7) == 0) reset_sent_since_change = true;
       sent_before = w;
     };
-    remote.on_phase = [this](co::master_phase phase, co::phase_reason why) {
-      on_phase(phase, why);
-    };
+    remote.on_phase = [this](detail::link_event why) { on_phase(why); };
   }
 
   const profile& table;
-  co::channel& bus;
   remote_config config;
 
   mutable std::mutex mutex;  // guards all here but the board, which has a lock of its own
   std::condition_variable job_done;
 
-  // The one CANopen 402 master: set-up, PDOs, SDO requests, polling, heartbeat, retry.
-  co::drive_master remote;
+  // The master that reaches the drive (CANopen or EtherCAT): set-up, the status word as it comes,
+  // the control word, SDO requests, retry.
+  std::unique_ptr<detail::remote_link> link;
+  detail::remote_link& remote;
   std::uint64_t now_us = 0;
   std::uint64_t next_publish_us = 0;
 
@@ -189,6 +275,7 @@ struct remote_drive::impl {
   std::optional<handshake_run> handshake;
 
   std::optional<std::int64_t> actual(std::uint16_t index) const {
+    if (const auto v = remote.cyclic(index)) return v;
     for (const actual_value& a : actuals) {
       if (a.index == index) return a.value;
     }
@@ -207,20 +294,24 @@ struct remote_drive::impl {
   // One read at a time, and none while the page's own requests wait: they go first.
   void read_actuals() {
     if (config.actual_poll_us == 0 || actual_in_flight || user_transfers > 0 ||
-        remote.phase() != co::master_phase::running || remote.request_pending() ||
+        !remote.running() || remote.request_pending() ||
         now_us < next_round_us) {
       return;
     }
-    while (next_actual < actuals.size() && actuals[next_actual].absent) ++next_actual;
+    // What the link carries cyclically is not read by SDO.
+    while (next_actual < actuals.size() &&
+           (actuals[next_actual].absent || remote.cyclic(actuals[next_actual].index))) {
+      ++next_actual;
+    }
     if (next_actual >= actuals.size()) {
       next_actual = 0;
       next_round_us = now_us + config.actual_poll_us;
       return;
     }
     const std::size_t k = next_actual++;
-    actual_in_flight = remote.read(actuals[k].index, 0, true, [this, k](const co::sdo_result& r) {
+    actual_in_flight = remote.read(actuals[k].index, true, [this, k](const detail::link_transfer& r) {
       actual_in_flight = false;
-      if (r.ok()) {
+      if (r.ok) {
         actuals[k].value = r.value;
       } else if (!r.cancelled && r.abort != sdo_abort::sdo_protocol_timed_out) {
         actuals[k].absent = true;  // the drive has no such object (or will not say)
@@ -229,37 +320,25 @@ struct remote_drive::impl {
     });
   }
 
-  std::string node_text() const { return "node " + std::to_string(config.node_id); }
+  std::string node_text() const { return remote.drive_text(); }
 
-  remote_status status() const {
-    switch (remote.phase()) {
-      case co::master_phase::configuring: return remote_status::configuring;
-      case co::master_phase::running: return remote_status::running;
-      case co::master_phase::failed: break;
-    }
-    switch (remote.failure()) {
-      case co::master_failure::bus_failed: return remote_status::bus_failed;
-      case co::master_failure::sdo_refused:
-      case co::master_failure::not_a_drive: return remote_status::refused;
-      default: return remote_status::no_answer;
-    }
-  }
+  remote_status status() const { return remote.status(); }
 
-  void on_phase(co::master_phase phase, co::phase_reason why) {
+  void on_phase(detail::link_event why) {
     switch (why) {
-      case co::phase_reason::node_restarted:
+      case detail::link_event::restarted:
         injected_fault = 0;
         state_known = false;
         forget_actuals();
         handshake.reset();
         break;
-      case co::phase_reason::failed:
+      case detail::link_event::failed:
         // The node went silent (or its set-up failed): nothing is known until set-up ran again.
         state_known = false;
         log.finish_pending(remote.phase_text().c_str());
         handshake.reset();
         break;
-      case co::phase_reason::running: {
+      case detail::link_event::running: {
         // Start from the drive's present values, so connecting changes nothing.
         objects.clear();
         for (const object_name& o : object_names(table)) {
@@ -276,9 +355,7 @@ struct remote_drive::impl {
         actual_in_flight = false;
         break;
       }
-      default: break;
     }
-    (void)phase;
   }
 
   // --- what the drive reports -------------------------------------------------------------------
@@ -328,7 +405,7 @@ struct remote_drive::impl {
   void process(std::uint32_t elapsed_us) {
     now_us += elapsed_us;
     transition_this_poll = no_transition;
-    (void)remote.poll(bus, elapsed_us);
+    remote.poll(elapsed_us);
     if (handshake) run_handshake();
     read_actuals();
     if (state_known) record_row();
@@ -456,7 +533,7 @@ struct remote_drive::impl {
   }
 
   std::optional<refused> not_running() const {
-    if (remote.phase() == co::master_phase::running) return std::nullopt;
+    if (remote.running()) return std::nullopt;
     std::string why = remote.phase_text().empty() ? node_text() + " is not ready" : remote.phase_text();
     return refused{503, why};
   }
@@ -468,12 +545,12 @@ struct remote_drive::impl {
                                       std::optional<std::string> track_action = std::nullopt) {
     auto w = std::make_shared<user_wait>();
     w->track_action = std::move(track_action);
-    const bool queued = remote.write(index, 0, value, bytes, [this, w, on_done](const co::sdo_result& r) {
+    const bool queued = remote.write(index, value, bytes, [this, w, on_done](const detail::link_transfer& r) {
       --user_transfers;
       w->done = true;
       w->cancelled = r.cancelled;
       w->abort = r.abort;
-      if (r.ok()) {
+      if (r.ok) {
         if (on_done) on_done();
         if (w->track_action) w->id = track(*w->track_action, false);
       }
@@ -527,27 +604,9 @@ struct remote_drive::impl {
     return {{"fault", fault_injection}, {"dc_link", false}, {"sto", false}, {"reasons", reasons}};
   }
 
-  json remote_json() const {
-    json r;
-    r["node"] = config.node_id;
-    r["bus"] = config.bus_name;
-    r["status"] = remote_status_name(status());
-    r["text"] = remote.phase_text();
-    const auto nmt_seen = remote.nmt_seen();
-    r["nmt"] = nmt_seen ? json(co::nmt_state_name(static_cast<co::nmt_state>(*nmt_seen)))
-                        : json(nullptr);
-    r["device_name"] = remote.device_name();
-    r["heartbeat_watched"] = remote.heartbeat_watched();
-    r["error_code_in_pdo"] = remote.error_code_mapped();
-    r["velocity_in_pdo"] = remote.velocity_mapped();
-    const auto last_emcy = remote.last_emcy();
-    r["last_emcy"] = last_emcy ? json(hex(*last_emcy, 4)) : json(nullptr);
-    return r;
-  }
-
   json snapshot(bool with_time) const {
     json j;
-    const bool live = remote.phase() != co::master_phase::failed;
+    const bool live = !remote.failed();
     const bool status_known = remote.status_known();
     const std::uint16_t status_word = remote.status_word();
     j["state"] = live ? shown_state() : "UNKNOWN";
@@ -593,7 +652,7 @@ struct remote_drive::impl {
     for (const auto& [index, value] : objects) objs[hex(index, 4)] = value;
     j["objects"] = std::move(objs);
     j["results"] = log.results_json();
-    j["remote"] = remote_json();
+    j["remote"] = remote.describe();
     j["capabilities"] = capabilities();
     if (with_time) {
       j["cycle"] = now_us / config.cycle_us;
@@ -604,7 +663,10 @@ struct remote_drive::impl {
 };
 
 remote_drive::remote_drive(const profile& p, canopen::channel& bus, const remote_config& config)
-    : impl_(std::make_unique<impl>(p, bus, config)) {}
+    : impl_(std::make_unique<impl>(p, std::make_unique<canopen_link>(p, bus, config), config)) {}
+
+remote_drive::remote_drive(const profile& p, std::unique_ptr<detail::remote_link> link, const remote_config& config)
+    : impl_(std::make_unique<impl>(p, std::move(link), config)) {}
 
 remote_drive::~remote_drive() { close(); }
 
@@ -735,7 +797,7 @@ std::string remote_drive::info_json(bool control, bool token_required) const {
   const impl& m = *impl_;
   json j = detail::profile_info(m.table);
   j["backend"] = "remote";
-  j["remote"] = {{"node", m.config.node_id}, {"bus", m.config.bus_name}};
+  j["remote"] = m.remote.where();
   j["transitions_inferred"] = true;
   j["control"] = control;
   j["token_required"] = token_required;

@@ -38,6 +38,10 @@
 
 namespace cia402::page {
 
+namespace detail {
+class remote_link;
+}
+
 struct remote_config {
   std::uint8_t node_id = 1;
   std::string bus_name;                   ///< shown on the page, e.g. the URL
@@ -77,6 +81,8 @@ class remote_drive final : public backend {
  public:
   /// The profile and the channel must outlive the backend. Nothing is sent before the first step.
   remote_drive(const profile& p, canopen::channel& bus, const remote_config& config = {});
+  /// A drive reached through another link (EtherCAT: ecat_drive.hpp makes one).
+  remote_drive(const profile& p, std::unique_ptr<detail::remote_link> link, const remote_config& config);
   ~remote_drive() override;
   remote_drive(const remote_drive&) = delete;
   remote_drive& operator=(const remote_drive&) = delete;
