@@ -7,7 +7,9 @@
 #include <ostream>
 #include <pthread.h>
 
+#include "cia402/apps/ethercat_link.hpp"
 #include "cia402/canopen/transport/channel_url.hpp"
+#include "cia402/page/ecat_drive.hpp"
 #include "cia402/page/instrument.hpp"
 #include "cia402/page/remote_drive.hpp"
 #include "cia402/page/runner.hpp"
@@ -25,7 +27,8 @@ constexpr int unreachable = 1;
 CLI::App* add_serve_subcommand(CLI::App& app, serve_args& args) {
   auto* cmd = app.add_subcommand(
       "serve",
-      "Run a virtual drive in real time, or with --can show a drive on a CAN bus, and serve its "
+      "Run a virtual drive in real time, or with --can show a drive on a CAN bus, or with --ecat one on "
+      "an EtherCAT line, and serve its "
       "instrument control page (control and status word bits, the state machine, the plant) on "
       "http://127.0.0.1:8402/; Ctrl-C stops");
   add_profile_options(*cmd, args.profile_name, args.profile_file,
@@ -59,6 +62,17 @@ CLI::App* add_serve_subcommand(CLI::App& app, serve_args& args) {
       ->default_str("1")
       ->excludes(can)
       ->excludes(node);
+  auto* ecat = cmd->add_option("--ecat", args.ecat,
+                               "show a drive on an EtherCAT line: the network interface our master runs "
+                               "the line on (raw socket, root)")
+                   ->type_name("IFACE")
+                   ->excludes(can)
+                   ->excludes(node);
+  cmd->add_option("--position", args.position, "with --ecat: the drive's position on the line, 0 first")
+      ->type_name("N")
+      ->check(CLI::Range(0, 65535))
+      ->default_str("0")
+      ->needs(ecat);
   return cmd;
 }
 
@@ -77,7 +91,21 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   std::vector<std::unique_ptr<canopen::channel>> channels;
   std::vector<std::unique_ptr<page::backend>> drives;
   std::vector<page::axis> axes;
-  if (args.can.empty()) {
+  std::unique_ptr<apps::ethercat_link> line;
+  if (!args.ecat.empty()) {
+    // A line answers in microseconds: 20 ms without an answer is a lost frame, and the page says
+    // the line is gone within half a second rather than after seconds of waiting.
+    line = std::make_unique<apps::ethercat_link>(20000);
+    if (const std::error_code ec = line->open(args.ecat)) {
+      err << "cia402 serve: cannot open " << args.ecat << ": " << ec.message()
+          << (ec.value() == EPERM ? " (a raw socket needs root or CAP_NET_RAW)" : "") << "\n";
+      return unreachable;
+    }
+    page::remote_config rc;
+    rc.bus_name = "EtherCAT " + args.ecat;
+    drives.push_back(page::make_ecat_drive(choice.get(), *line, static_cast<std::uint16_t>(args.position), args.ecat, rc));
+    axes.push_back({"slave " + std::to_string(args.position), drives.back().get()});
+  } else if (args.can.empty()) {
     for (int k = 1; k <= args.virtual_axes; ++k) {
       // Selectable on the page: the built-in profiles and this one (instrument_config's default).
       drives.push_back(std::make_unique<page::instrument>(choice.get()));
@@ -141,7 +169,10 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
 
   std::string what;
   for (const page::axis& a : axes) what += (what.empty() ? "" : ", ") + a.label;
-  if (args.can.empty()) {
+  if (!args.ecat.empty()) {
+    out << "cia402 serve: " << what << " on EtherCAT " << args.ecat << " (profile " << choice.get().name
+        << "), instrument page at " << http.url() << "\n";
+  } else if (args.can.empty()) {
     out << "cia402 serve: profile " << choice.get().name
         << (axes.size() > 1 ? ", " + std::to_string(axes.size()) + " virtual drives" : std::string())
         << ", instrument page at " << http.url() << "\n";

@@ -24,6 +24,8 @@ struct serve_args {
   std::string can;              ///< socketcand://HOST:PORT/BUS or socketcan://IFACE; "" = virtual drive
   std::vector<int> nodes{1};    ///< with --can: the drives' node-IDs, one axis each
   int virtual_axes = 1;         ///< without --can: how many virtual drives (--nodes N)
+  std::string ecat;             ///< a network interface: the drive on that EtherCAT line instead
+  int position = 0;             ///< with --ecat: the drive's position on the line, 0 first
 };
 
 /// Registers the subcommand on `app`, filling `args` when it is parsed.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "cia402/objects.hpp"
+
 
 namespace cia402::ethercat {
 namespace {
@@ -637,6 +639,47 @@ void ecat_master::release(std::size_t i) {
   s.held_command.reset();
 }
 
+void ecat_master::send_control_word(std::size_t i, std::uint16_t word) {
+  release(i);
+  slaves_.at(i).last_control = word;
+}
+
+std::optional<std::int64_t> ecat_master::input(std::size_t i, std::uint16_t index, std::uint8_t sub) const {
+  const ecat_slave& s = slaves_.at(i);
+  if (image_.empty()) return std::nullopt;
+  for (const ecat_slave::mapped_object& o : s.inputs) {
+    if (o.index != index || o.sub != sub || o.bits == 0 || o.bits > 32) continue;
+    const std::uint64_t raw = get_bits(image_, (s.logical_inputs - logical_base) * 8u + o.bit_offset, o.bits);
+    const object_description* d = find_drive_object(index, sub);
+    const bool is_signed = d != nullptr && type_signed(d->type);
+    if (is_signed && o.bits < 64 && ((raw >> (o.bits - 1)) & 1u)) {
+      return static_cast<std::int64_t>(raw | (~std::uint64_t{0} << o.bits));
+    }
+    return static_cast<std::int64_t>(raw);
+  }
+  return std::nullopt;
+}
+
+bool ecat_master::set_output(std::size_t i, std::uint16_t index, std::int64_t value, std::uint8_t sub) {
+  ecat_slave& s = slaves_.at(i);
+  if (image_.empty()) return false;
+  for (const ecat_slave::mapped_object& o : s.outputs) {
+    if (o.index != index || o.sub != sub || o.bits == 0 || o.bits > 32) continue;
+    put_bits(image_, (s.logical_outputs - logical_base) * 8u + o.bit_offset, o.bits, static_cast<std::uint64_t>(value));
+    if (index == 0x6040 && sub == 0) send_control_word(i, static_cast<std::uint16_t>(value));
+    return true;
+  }
+  return false;
+}
+
+bool ecat_master::all_operational() const noexcept {
+  if (slaves_.empty()) return false;
+  for (const ecat_slave& s : slaves_) {
+    if (s.al_state != static_cast<std::uint8_t>(line_state::operational)) return false;
+  }
+  return true;
+}
+
 bool ecat_master::cycle() {
   const std::uint64_t now = link_->now_us();
   for (ecat_slave& s : slaves_) {
@@ -695,7 +738,9 @@ bool ecat_master::cycle() {
               back.begin() + (s.logical_inputs - logical_base) + s.input_bytes,
               image_.begin() + (s.logical_inputs - logical_base));
   }
-  if (line != static_cast<std::uint8_t>(line_state::operational) && line != 0) {
+  if (line == static_cast<std::uint8_t>(line_state::operational)) {
+    for (ecat_slave& s : slaves_) s.al_state = line;
+  } else if (line != 0) {
     // Somebody left OP (a watchdog, an error): read each one's state and code.
     for (ecat_slave& s : slaves_) {
       const single st = read_register(s, reg_al_status, 6);

@@ -647,10 +647,12 @@ function showRemote(s) {
   }
   banner.hidden = false;
   banner.dataset.status = r.status;
-  const where = `node ${r.node}${r.bus ? ` on ${r.bus}` : ''}`;
+  // A drive on EtherCAT says where it is itself ("slave 1 on EtherCAT eth1") and its AL state.
+  const where = r.where || `node ${r.node}${r.bus ? ` on ${r.bus}` : ''}`;
   let text = r.status === 'running'
     ? `Remote drive: ${where}${r.device_name ? ` (${r.device_name})` : ''}` +
-      `${r.nmt ? `, NMT ${label(r.nmt)}` : ''}. Transition numbers are inferred from the observed states.`
+      `${r.nmt ? `, NMT ${label(r.nmt)}` : ''}${r.al_state ? `, AL state ${r.al_state}` : ''}. ` +
+      'Transition numbers are inferred from the observed states.'
     : `Remote drive: ${r.text || `${where}: ${r.status}`}`;
   banner.textContent = text;
 }

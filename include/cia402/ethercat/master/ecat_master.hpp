@@ -120,11 +120,23 @@ class ecat_master {
   void set_target(std::size_t i, state target);
   void hold_command(std::size_t i, cia402::command c);
   void release(std::size_t i);
+  /// Sends this control word every cycle from now on (no target, no held command).
+  void send_control_word(std::size_t i, std::uint16_t word);
+
+  /// An input object as the last cycle brought it (signed where the CiA 402 object table says so);
+  /// nothing when drive `i` does not map it.
+  std::optional<std::int64_t> input(std::size_t i, std::uint16_t index, std::uint8_t sub = 0) const;
+  /// Puts a value into an output object the drive maps, sent from the next cycle on; false (and
+  /// nothing changed) when it maps no such object.
+  bool set_output(std::size_t i, std::uint16_t index, std::int64_t value, std::uint8_t sub = 0);
+  /// Whether every slave shows OP (as the last cycle or status read saw it).
+  bool all_operational() const noexcept;
 
   ecat_sdo_result sdo_read(std::size_t i, std::uint16_t index, std::uint8_t sub);
   ecat_sdo_result sdo_write(std::size_t i, std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes);
 
   std::vector<ecat_slave>& slaves() noexcept { return slaves_; }
+  const std::vector<ecat_slave>& slaves() const noexcept { return slaves_; }
   const std::string& error() const noexcept { return error_; }
   std::uint16_t expected_working_counter() const noexcept { return expected_wkc_; }
   std::uint16_t last_working_counter() const noexcept { return last_wkc_; }
