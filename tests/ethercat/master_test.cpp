@@ -194,6 +194,39 @@ TEST(ecat_master, enables_quick_stops_faults_and_resets_every_drive_over_process
   EXPECT_EQ(l.master.last_working_counter(), 16 * 3);
 }
 
+TEST(ecat_master, cyclic_synchronous_position_over_the_process_data_at_1_ms) {
+  // Mode 8 in 0x6060 and a ramp of 0x607A in the RxPDO, one set-point a cycle; 0x6064 and 0x6061
+  // come back in the TxPDO. 100 increments a ms is 600 rpm at 10,000 increments a revolution.
+  line l(2);
+  l.up();
+  auto& m = l.master;
+  ASSERT_TRUE(m.set_output(1, 0x6060, 8));
+  m.set_target(1, state::operation_enabled);
+  ASSERT_GT(run_until(m, l.link, [&] { return shown(m.slaves()[1]) == state::operation_enabled; }), 0);
+  ASSERT_EQ(m.input(1, 0x6061), 8) << "the mode display in the process data";
+  const std::int64_t start = *m.input(1, 0x6064);
+  std::int64_t max_error = 0;
+  for (int k = 1; k <= 500; ++k) {
+    ASSERT_TRUE(m.set_output(1, 0x607A, start + 100 * k));
+    (void)m.cycle();
+    l.link.wait_us(1000);
+    // Once the shaft is up to speed (the plant's acceleration limit takes the first cycles), the
+    // inputs show the drive on the set-point two cycles before (it took it, then reported).
+    if (k > 50) max_error = std::max<std::int64_t>(max_error, std::llabs(*m.input(1, 0x6064) - (start + 100 * (k - 2))));
+    if (k == 400) EXPECT_EQ(m.input(1, 0x606C), 600) << "600 rpm while streaming, in the process data";
+  }
+  for (int k = 0; k < 5; ++k) {
+    (void)m.cycle();
+    l.link.wait_us(1000);
+  }
+  EXPECT_EQ(*m.input(1, 0x6064), start + 50000) << "followed to the last set-point";
+  EXPECT_LE(max_error, 100) << "within one set-point of the stream";
+  EXPECT_EQ(shown(m.slaves()[1]), state::operation_enabled) << "no following error fault";
+  EXPECT_EQ(*m.input(0, 0x6064), 0) << "the other drive did not move";
+  EXPECT_FALSE(m.set_output(1, 0x6081, 1)) << "0x6081 is not in the RxPDO";
+  EXPECT_FALSE(m.input(1, 0x6081));
+}
+
 TEST(ecat_master, the_outputs_start_as_the_drive_has_them) {
   line l(1);
   ASSERT_TRUE(l.master.scan());
