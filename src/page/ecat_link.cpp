@@ -161,8 +161,8 @@ class ecat_link final : public detail::remote_link {
       const ethercat::ecat_sdo_result r = j.writing ? master_.sdo_write(position_, j.index, 0, j.value, j.bytes)
                                                     : master_.sdo_read(position_, j.index, 0);
       t.ok = r.ok;
-      t.abort = r.ok ? sdo_abort::none : (r.error.find("aborted") != std::string::npos ? r.abort
-                                                                                       : sdo_abort::sdo_protocol_timed_out);
+      // No answer at all reads as the SDO time-out a CANopen master would report.
+      t.abort = r.ok ? sdo_abort::none : r.aborted ? r.abort : sdo_abort::sdo_protocol_timed_out;
       t.value = r.ok ? r.value(j.is_signed) : 0;
     }
     if (j.done) j.done(t);
@@ -201,7 +201,7 @@ class ecat_link final : public detail::remote_link {
     }
     // 0x2001 of this project's virtual drive is write-only: that is how it is told from others.
     const ethercat::ecat_sdo_result probe = master_.sdo_read(position_, fault_injection_index, 0);
-    fault_injection_ = !probe.ok && probe.abort == sdo_abort::write_only_object;
+    fault_injection_ = probe.aborted && probe.abort == sdo_abort::write_only_object;
     last_sent_ = slave().last_control;
     error_code_ = slave().last_error_code;
     const ethercat::ecat_sdo_result reg = master_.sdo_read(position_, 0x1001, 0);

@@ -255,13 +255,15 @@ TEST(ecat_master, sdo_reads_writes_and_reports_aborts_in_words) {
   EXPECT_EQ(id.value(false), 2) << "serial of the second drive";
   const ecat_sdo_result missing = l.master.sdo_read(0, 0x5555, 0);
   EXPECT_FALSE(missing.ok);
+  EXPECT_TRUE(missing.aborted);
   EXPECT_EQ(missing.abort, sdo_abort::object_does_not_exist);
   EXPECT_NE(missing.error.find("0x06020000"), std::string::npos) << missing.error;
   ASSERT_TRUE(l.master.sdo_write(0, 0x6083, 0, 2500, 4).ok);
   EXPECT_EQ(l.master.sdo_read(0, 0x6083, 0).value(false), 2500);
   const ecat_sdo_result range = l.master.sdo_write(0, 0x605A, 0, 100, 2);
   EXPECT_FALSE(range.ok) << "a quick stop option code out of range is refused, as on CAN";
-  EXPECT_NE(range.abort, sdo_abort::none);
+  EXPECT_TRUE(range.aborted);
+  EXPECT_EQ(range.abort, sdo_abort::invalid_value) << "0x605A takes only the codes the profile defines";
 }
 
 TEST(ecat_master, a_master_that_stops_leaves_the_drives_to_their_watchdog) {

@@ -378,6 +378,7 @@ ecat_sdo_result ecat_master::sdo(ecat_slave& s, const std::vector<std::uint8_t>&
     if (le16(sdo + 1) != index || sdo[3] != sub) continue;
     const std::uint8_t cmd = sdo[0];
     if (cmd == 0x80) {
+      result.aborted = true;
       result.abort = static_cast<sdo_abort>(le32(sdo + 4));
       result.error = slave_text(s) + " aborted " + hex(index, 4) + ":" + std::to_string(sub) + ": " +
                      hex(le32(sdo + 4), 8) + " (" + sdo_abort_text(result.abort) + ")";

@@ -90,6 +90,7 @@ struct ecat_slave {
 /// An SDO transfer's result.
 struct ecat_sdo_result {
   bool ok = false;
+  bool aborted = false;                  ///< the slave answered with an SDO abort
   sdo_abort abort = sdo_abort::general_error;  ///< when the slave aborted
   std::string error;                     ///< when there was no SDO answer at all (why)
   std::vector<std::uint8_t> data;        ///< an upload's bytes
