@@ -1,18 +1,14 @@
 #include "cia402/apps/ethercat_host.hpp"
 
-#include <arpa/inet.h>
 #include <linux/if_packet.h>
-#include <net/ethernet.h>
-#include <net/if.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include <cerrno>
-#include <cstring>
 #include <ctime>
 
 #include "cia402/apps/elapsed_clock.hpp"
+#include "raw_ethercat_socket.hpp"
 
 namespace cia402::apps {
 
@@ -28,22 +24,11 @@ ethercat_host::~ethercat_host() {
 }
 
 std::error_code ethercat_host::open(const std::string& interface) {
-  const unsigned index = ::if_nametoindex(interface.c_str());
-  if (index == 0) return {errno != 0 ? errno : ENODEV, std::generic_category()};
-  const int fd = ::socket(AF_PACKET, SOCK_RAW | SOCK_CLOEXEC, htons(ethercat::ethertype));
-  if (fd < 0) return {errno, std::generic_category()};
-  sockaddr_ll address{};
-  address.sll_family = AF_PACKET;
-  address.sll_protocol = htons(ethercat::ethertype);
-  address.sll_ifindex = static_cast<int>(index);
-  if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
-    const int e = errno;
-    ::close(fd);
-    return {e, std::generic_category()};
-  }
+  detail::raw_socket opened;
+  if (const std::error_code ec = detail::open_raw_ethercat_socket(interface, opened)) return ec;
   if (fd_ >= 0) ::close(fd_);
-  fd_ = fd;
-  ifindex_ = static_cast<int>(index);
+  fd_ = opened.fd;
+  ifindex_ = opened.ifindex;
   return {};
 }
 
@@ -80,13 +65,7 @@ void ethercat_host::run(const volatile std::sig_atomic_t& stop) {
       if (from.sll_pkttype == PACKET_OUTGOING) continue;  // our own answer, seen going out
       frame.resize(static_cast<std::size_t>(n));
       if (!pass(frame)) continue;
-      sockaddr_ll to{};
-      to.sll_family = AF_PACKET;
-      to.sll_protocol = htons(ethercat::ethertype);
-      to.sll_ifindex = ifindex_;
-      to.sll_halen = 6;
-      std::memcpy(to.sll_addr, frame.data(), 6);
-      (void)::sendto(fd_, frame.data(), frame.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+      (void)detail::send_raw_frame({fd_, ifindex_}, frame);
     }
     pending_us += clock.take();
     // Catch up at most a few cycles: a stalled host does not replay a second of drive time at once.

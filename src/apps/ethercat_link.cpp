@@ -1,16 +1,14 @@
 #include "cia402/apps/ethercat_link.hpp"
 
-#include <arpa/inet.h>
 #include <linux/if_packet.h>
-#include <net/if.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <ctime>
+
+#include "raw_ethercat_socket.hpp"
 
 namespace cia402::apps {
 namespace {
@@ -27,36 +25,17 @@ ethercat_link::~ethercat_link() {
 }
 
 std::error_code ethercat_link::open(const std::string& interface) {
-  const unsigned index = ::if_nametoindex(interface.c_str());
-  if (index == 0) return {errno != 0 ? errno : ENODEV, std::generic_category()};
-  const int fd = ::socket(AF_PACKET, SOCK_RAW | SOCK_CLOEXEC, htons(ethercat::ethertype));
-  if (fd < 0) return {errno, std::generic_category()};
-  sockaddr_ll address{};
-  address.sll_family = AF_PACKET;
-  address.sll_protocol = htons(ethercat::ethertype);
-  address.sll_ifindex = static_cast<int>(index);
-  if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
-    const int e = errno;
-    ::close(fd);
-    return {e, std::generic_category()};
-  }
+  detail::raw_socket opened;
+  if (const std::error_code ec = detail::open_raw_ethercat_socket(interface, opened)) return ec;
   if (fd_ >= 0) ::close(fd_);
-  fd_ = fd;
-  ifindex_ = static_cast<int>(index);
+  fd_ = opened.fd;
+  ifindex_ = opened.ifindex;
   return {};
 }
 
 bool ethercat_link::exchange(std::vector<std::uint8_t>& frame) {
   if (fd_ < 0 || frame.size() <= first_index_at) return false;
-  sockaddr_ll to{};
-  to.sll_family = AF_PACKET;
-  to.sll_protocol = htons(ethercat::ethertype);
-  to.sll_ifindex = ifindex_;
-  to.sll_halen = 6;
-  std::memcpy(to.sll_addr, frame.data(), 6);
-  if (::sendto(fd_, frame.data(), frame.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to) < 0) {
-    return false;
-  }
+  if (!detail::send_raw_frame({fd_, ifindex_}, frame)) return false;
   const std::uint8_t index = frame[first_index_at];
   const std::uint64_t until = now_us() + answer_timeout_us_;
   for (;;) {

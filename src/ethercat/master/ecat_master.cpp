@@ -186,13 +186,15 @@ bool ecat_master::scan() {
   for (ecat_slave& s : slaves_) {
     if (!read_sii(s)) return false;
   }
-  for (ecat_slave& s : slaves_) {
-    const single st = read_register(s, reg_al_status, 6);
-    if (st.ok && st.wkc == 1) {
-      s.al_state = st.data[0];
-      s.al_code = le16(st.data.data() + 4);
-    }
-  }
+  for (ecat_slave& s : slaves_) (void)read_al_status(s);
+  return true;
+}
+
+bool ecat_master::read_al_status(ecat_slave& s) {
+  const single st = read_register(s, reg_al_status, 6);  // status, reserved, status code
+  if (!st.ok || st.wkc != 1) return false;
+  s.al_state = st.data[0];
+  s.al_code = le16(st.data.data() + 4);
   return true;
 }
 
@@ -258,13 +260,10 @@ bool ecat_master::request_state(line_state target, bool cycling) {
   for (;;) {
     bool all = true;
     for (ecat_slave& s : slaves_) {
-      const single st = read_register(s, reg_al_status, 6);
-      if (!st.ok || st.wkc != 1) {
+      if (!read_al_status(s)) {
         all = false;
         continue;
       }
-      s.al_state = st.data[0];
-      s.al_code = le16(st.data.data() + 4);
       if (s.al_state & al_error_bit) {
         return fail(slave_text(s) + " refused " + line_state_name(want) + ": AL status code " + hex(s.al_code, 4) +
                     " (" + al_status_code_text(s.al_code) + "), stays in " + line_state_name(s.al_state));
@@ -743,13 +742,7 @@ bool ecat_master::cycle() {
     for (ecat_slave& s : slaves_) s.al_state = line;
   } else if (line != 0) {
     // Somebody left OP (a watchdog, an error): read each one's state and code.
-    for (ecat_slave& s : slaves_) {
-      const single st = read_register(s, reg_al_status, 6);
-      if (st.ok && st.wkc == 1) {
-        s.al_state = st.data[0];
-        s.al_code = le16(st.data.data() + 4);
-      }
-    }
+    for (ecat_slave& s : slaves_) (void)read_al_status(s);
   }
   return true;
 }

@@ -157,6 +157,7 @@ class ecat_master {
   single read_register(const ecat_slave& s, std::uint16_t reg, std::uint16_t length);
   bool write_register(const ecat_slave& s, std::uint16_t reg, const std::vector<std::uint8_t>& data);
   bool read_sii(ecat_slave& s);
+  bool read_al_status(ecat_slave& s);
   bool request_state(line_state target, bool cycling);
   bool configure_mailbox(ecat_slave& s);
   bool learn_mapping(ecat_slave& s);
