@@ -1,5 +1,7 @@
 #include "cia402/objects.hpp"
 
+#include <array>
+
 namespace cia402 {
 namespace {
 
@@ -125,8 +127,28 @@ std::size_t drive_object_count() noexcept { return count; }
 
 const object_description& drive_object(std::size_t i) noexcept { return objects[i < count ? i : 0]; }
 
+// Where each 0x60xx object starts in the table (its lowest sub-index), or none: the set-points
+// a master writes every cycle are all 0x60xx, so they are found by one load, not a search.
+constexpr std::uint8_t not_in_table = 0xFF;
+constexpr std::array<std::uint8_t, 256> first_of_60xx = [] {
+  std::array<std::uint8_t, 256> t{};
+  for (auto& e : t) e = not_in_table;
+  for (std::size_t i = count; i-- > 0;) {
+    if ((objects[i].index >> 8) == 0x60) t[objects[i].index & 0xFFu] = static_cast<std::uint8_t>(i);
+  }
+  return t;
+}();
+static_assert(count < not_in_table, "table positions fit a byte");
+
 const object_description* find_drive_object(std::uint16_t index, std::uint8_t sub) noexcept {
-  // Binary search: a master writes set-points of many axes every cycle through this.
+  if ((index >> 8) == 0x60) {
+    // The table is sorted by index, then sub-index: an object's entries follow its first.
+    for (std::size_t i = first_of_60xx[index & 0xFFu]; i < count && objects[i].index == index; ++i) {
+      if (objects[i].sub == sub) return &objects[i];
+    }
+    return nullptr;
+  }
+  // Binary search for the rest.
   const std::uint32_t key = (std::uint32_t{index} << 8) | sub;
   std::size_t lo = 0;
   std::size_t hi = count;

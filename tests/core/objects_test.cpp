@@ -5,6 +5,8 @@
 #include "cia402/objects.hpp"
 #include "cia402/profile.hpp"
 
+#include <vector>
+
 namespace cia402 {
 namespace {
 
@@ -99,6 +101,26 @@ TEST(objects, a_write_is_checked_against_access_type_and_limits) {
   EXPECT_EQ(check_write(*find_drive_object(0x60FF), -2147483648LL), sdo_abort::none);
   EXPECT_EQ(check_write(*find_drive_object(0x60FF), -2147483649LL), sdo_abort::value_too_low);
   EXPECT_EQ(check_write(*find_drive_object(0x605A), 32768), sdo_abort::value_too_high);
+}
+
+TEST(objects, lookup_finds_exactly_what_a_scan_of_the_table_finds_for_every_index_and_sub) {
+  // Every (index, sub) of 0x60xx (looked up by a table) and of each index beside a table entry
+  // (binary search), against a plain linear scan.
+  std::vector<std::uint32_t> indices;
+  for (std::uint32_t index = 0x6000; index <= 0x60FF; ++index) indices.push_back(index);
+  for (std::size_t i = 0; i < drive_object_count(); ++i) {
+    for (int d = -1; d <= 1; ++d) indices.push_back(static_cast<std::uint32_t>(drive_object(i).index + d));
+  }
+  for (const std::uint32_t index : indices) {
+    for (std::uint32_t sub = 0; sub <= 0xFF; ++sub) {
+      const object_description* scanned = nullptr;
+      for (std::size_t i = 0; i < drive_object_count(); ++i) {
+        if (drive_object(i).index == index && drive_object(i).sub == sub) scanned = &drive_object(i);
+      }
+      ASSERT_EQ(find_drive_object(static_cast<std::uint16_t>(index), static_cast<std::uint8_t>(sub)), scanned)
+          << std::hex << index << ":" << sub;
+    }
+  }
 }
 
 }  // namespace
