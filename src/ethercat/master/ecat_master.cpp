@@ -162,6 +162,8 @@ bool ecat_master::write_register(const ecat_slave& s, std::uint16_t reg, const s
 bool ecat_master::scan() {
   slaves_.clear();
   pre_operational_ = false;
+  cycling_ = false;
+  image_.clear();
   error_.clear();
   const single count = one(command::brd, static_cast<std::uint32_t>(reg_type) << 16, {0, 0});
   if (!count.ok) return fail("no frame came back: is the interface connected to an EtherCAT line?");
@@ -324,7 +326,7 @@ bool ecat_master::mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& c
     const single r = one(command::fpwr, s.station | (static_cast<std::uint32_t>(s.sii.mailbox_out_start) << 16), m);
     if (r.ok && r.wkc == 1) return true;  // 0: the slave has not read the one before yet
     if (link_->now_us() - start > mailbox_us) return false;
-    link_->wait_us(poll_us);
+    pause(poll_us);
   }
 }
 
@@ -334,7 +336,7 @@ std::optional<std::vector<std::uint8_t>> ecat_master::mailbox_receive(ecat_slave
                          std::vector<std::uint8_t>(s.sii.mailbox_in_size, 0));
     if (r.ok && r.wkc == 1) return r.data;  // 0: nothing in the mailbox yet
     if (link_->now_us() - start > mailbox_us) return std::nullopt;
-    link_->wait_us(poll_us);
+    pause(poll_us);
   }
 }
 
@@ -347,6 +349,15 @@ ecat_sdo_result ecat_master::sdo(ecat_slave& s, const std::vector<std::uint8_t>&
   }
   std::vector<std::uint8_t> coe{0x00, 0x20};  // CoE header: SDO request
   coe.insert(coe.end(), request.begin(), request.end());
+  // While the transfer runs the cycles go on (outputs stay valid, no watchdog expires), but leave
+  // the send mailbox to this transfer: its answer is there.
+  const bool was_in_mailbox = in_mailbox_;
+  in_mailbox_ = true;
+  struct restore {
+    bool& flag;
+    bool value;
+    ~restore() { flag = value; }
+  } restore_flag{in_mailbox_, was_in_mailbox};
   if (!mailbox_send(s, coe)) {
     result.error = slave_text(s) + ": its receive mailbox stays full";
     return result;
@@ -354,6 +365,7 @@ ecat_sdo_result ecat_master::sdo(ecat_slave& s, const std::vector<std::uint8_t>&
   // A slave that keeps sending what is not the answer (emergencies, stale replies) is given a
   // bounded number of mailboxes, not the master's whole life.
   for (int looked = 0; looked < 64; ++looked) {
+    pause(0);
     const auto reply = mailbox_receive(s);
     if (!reply) {
       result.error = slave_text(s) + ": no SDO answer for " + hex(index, 4) + ":" + std::to_string(sub);
@@ -612,6 +624,7 @@ bool ecat_master::bring_to_operational() {
     s.last_control = static_cast<std::uint16_t>(
         get_bits(image_, (s.logical_outputs - logical_base) * 8u + s.control_word->bit_offset, 16));
   }
+  cycling_ = true;
   // Outputs are valid before SAFE-OP -> OP: the drives get them from the first cycle on.
   if (!request_state(line_state::safe_operational, true)) return false;
   return request_state(line_state::operational, true);
@@ -637,6 +650,11 @@ void ecat_master::release(std::size_t i) {
   s.steering.clear_target();
   s.steered = false;
   s.held_command.reset();
+}
+
+void ecat_master::pause(std::uint32_t us) {
+  if (cycling_ && link_->now_us() - last_cycle_us_ >= cycle_us_) (void)cycle();
+  if (us != 0) link_->wait_us(us);
 }
 
 void ecat_master::send_control_word(std::size_t i, std::uint16_t word) {
@@ -682,6 +700,7 @@ bool ecat_master::all_operational() const noexcept {
 
 bool ecat_master::cycle() {
   const std::uint64_t now = link_->now_us();
+  last_cycle_us_ = now;
   for (ecat_slave& s : slaves_) {
     if (!s.control_word) continue;
     std::uint16_t cw = s.last_control;
@@ -699,7 +718,7 @@ bool ecat_master::cycle() {
   const long al = b.add(command::brd, ++index_, static_cast<std::uint32_t>(reg_al_status) << 16, {}, 2);
   // One slave a cycle, in turn: is its send mailbox full (SM1 status bit 3)? Then an emergency (or
   // anything else it sent unasked) is fetched after the cycle.
-  ecat_slave* asked = slaves_.empty() ? nullptr : &slaves_[cycles_ % slaves_.size()];
+  ecat_slave* asked = slaves_.empty() || in_mailbox_ ? nullptr : &slaves_[cycles_ % slaves_.size()];
   if (asked != nullptr && !asked->mailbox) asked = nullptr;
   const long sm1 = asked == nullptr ? -1
                                     : b.add(command::fprd, ++index_,

@@ -166,6 +166,9 @@ class ecat_master {
   std::optional<std::vector<std::uint8_t>> mailbox_receive(ecat_slave& s);
   ecat_sdo_result sdo(ecat_slave& s, const std::vector<std::uint8_t>& request, std::uint16_t index, std::uint8_t sub);
   bool fail(std::string text);
+  // Waits `us` (0: not at all), running a cycle first when one is due: set-up and SDO transfers
+  // keep the process data flowing once it is configured.
+  void pause(std::uint32_t us);
 
   master_link* link_;
   const profile* profile_;
@@ -178,6 +181,9 @@ class ecat_master {
   std::uint64_t lost_frames_ = 0;
   std::uint8_t index_ = 0;
   bool pre_operational_ = false;
+  bool cycling_ = false;       // the process data is configured: cycles run, also during SDOs
+  bool in_mailbox_ = false;    // an SDO transfer owns the send mailboxes
+  std::uint64_t last_cycle_us_ = 0;
   std::string error_;
 };
 
