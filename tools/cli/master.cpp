@@ -168,6 +168,28 @@ bool read_status(bus_session& s, const master_args& a, std::uint16_t& status_wor
   return true;
 }
 
+// One line per event: prose, or with --json one JSON object that names the node.
+using node_event = std::function<void(nlohmann::ordered_json, const std::string&)>;
+node_event node_events(const master_args& a, std::ostream& out) {
+  return [&a, &out](nlohmann::ordered_json j, const std::string& text) {
+    if (a.json) {
+      nlohmann::ordered_json line{{"node", a.node}};
+      line.update(j);
+      out << line.dump() << "\n";
+    } else {
+      out << "node " << a.node << ": " << text << "\n";
+    }
+  };
+}
+
+// A line for every state the drive reports.
+void print_states(canopen::drive_master& m, const node_event& event) {
+  m.on_state = [event](state, state to, std::uint16_t sw) {
+    event({{"event", "state"}, {"state", state_name(to)}, {"statusword", word(sw)}},
+          std::string(state_name(to)) + " (statusword " + word(sw) + ")");
+  };
+}
+
 std::string describe(const profile& p, int node, std::uint16_t status_word, std::uint16_t error_code) {
   state st = state::start;
   const bool known = decode_status(p, status_word, st);
@@ -340,19 +362,8 @@ int run_motion(bus_session& session, const master_args& a, const profile& p, std
   mc.master_heartbeat_ms = a.guard_ms;
   mc.drive_profile = &p;
   canopen::drive_master m(session.channel(), mc);
-  const auto event = [&](nlohmann::ordered_json j, const std::string& text) {
-    if (a.json) {
-      nlohmann::ordered_json line{{"node", a.node}};
-      line.update(j);
-      out << line.dump() << "\n";
-    } else {
-      out << "node " << a.node << ": " << text << "\n";
-    }
-  };
-  m.on_state = [&](state, state to, std::uint16_t sw) {
-    event({{"event", "state"}, {"state", state_name(to)}, {"statusword", word(sw)}},
-          std::string(state_name(to)) + " (statusword " + word(sw) + ")");
-  };
+  const node_event event = node_events(a, out);
+  print_states(m, event);
 
   enum class phase { write_before, confirm_mode, enable, write_after, offer, wait_ack, wait_done, read_position };
   phase now = phase::write_before;
@@ -536,19 +547,8 @@ int run_csp_stream(bus_session& session, const master_args& a, const profile& p,
   mc.map_position = true;
   canopen::drive_master m(session.channel(), mc);
   session.set_sync_period(a.sync_us);
-  const auto event = [&](nlohmann::ordered_json j, const std::string& text) {
-    if (a.json) {
-      nlohmann::ordered_json line{{"node", a.node}};
-      line.update(j);
-      out << line.dump() << "\n";
-    } else {
-      out << "node " << a.node << ": " << text << "\n";
-    }
-  };
-  m.on_state = [&](state, state to_state, std::uint16_t sw) {
-    event({{"event", "state"}, {"state", state_name(to_state)}, {"statusword", word(sw)}},
-          std::string(state_name(to_state)) + " (statusword " + word(sw) + ")");
-  };
+  const node_event event = node_events(a, out);
+  print_states(m, event);
 
   enum class phase { write_mode, confirm_mode, resolution, start_position, hold_position, enable, stream, done };
   phase now = phase::write_mode;
@@ -838,19 +838,8 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
   mc.map_velocity = velocity_command || a.command == "watch";
   canopen::drive_master m(session.channel(), mc);
   // One line per event: prose, or with --json one JSON object.
-  const auto event = [&](nlohmann::ordered_json j, const std::string& text) {
-    if (a.json) {
-      nlohmann::ordered_json line{{"node", a.node}};
-      line.update(j);
-      out << line.dump() << "\n";
-    } else {
-      out << "node " << a.node << ": " << text << "\n";
-    }
-  };
-  m.on_state = [&](state, state to, std::uint16_t sw) {
-    event({{"event", "state"}, {"state", state_name(to)}, {"statusword", word(sw)}},
-          std::string(state_name(to)) + " (statusword " + word(sw) + ")");
-  };
+  const node_event event = node_events(a, out);
+  print_states(m, event);
   m.on_emcy = [&](std::uint16_t code, std::uint8_t reg, const std::uint8_t*) {
     event({{"event", "emcy"}, {"error_code", hex(code, 4)}, {"error_register", hex(reg, 2)}},
           "EMCY " + hex(code, 4) + " error register " + hex(reg, 2) +
