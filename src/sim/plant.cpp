@@ -14,6 +14,8 @@ namespace cia402::sim {
 namespace {
 
 constexpr std::int64_t micro = 1000000;  // micro-rpm per rpm
+// micro-rpm x increments a revolution x cycle [us] of one increment a cycle: 60 s x 1e6 x 1e6.
+constexpr std::int64_t csp_velocity_scale = 60'000'000'000'000LL;
 
 std::int64_t magnitude(std::int64_t v) noexcept { return v < 0 ? -v : v; }
 
@@ -149,11 +151,14 @@ void torque_follow(const plant_constants& k, axis_state& a, motion::shaft& s,
 // the modes that command a velocity or a position.
 std::int32_t torque_of_motion(const plant_constants& k, const axis_state& a, std::int64_t v_old,
                               std::int64_t v_new) noexcept {
-  // micro-rpm per microsecond is rpm/s.
-  const std::int64_t accel = (v_new - v_old) / std::int64_t{k.cycle_us};
+  // micro-rpm per microsecond is rpm/s. At constant speed (standstill, a cruise, a csp ramp) there
+  // is no acceleration torque: two divisions a cycle are skipped.
+  const std::int64_t inertia =
+      v_new == v_old ? 0
+                     : (v_new - v_old) / std::int64_t{k.cycle_us} * 1000 /
+                           (k.torque_acceleration ? k.torque_acceleration : 1);
   const std::int64_t moving = v_new != 0 ? v_new : v_old;
-  const std::int64_t t = accel * 1000 / (k.torque_acceleration ? k.torque_acceleration : 1) +
-                         sign_of(moving) * k.friction + (moving != 0 || a.torque != 0 ? k.load : 0);
+  const std::int64_t t = inertia + sign_of(moving) * k.friction + (moving != 0 || a.torque != 0 ? k.load : 0);
   return static_cast<std::int32_t>(clamp(t, -32768, 32767));
 }
 
@@ -250,13 +255,18 @@ std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_
       const std::int64_t step = clamp(demand - s.position, -reach, reach);
       s.position += step;
       s.fraction = 0;
-      // micro-rpm = step x 60e12 / (increments a revolution x cycle), exact in 64 bits while
-      // |step| <= 153,000; beyond, in 128.
-      constexpr std::int64_t scale = 60'000'000'000'000LL;
+      // micro-rpm = step x 60e12 / (increments a revolution x cycle): one multiplication at the
+      // usual resolution, where the quotient is exact (a division's latency was a tenth of the
+      // cycle); else exact in 64 bits while |step| <= 153,000, beyond in 128.
+      constexpr std::int64_t scale = csp_velocity_scale;
       constexpr std::int64_t exact_64 = INT64_MAX / scale;
-      s.velocity = (step <= exact_64 && step >= -exact_64)
-                       ? step * scale / static_cast<std::int64_t>(per_rev_us)
-                       : static_cast<std::int64_t>(static_cast<wide>(step) * scale / static_cast<wide>(per_rev_us));
+      if (o.increments_per_rev == k.usual_increments_per_rev && k.usual_velocity_per_increment != 0) {
+        s.velocity = step * k.usual_velocity_per_increment;
+      } else {
+        s.velocity = (step <= exact_64 && step >= -exact_64)
+                         ? step * scale / static_cast<std::int64_t>(per_rev_us)
+                         : static_cast<std::int64_t>(static_cast<wide>(step) * scale / static_cast<wide>(per_rev_us));
+      }
       status |= 1u << 12;  // the drive follows the command value
       if (following_error_check(k, a)) status |= 1u << 13;
       break;
@@ -440,6 +450,14 @@ plant_constants plant_constants::from(const plant_config& c) noexcept {
   k.load = c.load_permille;
   k.home_switch_position = c.home_switch_position;
   k.index_position = c.index_position;
+  // The csp velocity of one increment a cycle at the default resolution, when it is an integer.
+  const object_description* resolution = find_drive_object(object::position_encoder_resolution, 1);
+  const std::uint64_t per_rev_us = (resolution != nullptr ? static_cast<std::uint64_t>(resolution->default_value) : 0) *
+                                   c.cycle_us;
+  if (per_rev_us != 0 && csp_velocity_scale % per_rev_us == 0) {
+    k.usual_increments_per_rev = static_cast<std::uint32_t>(resolution->default_value);
+    k.usual_velocity_per_increment = static_cast<std::int64_t>(csp_velocity_scale / per_rev_us);
+  }
   return k;
 }
 
@@ -535,18 +553,15 @@ drive_inputs plant_inputs(const plant_constants& k, const axis_state& a) noexcep
 }
 
 const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_state& a) noexcept {
-  const drive_outputs out = cia402::step(p, a.core, inputs_of(k, a));
-  // Field by field: a whole-struct copy is assembled on the stack and read back in words, which
-  // stalls on the narrow stores just made (a third of the cycle's time in the many-axes bench).
-  a.last.current = out.current;
-  a.last.status_word = out.status_word;
-  a.last.transition = out.transition;
-  a.last.ramp = out.ramp;
-  a.last.torque = out.torque;
-  a.last.brake_released = out.brake_released;
-  a.last.clear_setpoints = out.clear_setpoints;
-  a.last.error_code = out.error_code;
-  a.last.error_register = out.error_register;
+  // cia402::step, with the outputs written straight into a.last: a drive_outputs local is split
+  // into registers and spilled in pieces, and reading a piece back wider than it was stored stalls
+  // store forwarding (a fifth of the cycle in the 1,000-axis csp bench).
+  const drive_inputs in = inputs_of(k, a);
+  drive_outputs& out = a.last;
+#if !defined(__OPTIMIZE_SIZE__)
+  if (!detail::quiet_step(p, a.core, in, out))
+#endif
+    out = detail::full_step(p, a.core, in);
   if (out.clear_setpoints) {
     a.flags |= sim_flag::setpoints_cleared;
     a.pp.reset(motion::shaft{a.position, a.position_fraction, a.velocity});
@@ -568,19 +583,29 @@ const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_
 
 namespace {
 
+// The option codes' indices (0x605A..0x605E, 0x6007): one range test, as every set-point write asks.
+constexpr bool is_option_index(std::uint16_t index) noexcept {
+  return index == 0x6007 || static_cast<unsigned>(index - 0x605A) <= 4u;
+}
+
+// Why index/sub is not an object of this drive (find_drive_object found no entry).
+sdo_abort missing(std::uint16_t index) noexcept {
+  return find_drive_object(index, 0) == nullptr ? sdo_abort::object_does_not_exist
+                                                : sdo_abort::sub_index_does_not_exist;
+}
+
 // The object at index/sub as this drive has it: from the one object table, an option code only
 // where the profile has it. Existence, sub-index, access and range are checked here for every
-// object alike; what a value means is the switch's below.
+// object alike; what a value means is the switch's below. One table lookup when the object exists
+// (a master's set-point write each cycle comes here).
 sdo_abort describe(const profile& p, std::uint16_t index, std::uint8_t sub,
                    const object_description*& out) noexcept {
   out = find_drive_object(index, sub);
   option o;
-  if ((out == nullptr && find_drive_object(index, 0) == nullptr) ||
-      (option_of_index(index, o) && !p.spec(o).exists())) {
+  if (is_option_index(index) && option_of_index(index, o) && !p.spec(o).exists()) {
     return sdo_abort::object_does_not_exist;
   }
-  if (out == nullptr) return sdo_abort::sub_index_does_not_exist;
-  return sdo_abort::none;
+  return out != nullptr ? sdo_abort::none : missing(index);
 }
 
 // The set-point objects end the "set-points cleared" of T4 when written.
@@ -596,8 +621,7 @@ sdo_abort write_object(const profile& p, axis_state& a, std::uint16_t index, std
   const object_description* o = nullptr;
   if (const sdo_abort r = describe(p, index, sub, o); r != sdo_abort::none) return r;
   if (const sdo_abort r = check_write(*o, value); r != sdo_abort::none) return r;
-  option opt;
-  if (option_of_index(index, opt)) return write_option(p, a.core, index, static_cast<std::int32_t>(value));
+  if (is_option_index(index)) return write_option(p, a.core, index, static_cast<std::int32_t>(value));
   mode_objects& m = a.objects;
   const auto i32 = static_cast<std::int32_t>(value);
   const auto u32 = static_cast<std::uint32_t>(value);
@@ -669,8 +693,7 @@ sdo_abort read_object(const profile& p, const axis_state& a, std::uint16_t index
   const object_description* o = nullptr;
   if (const sdo_abort r = describe(p, index, sub, o); r != sdo_abort::none) return r;
   if (o->access == object_access::write_only) return sdo_abort::write_only_object;
-  option opt;
-  if (option_of_index(index, opt)) {
+  if (is_option_index(index)) {
     std::int32_t v = 0;
     const sdo_abort r = read_option(p, a.core, index, v);
     if (r == sdo_abort::none) value = v;
