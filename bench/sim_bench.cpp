@@ -138,28 +138,47 @@ void sim_pp_axis_steps(benchmark::State& st) {
 }
 BENCHMARK(sim_pp_axis_steps)->Arg(100)->UseRealTime();
 
+// Arguments: the machine's threads, and whether the set-points are written by a master inside the
+// step (machine::step(master): on the thread that steps the axis, just before it) or by the caller
+// between steps.
 void sim_1000_axes_csp_1khz(benchmark::State& st) {
   constexpr std::size_t axes = 1000;
   constexpr std::uint64_t cycles = 10000;  // 10 s of 1 ms
+  const auto threads = static_cast<unsigned>(st.range(0));
+  const bool master_in_step = st.range(1) != 0;
   double wall_s = 0;
   for (auto _ : st) {
-    machine m(standard_profile(), axes);
+    machine m(standard_profile(), axes, {}, threads);
     enable_in_mode(m, mode::cyclic_synchronous_position);
     const auto t0 = std::chrono::steady_clock::now();
     for (std::uint64_t c = 0; c < cycles; ++c) {
       // A sine-free ramp back and forth: 20 increments a ms (120 rpm), turning every 2 s.
       const std::int64_t leg = static_cast<std::int64_t>(c % 4000);
       const std::int64_t target = leg < 2000 ? 20 * leg : 20 * (4000 - leg);
-      for (std::size_t i = 0; i < axes; ++i) m.drive(i).write(0x607A, 0, target + static_cast<std::int64_t>(i));
-      m.step();
+      if (master_in_step) {
+        m.step([target](drive_view d, std::size_t i) {
+          d.write(0x607A, 0, target + static_cast<std::int64_t>(i));
+        });
+      } else {
+        for (std::size_t i = 0; i < axes; ++i) m.drive(i).write(0x607A, 0, target + static_cast<std::int64_t>(i));
+        m.step();
+      }
     }
     wall_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     benchmark::DoNotOptimize(m.axis_at(axes - 1).position);
+    st.counters["threads"] = m.threads();
   }
   const double runs = static_cast<double>(st.iterations());
   st.counters["realtime_factor"] = 10.0 * runs / wall_s;
   st.counters["axis_steps_per_s"] = static_cast<double>(axes) * static_cast<double>(cycles) * runs / wall_s;
 }
-BENCHMARK(sim_1000_axes_csp_1khz)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+BENCHMARK(sim_1000_axes_csp_1khz)
+    ->ArgNames({"threads", "master_in_step"})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Args({2, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime();
 
 }  // namespace

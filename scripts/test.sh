@@ -2,7 +2,7 @@
 # Builds cia402 and passes every test: the one command CI runs (.ci/run). As root on a fresh Debian 12
 # it installs what it needs first. Exits non-zero at the first failure.
 #   dev preset: build + ctest; asan-ubsan preset: build + ctest; the soak test (tests/soak/soak.py)
-#   on the dev build; the tsan preset: the page and CANopen tests under ThreadSanitizer;
+#   on the dev build; the tsan preset: the page, CANopen and machine-thread tests under ThreadSanitizer;
 #   no-exceptions preset: build the core
 #   alone as C++17 without exceptions or RTTI; release preset: benchmarks (a short run, ratios to the
 #   baseline), instructions per step (callgrind), the Cortex-M4 flash and RAM, the state diagrams
@@ -62,7 +62,9 @@ cmake --build --preset tsan
 # The threaded parts: the page server (HTTP threads, the cycle thread, event streams) and the bus.
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build/tsan/tests/page/page_tests
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build/tsan/tests/canopen/canopen_tests
-done_steps+=("tsan: page and CANopen tests")
+# A machine's axes on several threads.
+TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build/tsan/tests/sim/sim_tests --gtest_filter='machine.*'
+done_steps+=("tsan: page, CANopen and machine-thread tests")
 
 banner no-exceptions
 cmake --preset no-exceptions

@@ -6,7 +6,6 @@
 #include <limits>
 #include <stdexcept>
 
-#include "cia402/sim/machine.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 #include "cia402/words.hpp"
 
@@ -16,6 +15,12 @@ namespace {
 constexpr std::int64_t micro = 1000000;  // micro-rpm per rpm
 // micro-rpm x increments a revolution x cycle [us] of one increment a cycle: 60 s x 1e6 x 1e6.
 constexpr std::int64_t csp_velocity_scale = 60'000'000'000'000LL;
+
+// The most increments a cycle the motor's top speed travels in csp (per_rev_us: increments a
+// revolution x cycle in us).
+std::int64_t csp_reach(const plant_constants& k, std::uint64_t per_rev_us) noexcept {
+  return static_cast<std::int64_t>(static_cast<std::uint64_t>(k.max_velocity / micro) * per_rev_us / 60'000'000u);
+}
 
 std::int64_t magnitude(std::int64_t v) noexcept { return v < 0 ? -v : v; }
 
@@ -248,19 +253,19 @@ std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_
       }
       a.demand = demand;
       // Top speed [rpm] x increments a revolution x cycle [us] stays below 2^61 (1e5 x 2^24 x 1e6):
-      // 64-bit arithmetic, no 128-bit division in the cycle of a thousand axes.
+      // 64-bit arithmetic, no 128-bit division in the cycle of a thousand axes. At the usual
+      // resolution both the reach and the velocity of an increment are worked out beforehand.
+      const bool usual = o.increments_per_rev == k.usual_increments_per_rev && k.usual_velocity_per_increment != 0;
       const std::uint64_t per_rev_us = std::uint64_t{o.increments_per_rev} * k.cycle_us;
-      const auto reach = static_cast<std::int64_t>(static_cast<std::uint64_t>(k.max_velocity / micro) *
-                                                   per_rev_us / 60'000'000u);
+      const std::int64_t reach = usual ? k.usual_csp_reach : csp_reach(k, per_rev_us);
       const std::int64_t step = clamp(demand - s.position, -reach, reach);
       s.position += step;
       s.fraction = 0;
-      // micro-rpm = step x 60e12 / (increments a revolution x cycle): one multiplication at the
-      // usual resolution, where the quotient is exact (a division's latency was a tenth of the
-      // cycle); else exact in 64 bits while |step| <= 153,000, beyond in 128.
+      // micro-rpm = step x 60e12 / (increments a revolution x cycle), exact in 64 bits while
+      // |step| <= 153,000; beyond, in 128.
       constexpr std::int64_t scale = csp_velocity_scale;
       constexpr std::int64_t exact_64 = INT64_MAX / scale;
-      if (o.increments_per_rev == k.usual_increments_per_rev && k.usual_velocity_per_increment != 0) {
+      if (usual) {
         s.velocity = step * k.usual_velocity_per_increment;
       } else {
         s.velocity = (step <= exact_64 && step >= -exact_64)
@@ -457,6 +462,7 @@ plant_constants plant_constants::from(const plant_config& c) noexcept {
   if (per_rev_us != 0 && csp_velocity_scale % per_rev_us == 0) {
     k.usual_increments_per_rev = static_cast<std::uint32_t>(resolution->default_value);
     k.usual_velocity_per_increment = static_cast<std::int64_t>(csp_velocity_scale / per_rev_us);
+    k.usual_csp_reach = csp_reach(k, per_rev_us);
   }
   return k;
 }
@@ -527,19 +533,19 @@ inline drive_inputs inputs_of(const plant_constants& k, const axis_state& a) noe
   const bool standstill = magnitude(a.velocity) <= k.standstill_window;
   in.standstill = standstill;
   in.brake_engaged = brake_engaged(k, a);
-  const bool target_reached =
-      magnitude(a.velocity - std::int64_t{effective_target(a)} * micro) <= k.target_window;
-  // Status bit 11 while a stop at the current or voltage limit is still braking.
-  const bool internal_limit = !standstill && (a.last.ramp == stop_ramp::current_limit ||
-                                              a.last.ramp == stop_ramp::voltage_limit);
   // Profile velocity shows target reached and bit 12 "speed = 0" from the velocity; every other
   // mode what its motion produced last cycle (move_in_mode).
-  const std::uint16_t mode_bits =
-      a.operation_mode == cia402::mode::profile_velocity
-          ? static_cast<std::uint16_t>((target_reached ? status_bit::target_reached : 0u) |
-                                       (standstill ? 0x1000u : 0u) |
-                                       (a.mode_status & status_bit::internal_limit_active))
-          : a.mode_status;
+  std::uint16_t mode_bits = a.mode_status;
+  if (a.operation_mode == cia402::mode::profile_velocity) {
+    const bool target_reached =
+        magnitude(a.velocity - std::int64_t{effective_target(a)} * micro) <= k.target_window;
+    mode_bits = static_cast<std::uint16_t>((target_reached ? status_bit::target_reached : 0u) |
+                                           (standstill ? 0x1000u : 0u) |
+                                           (a.mode_status & status_bit::internal_limit_active));
+  }
+  // Status bit 11 while a stop at the current or voltage limit is still braking.
+  const bool internal_limit = !standstill && static_cast<unsigned>(a.last.ramp) -
+                                                     static_cast<unsigned>(stop_ramp::current_limit) <= 1u;
   in.status_bits = static_cast<std::uint16_t>(mode_bits |
                                               (internal_limit ? status_bit::internal_limit_active : 0u));
   in.actual_speed_rpm = velocity_rpm(a);
@@ -777,12 +783,6 @@ std::uint16_t drive_view::fault_cause() const noexcept {
 
 virtual_drive::virtual_drive(const profile& p, const plant_config& config)
     : profile_(&p), axis_(make_axis_state(p)) {
-  if (const char* why = check_plant_config(config)) throw std::invalid_argument(why);
-  constants_ = plant_constants::from(config);
-}
-
-machine::machine(const profile& p, std::size_t axes, const plant_config& config)
-    : profile_(&p), axes_(axes, make_axis_state(p)) {
   if (const char* why = check_plant_config(config)) throw std::invalid_argument(why);
   constants_ = plant_constants::from(config);
 }

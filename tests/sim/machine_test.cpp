@@ -2,7 +2,10 @@
 // the same inputs, axes do not affect one another, and an axis stays small.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstring>
+#include <thread>
 #include <vector>
 
 #include "cia402/sim/machine.hpp"
@@ -90,6 +93,89 @@ TEST(machine, an_axis_is_small) {
   EXPECT_LE(sizeof(axis_state), 288u);
   std::printf("sizeof(cia402::sim::axis_state) = %zu bytes (cia402::axis %zu)\n",
               sizeof(axis_state), sizeof(axis));
+}
+
+bool same_motion(const axis_state& a, const axis_state& b) {
+  return same(a, b) && a.position == b.position && a.position_fraction == b.position_fraction &&
+         a.demand == b.demand && a.torque == b.torque && a.mode_status == b.mode_status &&
+         a.operation_mode == b.operation_mode && a.following_error_us == b.following_error_us;
+}
+
+TEST(machine, on_several_threads_every_axis_ends_bit_for_bit_as_on_one) {
+  constexpr std::size_t n = 1000;
+  machine one(standard_profile(), n, {}, 1);
+  machine two(standard_profile(), n, {}, 2);
+  machine three(standard_profile(), n, {}, 3);
+  ASSERT_EQ(one.threads(), 1u);
+  ASSERT_EQ(two.threads(), 2u);
+  ASSERT_EQ(three.threads(), 3u);
+  for (std::uint64_t c = 0; c < 400; ++c) {
+    for (std::size_t i = 0; i < n; ++i) {
+      drive_inputs_for(one.drive(i), i, c);
+      drive_inputs_for(two.drive(i), i, c);
+      drive_inputs_for(three.drive(i), i, c);
+    }
+    one.step();
+    two.step();
+    three.step();
+  }
+  std::size_t moving = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    ASSERT_TRUE(same_motion(one.axis_at(i), two.axis_at(i))) << "axis " << i;
+    ASSERT_TRUE(same_motion(one.axis_at(i), three.axis_at(i))) << "axis " << i;
+    moving += one.drive(i).velocity_rpm() != 0;
+  }
+  EXPECT_GT(moving, 300u);
+  EXPECT_EQ(two.cycle(), 400u);
+}
+
+TEST(machine, threads_are_not_spent_on_a_few_axes) {
+  EXPECT_EQ(machine(standard_profile(), 10, {}, 4).threads(), 1u);
+  EXPECT_EQ(machine(standard_profile(), 2 * machine::axes_per_thread_at_least, {}, 4).threads(), 2u);
+  const machine hardware(standard_profile(), 100000, {}, 0);
+  EXPECT_GE(hardware.threads(), 1u);
+  EXPECT_LE(hardware.threads(), std::max(1u, std::thread::hardware_concurrency()));
+}
+
+// A cyclic master's set-points given inside the step: each axis's before it steps, once, on the
+// thread that steps it. In csp the demand of a cycle is the set-point written in that cycle, so an
+// axis that had stepped before its write would show last cycle's.
+TEST(machine, a_per_axis_master_writes_each_axis_once_right_before_it_steps) {
+  constexpr std::size_t n = 500;
+  machine m(standard_profile(), n, {}, 2);
+  ASSERT_EQ(m.threads(), 2u);
+  for (std::size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(m.drive(i).write(0x6060, 0, mode::cyclic_synchronous_position), sdo_abort::none);
+    m.drive(i).write(0x6040, 0, 0x0006);
+  }
+  for (int c = 0; c < 3; ++c) m.step();
+  for (std::size_t i = 0; i < n; ++i) m.drive(i).write(0x6040, 0, 0x000F);
+  for (int c = 0; c < 60; ++c) m.step();  // past the brake release
+  std::vector<int> calls(n, 0);
+  for (std::int64_t c = 1; c <= 50; ++c) {
+    m.step([&](drive_view d, std::size_t i) {
+      ++calls[i];
+      d.write(0x607A, 0, c * 10 + static_cast<std::int64_t>(i));
+    });
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(m.drive(i).current(), state::operation_enabled) << i;
+      ASSERT_EQ(m.drive(i).position_demand(), c * 10 + static_cast<std::int64_t>(i)) << "axis " << i;
+      ASSERT_EQ(calls[i], c) << "axis " << i;
+    }
+  }
+  // Followed within reach: the last set-point is where the shaft is.
+  EXPECT_EQ(m.drive(n - 1).position(), 500 + static_cast<std::int64_t>(n - 1));
+}
+
+TEST(machine, helpers_asleep_between_cycles_wake_for_the_next_and_end_with_the_machine) {
+  machine m(standard_profile(), 400, {}, 2);
+  for (std::size_t i = 0; i < m.size(); ++i) m.drive(i).write(0x6040, 0, 0x0006);
+  for (int c = 0; c < 3; ++c) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));  // past the helpers' spinning
+    m.step();
+  }
+  for (std::size_t i = 0; i < m.size(); ++i) EXPECT_EQ(m.drive(i).current(), state::ready_to_switch_on) << i;
+  EXPECT_EQ(m.cycle(), 3u);
 }
 
 TEST(machine, a_refused_configuration_throws) {

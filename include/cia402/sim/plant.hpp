@@ -92,9 +92,10 @@ struct plant_constants {
   std::int64_t home_switch_position = 0;
   std::int64_t index_position = 0;
   /// 0x608F's default and the csp velocity (micro-rpm) of one increment a cycle at it, when that is
-  /// an integer (0 if not): csp then needs no division.
+  /// an integer (0 if not): csp at that resolution then needs no division.
   std::uint32_t usual_increments_per_rev = 0;
   std::int64_t usual_velocity_per_increment = 0;
+  std::int64_t usual_csp_reach = 0;  ///< the most increments a csp cycle travels at it
 
   /// Requires check_plant_config(c) == nullptr.
   static plant_constants from(const plant_config& c) noexcept;
