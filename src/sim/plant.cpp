@@ -186,6 +186,45 @@ bool following_error_check(const plant_constants& k, axis_state& a) noexcept {
   return true;
 }
 
+// One cycle of cyclic synchronous position while the drive runs: the set-point of this cycle
+// (sampled at SYNC on CANopen) is reached within the cycle unless the motor's top speed cannot.
+// Works on the axis directly, apart from the other modes: it is the mode a master streams to many
+// axes every cycle. Returns the mode's status bits.
+std::uint16_t csp_follow(const plant_constants& k, axis_state& a) noexcept {
+  const mode_objects& o = a.objects;
+  std::uint16_t status = 1u << 12;  // the drive follows the command value
+  std::int64_t demand = std::int64_t{o.target_position} + o.position_offset;
+  if (limits_on(a)) {
+    const std::int64_t cut = clamp(demand, o.min_position, o.max_position);
+    if (cut != demand) status |= status_bit::internal_limit_active;
+    demand = cut;
+  }
+  a.demand = demand;
+  // The following error of this cycle: the new demand against where the shaft was.
+  if (following_error_check(k, a)) status |= 1u << 13;
+  // Top speed [rpm] x increments a revolution x cycle [us] stays below 2^61 (1e5 x 2^24 x 1e6):
+  // 64-bit arithmetic, no 128-bit division in the cycle of a thousand axes. At the usual
+  // resolution both the reach and the velocity of an increment are worked out beforehand.
+  const bool usual = o.increments_per_rev == k.usual_increments_per_rev && k.usual_velocity_per_increment != 0;
+  const std::uint64_t per_rev_us = std::uint64_t{o.increments_per_rev} * k.cycle_us;
+  const std::int64_t reach = usual ? k.usual_csp_reach : csp_reach(k, per_rev_us);
+  const std::int64_t step = clamp(demand - a.position, -reach, reach);
+  a.position += step;
+  a.position_fraction = 0;
+  // micro-rpm = step x 60e12 / (increments a revolution x cycle), exact in 64 bits while
+  // |step| <= 153,000; beyond, in 128.
+  constexpr std::int64_t scale = csp_velocity_scale;
+  constexpr std::int64_t exact_64 = INT64_MAX / scale;
+  if (usual) {
+    a.velocity = step * k.usual_velocity_per_increment;
+  } else {
+    a.velocity = (step <= exact_64 && step >= -exact_64)
+                     ? step * scale / static_cast<std::int64_t>(per_rev_us)
+                     : static_cast<std::int64_t>(static_cast<wide>(step) * scale / static_cast<wide>(per_rev_us));
+  }
+  return status;
+}
+
 // One cycle of the shaft in a mode other than profile velocity, while the drive runs. Returns the
 // mode's status bits (10..13).
 std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_outputs& out,
@@ -242,40 +281,6 @@ std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_
                                           (st.attained ? 1u << 12 : 0u) | (st.error ? 1u << 13 : 0u));
       break;
     }
-    case cia402::mode::cyclic_synchronous_position: {
-      // The set-point of this cycle (sampled at SYNC on CANopen): the position loop reaches it
-      // within the cycle unless the motor's top speed cannot.
-      std::int64_t demand = std::int64_t{o.target_position} + o.position_offset;
-      if (limits_on(a)) {
-        const std::int64_t cut = clamp(demand, o.min_position, o.max_position);
-        if (cut != demand) status |= status_bit::internal_limit_active;
-        demand = cut;
-      }
-      a.demand = demand;
-      // Top speed [rpm] x increments a revolution x cycle [us] stays below 2^61 (1e5 x 2^24 x 1e6):
-      // 64-bit arithmetic, no 128-bit division in the cycle of a thousand axes. At the usual
-      // resolution both the reach and the velocity of an increment are worked out beforehand.
-      const bool usual = o.increments_per_rev == k.usual_increments_per_rev && k.usual_velocity_per_increment != 0;
-      const std::uint64_t per_rev_us = std::uint64_t{o.increments_per_rev} * k.cycle_us;
-      const std::int64_t reach = usual ? k.usual_csp_reach : csp_reach(k, per_rev_us);
-      const std::int64_t step = clamp(demand - s.position, -reach, reach);
-      s.position += step;
-      s.fraction = 0;
-      // micro-rpm = step x 60e12 / (increments a revolution x cycle), exact in 64 bits while
-      // |step| <= 153,000; beyond, in 128.
-      constexpr std::int64_t scale = csp_velocity_scale;
-      constexpr std::int64_t exact_64 = INT64_MAX / scale;
-      if (usual) {
-        s.velocity = step * k.usual_velocity_per_increment;
-      } else {
-        s.velocity = (step <= exact_64 && step >= -exact_64)
-                         ? step * scale / static_cast<std::int64_t>(per_rev_us)
-                         : static_cast<std::int64_t>(static_cast<wide>(step) * scale / static_cast<wide>(per_rev_us));
-      }
-      status |= 1u << 12;  // the drive follows the command value
-      if (following_error_check(k, a)) status |= 1u << 13;
-      break;
-    }
     case cia402::mode::cyclic_synchronous_velocity: {
       const std::int64_t goal = clamp((std::int64_t{cleared ? 0 : a.target_velocity} + o.velocity_offset) * micro,
                                       -k.max_velocity, k.max_velocity);
@@ -317,13 +322,14 @@ std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_
   return status;
 }
 
+void brake_follow(const plant_constants& k, axis_state& a, const drive_outputs& out) noexcept;
+
 // The plant over one cycle under the outputs the drive just decided: first the shaft (with the
 // brake as it was at the start of the cycle), then the brake.
 void follow(const profile& p, const plant_constants& k, axis_state& a,
             const drive_outputs& out) noexcept {
   if (a.requested_mode != a.operation_mode) enter_mode(a);
   const std::int64_t v_old = a.velocity;
-  motion::shaft s{a.position, a.position_fraction, a.velocity};
   const bool brake_holds = k.brake_fitted && (a.flags & sim_flag::brake_closed);
   const bool run = out.torque && !brake_holds && p.info(out.current).activity == state_activity::run;
   // The mode moves the shaft while the drive runs and no stop does; in pp a halt too (the target
@@ -331,6 +337,13 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
   const bool halt = (a.control_word & control_bit::halt) != 0 && !stop_running(a.core);
   const bool mode_moves = run && (out.ramp == stop_ramp::none ||
                                   (halt && a.operation_mode == cia402::mode::profile_position));
+  if (mode_moves && a.operation_mode == cia402::mode::cyclic_synchronous_position) {
+    a.mode_status = csp_follow(k, a);
+    a.torque = torque_of_motion(k, a, v_old, a.velocity);  // run: torque is on
+    brake_follow(k, a, out);
+    return;
+  }
+  motion::shaft s{a.position, a.position_fraction, a.velocity};
   std::uint16_t status = 0;
   bool torque_set = false;
   if (mode_moves && a.operation_mode != cia402::mode::profile_velocity) {
@@ -352,7 +365,11 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
   a.velocity = s.velocity;
   a.mode_status = status;
   if (!torque_set) a.torque = out.torque ? torque_of_motion(k, a, v_old, s.velocity) : 0;
+  brake_follow(k, a, out);
+}
 
+// The brake over one cycle: it reaches what the drive commands after its delay.
+void brake_follow(const plant_constants& k, axis_state& a, const drive_outputs& out) noexcept {
   if (!k.brake_fitted) return;
   const bool open = out.brake_released;
   if (open != ((a.flags & sim_flag::brake_commanded_open) != 0)) {
