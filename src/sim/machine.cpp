@@ -78,14 +78,18 @@ void machine::step_part(std::size_t part) noexcept {
   const std::size_t n = parts_;
   const std::size_t first = axes_.size() * part / n;
   const std::size_t last = axes_.size() * (part + 1) / n;
+  // Locals: the loop must not reload them after every call.
+  const profile& p = *profile_;
+  const plant_constants& k = constants_;
+  axis_state* const axes = axes_.data();
   if (master_.call != nullptr) {
     for (std::size_t i = first; i < last; ++i) {
-      master_.call(master_.master, drive(i), i);
-      step_axis(*profile_, constants_, axes_[i]);
+      master_.call(master_.master, drive_view(p, k, axes[i]), i);
+      step_axis(p, k, axes[i]);
     }
     return;
   }
-  for (std::size_t i = first; i < last; ++i) step_axis(*profile_, constants_, axes_[i]);
+  for (std::size_t i = first; i < last; ++i) step_axis(p, k, axes[i]);
 }
 
 void machine::step_on_threads() noexcept {

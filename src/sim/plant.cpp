@@ -529,23 +529,27 @@ axis_state make_axis_state(const profile& p) noexcept {
 
 namespace {
 
-inline drive_inputs inputs_of(const plant_constants& k, const axis_state& a) noexcept {
-  // The core's quiet cycle reads the first eight bytes of the inputs as one word; they are copied
-  // whole from the defaults and touched only when an input differs, so that read is not stalled
-  // behind byte stores.
-  static constexpr drive_inputs nominal{};
-  drive_inputs in = nominal;
+// The inputs a healthy drive has: no fault cause, DC link on, no STO, the connection up.
+bool usual_inputs(const axis_state& a) noexcept {
   constexpr std::uint8_t unusual = sim_flag::sto | sim_flag::connection_lost;
-  if (a.fault_codes[0] != 0 || (a.flags & (sim_flag::dc_link | unusual)) != sim_flag::dc_link) {
-    const int n = fault_count(a);
-    if (n > 0) {
-      in.fault_code = a.fault_codes[n - 1];
-      in.fault_class = a.fault_classes[n - 1];
-    }
-    in.dc_link = (a.flags & sim_flag::dc_link) != 0;
-    in.sto = (a.flags & sim_flag::sto) != 0;
-    in.connection_lost = (a.flags & sim_flag::connection_lost) != 0;
+  return a.fault_codes[0] == 0 && (a.flags & (sim_flag::dc_link | unusual)) == sim_flag::dc_link;
+}
+
+// The fault cause, DC link, STO and connection into the inputs: what usual_inputs() leaves at the
+// defaults.
+void unusual_inputs_of(const axis_state& a, drive_inputs& in) noexcept {
+  const int n = fault_count(a);
+  if (n > 0) {
+    in.fault_code = a.fault_codes[n - 1];
+    in.fault_class = a.fault_classes[n - 1];
   }
+  in.dc_link = (a.flags & sim_flag::dc_link) != 0;
+  in.sto = (a.flags & sim_flag::sto) != 0;
+  in.connection_lost = (a.flags & sim_flag::connection_lost) != 0;
+}
+
+// The plant's feedback and the control word into the inputs.
+inline void feedback_of(const plant_constants& k, const axis_state& a, drive_inputs& in) noexcept {
   in.control_word = a.control_word;
   const bool standstill = magnitude(a.velocity) <= k.standstill_window;
   in.standstill = standstill;
@@ -566,6 +570,12 @@ inline drive_inputs inputs_of(const plant_constants& k, const axis_state& a) noe
   in.status_bits = static_cast<std::uint16_t>(mode_bits |
                                               (internal_limit ? status_bit::internal_limit_active : 0u));
   in.actual_speed_rpm = velocity_rpm(a);
+}
+
+inline drive_inputs inputs_of(const plant_constants& k, const axis_state& a) noexcept {
+  drive_inputs in;
+  if (!usual_inputs(a)) unusual_inputs_of(a, in);
+  feedback_of(k, a, in);
   return in;
 }
 
@@ -579,12 +589,20 @@ const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_
   // cia402::step, with the outputs written straight into a.last: a drive_outputs local is split
   // into registers and spilled in pieces, and reading a piece back wider than it was stored stalls
   // store forwarding (a fifth of the cycle in the 1,000-axis csp bench).
-  const drive_inputs in = inputs_of(k, a);
+  // On the usual inputs the compiler knows the defaults and the quiet cycle's test of them folds
+  // away; any other input makes it fail, so full_step is what cia402::step would run.
   drive_outputs& out = a.last;
+  drive_inputs in;
+  feedback_of(k, a, in);
+  if (usual_inputs(a)) {
 #if !defined(__OPTIMIZE_SIZE__)
-  if (!detail::quiet_step(p, a.core, in, out))
+    if (!detail::quiet_step(p, a.core, in, out))
 #endif
+      out = detail::full_step(p, a.core, in);
+  } else {
+    unusual_inputs_of(a, in);
     out = detail::full_step(p, a.core, in);
+  }
   if (out.clear_setpoints) {
     a.flags |= sim_flag::setpoints_cleared;
     a.pp.reset(motion::shaft{a.position, a.position_fraction, a.velocity});
