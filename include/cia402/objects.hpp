@@ -76,8 +76,28 @@ constexpr bool type_signed(object_type t) noexcept {
 /// The drive profile's objects, in index order.
 std::size_t drive_object_count() noexcept;
 const object_description& drive_object(std::size_t i) noexcept;
-/// The entry at index/sub, or nullptr.
-const object_description* find_drive_object(std::uint16_t index, std::uint8_t sub = 0) noexcept;
+namespace detail {
+/// The one object table (src/core/objects.cpp), and where each 0x60xx object's first entry sits in
+/// it (0xFF: no such object), for the inline lookup below.
+extern const object_description* const drive_object_table;
+extern const std::uint8_t* const drive_object_60xx;
+const object_description* find_drive_object_by_search(std::uint16_t index, std::uint8_t sub) noexcept;
+}  // namespace detail
+
+/// The entry at index/sub, or nullptr. Inline for 0x60xx, where every cyclic set-point lives: one
+/// table load and a short scan of the object's sub-indices (the table's last entry is not a 0x60xx
+/// object, so the scan ends inside it).
+inline const object_description* find_drive_object(std::uint16_t index, std::uint8_t sub = 0) noexcept {
+  if ((index >> 8) == 0x60) {
+    const std::uint8_t first = detail::drive_object_60xx[index & 0xFFu];
+    if (first == 0xFF) return nullptr;
+    for (const object_description* o = detail::drive_object_table + first; o->index == index; ++o) {
+      if (o->sub == sub) return o;
+    }
+    return nullptr;
+  }
+  return detail::find_drive_object_by_search(index, sub);
+}
 
 /// Whether a write of `value` is allowed: read_only_object, value_too_low / value_too_high (outside
 /// the type or the object's limits), or none. Whether the profile supports the value (an option

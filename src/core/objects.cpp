@@ -140,15 +140,15 @@ constexpr std::array<std::uint8_t, 256> first_of_60xx = [] {
 }();
 static_assert(count < not_in_table, "table positions fit a byte");
 
-const object_description* find_drive_object(std::uint16_t index, std::uint8_t sub) noexcept {
-  if ((index >> 8) == 0x60) {
-    // The table is sorted by index, then sub-index: an object's entries follow its first.
-    for (std::size_t i = first_of_60xx[index & 0xFFu]; i < count && objects[i].index == index; ++i) {
-      if (objects[i].sub == sub) return &objects[i];
-    }
-    return nullptr;
-  }
-  // Binary search for the rest.
+static_assert((objects[count - 1].index >> 8) != 0x60,
+              "the last entry is not a 0x60xx object: find_drive_object's scan ends inside the table");
+
+namespace detail {
+const object_description* const drive_object_table = objects;
+const std::uint8_t* const drive_object_60xx = first_of_60xx.data();
+
+// Binary search, for the objects outside 0x60xx.
+const object_description* find_drive_object_by_search(std::uint16_t index, std::uint8_t sub) noexcept {
   const std::uint32_t key = (std::uint32_t{index} << 8) | sub;
   std::size_t lo = 0;
   std::size_t hi = count;
@@ -164,6 +164,7 @@ const object_description* find_drive_object(std::uint16_t index, std::uint8_t su
   }
   return nullptr;
 }
+}  // namespace detail
 
 namespace {
 struct mode_name {
