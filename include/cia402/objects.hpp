@@ -4,6 +4,7 @@
 // it is. No heap, constexpr data in flash.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
@@ -79,8 +80,8 @@ const object_description& drive_object(std::size_t i) noexcept;
 namespace detail {
 /// The one object table (src/core/objects.cpp), and where each 0x60xx object's first entry sits in
 /// it (0xFF: no such object), for the inline lookup below.
-extern const object_description* const drive_object_table;
-extern const std::uint8_t* const drive_object_60xx;
+extern const object_description drive_object_table[];
+extern const std::array<std::uint8_t, 256> drive_object_60xx;
 const object_description* find_drive_object_by_search(std::uint16_t index, std::uint8_t sub) noexcept;
 }  // namespace detail
 

@@ -52,7 +52,10 @@ constexpr object_description option_code(std::uint16_t index, const char* name) 
 }
 
 // In index order, sub-indices ascending within an index.
-constexpr object_description objects[] = {
+}  // namespace
+
+namespace detail {
+constexpr object_description drive_object_table[] = {
     option_code(0x6007, "Abort connection option code"),
     var(0x603F, T::unsigned16, A::read_only, true, "Error code"),
     var(0x6040, T::unsigned16, A::read_write, true, "Controlword"),
@@ -109,6 +112,10 @@ constexpr object_description objects[] = {
     // pp (bit 0), pv (2), tq (3), hm (5), csp (7), csv (8), cst (9).
     var(0x6502, T::unsigned32, A::read_only, false, "Supported drive modes", "", 0x3AD),
 };
+}  // namespace detail
+
+namespace {
+constexpr const auto& objects = detail::drive_object_table;
 constexpr std::size_t count = sizeof(objects) / sizeof(objects[0]);
 
 constexpr bool in_index_order() noexcept {
@@ -130,7 +137,8 @@ const object_description& drive_object(std::size_t i) noexcept { return objects[
 // Where each 0x60xx object starts in the table (its lowest sub-index), or none: the set-points
 // a master writes every cycle are all 0x60xx, so they are found by one load, not a search.
 constexpr std::uint8_t not_in_table = 0xFF;
-constexpr std::array<std::uint8_t, 256> first_of_60xx = [] {
+namespace detail {
+constexpr std::array<std::uint8_t, 256> drive_object_60xx = [] {
   std::array<std::uint8_t, 256> t{};
   for (auto& e : t) e = not_in_table;
   for (std::size_t i = count; i-- > 0;) {
@@ -138,15 +146,13 @@ constexpr std::array<std::uint8_t, 256> first_of_60xx = [] {
   }
   return t;
 }();
+}  // namespace detail
 static_assert(count < not_in_table, "table positions fit a byte");
 
 static_assert((objects[count - 1].index >> 8) != 0x60,
               "the last entry is not a 0x60xx object: find_drive_object's scan ends inside the table");
 
 namespace detail {
-const object_description* const drive_object_table = objects;
-const std::uint8_t* const drive_object_60xx = first_of_60xx.data();
-
 // Binary search, for the objects outside 0x60xx.
 const object_description* find_drive_object_by_search(std::uint16_t index, std::uint8_t sub) noexcept {
   const std::uint32_t key = (std::uint32_t{index} << 8) | sub;
