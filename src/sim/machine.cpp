@@ -84,7 +84,7 @@ void machine::step_part(std::size_t part) noexcept {
   axis_state* const axes = axes_.data();
   if (master_.call != nullptr) {
     for (std::size_t i = first; i < last; ++i) {
-      master_.call(master_.master, drive_view(p, k, axes[i]), i);
+      master_.call(master_.master, p, k, axes[i], i);
       step_axis(p, k, axes[i]);
     }
     return;

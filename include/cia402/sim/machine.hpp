@@ -50,8 +50,9 @@ class machine {
   /// the axis is hot in cache and spread over the threads. It must touch only the axis it is given.
   template <typename Master>
   void step(Master&& master) noexcept {
-    master_ = {&master, [](void* m, drive_view d, std::size_t i) noexcept {
-                 (*static_cast<std::remove_reference_t<Master>*>(m))(d, i);
+    master_ = {&master, [](void* m, const profile& p, const plant_constants& k, axis_state& a,
+                           std::size_t i) noexcept {
+                 (*static_cast<std::remove_reference_t<Master>*>(m))(drive_view(p, k, a), i);
                }};
     if (helpers_.empty()) {
       step_part(0);
@@ -85,7 +86,8 @@ class machine {
   std::uint64_t cycle_ = 0;
   struct per_axis_master {
     void* master = nullptr;
-    void (*call)(void*, drive_view, std::size_t) noexcept = nullptr;
+    // The view is made inside, from what fits in registers.
+    void (*call)(void*, const profile&, const plant_constants&, axis_state&, std::size_t) noexcept = nullptr;
   };
   per_axis_master master_;  // set during step(master) only
 
