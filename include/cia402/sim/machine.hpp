@@ -47,7 +47,8 @@ class machine {
 
   /// One cycle in which `master(drive_view, std::size_t axis)` runs right before each axis steps,
   /// on the thread that steps it: a cyclic master's set-points (an RPDO before SYNC), written where
-  /// the axis is hot in cache and spread over the threads. It must touch only the axis it is given.
+  /// the axis is hot in cache and spread over the threads. It must touch only the axis it is given
+  /// and must not throw (the step is noexcept).
   template <typename Master>
   void step(Master&& master) noexcept {
     master_ = {&master, [](void* m, const profile& p, const plant_constants& k, axis_state& a,
