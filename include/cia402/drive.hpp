@@ -136,6 +136,16 @@ inline drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noe
   return detail::full_step(p, a, in);
 }
 
+/// The same cycle, its outputs written into `out` where the caller keeps them (a simulator's axis):
+/// a returned drive_outputs that the caller copies field by field is spilled in pieces and read
+/// back wider, which stalls store forwarding.
+inline void step(const profile& p, axis& a, const drive_inputs& in, drive_outputs& out) noexcept {
+#if !defined(__OPTIMIZE_SIZE__)
+  if (detail::quiet_step(p, a, in, out)) return;
+#endif
+  out = detail::full_step(p, a, in);
+}
+
 /// Writes an option code (0x605A..0x605E, 0x6007). A value the profile does not support is refused
 /// with its SDO abort code (0x06090030) and changes nothing; an object the profile lacks gives
 /// 0x06020000.

@@ -51,10 +51,10 @@ constexpr object_description option_code(std::uint16_t index, const char* name) 
   return var(index, T::integer16, A::read_write, false, name);
 }
 
-// In index order, sub-indices ascending within an index.
 }  // namespace
 
 namespace detail {
+// In index order, sub-indices ascending within an index.
 constexpr object_description drive_object_table[] = {
     option_code(0x6007, "Abort connection option code"),
     var(0x603F, T::unsigned16, A::read_only, true, "Error code"),
