@@ -24,8 +24,12 @@ std::uint32_t bus_host::cycle(std::uint32_t elapsed_us, int wait_ms) {
 
 std::uint32_t bus_host::advance(std::uint32_t elapsed_us) {
   server_->advance(elapsed_us);
+  // The time first, then the frames: they came in at some moment of the interval, and taking them
+  // at its end means that a host held up (a loaded machine) steps its drives through the time that
+  // passed before it answers the SYNCs queued meanwhile, so TPDOs show where the drives now are.
+  for (auto& d : drives_) (void)d->node().process(elapsed_us);
   std::uint32_t next_us = canopen::no_deadline;
-  for (auto& d : drives_) next_us = std::min(next_us, d->poll(elapsed_us));
+  for (auto& d : drives_) next_us = std::min(next_us, d->poll(0));
   server_->flush();
   return next_us;
 }

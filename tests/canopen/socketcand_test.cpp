@@ -333,6 +333,56 @@ TEST_F(socketcand_server_test, frames_for_unknown_nodes_pass_by_without_an_answe
   EXPECT_EQ(drives[0]->node().state(), nmt_state::pre_operational);
 }
 
+/// 0x6064 from the last TPDO3 of node 1 (0x6041 + 0x6064) among the frames a client got.
+std::int32_t last_tpdo3_position(const std::string& seen) {
+  element_reader reader;
+  reader.feed(seen);
+  std::string element;
+  std::string why;
+  std::int32_t position = 0;
+  bool found = false;
+  while (reader.next(element) == element_reader::result::element) {
+    frame f;
+    if (!socketcand::parse_frame(element, f, why) || f.id != 0x381 || f.len != 6) continue;
+    position = static_cast<std::int32_t>(f.data[2] | f.data[3] << 8 | f.data[4] << 16 |
+                                         static_cast<std::uint32_t>(f.data[5]) << 24);
+    found = true;
+  }
+  EXPECT_TRUE(found) << "no TPDO3 in " << seen;
+  return position;
+}
+
+std::string rpdo3_send(std::int32_t set_point) {
+  frame f = make_frame(0x401, {0x0F, 0x00});
+  f.len = 6;
+  const auto bits = static_cast<std::uint32_t>(set_point);
+  for (int i = 0; i < 4; ++i) f.data[2 + i] = static_cast<std::uint8_t>(bits >> (8 * i));
+  return socketcand::format_send(f);
+}
+
+TEST_F(socketcand_server_test, a_held_up_host_steps_its_drives_before_it_answers_the_sync_that_waited) {
+  add_drive(1);
+  auto a = join();
+  a->send("< send 0 2 1 1 >< send 301 3 0 0 8 >");  // NMT start; RPDO2: 0x6040 + 0x6060 = 8 (csp)
+  spin(5);
+  a->send("< send 201 2 6 0 >");
+  spin(5);
+  a->send("< send 201 2 f 0 >");
+  spin(100);  // enabled, the holding brake open
+  a->take();
+  a->send("< send 80 0 >");
+  spin(1, 0);
+  const std::int32_t start = last_tpdo3_position(a->take());
+  a->send(rpdo3_send(start + 100) + "< send 80 0 >");
+  spin(1, 0);  // the SYNC takes the set-point; no time has passed
+  EXPECT_EQ(last_tpdo3_position(a->take()), start);
+  // The host is held up for 5 ms while the next set-point and SYNC wait for it: it steps the drive
+  // through those 5 ms first, so TPDO3 shows the set-point before reached, not a position 5 ms old.
+  a->send(rpdo3_send(start + 200) + "< send 80 0 >");
+  spin(1, 5000);
+  EXPECT_EQ(last_tpdo3_position(a->take()), start + 100);
+}
+
 TEST_F(socketcand_server_test, our_client_channel_joins_and_exchanges_frames) {
   auto peer = join();
   std::error_code ec;
