@@ -16,25 +16,45 @@ flags=(-std=c++17 -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -Os
        -I"$root/include" -I"$root/src/core")
 core_sources=("$root"/src/core/drive.cpp "$root"/src/core/profile.cpp "$root"/src/core/names.cpp
               "$root"/src/core/master.cpp "$root"/src/core/profiles/*.cpp)
-objects=()
-for src in "${core_sources[@]}"; do
-  obj="$out/$(basename "${src%.cpp}").o"
-  "$cxx" "${flags[@]}" -c "$src" -o "$obj"
-  objects+=("$obj")
-done
 link=(-Wl,--gc-sections --specs=nosys.specs)
-"$cxx" "${flags[@]}" "$here/firmware.cpp" "${objects[@]}" "${link[@]}" -o "$out/firmware.elf"
-"$cxx" "${flags[@]}" "$here/firmware_one_profile.cpp" "${objects[@]}" "${link[@]}" -o "$out/firmware_one_profile.elf"
-"$cxx" "${flags[@]}" "$here/empty.cpp" "${link[@]}" -o "$out/empty.elf"
-echo "== Cortex-M4 objects of the core (-Os, no exceptions, no RTTI)"
-arm-none-eabi-size "${objects[@]}"
-echo "== firmware with every built-in profile, with the standard profile alone, and without the core"
-arm-none-eabi-size "$out/firmware.elf" "$out/firmware_one_profile.elf" "$out/empty.elf"
-read -r e_text e_data e_bss _ < <(arm-none-eabi-size "$out/empty.elf" | tail -1)
-report() {  # ELF, what it holds
-  local text data bss
-  read -r text data bss _ < <(arm-none-eabi-size "$1" | tail -1)
-  echo "cortex-m4: $2: flash $(( (text + data) - (e_text + e_data) )) bytes, RAM $(( (data + bss) - (e_data + e_bss) )) bytes"
+
+# build DIR [FLAG...]: the core's objects and the three firmwares, with the extra flags.
+build() {
+  local dir=$1
+  shift
+  mkdir -p "$dir"
+  local objects=()
+  for src in "${core_sources[@]}"; do
+    local obj="$dir/$(basename "${src%.cpp}").o"
+    "$cxx" "${flags[@]}" "$@" -c "$src" -o "$obj"
+    objects+=("$obj")
+  done
+  for firmware in firmware firmware_one_profile; do
+    "$cxx" "${flags[@]}" "$@" "$here/$firmware.cpp" "${objects[@]}" "${link[@]}" -o "$dir/$firmware.elf"
+  done
+  "$cxx" "${flags[@]}" "$@" "$here/empty.cpp" "${link[@]}" -o "$dir/empty.elf"
+  core_objects=("${objects[@]}")
 }
-report "$out/firmware.elf" "drive-side machine with all built-in profiles, 5 axes"
-report "$out/firmware_one_profile.elf" "drive-side machine with the cia402 profile alone, 1 axis"
+
+# report DIR HOW: each firmware's flash and RAM less the empty firmware's (the same registers read
+# and written with nothing between them).
+report() {
+  local dir=$1 how=$2 e_text e_data e_bss text data bss
+  read -r e_text e_data e_bss _ < <(arm-none-eabi-size "$dir/empty.elf" | tail -1)
+  for pair in "firmware:drive-side machine with all built-in profiles, 5 axes" \
+              "firmware_one_profile:drive-side machine with the cia402 profile alone, 1 axis"; do
+    read -r text data bss _ < <(arm-none-eabi-size "$dir/${pair%%:*}.elf" | tail -1)
+    echo "cortex-m4 ($how): ${pair#*:}: flash $(( (text + data) - (e_text + e_data) )) bytes," \
+         "RAM $(( (data + bss) - (e_data + e_bss) )) bytes"
+  done
+}
+
+build "$out/plain"
+echo "== Cortex-M4 objects of the core (-Os, no exceptions, no RTTI)"
+arm-none-eabi-size "${core_objects[@]}"
+echo "== firmware with every built-in profile, with the standard profile alone, and without the core"
+arm-none-eabi-size "$out/plain/firmware.elf" "$out/plain/firmware_one_profile.elf" "$out/plain/empty.elf"
+# A firmware is usually linked with -flto: the step is then compiled into the firmware's loop.
+build "$out/lto" -flto
+report "$out/plain" "-Os"
+report "$out/lto" "-Os -flto"
