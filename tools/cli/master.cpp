@@ -518,9 +518,11 @@ int run_motion(bus_session& session, const master_args& a, const profile& p, std
   return status;
 }
 
-// `csp-stream`: cyclic synchronous position (mode 8) over PDO 3 with SYNC, for tests. Switches the
-// mode by SDO (confirmed by 0x6061), reads the encoder resolution (0x608F) and the position (0x6064),
-// writes 0x607A = that position so enabling moves nothing, enables with the core's master step, then
+// `csp-stream`: cyclic synchronous position (mode 8) over PDO 3 with SYNC, for tests. Reads the
+// position (0x6064) and writes 0x607A = that position before it switches the mode by SDO (confirmed
+// by 0x6061): a drive in csp follows 0x607A from its first cycle, and a stale one (a move's target,
+// from before a homing run moved the zero) would send it there at full speed. Then it reads the
+// encoder resolution (0x608F), enables with the core's master step, then
 // before every SYNC moves the set-point RPDO3 carries on by one cycle of a ramp at --velocity until
 // --to. TPDO3 brings 0x6064 at every SYNC: the following error is how far it is from the set-point of
 // the SYNC before (the one the drive has had a cycle to reach). Done when the position is the target.
@@ -550,8 +552,8 @@ int run_csp_stream(bus_session& session, const master_args& a, const profile& p,
   const node_event event = node_events(a, out);
   print_states(m, event);
 
-  enum class phase { write_mode, confirm_mode, resolution, start_position, hold_position, enable, stream, done };
-  phase now = phase::write_mode;
+  enum class phase { start_position, hold_position, write_mode, confirm_mode, resolution, enable, stream, done };
+  phase now = phase::start_position;
   bool job_busy = false;
   bool failed_job = false;
   const auto on_refusal = [&](const std::string& what, const canopen::sdo_result& r) {
@@ -683,7 +685,8 @@ int run_csp_stream(bus_session& session, const master_args& a, const profile& p,
           if (v && *v > 0) increments = std::min<std::int64_t>(*v, std::int64_t{1} << 26);
           read_job(0x608F, 2, false, true, [&](std::optional<std::int64_t> r) {
             if (r && *r > 0) revolutions = *r;
-            now = phase::start_position;
+            m.set_target(state::operation_enabled);
+            now = phase::enable;
           });
         });
         break;
@@ -694,11 +697,11 @@ int run_csp_stream(bus_session& session, const master_args& a, const profile& p,
         });
         break;
       case phase::hold_position:
-        // Where it stands, so enabling moves nothing; RPDO3 keeps saying so until the stream starts.
+        // Where it stands, so neither the switch to csp nor enabling moves it; RPDO3 keeps saying so
+        // until the stream starts.
         write_job(0x607A, start, 4, [&] {
           m.set_position_set_point(start);
-          m.set_target(state::operation_enabled);
-          now = phase::enable;
+          now = phase::write_mode;
         });
         break;
       case phase::enable:

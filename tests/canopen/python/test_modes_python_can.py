@@ -148,8 +148,11 @@ def test_cia402_master_runs_the_modes_over_socketcand(bus_server):
     started = [e for e in events if e["event"] == "stream_started"]
     streamed = [e for e in events if e["event"] == "streamed"]
     assert len(started) == 1 and len(streamed) == 1 and streamed[0]["position"] == 5000
-    # 300 rpm x 10,000 increments a revolution = 100 increments a 2 ms SYNC, the last one shorter.
-    assert streamed[0]["set_points"] == -(-(5000 - started[0]["from"]) // 100), (started, streamed)
+    # The stream starts where homing left the drive: 0x607A still held the move's 12000, and the
+    # master pinned it to 0x6064 before the switch to csp, which follows 0x607A from its first cycle.
+    assert started[0]["from"] == -250, started
+    # 300 rpm x 10,000 increments a revolution = 100 increments a 2 ms SYNC: 5250 in 53, the last 50.
+    assert streamed[0]["set_points"] == 53, streamed
     # The lag the master sees is reported but not bounded here: both processes run on wall time,
     # and when the bus server is held up (a loaded CI machine) the SYNCs queued meanwhile are all
     # answered in one pass, from one position, several set-points old for the last of them. The
