@@ -84,7 +84,7 @@ done_steps+=("release: bench, sim bench, cortex-m4 size, diagrams")
 
 banner fuzz
 bash tests/fuzz/run.sh 30
-done_steps+=("fuzz: 6 targets, 30 s each")
+done_steps+=("fuzz: 8 targets, 30 s each")
 
 banner consumer
 bash scripts/test-consumer.sh
