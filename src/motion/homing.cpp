@@ -111,6 +111,7 @@ homing_status homing::step(bool start, const homing_parameters& par, shaft& s,
       break;
     }
     case phase::stopping:
+    case phase::returning:
     case phase::idle:
     case phase::done:
     case phase::failed: break;
