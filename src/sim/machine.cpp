@@ -83,10 +83,7 @@ void machine::step_part(std::size_t part) noexcept {
   const plant_constants& k = constants_;
   axis_state* const axes = axes_.data();
   if (master_.call != nullptr) {
-    for (std::size_t i = first; i < last; ++i) {
-      master_.call(master_.master, p, k, axes[i], i);
-      step_axis(p, k, axes[i]);
-    }
+    master_.call(master_.master, p, k, axes, first, last);
     return;
   }
   for (std::size_t i = first; i < last; ++i) step_axis(p, k, axes[i]);

@@ -3,6 +3,7 @@
 // brake back into its inputs.
 #include "cia402/sim/plant.hpp"
 
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -77,7 +78,7 @@ std::int64_t clamp(std::int64_t v, std::int64_t lo, std::int64_t hi) noexcept {
 
 // A mode change takes effect at the start of the next cycle's motion: the new mode takes the shaft
 // over as it is (pp with no set-point brakes it, homing waits for its start), and 0x6061 shows it.
-void enter_mode(axis_state& a) noexcept {
+[[gnu::noinline]] void enter_mode(axis_state& a) noexcept {
   a.operation_mode = a.requested_mode;
   a.pp.reset(motion::shaft{a.position, a.position_fraction, a.velocity});
   a.homing.reset();
@@ -158,6 +159,9 @@ std::int32_t torque_of_motion(const plant_constants& k, const axis_state& a, std
                               std::int64_t v_new) noexcept {
   // micro-rpm per microsecond is rpm/s. At constant speed (standstill, a cruise, a csp ramp) there
   // is no acceleration torque: two divisions a cycle are skipped.
+  if (v_new == v_old && v_new != 0) {  // a cruise: friction and load, |t| <= 2000
+    return static_cast<std::int32_t>((v_new > 0 ? k.friction : -k.friction) + k.load);
+  }
   const std::int64_t inertia =
       v_new == v_old ? 0
                      : (v_new - v_old) / std::int64_t{k.cycle_us} * 1000 /
@@ -169,13 +173,25 @@ std::int32_t torque_of_motion(const plant_constants& k, const axis_state& a, std
 
 // The following error check of the position modes (0x6065, 0x6066): beyond the window for longer
 // than the time out, status bit 13 and the fault 0x8611 (which the drive answers by 0x605E).
-bool following_error_check(const plant_constants& k, axis_state& a) noexcept {
+// Out of line: a position mode's cycle within the window (nearly all of them) keeps no registers for it.
+[[gnu::noinline]] bool following_error_beyond_window(const plant_constants& k, axis_state& a) noexcept;
+
+// The demand is within 0x6065's window of the actual position (or there is no window).
+bool within_window(const axis_state& a, std::int64_t demand) noexcept {
   const std::uint32_t window = a.objects.following_error_window;
-  const std::int64_t error = following_error(a);
-  if (window == 0xFFFFFFFFu || (error < 0 ? -error : error) <= std::int64_t{window}) {
+  const std::int64_t error = demand - a.position;
+  return window == 0xFFFFFFFFu || (error < 0 ? -error : error) <= std::int64_t{window};
+}
+
+bool following_error_check(const plant_constants& k, axis_state& a) noexcept {
+  if (within_window(a, a.demand)) {
     a.following_error_us = 0;
     return false;
   }
+  return following_error_beyond_window(k, a);
+}
+
+bool following_error_beyond_window(const plant_constants& k, axis_state& a) noexcept {
   const std::uint32_t room = UINT32_MAX - a.following_error_us;
   a.following_error_us += k.cycle_us < room ? k.cycle_us : room;
   if (a.following_error_us <= std::uint32_t{a.objects.following_error_time_out} * 1000u) return false;
@@ -186,28 +202,43 @@ bool following_error_check(const plant_constants& k, axis_state& a) noexcept {
   return true;
 }
 
-// One cycle of cyclic synchronous position while the drive runs: the set-point of this cycle
-// (sampled at SYNC on CANopen) is reached within the cycle unless the motor's top speed cannot.
-// Works on the axis directly, apart from the other modes: it is the mode a master streams to many
-// axes every cycle. Returns the mode's status bits.
-std::uint16_t csp_follow(const plant_constants& k, axis_state& a) noexcept {
+// Cyclic synchronous position while the drive runs: the set-point of this cycle (sampled at SYNC on
+// CANopen) is reached within the cycle unless the motor's top speed cannot. Works on the axis
+// directly, apart from the other modes: it is the mode a master streams to many axes every cycle.
+
+// The demand of a csp cycle: 0x607A + 0x60B0, cut to the software limits (status bit 11 then).
+std::int64_t csp_demand(const axis_state& a, std::uint16_t& status) noexcept {
   const mode_objects& o = a.objects;
-  std::uint16_t status = 1u << 12;  // the drive follows the command value
   std::int64_t demand = std::int64_t{o.target_position} + o.position_offset;
   if (limits_on(a)) {
     const std::int64_t cut = clamp(demand, o.min_position, o.max_position);
     if (cut != demand) status |= status_bit::internal_limit_active;
     demand = cut;
   }
-  a.demand = demand;
-  // The following error of this cycle: the new demand against where the shaft was.
-  if (following_error_check(k, a)) status |= 1u << 13;
+  return demand;
+}
+
+// The shaft's move of a csp cycle to the demand at the usual resolution (0x608F as the plant
+// constants have it): the reach and the velocity of an increment are worked out beforehand.
+void csp_move_usual(const plant_constants& k, axis_state& a, std::int64_t demand) noexcept {
+  const std::int64_t step = clamp(demand - a.position, -k.usual_csp_reach, k.usual_csp_reach);
+  a.position += step;
+  a.position_fraction = 0;
+  a.velocity = step * k.usual_velocity_per_increment;
+}
+
+// The shaft's move of a csp cycle to the demand.
+void csp_move(const plant_constants& k, axis_state& a, std::int64_t demand) noexcept {
+  const mode_objects& o = a.objects;
+  // (usual_increments_per_rev is 0 when there is no such figure; 0x608F is at least 1.)
+  if (o.increments_per_rev == k.usual_increments_per_rev) {
+    csp_move_usual(k, a, demand);
+    return;
+  }
   // Top speed [rpm] x increments a revolution x cycle [us] stays below 2^61 (1e5 x 2^24 x 1e6):
-  // 64-bit arithmetic, no 128-bit division in the cycle of a thousand axes. At the usual
-  // resolution both the reach and the velocity of an increment are worked out beforehand.
-  const bool usual = o.increments_per_rev == k.usual_increments_per_rev && k.usual_velocity_per_increment != 0;
+  // 64-bit arithmetic, no 128-bit division in the cycle of a thousand axes.
   const std::uint64_t per_rev_us = std::uint64_t{o.increments_per_rev} * k.cycle_us;
-  const std::int64_t reach = usual ? k.usual_csp_reach : csp_reach(k, per_rev_us);
+  const std::int64_t reach = csp_reach(k, per_rev_us);
   const std::int64_t step = clamp(demand - a.position, -reach, reach);
   a.position += step;
   a.position_fraction = 0;
@@ -215,13 +246,19 @@ std::uint16_t csp_follow(const plant_constants& k, axis_state& a) noexcept {
   // |step| <= 153,000; beyond, in 128.
   constexpr std::int64_t scale = csp_velocity_scale;
   constexpr std::int64_t exact_64 = INT64_MAX / scale;
-  if (usual) {
-    a.velocity = step * k.usual_velocity_per_increment;
-  } else {
-    a.velocity = (step <= exact_64 && step >= -exact_64)
-                     ? step * scale / static_cast<std::int64_t>(per_rev_us)
-                     : static_cast<std::int64_t>(static_cast<wide>(step) * scale / static_cast<wide>(per_rev_us));
-  }
+  a.velocity = (step <= exact_64 && step >= -exact_64)
+                   ? step * scale / static_cast<std::int64_t>(per_rev_us)
+                   : static_cast<std::int64_t>(static_cast<wide>(step) * scale / static_cast<wide>(per_rev_us));
+}
+
+// One csp cycle. Returns the mode's status bits.
+std::uint16_t csp_follow(const plant_constants& k, axis_state& a) noexcept {
+  std::uint16_t status = 1u << 12;  // the drive follows the command value
+  const std::int64_t demand = csp_demand(a, status);
+  a.demand = demand;
+  // The following error of this cycle: the new demand against where the shaft was.
+  if (following_error_check(k, a)) status |= 1u << 13;
+  csp_move(k, a, demand);
   return status;
 }
 
@@ -322,13 +359,28 @@ std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_
   return status;
 }
 
-void brake_follow(const plant_constants& k, axis_state& a, const drive_outputs& out) noexcept;
+[[gnu::noinline]] void brake_moves(const plant_constants& k, axis_state& a, bool open) noexcept;
+
+// The brake over one cycle: it reaches what the drive commands after its delay. Where it was
+// commanded, and commanded so before (the usual cycle), nothing moves.
+inline void brake_follow(const plant_constants& k, axis_state& a, const drive_outputs& out) noexcept {
+  constexpr std::uint8_t brake_bits = sim_flag::brake_commanded_open | sim_flag::brake_closed;
+  const bool open = out.brake_released;
+  if (!k.brake_fitted ||
+      (a.flags & brake_bits) == (open ? sim_flag::brake_commanded_open : sim_flag::brake_closed)) {
+    return;
+  }
+  brake_moves(k, a, open);
+}
+
+void shaft_follow(const profile& p, const plant_constants& k, axis_state& a, const drive_outputs& out,
+                  bool run, bool mode_moves, bool brake_holds) noexcept;
 
 // The plant over one cycle under the outputs the drive just decided: first the shaft (with the
 // brake as it was at the start of the cycle), then the brake.
 void follow(const profile& p, const plant_constants& k, axis_state& a,
             const drive_outputs& out) noexcept {
-  if (a.requested_mode != a.operation_mode) enter_mode(a);
+  if (a.requested_mode != a.operation_mode) enter_mode(a);  // out of line
   const std::int64_t v_old = a.velocity;
   const bool brake_holds = k.brake_fitted && (a.flags & sim_flag::brake_closed);
   const bool run = out.torque && !brake_holds && p.info(out.current).activity == state_activity::run;
@@ -343,6 +395,15 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
     brake_follow(k, a, out);
     return;
   }
+  shaft_follow(p, k, a, out, run, mode_moves, brake_holds);
+}
+
+// Every mode but a running csp. Out of line: the cycle of a csp axis, which a master streams to
+// many at once, does not pay for this one's registers.
+[[gnu::noinline]] void shaft_follow(const profile& p, const plant_constants& k, axis_state& a,
+                                    const drive_outputs& out, bool run, bool mode_moves,
+                                    bool brake_holds) noexcept {
+  const std::int64_t v_old = a.velocity;
   motion::shaft s{a.position, a.position_fraction, a.velocity};
   std::uint16_t status = 0;
   bool torque_set = false;
@@ -368,10 +429,8 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
   brake_follow(k, a, out);
 }
 
-// The brake over one cycle: it reaches what the drive commands after its delay.
-void brake_follow(const plant_constants& k, axis_state& a, const drive_outputs& out) noexcept {
-  if (!k.brake_fitted) return;
-  const bool open = out.brake_released;
+// The brake on its way to what was commanded, or a new command.
+void brake_moves(const plant_constants& k, axis_state& a, bool open) noexcept {
   if (open != ((a.flags & sim_flag::brake_commanded_open) != 0)) {
     set_flag(a, sim_flag::brake_commanded_open, open);
     a.brake_timer = open ? k.release_cycles : k.engage_cycles;
@@ -585,18 +644,84 @@ drive_inputs plant_inputs(const plant_constants& k, const axis_state& a) noexcep
   return inputs_of(k, a);
 }
 
-const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_state& a) noexcept {
-  // The outputs go straight into a.last: copying a returned drive_outputs field by field stalled
-  // store forwarding (0.80 s -> 0.69 s for the 1,000-axis csp run).
-  drive_outputs& out = a.last;
-  cia402::step(p, a.core, inputs_of(k, a), out);
-  if (out.clear_setpoints) {
+namespace {
+
+// Which bytes of axis_state's first core_source_bytes belong to a field: padding, which a
+// struct's assignment need not keep, must not tell a settled axis from a changed one.
+struct source_mask {
+  unsigned char bytes[core_source_bytes] = {};
+  constexpr void mark(std::size_t at, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) bytes[at + i] = 0xFF;
+  }
+};
+
+constexpr source_mask make_source_mask() {
+  source_mask m;
+  constexpr std::size_t core = offsetof(axis_state, core);
+  m.mark(core + offsetof(axis, current), sizeof(state));
+  m.mark(core + offsetof(axis, flags), 1);
+  m.mark(core + offsetof(axis, pending_row), 1);
+  m.mark(core + offsetof(axis, last_transition), 1);
+  m.mark(core + offsetof(axis, error_code), 2);
+  m.mark(core + offsetof(axis, options), sizeof(axis::options));
+  m.mark(core + offsetof(axis, stop_code), 1);
+  constexpr std::size_t last = offsetof(axis_state, last);
+  m.mark(last + offsetof(drive_outputs, current), sizeof(state));
+  m.mark(last + offsetof(drive_outputs, status_word), 2);
+  m.mark(last + offsetof(drive_outputs, transition), 1);
+  m.mark(last + offsetof(drive_outputs, ramp), sizeof(stop_ramp));
+  m.mark(last + offsetof(drive_outputs, torque), 1);
+  m.mark(last + offsetof(drive_outputs, brake_released), 1);
+  m.mark(last + offsetof(drive_outputs, clear_setpoints), 1);
+  m.mark(last + offsetof(drive_outputs, error_code), 2);
+  m.mark(last + offsetof(drive_outputs, error_register), 1);
+  m.mark(offsetof(axis_state, control_word), 2);
+  m.mark(offsetof(axis_state, mode_status), 2);
+  m.mark(offsetof(axis_state, velocity), 8);
+  m.mark(offsetof(axis_state, target_velocity), 4);
+  m.mark(offsetof(axis_state, fault_codes), sizeof(axis_state::fault_codes));
+  m.mark(offsetof(axis_state, fault_classes), sizeof(axis_state::fault_classes));
+  m.mark(offsetof(axis_state, flags), 1);
+  m.mark(offsetof(axis_state, operation_mode), 1);
+  return m;
+}
+
+constexpr source_mask source_bytes = make_source_mask();
+
+// The core's axis and its inputs' sources are as a cycle whose step changed nothing left them.
+// Eight bytes at a time, padding masked out, ORed into one test (the last word overlaps the one
+// before it): a call to memcmp would cost more than the compare.
+bool core_settled(const axis_state& a) noexcept {
+  static_assert(core_source_bytes >= 8);
+  const auto* now = reinterpret_cast<const unsigned char*>(&a);
+  const auto word = [](const unsigned char* at) {
+    std::uint64_t w;
+    std::memcpy(&w, at, 8);
+    return w;
+  };
+  std::uint64_t differ = a.settled_valid ? 0u : 1u;
+  for (std::size_t at = 0; at + 8 < core_source_bytes; at += 8) {
+    differ |= (word(a.settled + at) ^ word(now + at)) & word(source_bytes.bytes + at);
+  }
+  constexpr std::size_t tail = core_source_bytes - 8;
+  differ |= (word(a.settled + tail) ^ word(now + tail)) & word(source_bytes.bytes + tail);
+  return differ == 0;
+}
+
+}  // namespace
+
+namespace {
+
+// What the core's decision does to the plant beyond the motion: the set-points it clears, and the
+// following error it has reacted to. Out of line: it is rare.
+[[gnu::noinline]] void after_decision(axis_state& a) noexcept {
+  if (a.last.clear_setpoints) {
     a.flags |= sim_flag::setpoints_cleared;
     a.pp.reset(motion::shaft{a.position, a.position_fraction, a.velocity});
   }
   // A following error is an event: once the drive has reacted (FAULT), its cause is gone and a
   // fault reset can clear 0x603F.
-  if ((a.flags & sim_flag::following_error_raised) && out.current == state::fault) {
+  if ((a.flags & sim_flag::following_error_raised) && a.last.current == state::fault) {
     for (int i = 0; i < max_fault_causes; ++i) {
       if (a.fault_codes[i] == following_error_code) {
         remove_fault_at(a, i);
@@ -605,13 +730,64 @@ const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_
     }
     a.flags &= static_cast<std::uint8_t>(~sim_flag::following_error_raised);
   }
-  follow(p, k, a, out);
+}
+
+// The core's step, into a.last, from the plant's feedback; the axis is settled after it if the step
+// left the core's axis as it was. Out of line: a settled axis (most cycles) does not pay for its
+// registers.
+[[gnu::noinline]] void decide(const profile& p, const plant_constants& k, axis_state& a) noexcept {
+  std::memcpy(a.settled, &a, core_source_bytes);
+  cia402::step(p, a.core, inputs_of(k, a), a.last);
+  a.settled_valid = std::memcmp(a.settled, &a.core, sizeof(axis)) == 0;
+}
+
+}  // namespace
+
+namespace {
+
+// A cycle in full: the core's decision unless the axis is settled, what it does beyond the
+// motion, then the plant in whatever mode and state.
+[[gnu::noinline]] const drive_outputs& full_cycle(const profile& p, const plant_constants& k,
+                                                  axis_state& a, bool settled) noexcept {
+  if (!settled) decide(p, k, a);
+  if (a.last.clear_setpoints | ((a.flags & sim_flag::following_error_raised) != 0)) after_decision(a);
+  follow(p, k, a, a.last);
   return a.last;
+}
+
+}  // namespace
+
+const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_state& a) noexcept {
+  // The common cycle of a machine whose master streams csp set-points, handled here with no call:
+  // the core settled, nothing for after_decision(), no mode change, csp running (follow()'s test,
+  // which with a settled core and no stop is this) at the usual resolution, the brake where it was
+  // commanded, and the demand within the following error window. It does what full_cycle() does
+  // for it, byte for byte. Any other cycle goes there.
+  const bool settled = core_settled(a);
+  const drive_outputs& out = a.last;
+  constexpr std::uint8_t brake_bits = sim_flag::brake_commanded_open | sim_flag::brake_closed;
+  const bool usual = settled & !out.clear_setpoints & ((a.flags & sim_flag::following_error_raised) == 0) &
+                     (a.requested_mode == a.operation_mode) &
+                     (a.operation_mode == cia402::mode::cyclic_synchronous_position) &
+                     out.torque & (out.ramp == stop_ramp::none) &
+                     (a.objects.increments_per_rev == k.usual_increments_per_rev) &
+                     (!k.brake_fitted || (out.brake_released && (a.flags & brake_bits) == sim_flag::brake_commanded_open));
+  if (!usual || p.info(out.current).activity != state_activity::run) return full_cycle(p, k, a, settled);
+  std::uint16_t status = 1u << 12;  // the drive follows the command value
+  const std::int64_t demand = csp_demand(a, status);
+  if (!within_window(a, demand)) return full_cycle(p, k, a, settled);
+  a.demand = demand;
+  a.following_error_us = 0;
+  const std::int64_t v_old = a.velocity;
+  csp_move_usual(k, a, demand);
+  a.mode_status = status;
+  a.torque = torque_of_motion(k, a, v_old, a.velocity);
+  return out;
 }
 
 namespace {
 
-// The option codes' indices (0x605A..0x605E, 0x6007): one range test, as every set-point write asks.
+// The option codes' indices (0x605A..0x605E, 0x6007): one range test.
 constexpr bool is_option_index(std::uint16_t index) noexcept {
   return index == 0x6007 || static_cast<unsigned>(index - 0x605A) <= 4u;
 }
@@ -624,8 +800,7 @@ sdo_abort missing(std::uint16_t index) noexcept {
 
 // The object at index/sub as this drive has it: from the one object table, an option code only
 // where the profile has it. Existence, sub-index, access and range are checked here for every
-// object alike; what a value means is the switch's below. One table lookup when the object exists
-// (a master's set-point write each cycle comes here).
+// object alike; what a value means is the switch's below. One table lookup when the object exists.
 sdo_abort describe(const profile& p, std::uint16_t index, std::uint8_t sub,
                    const object_description*& out) noexcept {
   out = find_drive_object(index, sub);
@@ -641,8 +816,8 @@ void setpoint_written(axis_state& a) noexcept { set_flag(a, sim_flag::setpoints_
 
 }  // namespace
 
-sdo_abort write_object(const profile& p, axis_state& a, std::uint16_t index, std::uint8_t sub,
-                       std::int64_t value) noexcept {
+sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_t index,
+                                   std::uint8_t sub, std::int64_t value) noexcept {
   if (index == object::error_register) {
     return sub != 0 ? sdo_abort::sub_index_does_not_exist : sdo_abort::read_only_object;
   }

@@ -88,9 +88,10 @@ TEST(machine, ten_thousand_axes_enable_together) {
 
 TEST(machine, an_axis_is_small) {
   // The core's axis (14 bytes) plus the plant, the objects of every operation mode, the profile
-  // position generator and homing, and the injected inputs: 1,000 axes in a quarter megabyte.
+  // position generator and homing, the injected inputs, and the settled core's 58-byte snapshot
+  // (which lets a cycle skip the core): 1,000 axes in a third of a megabyte.
   EXPECT_EQ(machine::bytes_per_axis, sizeof(axis_state));
-  EXPECT_LE(sizeof(axis_state), 288u);
+  EXPECT_LE(sizeof(axis_state), 336u);
   std::printf("sizeof(cia402::sim::axis_state) = %zu bytes (cia402::axis %zu)\n",
               sizeof(axis_state), sizeof(axis));
 }

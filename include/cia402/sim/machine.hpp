@@ -51,9 +51,14 @@ class machine {
   /// and must not throw (the step is noexcept).
   template <typename Master>
   void step(Master&& master) noexcept {
-    master_ = {&master, [](void* m, const profile& p, const plant_constants& k, axis_state& a,
-                           std::size_t i) noexcept {
-                 (*static_cast<std::remove_reference_t<Master>*>(m))(drive_view(p, k, a), i);
+    // The loop over a thread's part is instantiated here, with the master's call inlined in it.
+    master_ = {&master, [](void* m, const profile& p, const plant_constants& k, axis_state* axes,
+                           std::size_t first, std::size_t last) noexcept {
+                 auto& each = *static_cast<std::remove_reference_t<Master>*>(m);
+                 for (std::size_t i = first; i < last; ++i) {
+                   each(drive_view(p, k, axes[i]), i);
+                   step_axis(p, k, axes[i]);
+                 }
                }};
     if (helpers_.empty()) {
       step_part(0);
@@ -87,8 +92,9 @@ class machine {
   std::uint64_t cycle_ = 0;
   struct per_axis_master {
     void* master = nullptr;
-    // The view is made inside, from what fits in registers.
-    void (*call)(void*, const profile&, const plant_constants&, axis_state&, std::size_t) noexcept = nullptr;
+    // Steps axes [first, last), each after the master's call for it.
+    void (*call)(void*, const profile&, const plant_constants&, axis_state*, std::size_t,
+                 std::size_t) noexcept = nullptr;
   };
   per_axis_master master_;  // set during step(master) only
 

@@ -11,6 +11,7 @@
 // [us], is an exact integer, and the position with an exact fraction of an increment.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "cia402/drive.hpp"
@@ -149,26 +150,35 @@ inline constexpr int max_fault_causes = 4;
 /// Everything one virtual axis keeps between cycles: the core's axis, the motion objects, the plant
 /// and the injected inputs. Plain data, so a machine keeps N of them in one array.
 struct axis_state {
+  // The first core_source_bytes, core to operation_mode, are all a cycle's core step depends on:
+  // the core's axis and every field plant_inputs() reads. Kept together so that step_axis() sees
+  // by one comparison that they are as they were in a cycle whose step changed nothing: the core is
+  // a function of its axis and its inputs, so it would decide again what `last` holds.
   axis core;                          ///< the core state machine's memory
+  std::uint16_t control_word = 0;     ///< 0x6040, read by the next cycle
   drive_outputs last;                 ///< what the core decided in the last cycle
+  /// The mode-specific status bits (10..13) this cycle's motion produced, shown by the next cycle.
+  std::uint16_t mode_status = 0;
   std::int64_t velocity = 0;          ///< actual velocity, micro-rpm (0x606C = velocity / 1e6)
   std::int32_t target_velocity = 0;   ///< 0x60FF, rpm
-  std::uint32_t acceleration = 1000;  ///< 0x6083, rpm/s
-  std::uint32_t deceleration = 1000;  ///< 0x6084, rpm/s: the slow-down ramp
-  std::uint32_t quick_stop_deceleration = 10000;  ///< 0x6085, rpm/s
-  std::uint16_t control_word = 0;     ///< 0x6040, read by the next cycle
-  std::uint16_t brake_timer = 0;      ///< cycles until the brake reaches its command
   /// Present fault causes, oldest first; a free slot holds code 0. The newest is the one the drive
   /// sees (drive_inputs.fault_code, fault_class).
   std::uint16_t fault_codes[max_fault_causes] = {};
   std::uint8_t fault_classes[max_fault_causes] = {};
   std::uint8_t flags = sim_flag::dc_link | sim_flag::brake_closed;  ///< sim_flag bits
+  std::int8_t operation_mode = cia402::mode::profile_velocity;  ///< 0x6061: the mode it runs
+
+  std::int8_t requested_mode = cia402::mode::profile_velocity;  ///< 0x6060 as written
+  /// step_axis() only: the core's sources as the last cycle whose step left the core's axis as it
+  /// was found them (valid while settled_valid).
+  bool settled_valid = false;
+  std::uint8_t settled[58] = {};
+  std::uint32_t acceleration = 1000;  ///< 0x6083, rpm/s
+  std::uint32_t deceleration = 1000;  ///< 0x6084, rpm/s: the slow-down ramp
+  std::uint32_t quick_stop_deceleration = 10000;  ///< 0x6085, rpm/s
+  std::uint16_t brake_timer = 0;      ///< cycles until the brake reaches its command
 
   // The operation modes.
-  std::int8_t requested_mode = cia402::mode::profile_velocity;  ///< 0x6060 as written
-  std::int8_t operation_mode = cia402::mode::profile_velocity;  ///< 0x6061: the mode it runs
-  /// The mode-specific status bits (10..13) this cycle's motion produced, shown by the next cycle.
-  std::uint16_t mode_status = 0;
   std::int64_t position = 0;           ///< 0x6064, increments
   std::int64_t position_fraction = 0;  ///< parts of an increment (motion::shaft::fraction_unit)
   std::int64_t demand = 0;             ///< 0x6062
@@ -179,6 +189,11 @@ struct axis_state {
   motion::profile_position pp;
   motion::homing homing;
 };
+
+/// The bytes of axis_state a core step depends on (its first ones, core to operation_mode).
+inline constexpr std::size_t core_source_bytes = sizeof(axis_state::settled);
+static_assert(offsetof(axis_state, operation_mode) + 1 == core_source_bytes,
+              "axis_state::settled holds exactly the fields from core to operation_mode");
 
 /// A fresh axis at power-on: the profile's default option codes, the motion objects' defaults, DC
 /// link present, brake engaged, at rest. Its first cycles take T0 and T1.

@@ -24,14 +24,44 @@ inline constexpr std::uint16_t error_register = 0x1001;  ///< UINT8, read-only (
 /// The mode a drive powers up in (0x6060 / 0x6061); cia402::mode lists every mode the plant runs.
 inline constexpr std::int64_t profile_velocity_mode = cia402::mode::profile_velocity;
 
+namespace detail {
+/// write_object() for every object but the set-points it writes inline.
+sdo_abort write_any_object(const profile& p, axis_state& a, std::uint16_t index, std::uint8_t sub,
+                           std::int64_t value) noexcept;
+}  // namespace detail
+
 /// Writes an object of one axis. Results: none; object_does_not_exist (unknown index, or an option
 /// code the profile lacks); sub_index_does_not_exist (sub != 0); read_only_object (0x6041, 0x606C,
 /// 0x603F, 0x1001, 0x6061); value_too_high / value_too_low (outside the object's type, or a ramp of
 /// 0 rpm/s, which would never end); invalid_value (an option code or mode the profile does not
 /// support). A refused write changes nothing. A write of 0x60FF also ends the "set-points cleared"
 /// of T4.
-sdo_abort write_object(const profile& p, axis_state& a, std::uint16_t index, std::uint8_t sub,
-                       std::int64_t value) noexcept;
+///
+/// Inline for 0x607A, 0x60FF and 0x6071 (sub 0), the set-points a cyclic master writes to every axis
+/// every cycle (an RPDO's): the table's entry and limits as for every object, then the field.
+inline sdo_abort write_object(const profile& p, axis_state& a, std::uint16_t index,
+                              std::uint8_t sub, std::int64_t value) noexcept {
+  if (index == object::target_position || index == object::target_velocity ||
+      index == object::target_torque) {
+    if (const object_description* o = find_drive_object(index, sub)) {
+      if (const sdo_abort r = check_write(*o, value); r != sdo_abort::none) return r;
+      if (index == object::target_position) {
+        a.objects.target_position = static_cast<std::int32_t>(value);
+      } else if (index == object::target_velocity) {
+        a.target_velocity = static_cast<std::int32_t>(value);
+      } else {
+        a.objects.target_torque = static_cast<std::int16_t>(value);
+      }
+      // T4's clearing ends. Stored only when set: the next step reads the flags in a wide load,
+      // which a narrow store just before would stall (store forwarding).
+      if (a.flags & sim_flag::setpoints_cleared) {
+        a.flags &= static_cast<std::uint8_t>(~sim_flag::setpoints_cleared);
+      }
+      return sdo_abort::none;
+    }
+  }
+  return detail::write_any_object(p, a, index, sub, value);
+}
 
 /// Reads an object of one axis; on success `value` holds it (sign-extended for signed types).
 sdo_abort read_object(const profile& p, const axis_state& a, std::uint16_t index, std::uint8_t sub,
