@@ -739,6 +739,16 @@ namespace {
   std::memcpy(a.settled, &a, core_source_bytes);
   cia402::step(p, a.core, inputs_of(k, a), a.last);
   a.settled_valid = std::memcmp(a.settled, &a.core, sizeof(axis)) == 0;
+  // What follow() would ask of a csp cycle, from fields that stay as they are while the axis is
+  // settled (last, flags and operation_mode are among the compared bytes; only decide() writes last).
+  constexpr std::uint8_t brake_bits = sim_flag::brake_commanded_open | sim_flag::brake_closed;
+  const drive_outputs& out = a.last;
+  a.settled_csp_runs =
+      a.operation_mode == cia402::mode::cyclic_synchronous_position && out.torque &&
+      out.ramp == stop_ramp::none && !out.clear_setpoints &&
+      (a.flags & sim_flag::following_error_raised) == 0 &&
+      (!k.brake_fitted || (out.brake_released && (a.flags & brake_bits) == sim_flag::brake_commanded_open)) &&
+      p.info(out.current).activity == state_activity::run;
 }
 
 }  // namespace
@@ -759,20 +769,14 @@ namespace {
 
 const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_state& a) noexcept {
   // The common cycle of a machine whose master streams csp set-points, handled here with no call:
-  // the core settled, nothing for after_decision(), no mode change, csp running (follow()'s test,
-  // which with a settled core and no stop is this) at the usual resolution, the brake where it was
-  // commanded, and the demand within the following error window. It does what full_cycle() does
-  // for it, byte for byte. Any other cycle goes there.
+  // the core settled as a running csp axis (nothing for after_decision(), no stop, the brake where
+  // it was commanded: decide() worked that out), no mode change, the usual resolution, and the
+  // demand within the following error window. It does what full_cycle() does for it, byte for
+  // byte. Any other cycle goes there.
   const bool settled = core_settled(a);
-  const drive_outputs& out = a.last;
-  constexpr std::uint8_t brake_bits = sim_flag::brake_commanded_open | sim_flag::brake_closed;
-  const bool usual = settled & !out.clear_setpoints & ((a.flags & sim_flag::following_error_raised) == 0) &
-                     (a.requested_mode == a.operation_mode) &
-                     (a.operation_mode == cia402::mode::cyclic_synchronous_position) &
-                     out.torque & (out.ramp == stop_ramp::none) &
-                     (a.objects.increments_per_rev == k.usual_increments_per_rev) &
-                     (!k.brake_fitted || (out.brake_released && (a.flags & brake_bits) == sim_flag::brake_commanded_open));
-  if (!usual || p.info(out.current).activity != state_activity::run) return full_cycle(p, k, a, settled);
+  const bool usual = settled & a.settled_csp_runs & (a.requested_mode == a.operation_mode) &
+                     (a.objects.increments_per_rev == k.usual_increments_per_rev);
+  if (!usual) return full_cycle(p, k, a, settled);
   std::uint16_t status = 1u << 12;  // the drive follows the command value
   const std::int64_t demand = csp_demand(a, status);
   if (!within_window(a, demand)) return full_cycle(p, k, a, settled);
@@ -782,7 +786,7 @@ const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_
   csp_move_usual(k, a, demand);
   a.mode_status = status;
   a.torque = torque_of_motion(k, a, v_old, a.velocity);
-  return out;
+  return a.last;
 }
 
 namespace {

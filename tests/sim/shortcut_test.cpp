@@ -261,4 +261,20 @@ TEST(step_axis_shortcuts, software_limits_written_under_a_standing_csp_axis_set_
   EXPECT_NE(t.fast.mode_status & status_bit::internal_limit_active, 0u);
 }
 
+// A halt (bit 8) stops csp on the 0x605D ramp and holds the axis while the master streams on; a
+// quick stop that stays in QUICK STOP ACTIVE (0x605A = 6) holds it too. Neither runs the csp path.
+TEST(step_axis_shortcuts, a_halted_or_quick_stopped_csp_axis_stays_where_it_stopped) {
+  for (const std::uint16_t stop : {std::uint16_t{0x010F}, std::uint16_t{0x000B}}) {
+    twins t;
+    t.each([](drive_view d) { d.write(0x605A, 0, 6); });
+    ASSERT_TRUE(t.enable_in_csp());
+    ASSERT_TRUE(t.stream(20, 50));
+    t.each([&](drive_view d) { d.write(0x6040, 0, stop); });
+    ASSERT_TRUE(t.stream(20, 400));
+    const std::int64_t stopped_at = t.fast.position;
+    ASSERT_TRUE(t.stream(20, 100));
+    EXPECT_EQ(t.fast.position, stopped_at) << "control word " << stop;
+  }
+}
+
 }  // namespace

@@ -173,6 +173,9 @@ struct axis_state {
   /// was found them (valid while settled_valid).
   bool settled_valid = false;
   std::uint8_t settled[58] = {};
+  /// step_axis() only: with those bytes the axis is a csp axis running with its brake released
+  /// (what step_axis() asks of the settled core before it takes its path with no call).
+  bool settled_csp_runs = false;
   std::uint32_t acceleration = 1000;  ///< 0x6083, rpm/s
   std::uint32_t deceleration = 1000;  ///< 0x6084, rpm/s: the slow-down ramp
   std::uint32_t quick_stop_deceleration = 10000;  ///< 0x6085, rpm/s
