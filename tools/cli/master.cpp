@@ -810,11 +810,13 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
   if (velocity_command) {
     const auto v = a.operands.size() == 1 ? parse_number(a.operands[0]) : std::nullopt;
     const object_description* target = find_drive_object(0x60FF, 0);
-    if (!v || target == nullptr || *v < type_low(target->type) || *v > type_high(target->type)) {
+    // value_or: GCC 12 -O3 takes *v after the !v test for a read of an unset optional.
+    const std::int64_t value = v.value_or(0);
+    if (!v || target == nullptr || value < type_low(target->type) || value > type_high(target->type)) {
       err << "cia402 master: velocity RPM: one integer for 0x60FF (target velocity, rpm)\n";
       return usage_error;
     }
-    rpm = static_cast<std::int32_t>(*v);
+    rpm = static_cast<std::int32_t>(value);
   } else if (!a.operands.empty()) {
     err << "cia402 master: " << a.command << " takes no operands\n";
     return usage_error;
