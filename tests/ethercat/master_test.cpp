@@ -247,6 +247,47 @@ TEST(ecat_master, a_long_run_of_sdo_transfers_keeps_the_process_data_flowing) {
   EXPECT_EQ(shown(l.master.slaves()[2]), state::operation_enabled) << "steered meanwhile";
 }
 
+TEST(ecat_master, the_cycle_runs_while_the_line_goes_to_op) {
+  // Each frame takes 3 ms to come back, and 24 slaves are asked for SAFE-OP and OP one by one.
+  // The outputs' watchdog runs from the moment the sync managers are set up. The master used to
+  // send its first LRW only once a state took more than one pass of status reads, and each cycle
+  // before the line was in OP read every slave's AL status: a round trip per slave between LRWs,
+  // which a loaded host stretched past the 100 ms watchdog (AL status 0x001B, the veth test's line
+  // of 16 in CI). So the first LRW goes out before any slave is asked for OP, and from then on no
+  // two are further apart than a cycle and the round trip in between.
+  line l(24);
+  ASSERT_TRUE(l.master.scan()) << l.master.error();
+  l.link.exchange_us = 3000;
+  std::uint64_t first_lrw = 0;
+  std::uint64_t last_lrw = 0;
+  std::uint64_t widest_gap = 0;
+  std::uint64_t first_op_request = 0;
+  l.master.on_frame = [&](const std::vector<std::uint8_t>& sent, const std::vector<std::uint8_t>&) {
+    if (sent.size() <= 26) return;
+    const std::uint8_t command = sent[16];  // the first datagram's, after the Ethernet and EtherCAT headers
+    const unsigned offset = sent[20] | (sent[21] << 8);
+    if (command == 5 && offset == 0x0120 && (sent[26] & 0x0F) == 8 && first_op_request == 0) {
+      first_op_request = l.link.now;
+    }
+    if (command != 12) return;
+    if (last_lrw == 0) first_lrw = l.link.now;
+    if (last_lrw != 0) widest_gap = std::max(widest_gap, l.link.now - last_lrw);
+    last_lrw = l.link.now;
+  };
+  ASSERT_TRUE(l.master.bring_to_operational()) << l.master.error();
+  ASSERT_NE(first_lrw, 0u) << "no LRW while the line went to OP";
+  ASSERT_NE(first_op_request, 0u);
+  EXPECT_LT(first_lrw, first_op_request);
+  EXPECT_LE(widest_gap, 1000u + 2 * 3000u);
+  for (int i = 0; i < 50; ++i) {
+    (void)l.master.cycle();
+    l.link.wait_us(1000);
+  }
+  for (std::size_t i = 0; i < 24; ++i) {
+    EXPECT_EQ(l.link.slaves[i]->state(), al_state::operational) << "slave " << i;
+  }
+}
+
 TEST(ecat_master, the_outputs_start_as_the_drive_has_them) {
   line l(1);
   ASSERT_TRUE(l.master.scan());

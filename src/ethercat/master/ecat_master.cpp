@@ -251,7 +251,11 @@ bool ecat_master::read_sii(ecat_slave& s) {
 
 bool ecat_master::request_state(line_state target, bool cycling) {
   const auto want = static_cast<std::uint8_t>(target);
+  // Slave by slave, a request and a status read are a round trip each: with the line cycling, the
+  // LRW goes on between them (pause), so a slave already in OP never waits for the whole line's
+  // round trips to see its outputs (a loaded host made that longer than the 100 ms watchdog).
   for (ecat_slave& s : slaves_) {
+    if (cycling) pause(0);
     // An error left from before is acknowledged with the request (bit 4).
     const std::uint8_t ack = (s.al_state & al_error_bit) ? al_error_bit : 0;
     if (!write_register(s, reg_al_control, {static_cast<std::uint8_t>(want | ack), 0x00})) {
@@ -262,6 +266,7 @@ bool ecat_master::request_state(line_state target, bool cycling) {
   for (;;) {
     bool all = true;
     for (ecat_slave& s : slaves_) {
+      if (cycling) pause(0);
       if (!read_al_status(s)) {
         all = false;
         continue;
@@ -757,12 +762,16 @@ bool ecat_master::cycle() {
               back.begin() + (s.logical_inputs - logical_base) + s.input_bytes,
               image_.begin() + (s.logical_inputs - logical_base));
   }
-  if (line == static_cast<std::uint8_t>(line_state::operational)) {
+  const bool operational = line == static_cast<std::uint8_t>(line_state::operational);
+  if (operational) {
     for (ecat_slave& s : slaves_) s.al_state = line;
-  } else if (line != 0) {
-    // Somebody left OP (a watchdog, an error): read each one's state and code.
+  } else if (line != 0 && (line_was_operational_ || (line & al_error_bit))) {
+    // Somebody left OP or shows an error (a watchdog, a refusal): read each one's state and code.
+    // Not while the line is on its way to OP: request_state() reads them, and a round trip per
+    // slave in every cycle would space the LRWs out past the slaves' watchdog on a long line.
     for (ecat_slave& s : slaves_) (void)read_al_status(s);
   }
+  line_was_operational_ = operational;
   return true;
 }
 

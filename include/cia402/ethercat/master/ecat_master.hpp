@@ -181,6 +181,7 @@ class ecat_master {
   std::uint64_t lost_frames_ = 0;
   std::uint8_t index_ = 0;
   bool pre_operational_ = false;
+  bool line_was_operational_ = false;  // the last cycle's BRD of the AL status read OP
   bool cycling_ = false;       // the process data is configured: cycles run, also during SDOs
   bool in_mailbox_ = false;    // an SDO transfer owns the send mailboxes
   std::uint64_t last_cycle_us_ = 0;
