@@ -44,6 +44,12 @@ def sdo_download(bus, node, index, sub, value, size):
     return msg
 
 
+def wait_for_state(bus, state, timeout=3.0):
+    """The first status word TPDO1 (0x6041, sent on change) of NODE in `state`, or None."""
+    return wait_for(bus, lambda m: m.arbitration_id == 0x180 + NODE and len(m.data) >= 2
+                    and status_state(int.from_bytes(m.data[0:2], "little")) == state, timeout)
+
+
 def status_state(word):
     """CiA 402 state from a status word (masks 0x4F / 0x6F)."""
     if word & 0x4F == 0x40:
@@ -119,9 +125,12 @@ def test_drive_reaches_operation_enabled_over_pdos(client):
     msg = wait_for(client, status)
     assert msg is not None
     log.append(status_state(int.from_bytes(msg.data, "little")))
-    for control_word in (0x0006, 0x000F):  # Shutdown, then Enable operation (T2, T3, T4)
-        send(client, 0x201, control_word.to_bytes(2, "little"))
-        time.sleep(0.05)
+    send(client, 0x201, (0x0006).to_bytes(2, "little"))  # Shutdown (T2)
+    # Enable operation waits for Shutdown to act: a drive sees the last RPDO before its cycle, so a
+    # word sent before it has stepped would replace the one before (a held-up bus server does that).
+    assert wait_for_state(client, "READY_TO_SWITCH_ON") is not None, log
+    log.append("READY_TO_SWITCH_ON")
+    send(client, 0x201, (0x000F).to_bytes(2, "little"))  # Enable operation (T3, T4)
     deadline = time.monotonic() + 3
     state = log[-1]
     while state != "OPERATION_ENABLED" and time.monotonic() < deadline:
@@ -159,7 +168,7 @@ def test_tpdo_timing_a_standard_master_can_rely_on(client):
     assert all(seen.get(i, 0) >= 2 for i in (0x181, 0x281, 0x481)), seen
     # Ramping from 0 to 3000 rpm (3 s at the default 1000 rpm/s): count TPDO4 over one second.
     send(client, 0x201, [0x06, 0x00])
-    time.sleep(0.05)
+    assert wait_for_state(client, "READY_TO_SWITCH_ON") is not None
     send(client, 0x201, [0x0F, 0x00])
     time.sleep(0.1)
     send(client, 0x501, [0x0F, 0x00] + list((3000).to_bytes(4, "little", signed=True)))

@@ -28,9 +28,10 @@ def wait_status(bus, predicate, timeout=5.0):
 
 def enable(bus):
     send(bus, 0x000, [0x01, NODE])  # NMT start
-    for control_word in (0x06, 0x0F):
-        send(bus, RPDO1, [control_word, 0x00])
-        time.sleep(0.05)
+    send(bus, RPDO1, [0x06, 0x00])
+    # 0x0F waits for 0x06 to act: the drive sees the last RPDO before its cycle (a held-up server).
+    assert wait_status(bus, lambda w: status_state(w) == "READY_TO_SWITCH_ON", timeout=3) is not None
+    send(bus, RPDO1, [0x0F, 0x00])
     word = wait_status(bus, lambda w: status_state(w) == "OPERATION_ENABLED")
     assert word is not None, "not enabled"
     time.sleep(0.1)  # the holding brake opens (30 ms)
@@ -56,7 +57,9 @@ def test_modes_switch_by_sdo_and_by_rpdo2(client):
     assert sdo_upload_expedited(client, NODE, 0x1A02, 2) == 0x60640020
     assert sdo_download(client, NODE, 0x6060, 0, 1, 1).data[0] == 0x60
     assert sdo_upload_expedited(client, NODE, 0x6061, 0) in (1, 3)  # switched by the next cycle
-    time.sleep(0.05)
+    end = time.monotonic() + 2
+    while sdo_upload_expedited(client, NODE, 0x6061, 0) != 1 and time.monotonic() < end:
+        time.sleep(0.005)
     assert sdo_upload_expedited(client, NODE, 0x6061, 0) == 1
     # RPDO2 = 0x6040 + 0x6060; TPDO2 = 0x6041 + 0x6061 shows the switch.
     send(client, RPDO2, [0x00, 0x00, 8])
