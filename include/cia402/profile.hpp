@@ -47,28 +47,23 @@ enum class fact : std::uint32_t {
 
 inline constexpr int fact_count = 25;
 
-/// A set of facts. Stored as two 16-bit halves, so a transition row packs into 18 bytes rather
-/// than 20 (2-byte alignment): rows are most of a profile's flash on a microcontroller.
+/// A set of facts.
 class fact_set {
  public:
   constexpr fact_set() noexcept = default;
-  constexpr fact_set(fact f) noexcept : fact_set(static_cast<std::uint32_t>(f)) {}
-  constexpr explicit fact_set(std::uint32_t bits) noexcept
-      : lo_(static_cast<std::uint16_t>(bits)), hi_(static_cast<std::uint16_t>(bits >> 16)) {}
-  constexpr std::uint32_t bits() const noexcept {
-    return lo_ | (static_cast<std::uint32_t>(hi_) << 16);
-  }
-  constexpr bool has(fact f) const noexcept { return (bits() & static_cast<std::uint32_t>(f)) != 0; }
-  constexpr bool empty() const noexcept { return bits() == 0; }
-  constexpr fact_set operator|(fact_set o) const noexcept { return fact_set(bits() | o.bits()); }
-  constexpr fact_set operator&(fact_set o) const noexcept { return fact_set(bits() & o.bits()); }
+  constexpr fact_set(fact f) noexcept : bits_(static_cast<std::uint32_t>(f)) {}
+  constexpr explicit fact_set(std::uint32_t bits) noexcept : bits_(bits) {}
+  constexpr std::uint32_t bits() const noexcept { return bits_; }
+  constexpr bool has(fact f) const noexcept { return (bits_ & static_cast<std::uint32_t>(f)) != 0; }
+  constexpr bool empty() const noexcept { return bits_ == 0; }
+  constexpr fact_set operator|(fact_set o) const noexcept { return fact_set(bits_ | o.bits_); }
+  constexpr fact_set operator&(fact_set o) const noexcept { return fact_set(bits_ & o.bits_); }
   constexpr fact_set& operator|=(fact_set o) noexcept { return *this = *this | o; }
-  constexpr bool operator==(fact_set o) const noexcept { return bits() == o.bits(); }
-  constexpr bool operator!=(fact_set o) const noexcept { return bits() != o.bits(); }
+  constexpr bool operator==(fact_set o) const noexcept { return bits_ == o.bits_; }
+  constexpr bool operator!=(fact_set o) const noexcept { return bits_ != o.bits_; }
 
  private:
-  std::uint16_t lo_ = 0;
-  std::uint16_t hi_ = 0;
+  std::uint32_t bits_ = 0;
 };
 
 constexpr fact_set operator|(fact a, fact b) noexcept { return fact_set(a) | fact_set(b); }
@@ -102,7 +97,8 @@ inline constexpr std::uint8_t interrupts_stop = 1u << 0;
 inline constexpr std::uint8_t clears_setpoints = 1u << 1;
 }  // namespace row_flag
 
-/// One transition row, as a seed prints it.
+/// One transition row, as a seed prints it: how rows are written (built-in tables, profile files)
+/// and how tools read them (profile::row). A profile stores them as `stored_row`s.
 struct transition_row {
   std::uint8_t number = 0;      ///< the seed's transition number, 0..17
   state to = state::start;
@@ -113,6 +109,50 @@ struct transition_row {
   row_stop stop = row_stop::immediate;
   std::uint8_t flags = 0;       ///< row_flag bits
 };
+
+/// A transition row as a profile stores it: its three fact sets are indices into the profile's pool
+/// of distinct sets (`profile::fact_sets`). A profile has few distinct sets (the standard one 17 in
+/// its 54 places), so a row takes 9 bytes instead of 18: rows are most of a profile's flash on a
+/// microcontroller.
+struct stored_row {
+  std::uint8_t number = 0;
+  state to = state::start;
+  std::uint8_t from_low = 0;   ///< `from`, in two bytes so the row needs no alignment
+  std::uint8_t from_high = 0;
+  std::uint8_t any = 0;        ///< index into profile::fact_sets
+  std::uint8_t all = 0;
+  std::uint8_t none = 0;
+  row_stop stop = row_stop::immediate;
+  std::uint8_t flags = 0;
+  constexpr std::uint16_t from() const noexcept {
+    return static_cast<std::uint16_t>(from_low | (from_high << 8));
+  }
+};
+
+namespace detail {
+/// The index of `bits` in sets[0..count), appending it if absent: how rows' fact sets are pooled.
+constexpr std::uint8_t pooled(std::uint32_t bits, std::uint32_t* sets, std::size_t& count) noexcept {
+  for (std::size_t i = 0; i < count; ++i) {
+    if (sets[i] == bits) return static_cast<std::uint8_t>(i);
+  }
+  sets[count] = bits;
+  return static_cast<std::uint8_t>(count++);
+}
+/// Stores a row, pooling its fact sets; `sets` has room for three more.
+constexpr stored_row store_row(const transition_row& r, std::uint32_t* sets, std::size_t& count) noexcept {
+  stored_row s;
+  s.number = r.number;
+  s.to = r.to;
+  s.from_low = static_cast<std::uint8_t>(r.from & 0xFFu);
+  s.from_high = static_cast<std::uint8_t>(r.from >> 8);
+  s.any = pooled(r.any.bits(), sets, count);
+  s.all = pooled(r.all.bits(), sets, count);
+  s.none = pooled(r.none.bits(), sets, count);
+  s.stop = r.stop;
+  s.flags = r.flags;
+  return s;
+}
+}  // namespace detail
 
 /// One rule of a control-word decoder: if (control_word & mask) == value, the command is `result`.
 /// Rules are tried in order and the first match wins (S1). Masks may use bits 0..4 only.
@@ -187,6 +227,39 @@ struct option_spec {
 inline constexpr std::size_t max_rows = 32;
 inline constexpr std::size_t max_decoder_rules = 8;
 
+/// Rows as a profile stores them, built at compile time from rows as written:
+///   constexpr cia402::transition_row my_rows[] = {...};
+///   profile.use_rows(cia402::stored_rows<my_rows>);  // my_rows needs static storage
+template <std::size_t NRows, std::size_t NSets>
+struct stored_table {
+  static_assert(NRows <= max_rows, "too many rows");
+  std::array<stored_row, NRows> rows{};
+  std::array<std::uint32_t, NSets> sets{};
+};
+
+namespace detail {
+template <std::size_t NRows>
+constexpr std::size_t distinct_fact_sets(const transition_row (&rows)[NRows]) noexcept {
+  std::uint32_t sets[3 * NRows] = {};
+  std::size_t count = 0;
+  for (const transition_row& r : rows) store_row(r, sets, count);
+  return count;
+}
+
+template <std::size_t NSets, std::size_t NRows>
+constexpr stored_table<NRows, NSets> store_table(const transition_row (&rows)[NRows]) noexcept {
+  std::uint32_t sets[3 * NRows] = {};
+  std::size_t count = 0;
+  stored_table<NRows, NSets> t;
+  for (std::size_t i = 0; i < NRows; ++i) t.rows[i] = store_row(rows[i], sets, count);
+  for (std::size_t i = 0; i < NSets; ++i) t.sets[i] = sets[i];
+  return t;
+}
+}  // namespace detail
+
+template <const auto& Rows>
+inline constexpr auto stored_rows = detail::store_table<detail::distinct_fact_sets(Rows)>(Rows);
+
 /// A profile: a view of its tables (which live in static storage, or in a `custom_profile`) plus
 /// lookup tables derived from them by finalize(). Copying a profile copies the view, not the rows.
 struct profile {
@@ -196,8 +269,11 @@ struct profile {
 
   const decoder_rule* decoder = nullptr;
   std::uint8_t decoder_size = 0;
-  const transition_row* rows = nullptr;
+  const stored_row* rows = nullptr;
   std::uint8_t row_count = 0;
+  /// The distinct fact sets the rows use (stored_row::any, all, none index it), as fact_set::bits().
+  const std::uint32_t* fact_sets = nullptr;
+  std::uint8_t fact_set_count = 0;
   std::array<state_info, state_count> states{};
   std::array<option_spec, option_count> options{};
   /// T2/T7 of seed 001 test |actual speed| against this (rpm); 0 = no such condition.
@@ -216,6 +292,15 @@ struct profile {
   /// changes nothing (the quiet step, drive.hpp), and no row can fire without one.
   std::array<std::uint32_t, state_count> busy_from{};
 
+  /// Points the profile at stored rows (stored_rows<...>) that outlive it.
+  template <std::size_t NRows, std::size_t NSets>
+  constexpr void use_rows(const stored_table<NRows, NSets>& t) noexcept {
+    rows = t.rows.data();
+    row_count = static_cast<std::uint8_t>(NRows);
+    fact_sets = t.sets.data();
+    fact_set_count = static_cast<std::uint8_t>(NSets);
+  }
+
   /// Recomputes the derived tables from the data above. Call after any change to it.
   constexpr void finalize() noexcept {
     for (unsigned bits = 0; bits < 32; ++bits) {
@@ -232,9 +317,9 @@ struct profile {
       rows_from[s] = 0;
       std::uint32_t triggers = 0;
       for (std::size_t r = 0; r < row_count && r < max_rows; ++r) {
-        if ((rows[r].from >> s) & 1u) {
+        if ((rows[r].from() >> s) & 1u) {
           rows_from[s] |= 1u << r;
-          triggers |= rows[r].any.bits();
+          triggers |= fact_sets[rows[r].any];
         }
       }
       const state_activity act = states[s].activity;
@@ -242,6 +327,21 @@ struct profile {
           act == state_activity::quick_stop || act == state_activity::fault_reaction;
       busy_from[s] = stopping ? 0xFFFFFFFFu : triggers;
     }
+  }
+
+  /// Row i as written (i < row_count).
+  constexpr transition_row row(std::size_t i) const noexcept {
+    const stored_row& s = rows[i];
+    transition_row r;
+    r.number = s.number;
+    r.to = s.to;
+    r.from = s.from();
+    r.any = fact_set(fact_sets[s.any]);
+    r.all = fact_set(fact_sets[s.all]);
+    r.none = fact_set(fact_sets[s.none]);
+    r.stop = s.stop;
+    r.flags = s.flags;
+    return r;
   }
 
   /// The command that bits 0..4 of a control word decode to.
@@ -269,7 +369,7 @@ class custom_profile {
   custom_profile(const custom_profile& o) noexcept { *this = o; }
   custom_profile& operator=(const custom_profile& o) noexcept {
     name_ = o.name_; seed_ = o.seed_; title_ = o.title_;
-    decoder_ = o.decoder_; rows_ = o.rows_; view_ = o.view_;
+    decoder_ = o.decoder_; rows_ = o.rows_; fact_sets_ = o.fact_sets_; view_ = o.view_;
     repoint();
     return *this;
   }
@@ -282,7 +382,8 @@ class custom_profile {
   bool set_name(std::string_view s) noexcept { return assign(name_, s); }
   bool set_seed(std::string_view s) noexcept { return assign(seed_, s); }
   bool set_title(std::string_view s) noexcept { return assign(title_, s); }
-  /// Replace the tables; false (and no change) if they exceed the capacities.
+  /// Replace the tables; false (and no change) if they exceed the capacities. set_rows stores the
+  /// rows with their fact sets pooled.
   bool set_decoder(const decoder_rule* rules, std::size_t n) noexcept;
   bool set_rows(const transition_row* rows, std::size_t n) noexcept;
   /// The rest of the profile (states, options, flags); tables and names are kept.
@@ -299,13 +400,14 @@ class custom_profile {
   }
   void repoint() noexcept {
     view_.name = name_.data(); view_.seed = seed_.data(); view_.title = title_.data();
-    view_.decoder = decoder_.data(); view_.rows = rows_.data();
+    view_.decoder = decoder_.data(); view_.rows = rows_.data(); view_.fact_sets = fact_sets_.data();
   }
   std::array<char, 40> name_{};
   std::array<char, 64> seed_{};
   std::array<char, 128> title_{};
   std::array<decoder_rule, max_decoder_rules> decoder_{};
-  std::array<transition_row, max_rows> rows_{};
+  std::array<stored_row, max_rows> rows_{};
+  std::array<std::uint32_t, 3 * max_rows> fact_sets_{};
   profile view_{};
 };
 

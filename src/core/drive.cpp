@@ -90,7 +90,7 @@ constexpr unsigned ramp = 0xFFu;
 
 unsigned activity_of(const profile& p, const axis& a, bool halt) noexcept {
   if (a.pending_row != no_row) {
-    const transition_row& r = p.rows[a.pending_row];
+    const stored_row& r = p.rows[a.pending_row];
     // A stop into a state that holds torque (SWITCHED ON of seeds 003/004) keeps the brake open.
     return static_cast<unsigned>(ramp_of_row(a, stop_of(r.stop), a.stop_code)) |
            activity::torque_wanted | (p.torque_allowed(r.to) ? 0u : activity::stop_ends_torque);
@@ -248,8 +248,9 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   if (p.busy_from[from] & f) {
     for (std::uint32_t rows = p.rows_from[from]; rows != 0; rows &= rows - 1) {
       const std::uint8_t i = static_cast<std::uint8_t>(detail::lowest_bit(rows));
-      const transition_row& r = p.rows[i];
-      if ((r.any.bits() & f) && (r.all.bits() & f) == r.all.bits() && !(r.none.bits() & f)) {
+      const stored_row& r = p.rows[i];
+      const std::uint32_t all = p.fact_sets[r.all];
+      if ((p.fact_sets[r.any] & f) && (all & f) == all && !(p.fact_sets[r.none] & f)) {
         match = i;
         break;
       }
@@ -288,8 +289,8 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   }
 
   if (commit != no_row) {
-    const transition_row& r = p.rows[commit];
-    const std::uint32_t why = r.any.bits() & f;
+    const stored_row& r = p.rows[commit];
+    const std::uint32_t why = p.fact_sets[r.any] & f;
     a.current = r.to;
     a.pending_row = no_row;
     // S16: the quick stop and the fault reaction run by the code they find as they start.

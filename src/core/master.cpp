@@ -234,7 +234,7 @@ namespace {
 
 bool reads_entered_by_fault(const profile& p) noexcept {
   for (std::size_t i = 0; i < p.row_count; ++i) {
-    const transition_row& r = p.rows[i];
+    const transition_row r = p.row(i);
     if ((r.any | r.all | r.none).has(fact::entered_by_fault)) return true;
   }
   return false;

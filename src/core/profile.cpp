@@ -47,7 +47,7 @@ const char* check_profile(const profile& p, int& row) noexcept {
   row = -1;
   if (p.row_count > max_rows) return "more than 32 transition rows";
   if (p.decoder_size > max_decoder_rules) return "more than 8 decoder rules";
-  if (p.row_count > 0 && p.rows == nullptr) return "rows missing";
+  if (p.row_count > 0 && (p.rows == nullptr || p.fact_sets == nullptr)) return "rows missing";
   if (p.decoder_size > 0 && p.decoder == nullptr) return "decoder missing";
   for (std::size_t i = 0; i < p.decoder_size; ++i) {
     const decoder_rule& d = p.decoder[i];
@@ -59,8 +59,12 @@ const char* check_profile(const profile& p, int& row) noexcept {
   }
   constexpr std::uint32_t all_facts = (1u << fact_count) - 1;
   for (std::size_t i = 0; i < p.row_count; ++i) {
-    const transition_row& r = p.rows[i];
     row = static_cast<int>(i);
+    const stored_row& s = p.rows[i];
+    if (s.any >= p.fact_set_count || s.all >= p.fact_set_count || s.none >= p.fact_set_count) {
+      return "row names a fact set the profile does not have";
+    }
+    const transition_row r = p.row(i);
     if (r.number > 17) return "transition number outside 0..17";
     if (r.from == 0) return "row leaves no state";
     if ((r.from >> state_count) != 0) return "row leaves an unknown state";
@@ -108,7 +112,10 @@ custom_profile::custom_profile(const profile& base) noexcept {
   set_seed(base.seed);
   set_title(base.title);
   set_decoder(base.decoder, base.decoder_size);
-  set_rows(base.rows, base.row_count);
+  std::array<transition_row, max_rows> rows{};
+  const std::size_t n = base.row_count < max_rows ? base.row_count : max_rows;
+  for (std::size_t i = 0; i < n; ++i) rows[i] = base.row(i);
+  set_rows(rows.data(), n);
   finalize();
 }
 
@@ -121,8 +128,10 @@ bool custom_profile::set_decoder(const decoder_rule* rules, std::size_t n) noexc
 
 bool custom_profile::set_rows(const transition_row* rows, std::size_t n) noexcept {
   if (n > max_rows || (n > 0 && rows == nullptr)) return false;
-  for (std::size_t i = 0; i < n; ++i) rows_[i] = rows[i];
+  std::size_t sets = 0;
+  for (std::size_t i = 0; i < n; ++i) rows_[i] = detail::store_row(rows[i], fact_sets_.data(), sets);
   view_.row_count = static_cast<std::uint8_t>(n);
+  view_.fact_set_count = static_cast<std::uint8_t>(sets);
   return true;
 }
 

@@ -13,7 +13,7 @@ using arrow = std::tuple<int, int, int>;
 std::set<arrow> arrows_of(const profile& p) {
   std::set<arrow> arrows;
   for (std::size_t r = 0; r < p.row_count; ++r) {
-    const transition_row& row = p.rows[r];
+    const transition_row row = p.row(r);
     for (int s = 0; s < state_count; ++s) {
       if ((row.from >> s) & 1u) arrows.insert({s, static_cast<int>(row.to), row.number});
     }
@@ -64,7 +64,7 @@ std::string diagram_dot(const profile& p) {
   // arrow leaving a frame around all of them.
   std::uint16_t group = 0;
   for (std::size_t r = 0; r < p.row_count; ++r) {
-    const std::uint16_t from = p.rows[r].from;
+    const std::uint16_t from = p.row(r).from;
     if (__builtin_popcount(from) >= 3 && __builtin_popcount(from) > __builtin_popcount(group)) {
       group = from;
     }
@@ -105,7 +105,7 @@ std::string diagram_dot(const profile& p) {
   }
   std::set<std::pair<int, int>> grouped_drawn;  // (number, to)
   for (std::size_t r = 0; r < p.row_count; ++r) {
-    const transition_row& row = p.rows[r];
+    const transition_row row = p.row(r);
     if (group == 0 || row.from != group) continue;
     const int to = static_cast<int>(row.to);
     if (!grouped_drawn.insert({row.number, to}).second) continue;

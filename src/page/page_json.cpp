@@ -67,7 +67,7 @@ json profile_info(const profile& p) {
   json rows = json::array();
   std::vector<std::tuple<int, std::uint16_t, int>> seen;
   for (std::size_t r = 0; r < p.row_count; ++r) {
-    const transition_row& row = p.rows[r];
+    const transition_row row = p.row(r);
     const auto key = std::make_tuple(int{row.number}, row.from, static_cast<int>(row.to));
     if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
     seen.push_back(key);

@@ -40,7 +40,7 @@ struct search {
       return;
     }
     for (std::size_t r = 0; r < p.row_count; ++r) {
-      const transition_row& row = p.rows[r];
+      const transition_row row = p.row(r);
       if (((row.from >> static_cast<unsigned>(at)) & 1u) == 0) continue;
       // A chain through its own end or back through a state it left is no shorter explanation.
       if (row.to == at) continue;
@@ -69,7 +69,7 @@ std::vector<inferred_transition> infer_transitions(const profile& p, state from,
     if (s.best_score < 0) continue;
     state at = from;
     for (std::size_t r : s.best) {
-      const transition_row& row = p.rows[r];
+      const transition_row row = p.row(r);
       out.push_back({row.number, at, row.to});
       at = row.to;
     }

@@ -49,7 +49,7 @@ action_log::expectation word_change::expect_in(const profile& p, std::uint16_t b
   // SWITCH ON.
   const auto wanted = static_cast<std::uint32_t>(command_fact(p.decode(word)));
   for (std::size_t r = 0; r < p.row_count; ++r) {
-    const transition_row& row = p.rows[r];
+    const transition_row row = p.row(r);
     if (row.to == *now && (row.any.bits() & wanted) != 0) return action_log::expectation::already_there;
   }
   return action_log::expectation::act;

@@ -558,7 +558,7 @@ std::string dump_profile_toml(const profile& p) {
 
   o << "\n# Transition rows, tried in this order; the first whose facts hold fires.\n";
   for (std::size_t i = 0; i < p.row_count; ++i) {
-    const transition_row& r = p.rows[i];
+    const transition_row r = p.row(i);
     o << "\n[[rows]]\nnumber = " << static_cast<int>(r.number) << "\n";
     o << "from = " << state_list(r.from) << "\n";
     o << "to = \"" << lower(state_name(r.to)) << "\"\n";

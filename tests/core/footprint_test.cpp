@@ -1,7 +1,9 @@
 // Properties tested like behaviour (STYLE.md, boost-ext/sml): the per-axis state is small and
 // trivially copyable, every built-in profile passes check_profile, and check_profile refuses each
 // kind of malformed table with a reason and the offending row.
+#include <array>
 #include <cstring>
+#include <set>
 #include <string>
 #include <type_traits>
 
@@ -16,6 +18,8 @@ static_assert(std::is_trivially_copyable_v<drive_inputs>);
 static_assert(std::is_trivially_copyable_v<drive_outputs>);
 static_assert(std::is_trivially_copyable_v<transition_row>);
 static_assert(std::is_trivially_copyable_v<profile>, "a profile is a view: copying it is cheap");
+static_assert(sizeof(stored_row) == 9 && alignof(stored_row) == 1,
+              "a stored row is 9 bytes with no padding: rows are most of a profile's flash");
 
 TEST(footprint, axis_fits_in_sixteen_bytes_and_is_trivially_copyable) {
   EXPECT_LE(sizeof(axis), 16u);
@@ -75,12 +79,12 @@ struct malformation {
   void (*spoil)(custom_profile&);
 };
 
-transition_row rows_of(const custom_profile& c, int i) { return c.get().rows[i]; }
+transition_row rows_of(const custom_profile& c, int i) { return c.get().row(static_cast<std::size_t>(i)); }
 
 void replace_row(custom_profile& c, int i, transition_row r) {
   transition_row rows[max_rows];
   const profile& v = c.get();
-  for (int k = 0; k < v.row_count; ++k) rows[k] = v.rows[k];
+  for (int k = 0; k < v.row_count; ++k) rows[k] = v.row(static_cast<std::size_t>(k));
   rows[i] = r;
   ASSERT_TRUE(c.set_rows(rows, v.row_count));
   c.finalize();
@@ -233,10 +237,63 @@ TEST(footprint, custom_profile_refuses_tables_beyond_its_capacity_and_keeps_the_
   EXPECT_EQ(check_profile(c, row), nullptr);
 }
 
+// A profile written in code stores its rows at compile time: two rows, three sets, two distinct.
+constexpr transition_row user_rows[] = {
+    {0, state::not_ready_to_switch_on, state_bit(state::start), fact_set(fact::automatic), {}, {},
+     row_stop::immediate, 0},
+    {1, state::switch_on_disabled, state_bit(state::not_ready_to_switch_on),
+     fact_set(fact::automatic), {}, {}, row_stop::immediate, 0},
+};
+static_assert(stored_rows<user_rows>.sets.size() == 2, "automatic, and the empty set");
+static_assert(stored_rows<user_rows>.rows[0].any == stored_rows<user_rows>.rows[1].any);
+static_assert(stored_rows<user_rows>.sets[stored_rows<user_rows>.rows[1].any] ==
+              static_cast<std::uint32_t>(fact::automatic));
+static_assert(stored_rows<user_rows>.rows[1].from() == state_bit(state::not_ready_to_switch_on));
+
+// The rows' fact sets are stored once per profile: each distinct set in the pool once, every row's
+// indices naming the set it was written with.
+TEST(footprint, a_profile_stores_each_distinct_fact_set_once) {
+  for (const profile* p : test::all_builtins()) {
+    std::set<std::uint32_t> distinct;
+    for (std::size_t i = 0; i < p->row_count; ++i) {
+      const transition_row r = p->row(i);
+      distinct.insert({r.any.bits(), r.all.bits(), r.none.bits()});
+    }
+    EXPECT_EQ(p->fact_set_count, distinct.size()) << p->name;
+    const std::set<std::uint32_t> pool(p->fact_sets, p->fact_sets + p->fact_set_count);
+    EXPECT_EQ(pool, distinct) << p->name;
+    const custom_profile c(*p);
+    EXPECT_EQ(c.get().fact_set_count, p->fact_set_count) << p->name << ", copied";
+    for (std::size_t i = 0; i < p->row_count; ++i) {
+      const transition_row x = c.get().row(i), y = p->row(i);
+      EXPECT_TRUE(x.number == y.number && x.to == y.to && x.from == y.from && x.any == y.any &&
+                  x.all == y.all && x.none == y.none && x.stop == y.stop && x.flags == y.flags)
+          << p->name << " row " << i;
+    }
+  }
+}
+
+TEST(footprint, check_profile_refuses_a_row_that_names_a_fact_set_the_profile_lacks) {
+  const profile& base = standard_profile();
+  std::array<stored_row, max_rows> rows{};
+  for (std::size_t i = 0; i < base.row_count; ++i) rows[i] = base.rows[i];
+  rows[4].none = base.fact_set_count;  // one past the pool
+  profile p = base;
+  p.rows = rows.data();
+  int row = -1;
+  const char* reason = check_profile(p, row);
+  ASSERT_NE(reason, nullptr);
+  EXPECT_STREQ(reason, "row names a fact set the profile does not have");
+  EXPECT_EQ(row, 4);
+  rows[4].none = base.rows[4].none;
+  EXPECT_EQ(check_profile(p, row), nullptr);
+}
+
 TEST(footprint, a_copied_custom_profile_points_at_its_own_tables) {
   custom_profile a(standard_profile());
   custom_profile b = a;
   EXPECT_NE(a.get().rows, b.get().rows);
+  EXPECT_NE(a.get().fact_sets, b.get().fact_sets);
   EXPECT_NE(a.get().decoder, b.get().decoder);
   EXPECT_NE(static_cast<const void*>(a.get().name), static_cast<const void*>(b.get().name));
   b.set_name("changed");

@@ -47,7 +47,7 @@ struct report {
 
 inline bool reads_fact(const profile& p, fact f) {
   for (std::size_t i = 0; i < p.row_count; ++i) {
-    const transition_row& r = p.rows[i];
+    const transition_row r = p.row(i);
     if ((r.any | r.all | r.none).has(f)) return true;
   }
   return false;

@@ -80,7 +80,7 @@ custom_profile standard_with(void (*edit)(transition_row*, std::size_t&)) {
   custom_profile c(standard_profile());
   std::array<transition_row, max_rows> rows{};
   std::size_t n = c.get().row_count;
-  for (std::size_t i = 0; i < n; ++i) rows[i] = c.get().rows[i];
+  for (std::size_t i = 0; i < n; ++i) rows[i] = c.get().row(i);
   edit(rows.data(), n);
   c.set_rows(rows.data(), n);
   c.finalize();

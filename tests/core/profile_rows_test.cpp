@@ -553,7 +553,7 @@ std::uint16_t reachable_states(const profile& p) {
   for (bool grew = true; grew;) {
     grew = false;
     for (std::size_t i = 0; i < p.row_count; ++i) {
-      const transition_row& r = p.rows[i];
+      const transition_row r = p.row(i);
       if ((r.from & seen) != 0 && (seen & state_bit(r.to)) == 0) {
         seen = static_cast<std::uint16_t>(seen | state_bit(r.to));
         grew = true;
@@ -584,7 +584,7 @@ TEST(profile_rows, every_row_source_and_trigger_of_every_profile_has_a_case) {
       }
     }
     for (std::size_t i = 0; i < p->row_count; ++i) {
-      const transition_row& r = p->rows[i];
+      const transition_row r = p->row(i);
       for (int s = 0; s < state_count; ++s) {
         if (((r.from >> s) & 1u) == 0 || ((reachable >> s) & 1u) == 0) continue;
         for (int f = 0; f < fact_count; ++f) {
@@ -607,7 +607,7 @@ TEST(profile_rows, every_profile_has_exactly_its_seeds_transition_numbers) {
     const std::vector<int> seed = test::seed_transitions(*p);
     std::set<int> in_rows;
     for (std::size_t i = 0; i < p->row_count; ++i) {
-      const int n = p->rows[i].number;
+      const int n = p->row(i).number;
       in_rows.insert(n);
       EXPECT_NE(std::find(seed.begin(), seed.end(), n), seed.end())
           << p->name << " row " << i << " is T" << n << ", which seed " << p->seed

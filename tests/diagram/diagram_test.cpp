@@ -13,16 +13,16 @@ namespace {
 std::set<std::string> expected_arrows(const cia402::profile& p) {
   std::set<std::string> arrows;
   for (std::size_t r = 0; r < p.row_count; ++r) {
-    if (__builtin_popcount(p.rows[r].from) >= 3) {
-      arrows.insert("t" + std::to_string(p.rows[r].number) + ".ANY." +
-                    cia402::state_name(p.rows[r].to));
+    if (__builtin_popcount(p.row(r).from) >= 3) {
+      arrows.insert("t" + std::to_string(p.row(r).number) + ".ANY." +
+                    cia402::state_name(p.row(r).to));
       continue;
     }
     for (int s = 0; s < cia402::state_count; ++s) {
-      if ((p.rows[r].from >> s) & 1u) {
-        arrows.insert("t" + std::to_string(p.rows[r].number) + "." +
+      if ((p.row(r).from >> s) & 1u) {
+        arrows.insert("t" + std::to_string(p.row(r).number) + "." +
                       cia402::state_name(static_cast<cia402::state>(s)) + "." +
-                      cia402::state_name(p.rows[r].to));
+                      cia402::state_name(p.row(r).to));
       }
     }
   }
@@ -75,7 +75,7 @@ TEST(diagram, mermaid_lists_every_arrow) {
   for (char c : m) lines += c == '\n';
   // Header, one line per state (8), one per arrow from each source state.
   std::size_t arrows = 0;
-  for (std::size_t r = 0; r < p.row_count; ++r) arrows += __builtin_popcount(p.rows[r].from);
+  for (std::size_t r = 0; r < p.row_count; ++r) arrows += __builtin_popcount(p.row(r).from);
   EXPECT_LE(lines, 1 + 8 + arrows);  // rows differing only in trigger share one line
   EXPECT_GE(lines, 1 + 8 + arrows - 1);
 }

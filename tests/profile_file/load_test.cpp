@@ -1,6 +1,7 @@
 // Profile files that load: the example, a base with overrides, a complete file without base.
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <string>
 
 #include "cia402/drive.hpp"
@@ -13,11 +14,11 @@ namespace {
 using test::load_error;
 using test::load_ok;
 
-const transition_row* find_row(const profile& p, int number) {
+std::optional<transition_row> find_row(const profile& p, int number) {
   for (std::size_t i = 0; i < p.row_count; ++i) {
-    if (p.rows[i].number == number) return &p.rows[i];
+    if (p.row(i).number == number) return p.row(i);
   }
-  return nullptr;
+  return std::nullopt;
 }
 
 // Powers up a drive and commands Shutdown; returns the state it ends in.
@@ -67,9 +68,9 @@ default = 6
   EXPECT_STREQ(p.seed, base.seed);
   ASSERT_EQ(p.row_count, base.row_count);
   for (std::size_t i = 0; i < p.row_count; ++i) {
-    EXPECT_EQ(p.rows[i].number, base.rows[i].number);
-    EXPECT_EQ(p.rows[i].from, base.rows[i].from);
-    EXPECT_EQ(p.rows[i].any, base.rows[i].any);
+    EXPECT_EQ(p.row(i).number, base.row(i).number);
+    EXPECT_EQ(p.row(i).from, base.row(i).from);
+    EXPECT_EQ(p.row(i).any, base.row(i).any);
   }
   EXPECT_EQ(p.spec(option::quick_stop).supported, (1u << 2) | (1u << 6));
   EXPECT_EQ(p.spec(option::quick_stop).default_value, 6);
@@ -121,7 +122,7 @@ to = "not_ready_to_switch_on"
 any = ["automatic"]
 )");
   ASSERT_EQ(c.get().row_count, 1);
-  EXPECT_EQ(c.get().rows[0].to, state::not_ready_to_switch_on);
+  EXPECT_EQ(c.get().row(0).to, state::not_ready_to_switch_on);
 }
 
 TEST(profile_file_load, complete_file_without_base_loads_and_start_defaults_to_idle_zero) {
@@ -139,8 +140,8 @@ TEST(profile_file_load, complete_file_without_base_loads_and_start_defaults_to_i
 
 TEST(profile_file_load, row_optional_keys_default_to_immediate_no_flags_no_guards) {
   const custom_profile c = load_ok(test::minimal_profile);
-  const transition_row* t2 = find_row(c.get(), 2);
-  ASSERT_NE(t2, nullptr);
+  const std::optional<transition_row> t2 = find_row(c.get(), 2);
+  ASSERT_TRUE(t2.has_value());
   EXPECT_EQ(t2->stop, row_stop::immediate);
   EXPECT_EQ(t2->flags, 0);
   EXPECT_TRUE(t2->all.empty());
@@ -166,7 +167,7 @@ interrupts_stop = true
 clears_setpoints = true
 )");
   ASSERT_EQ(c.get().row_count, 2);
-  const transition_row& r = c.get().rows[1];
+  const transition_row r = c.get().row(1);
   EXPECT_EQ(r.number, 17);
   EXPECT_EQ(r.from, state_bit(state::operation_enabled) | state_bit(state::quick_stop_active));
   EXPECT_EQ(r.to, state::switch_on_disabled);
@@ -194,8 +195,8 @@ activity = "Quick_Stop"
 [options.0x605a]
 default = 6
 )");
-  EXPECT_EQ(c.get().rows[0].to, state::not_ready_to_switch_on);
-  EXPECT_EQ(c.get().rows[0].stop, row_stop::slow_down_ramp);
+  EXPECT_EQ(c.get().row(0).to, state::not_ready_to_switch_on);
+  EXPECT_EQ(c.get().row(0).stop, row_stop::slow_down_ramp);
   EXPECT_EQ(c.get().spec(option::quick_stop).default_value, 6);
 }
 

@@ -24,8 +24,8 @@ void expect_same_tables(const profile& a, const profile& b) {
   }
   ASSERT_EQ(a.row_count, b.row_count);
   for (std::size_t i = 0; i < a.row_count; ++i) {
-    const transition_row& x = a.rows[i];
-    const transition_row& y = b.rows[i];
+    const transition_row x = a.row(i);
+    const transition_row y = b.row(i);
     EXPECT_EQ(x.number, y.number) << "row " << i;
     EXPECT_EQ(x.from, y.from) << "row " << i;
     EXPECT_EQ(x.to, y.to) << "row " << i;

@@ -71,7 +71,7 @@ constexpr std::array<option_spec, option_count> options = {{
 constexpr profile make() noexcept {
   profile p = make_profile(
     "ax2000-profibus", "004_e07fd68605b3a8c6.txt",
-    "Beckhoff AX2000 PROFIBUS DP: fast stop on bit 4, T17 on bit 2", decoder, rows,
+    "Beckhoff AX2000 PROFIBUS DP: fast stop on bit 4, T17 on bit 2", decoder, stored_rows<rows>,
     standard_states(state_activity::hold), options);
   p.words = word_names::drivecom;  // STW / ZSW: bit 8 is jog, not halt
   return p;

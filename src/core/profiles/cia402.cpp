@@ -58,7 +58,7 @@ constexpr std::array<option_spec, option_count> options = {{
 const profile cia402_profile = make_profile(
     "cia402", "002_522d2c0bb8f5a5f8.txt",
     "CiA 402 standard (CoE table 7.8)",
-    standard_decoder, rows,
+    standard_decoder, stored_rows<rows>,
     standard_states(state_activity::idle), options);
 
 }  // namespace cia402::detail

@@ -77,7 +77,7 @@ constexpr std::array<option_spec, option_count> options = {{
 constexpr profile make() noexcept {
   profile p = make_profile("lexium32", "001_f9323c8e43dc977c.txt",
                            "Lexium-32-style: error classes, T2/T7 conditions, T16 by Fault Reset",
-                           standard_decoder, rows, standard_states(state_activity::idle), options);
+                           standard_decoder, stored_rows<rows>, standard_states(state_activity::idle), options);
   p.speed_limit_rpm = 1000;
   p.error_classes = true;
   return p;

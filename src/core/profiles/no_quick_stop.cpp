@@ -57,7 +57,7 @@ constexpr std::array<option_spec, option_count> options = {{
 
 const profile no_quick_stop_profile = make_profile(
     "no-quick-stop", "000_44b471b7401b86be.txt",
-    "CANopen drive without quick stop; ramped T5/T8 on 0x221E, coasting T9", standard_decoder, rows,
+    "CANopen drive without quick stop; ramped T5/T8 on 0x221E, coasting T9", standard_decoder, stored_rows<rows>,
     standard_states(state_activity::idle), options);
 
 }  // namespace cia402::detail

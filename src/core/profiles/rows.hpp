@@ -77,10 +77,10 @@ constexpr std::uint16_t value_range(int lo, int hi) noexcept {
 }
 
 /// Puts the pieces together and derives the lookup tables.
-template <std::size_t NDecoder, std::size_t NRows>
+template <std::size_t NDecoder, std::size_t NRows, std::size_t NSets>
 constexpr profile make_profile(const char* name, const char* seed, const char* title,
                                const decoder_rule (&decoder)[NDecoder],
-                               const transition_row (&rows)[NRows],
+                               const stored_table<NRows, NSets>& rows,
                                std::array<state_info, state_count> states,
                                std::array<option_spec, option_count> options) noexcept {
   static_assert(NDecoder <= max_decoder_rules, "too many decoder rules");
@@ -91,8 +91,7 @@ constexpr profile make_profile(const char* name, const char* seed, const char* t
   p.title = title;
   p.decoder = decoder;
   p.decoder_size = static_cast<std::uint8_t>(NDecoder);
-  p.rows = rows;
-  p.row_count = static_cast<std::uint8_t>(NRows);
+  p.use_rows(rows);
   p.states = states;
   p.options = options;
   p.finalize();

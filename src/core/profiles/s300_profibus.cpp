@@ -60,7 +60,7 @@ constexpr profile make() noexcept {
   profile p = make_profile(
     "s300-profibus", "003_83442f2f4b0b2bb9.txt",
     "PROFIBUS instrument control (STW/ZSW): fast stop on bit 2, T16 on bit 2 set",
-    standard_decoder, rows, standard_states(state_activity::hold), options);
+    standard_decoder, stored_rows<rows>, standard_states(state_activity::hold), options);
   p.words = word_names::drivecom;  // STW / ZSW: bit 8 is jog, not halt
   return p;
 }
