@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Cross-compiles the core for a Cortex-M4 (-Os -fno-exceptions -fno-rtti) and prints its flash and
+# Cross-compiles the core for a Cortex-M4 (-Os -fno-exceptions -fno-rtti, no profile text) and prints its flash and
 # RAM: arm-none-eabi-size of the core's objects, and of a firmware with and without it.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -11,9 +11,10 @@ if ! command -v "$cxx" >/dev/null; then
   echo "cortex-m4: $cxx not found (Debian: gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib)" >&2
   exit 1
 fi
+# CIA402_PROFILE_TEXT=0: a firmware has no use for the text the tools show (seed file, title).
 flags=(-std=c++17 -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -Os
        -fno-exceptions -fno-rtti -ffunction-sections -fdata-sections -Wall -Wextra
-       -I"$root/include" -I"$root/src/core")
+       -DCIA402_PROFILE_TEXT=0 -I"$root/include" -I"$root/src/core")
 core_sources=("$root"/src/core/drive.cpp "$root"/src/core/profile.cpp "$root"/src/core/names.cpp
               "$root"/src/core/master.cpp "$root"/src/core/profiles/*.cpp)
 link=(-Wl,--gc-sections --specs=nosys.specs)

@@ -12,6 +12,12 @@
 #include "cia402/state.hpp"
 #include "cia402/words.hpp"
 
+/// 0 leaves the built-in profiles' text for tools (profile::seed, profile::title) out, as "": 436
+/// bytes of a firmware's flash for the five, which no drive reads. Names stay.
+#ifndef CIA402_PROFILE_TEXT
+#define CIA402_PROFILE_TEXT 1
+#endif
+
 namespace cia402 {
 
 /// A fact is something true in this step: a decoded command, an input, a guard condition.
@@ -264,8 +270,8 @@ inline constexpr auto stored_rows = detail::store_table<detail::distinct_fact_se
 /// lookup tables derived from them by finalize(). Copying a profile copies the view, not the rows.
 struct profile {
   const char* name = "";
-  const char* seed = "";   ///< the seed file the table comes from, or "" for a user profile
-  const char* title = "";  ///< one line for `cia402 profiles`
+  const char* seed = "";   ///< the seed file the table comes from, or "" (user profile, CIA402_PROFILE_TEXT=0)
+  const char* title = "";  ///< one line for `cia402 profiles`, or "" (CIA402_PROFILE_TEXT=0)
 
   const decoder_rule* decoder = nullptr;
   std::uint8_t decoder_size = 0;

@@ -87,8 +87,8 @@ constexpr profile make_profile(const char* name, const char* seed, const char* t
   static_assert(NRows <= max_rows, "too many rows");
   profile p;
   p.name = name;
-  p.seed = seed;
-  p.title = title;
+  p.seed = CIA402_PROFILE_TEXT ? seed : "";
+  p.title = CIA402_PROFILE_TEXT ? title : "";
   p.decoder = decoder;
   p.decoder_size = static_cast<std::uint8_t>(NDecoder);
   p.use_rows(rows);
