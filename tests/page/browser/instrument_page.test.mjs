@@ -28,6 +28,11 @@ fs.mkdirSync(outDir, { recursive: true });
 const STATES = ['NOT_READY_TO_SWITCH_ON', 'SWITCH_ON_DISABLED', 'READY_TO_SWITCH_ON', 'SWITCHED_ON',
   'OPERATION_ENABLED', 'QUICK_STOP_ACTIVE', 'FAULT_REACTION_ACTIVE', 'FAULT'];
 
+// How long a wait for the page may take before the check fails, in ms. Generous: on a loaded machine
+// (ctest -j2 beside the model check) chromium may lag by seconds, and a wait ends as soon as its
+// condition holds, so only a failing check pays for it.
+const patience = 20000;
+
 let passed = 0;
 const servers = [];
 let context = null;
@@ -124,11 +129,11 @@ async function stopServer(server) {
 
 // --- reading the page ------------------------------------------------------------------------
 
-function waitPresent(page, state, timeout = 8000) {
+function waitPresent(page, state, timeout = patience) {
   return page.waitForSelector(`#diagram [id="state.${state}"].present`, { timeout });
 }
 
-function waitResult(page, text, timeout = 8000) {
+function waitResult(page, text, timeout = patience) {
   return page.waitForFunction((t) => document.getElementById('result').textContent.includes(t),
     text, { timeout });
 }
@@ -190,7 +195,7 @@ async function expectPresentState(page, state) {
 }
 
 async function expectAccented(page, number) {
-  await page.waitForSelector(`#diagram .number.last[data-number="${number}"]`, { timeout: 8000 });
+  await page.waitForSelector(`#diagram .number.last[data-number="${number}"]`, { timeout: patience });
   const { numbers } = await diagramStyle(page);
   const last = numbers.filter((n) => n.last);
   expect(last.length === 1 && last[0].number === number,
@@ -237,7 +242,7 @@ async function main() {
   await page.goto(main.url);
 
   await check('power-up: SWITCH ON DISABLED black, the others gray, transition 1 accented', async () => {
-    await page.waitForSelector('#link[data-live="true"]', { timeout: 8000 });
+    await page.waitForSelector('#link[data-live="true"]', { timeout: patience });
     await expectPresentState(page, 'SWITCH_ON_DISABLED');
     await expectAccented(page, 1);
   });
@@ -305,7 +310,7 @@ async function main() {
     await page.fill('#target-input', '1500');
     await page.click('#target-form button[type="submit"]');
     await page.waitForFunction(() => Number(document.getElementById('velocity').textContent) > 300,
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     expect((await page.textContent('#lamp-torque b')) === 'ON', 'torque lamp ON');
     expect((await page.textContent('#lamp-brake b')).startsWith('OFF'), 'brake lamp OFF (released)');
     const inked = await page.evaluate(() => {
@@ -330,7 +335,7 @@ async function main() {
     await expectPresentState(page, 'FAULT');
     await expectAccented(page, 14);
     await page.waitForFunction(() => document.getElementById('error-code').textContent === '0x2310',
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     expect((await page.textContent('#lamp-fault b')).startsWith('ON'), 'fault lamp ON');
     expect((await page.textContent('#lamp-torque b')) === 'OFF', 'torque lamp OFF');
   });
@@ -345,7 +350,7 @@ async function main() {
   await check('cause gone, Fault reset: SWITCH ON DISABLED by T15, transition 15 accented', async () => {
     await page.click('label:has(#fault-switch)');
     await page.waitForFunction(() => document.getElementById('lamp-fault').textContent.includes('OFF'),
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     await click(page, 'fault_reset');
     await expectPresentState(page, 'SWITCH_ON_DISABLED');
     await expectAccented(page, 15);
@@ -361,16 +366,16 @@ async function main() {
     const was = await page.getAttribute(bit4, 'aria-checked');
     await page.click(bit4);
     await page.waitForFunction((w) => document.getElementById('cw-hex').textContent === w,
-      `0x${(before ^ 0x10).toString(16).toUpperCase().padStart(4, '0')}`, { timeout: 8000 });
+      `0x${(before ^ 0x10).toString(16).toUpperCase().padStart(4, '0')}`, { timeout: patience });
     expect(await page.getAttribute(bit4, 'aria-checked') !== was, 'bit 4 shows the new value');
     await page.click(bit4);
     await page.waitForFunction((w) => document.getElementById('cw-hex').textContent === w,
-      `0x${before.toString(16).toUpperCase().padStart(4, '0')}`, { timeout: 8000 });
+      `0x${before.toString(16).toUpperCase().padStart(4, '0')}`, { timeout: patience });
   });
 
   await check('the recorder lists every transition newest first and draws the timeline', async () => {
     await page.waitForFunction(() => document.querySelectorAll('#history tr').length >= 8,
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     const numbers = await page.$$eval('#history tr', (rows) => rows.map((r) => r.dataset.number));
     // Newest first: T15 (fault reset), T14, T13 (the fault), T4, T3, T2, then T1, T0 at power-up.
     expect(numbers.join(' ') === '15 14 13 4 3 2 1 0', `history ${numbers.join(' ')}`);
@@ -418,9 +423,9 @@ async function main() {
   }, id);
   const statusBitOn = (bit) => page.waitForFunction(
     (b) => document.querySelector(`#status-bits li[data-bit="${b}"]`).classList.contains('on'), bit,
-    { timeout: 10000 });
+    { timeout: patience });
   const positionIs = (value) => page.waitForFunction(
-    (v) => document.getElementById('position').textContent === v, value, { timeout: 10000 });
+    (v) => document.getElementById('position').textContent === v, value, { timeout: patience });
 
   await check('operation modes: the select offers the modes 0x6502 announces, by name', async () => {
     const options = await page.$$eval('#mode-select option', (os) => os.map((o) => `${o.value} ${o.textContent}`));
@@ -435,7 +440,7 @@ async function main() {
   await check('pp: a target and the new set-point handshake move the drive; the bits take pp names', async () => {
     await page.selectOption('#mode-select', '1');
     await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('1 '),
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     expect(await page.textContent('#control-bits button[data-bit="4"] .name') === 'New set-point',
       'control bit 4 named for pp');
     expect(await page.textContent('#control-bits button[data-bit="5"] .name') === 'Change set immediately',
@@ -462,7 +467,7 @@ async function main() {
     expect((cw & 0x10) === 0, `bit 4 down after the handshake, control word 0x${cw.toString(16)}`);
     await page.click('label:has(#pp-relative)');
     await page.waitForFunction(() => (parseInt(document.getElementById('cw-hex').textContent, 16) & 0x40) !== 0,
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     await page.fill('#position-input', '-5000');
     await page.click('#position-go');
     await waitResult(page, 'relative');
@@ -470,14 +475,14 @@ async function main() {
     await page.screenshot({ path: path.join(outDir, 'pp-1280x800.png'), fullPage: true });
     await page.click('label:has(#pp-relative)');
     await page.waitForFunction(() => (parseInt(document.getElementById('cw-hex').textContent, 16) & 0x40) === 0,
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     expect(await diagramTop() === diagramAtStart, `diagram moved from ${diagramAtStart} to ${await diagramTop()}`);
   });
 
   await check('hm: homing method 37 and homing start set the position to the home offset', async () => {
     await page.selectOption('#mode-select', '6');
     await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('6 '),
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     expect(await page.textContent('#status-bits li[data-bit="12"] .name') === 'Homing attained',
       'status bit 12 named for homing');
     expect(await page.textContent('#status-bits li[data-bit="13"] .name') === 'Homing error',
@@ -494,18 +499,18 @@ async function main() {
     await positionIs('777');
     await statusBitOn(12);
     await page.waitForFunction(() => document.getElementById('homing-start').textContent === 'Stop homing',
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     const method = await page.$eval('#object-values', (t) => [...t.querySelectorAll('tr')]
       .find((r) => r.querySelector('th').textContent.startsWith('0x6098')).querySelector('td').textContent);
     expect(method === '37', `0x6098 reads ${method}`);
     await page.click('#homing-start');
     await page.waitForFunction(() => document.getElementById('homing-start').textContent === 'Start homing',
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     await click(page, 'disable_voltage');
     await expectPresentState(page, 'SWITCH_ON_DISABLED');
     await page.selectOption('#mode-select', '3');
     await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('3 '),
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     expect(await page.textContent('#control-bits button[data-bit="4"] .name') === 'Reserved in pv',
       'control bit 4 back to pv');
   });
@@ -555,13 +560,15 @@ async function main() {
   });
 
   await check('with the server gone the whole instrument is marked stale and its controls are off', async () => {
-    await page.waitForSelector('#stale:not([hidden])', { timeout: 8000 });
+    await page.waitForSelector('#stale:not([hidden])', { timeout: patience });
     expect(await page.evaluate(() => document.body.classList.contains('stale')), 'body not marked stale');
     const enabled = await page.evaluate(() =>
       [...document.querySelectorAll('.command, .control')].filter((c) => !c.disabled).length);
     expect(enabled === 0, `${enabled} controls still enabled on a dead page`);
     await page.screenshot({ path: path.join(outDir, 'stale-1280x800.png') });
   });
+  // A page whose server is gone keeps retrying it: closed, so it takes no time from the next pages.
+  await page.close();
 
   // --- a server that requires its token -------------------------------------------------------
   const guarded = await startServer(['--token-required']);
@@ -574,7 +581,7 @@ async function main() {
   await check('without the token the page is view-only: banner shown, controls disabled', async () => {
     await viewer.goto(guarded.url.replace(/\?token=.*$/, ''));
     await waitPresent(viewer, 'SWITCH_ON_DISABLED');
-    await viewer.waitForSelector('#view-only:not([hidden])', { timeout: 8000 });
+    await viewer.waitForSelector('#view-only:not([hidden])', { timeout: patience });
     const enabled = await viewer.evaluate(() =>
       [...document.querySelectorAll('button, input, select')].filter((c) => !c.disabled).length);
     expect(enabled === 0, `${enabled} controls still enabled`);
@@ -599,6 +606,7 @@ async function main() {
   });
   const r = await stopServer(guarded);
   expect(r.code === 0, `guarded server exit ${JSON.stringify(r)}`);
+  await viewer.close();
 
   // --- a PROFIBUS profile: the seed's names, no Halt -------------------------------------------
   const profibus = await startServer(['--profile', 's300-profibus']);
@@ -636,6 +644,7 @@ async function main() {
   });
   const pr = await stopServer(profibus);
   expect(pr.code === 0, `profibus server exit ${JSON.stringify(pr)}`);
+  await pb.close();
 
   // --- several axes, and choosing the profile on the page ----------------------------------------
   const multi = await startServer(['--nodes', '3']);
@@ -647,7 +656,7 @@ async function main() {
     await mp.goto(multi.url);
     await waitPresent(mp, 'SWITCH_ON_DISABLED');
     await mp.waitForFunction(() => document.querySelectorAll('.axis-card').length === 3, null,
-      { timeout: 8000 });
+      { timeout: patience });
     expect(await mp.getAttribute('.axis-card[data-axis="1"]', 'aria-current') === 'page', 'axis 1 marked');
     expect((await mp.textContent('h1')).startsWith('axis 1'), 'the heading names the axis');
   });
@@ -658,7 +667,7 @@ async function main() {
     await click(mp, 'shutdown');
     await waitPresent(mp, 'READY_TO_SWITCH_ON');
     await mp.waitForFunction(() => document.querySelector('.axis-card[data-axis="2"] .axis-state')
-      .textContent === 'READY TO SWITCH ON', null, { timeout: 8000 });
+      .textContent === 'READY TO SWITCH ON', null, { timeout: patience });
     expect(await cardState(1) === 'SWITCH ON DISABLED' && await cardState(3) === 'SWITCH ON DISABLED',
       `axes 1 and 3: ${await cardState(1)}, ${await cardState(3)}`);
     await mp.screenshot({ path: path.join(outDir, 'axes-1280x800.png') });
@@ -666,7 +675,7 @@ async function main() {
   await check('choosing s300-profibus on the page restarts axis 2 under it, in its own words', async () => {
     await mp.selectOption('#profile-select', 's300-profibus');
     await mp.waitForFunction(() => document.getElementById('profile').textContent.includes('s300-profibus'),
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     await waitPresent(mp, 'SWITCH_ON_DISABLED');
     expect(await mp.textContent('#state-name') === 'Switch-on inhibited', 'seed 003 state name');
     expect(await mp.locator('button[data-command="halt"]').count() === 0, 'no Halt on PROFIBUS');
@@ -675,6 +684,7 @@ async function main() {
   });
   const mr = await stopServer(multi);
   expect(mr.code === 0, `--nodes server exit ${JSON.stringify(mr)}`);
+  await mp.close();
 
   // --- a drive on a CAN bus: cia402 serve --can against a cia402 bus node ----------------------
   const bus = await startBus(['--nodes', '1']);
@@ -688,14 +698,14 @@ async function main() {
   await rp.setViewportSize({ width: 1280, height: 800 });
   await check('--can: the page shows node 1 of the bus, its state, and says numbers are inferred', async () => {
     await rp.goto(remote.url);
-    await rp.waitForSelector('#remote[data-status="running"]', { timeout: 10000 });
+    await rp.waitForSelector('#remote[data-status="running"]', { timeout: patience });
     const text = await rp.textContent('#remote');
     expect(text.includes('node 1') && text.includes('inferred'), `banner: "${text}"`);
     await expectPresentState(rp, 'SWITCH_ON_DISABLED');
   });
   await check('--can: DC-link and STO switches disabled with the reason, fault injection offered', async () => {
     await rp.waitForFunction(() => !document.getElementById('fault-switch').disabled, null,
-      { timeout: 8000 });
+      { timeout: patience });
     const sw = await rp.evaluate(() => ['dc-switch', 'sto-switch'].map((id) => {
       const e = document.getElementById(id);
       return { disabled: e.disabled, title: e.title };
@@ -728,10 +738,10 @@ async function main() {
     await expectPresentState(rp, 'FAULT');
     await expectAccented(rp, 14);
     await rp.waitForFunction(() => document.getElementById('error-code').textContent === '0x2310',
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     await rp.click('label:has(#fault-switch)');
     await rp.waitForFunction(() => document.getElementById('lamp-fault').textContent.includes('OFF'),
-      null, { timeout: 8000 });
+      null, { timeout: patience });
     await click(rp, 'fault_reset');
     await expectPresentState(rp, 'SWITCH_ON_DISABLED');
     await expectAccented(rp, 15);
@@ -739,11 +749,11 @@ async function main() {
   await check('--can: when the bus goes away the page says so and shows no present state', async () => {
     const b = await stopServer(bus);
     expect(b.code === 0, `cia402 bus exit ${JSON.stringify(b)}`);
-    await rp.waitForSelector('#remote:not([data-status="running"])', { timeout: 8000 });
+    await rp.waitForSelector('#remote:not([data-status="running"])', { timeout: patience });
     const text = await rp.textContent('#remote');
     expect(text.includes('bus connection failed'), `banner: "${text}"`);
     await rp.waitForFunction(() => document.querySelectorAll('#diagram .state.present').length === 0,
-      null, { timeout: 8000 });
+      null, { timeout: patience });
   });
   await rp.screenshot({ path: path.join(outDir, 'remote-bus-gone-1280x800.png') });
   await check('--can: no console errors; Ctrl-C stops the server with exit status 0', async () => {
