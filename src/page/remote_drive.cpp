@@ -75,6 +75,7 @@ co::drive_master_config master_config(const profile& p, const remote_config& c) 
   m.cycle_us = c.cycle_us;
   m.drive_heartbeat_ms = c.heartbeat_ms;
   m.master_heartbeat_ms = c.guard_ms;
+  m.heartbeat_clock_us = c.heartbeat_clock_us;
   m.heartbeat_required = false;
   m.sdo_timeout_us = c.sdo_timeout_us;
   m.drive_profile = &p;

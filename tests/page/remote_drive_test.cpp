@@ -54,16 +54,20 @@ class remote_bench {
   }
 
   void run_ms(int ms) {
-    for (int i = 0; i < ms; ++i) {
-      remote_->step();
-      if (alive_) node_->poll(1000);
-      remote_->process(0);
-      if (alive_) node_->poll(0);
-      remote_->process(0);
-      if (!alive_) {
-        co::frame f;
-        while (node_->bus_channel().receive(f)) {}
-      }
+    for (int i = 0; i < ms; ++i) cycle(1000);
+  }
+
+  /// One step() of the page while `drive_us` pass for the drive: a page slowed down by its
+  /// machine, whose runner skips the cycles it lost, when drive_us is above cycle_us.
+  void cycle(std::uint32_t drive_us) {
+    remote_->step();
+    if (alive_) node_->poll(drive_us);
+    remote_->process(0);
+    if (alive_) node_->poll(0);
+    remote_->process(0);
+    if (!alive_) {
+      co::frame f;
+      while (node_->bus_channel().receive(f)) {}
     }
   }
 
@@ -97,6 +101,7 @@ class remote_bench {
     }
   }
   co::virtual_drive_node& drive_node() { return *node_; }
+  co::virtual_bus& bus() { return bus_; }
   void revive() { alive_ = true; }
 
   json snapshot() const { return json::parse(remote_->snapshot_json()); }
@@ -332,6 +337,48 @@ TEST(remote_drive, the_drive_watches_the_pages_heartbeat_and_applies_0x6007_when
   std::int64_t err = 0;
   ASSERT_EQ(b.drive_node().node().read(0x603F, 0, err), cia402::sdo_abort::none);
   EXPECT_EQ(err, 0x8130) << "0x6007 = 1 by default: a fault with the heartbeat error code";
+}
+
+// The page's runner on a loaded machine: each step() stands for 1 ms while 4 ms pass on the wall
+// and for the drive, which watches the page's heartbeat (100 ms) at 300 ms. On step() time the
+// heartbeat would go out every 400 ms of the drive's time; on the wall's clock, every 100 ms.
+struct slowed_page_result {
+  int heartbeats = 0;  // the page's heartbeats on the bus in one second of wall time
+  std::int64_t error_code = 0;  // the drive's 0x603F afterwards: 0x8130 if it missed the heartbeat
+};
+
+slowed_page_result run_slowed_page(bool heartbeat_on_wall_clock) {
+  auto wall_us = std::make_shared<std::uint64_t>(0);
+  remote_config c = test_config();
+  if (heartbeat_on_wall_clock) c.heartbeat_clock_us = [wall_us] { return *wall_us; };
+  remote_bench b(c);
+  for (int i = 0; i < 2000 && b.remote().status() != remote_status::running; ++i) {
+    *wall_us += 1000;
+    b.cycle(1000);
+  }
+  EXPECT_EQ(b.remote().status(), remote_status::running) << b.remote().status_text();
+  const auto listener = b.bus().attach();
+  slowed_page_result r;
+  for (int i = 0; i < 250; ++i) {
+    *wall_us += 4000;
+    b.cycle(4000);
+    co::frame f;
+    while (listener->receive(f)) r.heartbeats += f.id == 0x700 + 127 ? 1 : 0;
+  }
+  EXPECT_EQ(b.drive_node().node().read(0x603F, 0, r.error_code), cia402::sdo_abort::none);
+  return r;
+}
+
+TEST(remote_drive, a_page_slower_than_the_wall_sends_its_heartbeat_on_its_heartbeat_clock) {
+  const slowed_page_result on_wall = run_slowed_page(true);
+  EXPECT_GE(on_wall.heartbeats, 9);
+  EXPECT_LE(on_wall.heartbeats, 11);
+  EXPECT_EQ(on_wall.error_code, 0);
+
+  // Why serve sets the clock: on step() time the drive misses the heartbeat and faults (0x6007).
+  const slowed_page_result on_steps = run_slowed_page(false);
+  EXPECT_LE(on_steps.heartbeats, 3);
+  EXPECT_EQ(on_steps.error_code, 0x8130);
 }
 
 TEST(remote_drive, node_that_is_not_on_the_bus_does_not_answer_set_up) {

@@ -1,6 +1,7 @@
 #include "cli/serve.hpp"
 
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <csignal>
 #include <memory>
 #include <vector>
@@ -138,6 +139,11 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
       page::remote_config rc;
       rc.node_id = static_cast<std::uint8_t>(node);
       rc.bus_name = args.can;
+      rc.heartbeat_clock_us = [] {
+        return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                              std::chrono::steady_clock::now().time_since_epoch())
+                                              .count());
+      };
       drives.push_back(std::make_unique<page::remote_drive>(choice.get(), *channels.back(), rc));
       axes.push_back({"node " + std::to_string(node), drives.back().get()});
     }

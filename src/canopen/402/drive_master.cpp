@@ -440,7 +440,15 @@ std::uint32_t drive_master::process(std::uint32_t elapsed_us) {
     started_ = true;
     set_phase(master_phase::configuring, phase_reason::started);
   }
-  std::uint32_t next = producer_.process(elapsed_us, *out_, config_.master_node_id,
+  std::uint32_t heartbeat_elapsed_us = elapsed_us;
+  if (config_.heartbeat_clock_us) {
+    const std::uint64_t now = config_.heartbeat_clock_us();
+    const std::uint64_t before = heartbeat_clock_before_.value_or(now);
+    const std::uint64_t passed = now > before ? now - before : 0;
+    heartbeat_elapsed_us = static_cast<std::uint32_t>(std::min<std::uint64_t>(passed, no_deadline));
+    heartbeat_clock_before_ = now;
+  }
+  std::uint32_t next = producer_.process(heartbeat_elapsed_us, *out_, config_.master_node_id,
                                          nmt_state::operational);
   next = earliest(next, consumer_.process(elapsed_us));
   if (heartbeat_lost_ && phase_ == master_phase::running) {

@@ -68,6 +68,10 @@ struct drive_master_config {
   std::uint16_t drive_heartbeat_ms = 100;   ///< written to the drive's 0x1017; 0 = not watched
   bool heartbeat_required = true;           ///< false: a refused 0x1017 or 0x1016 is run without
   std::uint16_t master_heartbeat_ms = 0;    ///< produced, and watched by the drive; 0 = off
+  /// The clock the master's own heartbeat runs on, in microseconds from any start; empty: the time
+  /// given to process(). The drive watches that heartbeat on its own (wall) time, which a master
+  /// whose process() time lags the wall (a held-up host skipping cycles) would otherwise miss.
+  std::function<std::uint64_t()> heartbeat_clock_us;
   std::uint32_t sdo_timeout_us = 500000;
   std::uint64_t transition_timeout_us = 3000000;  ///< per transition, 0 = none
   const profile* drive_profile = nullptr;  ///< the drive's profile; nullptr = the standard one
@@ -246,6 +250,7 @@ class drive_master {
   const profile* profile_;
   sdo_client sdo_;
   heartbeat_producer producer_;
+  std::optional<std::uint64_t> heartbeat_clock_before_;  // heartbeat_clock_us at the last process()
   heartbeat_consumer consumer_;
   bool heartbeat_lost_ = false;
   interval_timer sync_timer_;

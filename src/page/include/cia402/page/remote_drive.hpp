@@ -24,11 +24,13 @@
 // socketcand server went away) is "bus_failed", for good.
 //
 // All CAN traffic happens in step()/process(): HTTP threads only queue requests and wait for them,
-// so the channel is used by one thread. The clock is passed in: step() stands for cycle_us.
+// so the channel is used by one thread. The clock is passed in: step() stands for cycle_us (the
+// page's own heartbeat may run on a clock of its own: remote_config::heartbeat_clock_us).
 #pragma once
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -62,6 +64,12 @@ struct remote_config {
   std::uint32_t reset_pulse_us = 20000;   ///< bit 7 high this long for a fault-reset edge
   std::uint16_t velocity_inhibit_100us = 200;  ///< TPDO2 inhibit time (20 ms)
   std::size_t results_kept = 8;
+  /// The clock the page's heartbeat runs on, in microseconds from any start; empty: step() time.
+  /// `cia402 serve --can` sets the steady clock: the drive watches that heartbeat on wall time, and
+  /// a page slowed down by a loaded machine (its runner skips lost cycles, so step() time lags)
+  /// must still send it every guard_ms of wall time. Everything else stays on step() time: a page
+  /// held up must not find its drive silent from answers that wait, unread, in its socket.
+  std::function<std::uint64_t()> heartbeat_clock_us;
   /// Wall time an HTTP request waits for its SDO transfer before it is answered 504 (the transfer
   /// itself ends by its own timeout in bus time).
   std::chrono::milliseconds request_timeout{10000};
