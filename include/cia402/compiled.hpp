@@ -92,19 +92,32 @@ inline std::uint64_t ordinary_head() noexcept {
 
 }  // namespace detail
 
+namespace detail {
+
+// The full step on a copy of the inputs. The fallback is the only place the inputs' address is
+// taken; on a copy made there, a caller's inputs built in locals stay in registers on the table's
+// path instead of being stored to memory every cycle for a call that seldom comes (10,000 axes:
+// 2.45x the bare table's time where passing them on was 3.0x).
+inline drive_outputs full_step_on_copy(const profile& p, axis& a, const drive_inputs& in) noexcept {
+  const drive_inputs copy = in;
+  return full_step(p, a, copy);
+}
+
+}  // namespace detail
+
 /// Runs one cycle: one table load for an ordinary cycle, detail::full_step for the rest. The same
 /// outputs and axis as cia402::step(profile, ...), byte for byte.
 inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs& in) noexcept {
   std::uint64_t head;
   std::memcpy(&head, &in, 8);
   if ((head != detail::ordinary_head()) | (a.pending_row != no_pending_row)) {
-    return detail::full_step(*c.profile_, a, in);
+    return detail::full_step_on_copy(*c.profile_, a, in);
   }
   if (c.has_speed_limit_) {
     // |speed| < limit as one unsigned compare, in 64 bits so no limit or speed can overflow it.
     const std::int64_t limit = c.profile_->speed_limit_rpm;
     if (static_cast<std::uint64_t>(std::int64_t{in.actual_speed_rpm} + limit - 1) > c.speed_span_) {
-      return detail::full_step(*c.profile_, a, in);
+      return detail::full_step_on_copy(*c.profile_, a, in);
     }
   }
   static_assert(offsetof(axis, flags) == 1 && offsetof(axis, pending_row) == 2 &&
@@ -127,7 +140,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   // One test for the rare cases: the full step decides, the state runs and the control word halts
   // (bit 8), or a fault reset clears the error code.
   if (actions & (((cw >> 8) & 1u) | compiled_profile::fallback | compiled_profile::resets_error)) {
-    if (actions & compiled_profile::fallback) return detail::full_step(*c.profile_, a, in);
+    if (actions & compiled_profile::fallback) return detail::full_step_on_copy(*c.profile_, a, in);
     if (actions & compiled_profile::resets_error) a.error_code = 0;
     if ((actions & compiled_profile::halt_possible) && (cw & control_bit::halt)) {
       // 0x605D: 1 slow-down, 2 quick-stop, 3 current limit, 4 voltage limit (stop_ramp's values,
