@@ -90,10 +90,6 @@ inline std::uint64_t ordinary_head() noexcept {
   return head;
 }
 
-}  // namespace detail
-
-namespace detail {
-
 // The full step on a copy of the inputs. The fallback is the only place the inputs' address is
 // taken; on a copy made there, a caller's inputs built in locals stay in registers on the table's
 // path instead of being stored to memory every cycle for a call that seldom comes (10,000 axes:
