@@ -25,18 +25,14 @@ namespace cia402 {
 
 class compiled_profile;
 
-/// One entry of a compiled table: what an ordinary cycle with its key does.
+/// What an ordinary cycle with a key does to the axis: its first four bytes (state, flags, pending
+/// row, last transition) after the cycle are (before & keep) | set, in the axis's own byte order.
+/// The pending row is none before (tested) and kept, so set's third byte is free: it carries the
+/// actions (compiled_profile::fallback, ...), which come with the load of `set` and OR into a byte
+/// that stays 0xFF.
 struct compiled_entry {
-  /// The first four bytes of the axis (state, flags, pending row, last transition) after the
-  /// cycle are (before & keep) | set, in the axis's own byte order.
   std::uint32_t keep = 0;
   std::uint32_t set = 0;
-  std::uint16_t status = 0;      ///< status word of `next` with DC link and remote, unreported bits
-  std::uint16_t passed = 0;      ///< the drive_inputs::status_bits the status word shows
-  state next = state::start;                ///< the state after the cycle
-  std::uint8_t transition = no_transition;  ///< the transition taken
-  std::uint8_t actions = 0;      ///< compiled_profile::fallback, ::halt_possible, ...
-  std::uint8_t unused = 0;
 };
 
 class compiled_profile {
@@ -56,14 +52,19 @@ class compiled_profile {
 
   static constexpr std::uint8_t halt_possible = 1u << 0;  ///< running, and the profile has 0x605D
   static constexpr std::uint8_t fallback = 1u << 1;       ///< detail::full_step decides
-  static constexpr std::uint8_t resets_error = 1u << 2;   ///< a fault reset (T15, seed 001 T16)
-  static constexpr std::uint8_t clears = 1u << 3;         ///< it clears the set-points
-  static constexpr std::uint8_t torque = 1u << 4;         ///< torque on, brake released
+  static constexpr std::uint8_t runs = 1u << 2;           ///< the status word shows target reached
+  static constexpr std::uint8_t resets_error = 1u << 3;   ///< a fault reset (T15, seed 001 T16)
+  static constexpr std::uint8_t clears = 1u << 4;         ///< it clears the set-points
 
  private:
   friend drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs& in) noexcept;
 
+  // Two tables of 8-byte entries under one key, so the key indexes both with the CPU's own scale
+  // and no shift lies on the path from one cycle's axis word to the next.
   std::array<compiled_entry, entry_count> table_{};
+  /// Bytes 0..7 of the drive_outputs of each key (state, status word without the reported bits,
+  /// transition, no ramp, torque, brake; padding zero): the outputs are one load and one OR.
+  std::array<std::uint64_t, entry_count> outputs_{};
   std::array<std::uint8_t, 256> command_key_{};  ///< control-word bits 0..7 to key bits 4..7
   const profile* profile_;
   std::uint64_t speed_span_ = 0;  ///< 2 * limit - 2: |speed| < limit is (speed + limit - 1) <= this
@@ -77,6 +78,12 @@ inline constexpr bool little_endian = false;
 #else
 inline constexpr bool little_endian = true;
 #endif
+
+/// Where byte `i` of an object of `Size` bytes sits in an integer read from it, in bits.
+template <unsigned Size>
+constexpr unsigned byte_shift(unsigned i) noexcept {
+  return little_endian ? 8u * i : 8u * (Size - 1u - i);
+}
 
 /// The first 8 bytes of drive_inputs as an ordinary cycle has them: no fault code, DC link, no STO,
 /// remote, link up, no local request. One compare tells an ordinary cycle from one the table does
@@ -119,6 +126,10 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   static_assert(offsetof(axis, flags) == 1 && offsetof(axis, pending_row) == 2 &&
                     offsetof(axis, last_transition) == 3,
                 "the table rewrites the axis's first four bytes as one word");
+  static_assert(sizeof(drive_outputs) == 16 && offsetof(drive_outputs, status_word) == 2 &&
+                    offsetof(drive_outputs, ramp) == 5 && offsetof(drive_outputs, clear_setpoints) == 8,
+                "an entry holds the first 8 bytes of the outputs");
+  constexpr unsigned status_shift = detail::little_endian ? 16u : 32u;  // the status word's low bit
   const unsigned cw = in.control_word;
   // The first four bytes of the axis are read, and written back, as one word: no branch on
   // whether a row fires, and a wide load of what the last cycle stored in narrow stores would
@@ -127,12 +138,27 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   std::memcpy(&word, &a, 4);
   const unsigned state_and_flags =
       detail::little_endian ? word : (((word >> 24) & 0xFFu) | ((word >> 8) & 0xFF00u));
-  const unsigned key = (state_and_flags & 0x30Fu) | c.command_key_[cw & 0xFFu];
-  const compiled_entry& e = c.table_[key];
-  const unsigned actions = e.actions;
-  drive_outputs out;
-  out.ramp = stop_ramp::none;
-  unsigned status = e.status | (in.status_bits & e.passed);
+  // The command's part of the key first: it does not depend on the last cycle, so only a mask lies
+  // between the axis word and the load of the entry.
+  const unsigned command = c.command_key_[cw & 0xFFu];
+  const unsigned state_key = state_and_flags & 0x30Fu;
+  const compiled_entry* entries = c.table_.data() + command;
+  const std::uint64_t* images = c.outputs_.data() + command;
+#if defined(__GNUC__)
+  // Keeps the compiler from folding the command back into the axis's index (a shift and two adds
+  // more between one cycle's axis word and the next).
+  __asm__("" : "+r"(entries), "+r"(images));
+#endif
+  const compiled_entry& e = entries[state_key];
+  const std::uint64_t image = images[state_key];
+  const std::uint32_t set = e.set;
+  const unsigned actions = (set >> detail::byte_shift<4>(2)) & 0xFFu;
+  // The reported bits the status word shows: target reached only in a running state.
+  const unsigned reported =
+      in.status_bits & ((status_bit::reported & ~unsigned{status_bit::target_reached}) |
+                        ((actions & compiled_profile::runs) << 8));
+  static_assert(compiled_profile::runs << 8 == status_bit::target_reached, "runs passes bit 10");
+  std::uint64_t head_out = image | (std::uint64_t{reported} << status_shift);
   // One test for the rare cases: the full step decides, the state runs and the control word halts
   // (bit 8), or a fault reset clears the error code.
   if (actions & (((cw >> 8) & 1u) | compiled_profile::fallback | compiled_profile::resets_error)) {
@@ -141,25 +167,29 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
     if ((actions & compiled_profile::halt_possible) && (cw & control_bit::halt)) {
       // 0x605D: 1 slow-down, 2 quick-stop, 3 current limit, 4 voltage limit (stop_ramp's values,
       // S8); bit 10 then says standstill.
-      out.ramp = static_cast<stop_ramp>(a.options[static_cast<int>(option::halt)]);
-      status = (status & ~unsigned{status_bit::target_reached}) |
-               (static_cast<unsigned>(in.standstill) << 10);
+      const auto ramp = static_cast<std::uint8_t>(a.options[static_cast<int>(option::halt)]);
+      const unsigned standstill = static_cast<unsigned>(in.standstill) << 10;
+      head_out = (head_out & ~(std::uint64_t{status_bit::target_reached} << status_shift)) |
+                 (std::uint64_t{standstill} << status_shift) |
+                 (std::uint64_t{ramp} << detail::byte_shift<8>(5));
     }
   }
   // A committed row's stop code needs no clearing: outside a stop it is 0 (S16; the model check
   // holds every reachable axis to it).
-  const std::uint32_t after = (word & e.keep) | e.set;
+  const std::uint32_t after = (word & e.keep) | set;
   // Stored every cycle, whole: a store only on a change would be a branch that a command changing
   // at random mispredicts, and the next cycle's load of the same word is forwarded from this store.
   std::memcpy(static_cast<void*>(&a), &after, 4);
-  out.current = e.next;
-  out.status_word = static_cast<std::uint16_t>(status);
-  out.transition = e.transition;
-  out.torque = (actions & compiled_profile::torque) != 0;
-  out.brake_released = out.torque;
-  out.clear_setpoints = (actions & compiled_profile::clears) != 0;
-  out.error_code = a.error_code;
-  out.error_register = error_register_of(a.error_code);
+  const std::uint16_t code = a.error_code;
+  const std::uint64_t tail = detail::little_endian
+      ? (std::uint64_t{(actions >> 4) & 1u} | (std::uint64_t{code} << 16) |
+         (std::uint64_t{error_register_of(code)} << 32))
+      : ((std::uint64_t{(actions >> 4) & 1u} << 56) | (std::uint64_t{code} << 32) |
+         (std::uint64_t{error_register_of(code)} << 24));
+  static_assert(compiled_profile::clears == 1u << 4, "clears is bit 4");
+  drive_outputs out;
+  std::memcpy(static_cast<void*>(&out), &head_out, 8);
+  std::memcpy(reinterpret_cast<unsigned char*>(&out) + 8, &tail, 8);
   return out;
 }
 

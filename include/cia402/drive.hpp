@@ -47,7 +47,7 @@ enum class stop_ramp : std::uint8_t {
 const char* stop_ramp_name(stop_ramp r) noexcept;
 
 /// Everything the drive decides in one cycle.
-struct drive_outputs {
+struct alignas(8) drive_outputs {
   state current = state::start;
   std::uint16_t status_word = 0;            ///< 0x6041
   std::uint8_t transition = no_transition;  ///< the transition taken this cycle (0..17)

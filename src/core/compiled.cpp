@@ -68,7 +68,8 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
   const bool has_halt = p.spec(option::halt).exists();
   const std::array<std::uint8_t, 8> words = word_of_command(p);
   compiled_entry fall_back;
-  fall_back.actions = fallback;
+  const std::uint8_t fall_back_set[4] = {0, 0, fallback, 0};
+  std::memcpy(&fall_back.set, fall_back_set, 4);
   table_.fill(fall_back);
   for (unsigned key = 0; key < entry_count; ++key) {
     const unsigned s = key & 0xFu;
@@ -95,29 +96,35 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
     }
     if ((same_after | kept) != 0x1Fu) continue;
     const state_info info = p.info(first.a.current);
+    const bool running = info.activity == state_activity::run;
+    std::uint8_t actions = 0;
+    if (committed && first.a.error_code == 0 && before.error_code != 0) actions |= resets_error;
+    if (out.clear_setpoints) actions |= clears;
+    if (running) actions |= runs;
+    if (running && has_halt) actions |= halt_possible;
     compiled_entry e;
-    // Bytes 0..3 of the axis: the state, the flags, the pending row (none, and none after), the
-    // last transition (kept unless a row fires).
+    // Bytes 0..3 of the axis: the state, the flags, the pending row (none, and none after: the
+    // actions ride in set's byte, OR-ed into 0xFF), the last transition (kept unless a row fires).
     const std::uint8_t keep[4] = {0, static_cast<std::uint8_t>(kept & ~same_after), 0xFF,
                                   static_cast<std::uint8_t>(committed ? 0x00 : 0xFF)};
     const std::uint8_t set[4] = {static_cast<std::uint8_t>(first.a.current),
-                                 static_cast<std::uint8_t>(first.a.flags & same_after), 0,
+                                 static_cast<std::uint8_t>(first.a.flags & same_after), actions,
                                  static_cast<std::uint8_t>(committed ? out.transition : 0)};
     std::memcpy(&e.keep, keep, 4);
     std::memcpy(&e.set, set, 4);
-    e.next = first.a.current;
-    e.transition = out.transition;
-    e.status = static_cast<std::uint16_t>(info.status_pattern | status_bit::voltage_enabled |
-                                          status_bit::remote);
-    const bool runs = info.activity == state_activity::run;
-    e.passed = static_cast<std::uint16_t>(status_bit::reported &
-                                          ~(runs ? 0u : unsigned{status_bit::target_reached}));
-    if (committed && first.a.error_code == 0 && before.error_code != 0) e.actions |= resets_error;
-    if (out.clear_setpoints) e.actions |= clears;
-    if (info.activity != state_activity::idle) e.actions |= torque;
-    if (runs && has_halt) e.actions |= halt_possible;
+    // The outputs' first 8 bytes, padding zero: the reported status bits are OR-ed in per cycle.
+    drive_outputs image;
+    std::memset(static_cast<void*>(&image), 0, sizeof image);
+    image.current = first.a.current;
+    image.status_word = static_cast<std::uint16_t>(info.status_pattern | status_bit::voltage_enabled |
+                                                   status_bit::remote);
+    image.transition = out.transition;
+    image.ramp = stop_ramp::none;
+    image.torque = info.activity != state_activity::idle;
+    image.brake_released = image.torque;
     // The entry stands only if the compiled step with it equals the full step on every probe.
     table_[key] = e;
+    std::memcpy(&outputs_[key], &image, 8);
     for (unsigned v = 0; v < variant_count; ++v) {
       probe full = make_probe(p, key, words[command], v);
       probe table = full;
@@ -133,7 +140,7 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
 
 std::size_t compiled_profile::covered() const noexcept {
   std::size_t n = 0;
-  for (const compiled_entry& e : table_) n += (e.actions & fallback) == 0;
+  for (const compiled_entry& e : table_) n += ((e.set >> detail::byte_shift<4>(2)) & fallback) == 0;
   return n;
 }
 
