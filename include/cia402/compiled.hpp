@@ -6,8 +6,8 @@
 // detail::full_step, so the compiled step is exactly the full step: the model check
 // (tests/core/model_check.hpp) proves it on every reachable pair of every built-in profile.
 //
-// Where the table lives: in RAM, built by the constructor: 1,024 entries of 16 bytes, 16 KiB a
-// profile, of which the 576 keys of the nine states are used (the gaps buy a key of one mask).
+// Where the table lives: in RAM, built by the constructor: 1,024 keys of 16 bytes (an 8-byte axis
+// word entry and an 8-byte image of the outputs), 16 KiB a profile, of which the 576 keys of the nine states are used (the gaps buy a key of one mask).
 // Built at run time because a profile loaded from a file can only be compiled then, and because
 // on a Cortex-M4 16 KiB of flash for each profile would cost more than the whole interpreter: a
 // firmware there runs cia402::step(profile, ...) and keeps its flash. Build it once at start-up,

@@ -46,7 +46,9 @@ enum class stop_ramp : std::uint8_t {
 /// "none", "slow_down", ...; never null.
 const char* stop_ramp_name(stop_ramp r) noexcept;
 
-/// Everything the drive decides in one cycle.
+/// Everything the drive decides in one cycle. Two whole 8-byte words (aligned, 16 bytes): the
+/// compiled step builds the first from one table load, and a caller's copy moves two words, not
+/// seven fields.
 struct alignas(8) drive_outputs {
   state current = state::start;
   std::uint16_t status_word = 0;            ///< 0x6041
