@@ -7,7 +7,8 @@
 // (tests/core/model_check.hpp) proves it on every reachable pair of every built-in profile.
 //
 // Where the table lives: in RAM, built by the constructor: 1,024 keys of 16 bytes (an 8-byte axis
-// word entry and an 8-byte image of the outputs), 16 KiB a profile, of which the 576 keys of the nine states are used (the gaps buy a key of one mask).
+// word entry and an 8-byte image of the outputs), 16 KiB a profile, of which the 576 keys of the
+// nine states are used (the gaps buy a key of one mask).
 // Built at run time because a profile loaded from a file can only be compiled then, and because
 // on a Cortex-M4 16 KiB of flash for each profile would cost more than the whole interpreter: a
 // firmware there runs cia402::step(profile, ...) and keeps its flash. Build it once at start-up,
@@ -181,12 +182,11 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   // at random mispredicts, and the next cycle's load of the same word is forwarded from this store.
   std::memcpy(static_cast<void*>(&a), &after, 4);
   const std::uint16_t code = a.error_code;
-  const std::uint64_t tail = detail::little_endian
-      ? (std::uint64_t{(actions >> 4) & 1u} | (std::uint64_t{code} << 16) |
-         (std::uint64_t{error_register_of(code)} << 32))
-      : ((std::uint64_t{(actions >> 4) & 1u} << 56) | (std::uint64_t{code} << 32) |
-         (std::uint64_t{error_register_of(code)} << 24));
-  static_assert(compiled_profile::clears == 1u << 4, "clears is bit 4");
+  // The second word: clear the set-points (byte 8), 0x603F (bytes 10, 11), 0x1001 (byte 12).
+  const std::uint64_t clears = (actions & compiled_profile::clears) != 0;
+  const std::uint64_t tail = (clears << detail::byte_shift<8>(0)) |
+                             (std::uint64_t{code} << (detail::little_endian ? 16u : 32u)) |
+                             (std::uint64_t{error_register_of(code)} << detail::byte_shift<8>(4));
   drive_outputs out;
   std::memcpy(static_cast<void*>(&out), &head_out, 8);
   std::memcpy(reinterpret_cast<unsigned char*>(&out) + 8, &tail, 8);
