@@ -1,14 +1,15 @@
 // A profile compiled to a lookup table: the drive-side step at the speed of a table, with every
 // feature of the full step kept. The table is derived once, by running detail::full_step on every
 // (state, decoded command, control-word bit 7, the axis's two remembered bits) an ordinary cycle can
-// meet; the rows stay the one source of truth. What no table holds (a fault, STO, no DC link, no
-// remote control, a lost link, a local request, overspeed, a stop that is running) goes to
-// detail::full_step, so the compiled step is exactly the full step: the model check
+// meet; the rows stay the one source of truth. A stop that runs or starts goes to a second table,
+// built the same way for an axis with the profile's default option codes. What neither holds (a
+// fault, STO, no DC link, no remote control, a lost link, a local request, overspeed, other option
+// codes) goes to detail::full_step, so the compiled step is exactly the full step: the model check
 // (tests/core/model_check.hpp) proves it on every reachable pair of every built-in profile.
 //
 // Where the table lives: in RAM, built by the constructor: 1,024 keys of 16 bytes (an 8-byte axis
 // word entry and an 8-byte image of the outputs), 16 KiB a profile, of which the 576 keys of the
-// nine states are used (the gaps buy a key of one mask).
+// nine states are used (the gaps buy a key of one mask), and 98 KiB for the stop table.
 // Built at run time because a profile loaded from a file can only be compiled then, and because
 // on a Cortex-M4 16 KiB of flash for each profile would cost more than the whole interpreter: a
 // firmware there runs cia402::step(profile, ...) and keeps its flash. Build it once at start-up,
@@ -50,6 +51,9 @@ class compiled_profile {
   /// Entries the table answers itself (the rest fall back to the full step), of the 576 keys the
   /// nine states can have.
   std::size_t covered() const noexcept;
+  /// Entries the stop table answers (cycles with a stop running or starting, on an axis whose
+  /// option codes are the profile's defaults).
+  std::size_t stops_covered() const noexcept;
 
   static constexpr std::uint8_t halt_possible = 1u << 0;  ///< running, and the profile has 0x605D
   static constexpr std::uint8_t fallback = 1u << 1;       ///< detail::full_step decides
@@ -70,6 +74,41 @@ class compiled_profile {
   const profile* profile_;
   std::uint64_t speed_span_ = 0;  ///< 2 * limit - 2: |speed| < limit is (speed + limit - 1) <= this
   bool has_speed_limit_ = false;
+
+  // The stop table: what the ordinary table leaves to the full step because a stop runs (a pending
+  // row's ramp, QUICK STOP ACTIVE) or starts (T5, T8 or a quick stop whose outcome the option codes
+  // decide). Its entries hold for an axis with the profile's default option codes, so the option
+  // codes need not be in the key; standstill, the brake and the pending row are. Reached on the
+  // rare path only, so the ordinary cycle does not pay for it.
+  struct stop_entry {
+    std::uint32_t keep = 0;  ///< the axis's first four bytes: (before & keep) | set
+    std::uint32_t set = 0;
+    std::uint64_t image = 0;  ///< the outputs' first 8 bytes, as outputs_
+    std::int8_t code_before = 0;  ///< the stop code the axis must have (S16)
+    std::int8_t code_after = 0;   ///< its stop code after the cycle
+    std::uint8_t actions = fallback;
+  };
+  static constexpr std::size_t stop_block = 16;  ///< per key: standstill, brake, 4 pending slots
+  static constexpr std::size_t stop_capacity = 4096;
+  static constexpr std::uint16_t no_block = 0xFFFF;
+  static constexpr std::uint8_t no_slot = 0xFF;
+
+  // Everything the ordinary table does not answer: the stop table, else detail::full_step.
+  drive_outputs rare_step(axis& a, const drive_inputs& in) const noexcept;
+  // The rare path on a copy of the inputs. It is the only place the inputs' address is taken; on a
+  // copy made there, a caller's inputs built in locals stay in registers on the table's path
+  // instead of being stored to memory every cycle for a call that seldom comes (10,000 axes: 2.45x
+  // the bare table's time where passing them on was 3.01x, docs/compiled-step.md).
+  drive_outputs rare_on_copy(axis& a, const drive_inputs& in) const noexcept {
+    const drive_inputs copy = in;
+    return rare_step(a, copy);
+  }
+  void compile_stops() noexcept;
+
+  std::array<stop_entry, stop_capacity> stops_{};
+  std::array<std::uint16_t, entry_count> stop_block_{};  ///< key -> first of its 16, or no_block
+  std::array<std::uint8_t, 256> slot_of_row_{};  ///< pending row -> 1..3 (none: 0), or no_slot
+  std::int8_t default_options_[option_count] = {};
 };
 
 namespace detail {
@@ -86,6 +125,25 @@ constexpr unsigned byte_shift(unsigned i) noexcept {
   return little_endian ? 8u * i : 8u * (Size - 1u - i);
 }
 
+/// Where the status word's lowest bit sits in the outputs' first 8 bytes read as one integer.
+inline constexpr unsigned status_shift = little_endian ? 16u : 32u;
+
+/// The outputs from their first 8 bytes (`head`) and what fills the second: clear the set-points
+/// (byte 8), 0x603F (bytes 10, 11) and its 0x1001 (byte 12). Two whole words, no field stores.
+inline drive_outputs outputs_of(std::uint64_t head, bool clears, std::uint16_t code) noexcept {
+  static_assert(sizeof(drive_outputs) == 16 && offsetof(drive_outputs, status_word) == 2 &&
+                    offsetof(drive_outputs, ramp) == 5 && offsetof(drive_outputs, clear_setpoints) == 8 &&
+                    offsetof(drive_outputs, error_code) == 10 && offsetof(drive_outputs, error_register) == 12,
+                "the outputs are two 8-byte words");
+  const std::uint64_t tail = (std::uint64_t{clears} << byte_shift<8>(0)) |
+                             (std::uint64_t{code} << (little_endian ? 16u : 32u)) |
+                             (std::uint64_t{error_register_of(code)} << byte_shift<8>(4));
+  drive_outputs out;
+  std::memcpy(static_cast<void*>(&out), &head, 8);
+  std::memcpy(reinterpret_cast<unsigned char*>(&out) + 8, &tail, 8);
+  return out;
+}
+
 /// The first 8 bytes of drive_inputs as an ordinary cycle has them: no fault code, DC link, no STO,
 /// remote, link up, no local request. One compare tells an ordinary cycle from one the table does
 /// not hold.
@@ -98,15 +156,6 @@ inline std::uint64_t ordinary_head() noexcept {
   return head;
 }
 
-// The full step on a copy of the inputs. The fallback is the only place the inputs' address is
-// taken; on a copy made there, a caller's inputs built in locals stay in registers on the table's
-// path instead of being stored to memory every cycle for a call that seldom comes (10,000 axes:
-// 2.45x the bare table's time where passing them on was 3.01x, docs/compiled-step.md).
-inline drive_outputs full_step_on_copy(const profile& p, axis& a, const drive_inputs& in) noexcept {
-  const drive_inputs copy = in;
-  return full_step(p, a, copy);
-}
-
 }  // namespace detail
 
 /// Runs one cycle: one table load for an ordinary cycle, detail::full_step for the rest. The same
@@ -115,22 +164,18 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   std::uint64_t head;
   std::memcpy(&head, &in, 8);
   if ((head != detail::ordinary_head()) | (a.pending_row != no_pending_row)) {
-    return detail::full_step_on_copy(*c.profile_, a, in);
+    return c.rare_on_copy(a, in);
   }
   if (c.has_speed_limit_) {
     // |speed| < limit as one unsigned compare, in 64 bits so no limit or speed can overflow it.
     const std::int64_t limit = c.profile_->speed_limit_rpm;
     if (static_cast<std::uint64_t>(std::int64_t{in.actual_speed_rpm} + limit - 1) > c.speed_span_) {
-      return detail::full_step_on_copy(*c.profile_, a, in);
+      return c.rare_on_copy(a, in);
     }
   }
   static_assert(offsetof(axis, flags) == 1 && offsetof(axis, pending_row) == 2 &&
                     offsetof(axis, last_transition) == 3,
                 "the table rewrites the axis's first four bytes as one word");
-  static_assert(sizeof(drive_outputs) == 16 && offsetof(drive_outputs, status_word) == 2 &&
-                    offsetof(drive_outputs, ramp) == 5 && offsetof(drive_outputs, clear_setpoints) == 8,
-                "an entry holds the first 8 bytes of the outputs");
-  constexpr unsigned status_shift = detail::little_endian ? 16u : 32u;  // the status word's low bit
   const unsigned cw = in.control_word;
   // The first four bytes of the axis are read, and written back, as one word: no branch on
   // whether a row fires, and a wide load of what the last cycle stored in narrow stores would
@@ -159,19 +204,19 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
       in.status_bits & ((status_bit::reported & ~unsigned{status_bit::target_reached}) |
                         ((actions & compiled_profile::runs) << 8));
   static_assert(compiled_profile::runs << 8 == status_bit::target_reached, "runs passes bit 10");
-  std::uint64_t head_out = image | (std::uint64_t{reported} << status_shift);
+  std::uint64_t head_out = image | (std::uint64_t{reported} << detail::status_shift);
   // One test for the rare cases: the full step decides, the state runs and the control word halts
   // (bit 8), or a fault reset clears the error code.
   if (actions & (((cw >> 8) & 1u) | compiled_profile::fallback | compiled_profile::resets_error)) {
-    if (actions & compiled_profile::fallback) return detail::full_step_on_copy(*c.profile_, a, in);
+    if (actions & compiled_profile::fallback) return c.rare_on_copy(a, in);
     if (actions & compiled_profile::resets_error) a.error_code = 0;
     if ((actions & compiled_profile::halt_possible) && (cw & control_bit::halt)) {
       // 0x605D: 1 slow-down, 2 quick-stop, 3 current limit, 4 voltage limit (stop_ramp's values,
       // S8); bit 10 then says standstill.
       const auto ramp = static_cast<std::uint8_t>(a.options[static_cast<int>(option::halt)]);
       const unsigned standstill = static_cast<unsigned>(in.standstill) << 10;
-      head_out = (head_out & ~(std::uint64_t{status_bit::target_reached} << status_shift)) |
-                 (std::uint64_t{standstill} << status_shift) |
+      head_out = (head_out & ~(std::uint64_t{status_bit::target_reached} << detail::status_shift)) |
+                 (std::uint64_t{standstill} << detail::status_shift) |
                  (std::uint64_t{ramp} << detail::byte_shift<8>(5));
     }
   }
@@ -181,16 +226,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   // Stored every cycle, whole: a store only on a change would be a branch that a command changing
   // at random mispredicts, and the next cycle's load of the same word is forwarded from this store.
   std::memcpy(static_cast<void*>(&a), &after, 4);
-  const std::uint16_t code = a.error_code;
-  // The second word: clear the set-points (byte 8), 0x603F (bytes 10, 11), 0x1001 (byte 12).
-  const std::uint64_t clears = (actions & compiled_profile::clears) != 0;
-  const std::uint64_t tail = (clears << detail::byte_shift<8>(0)) |
-                             (std::uint64_t{code} << (detail::little_endian ? 16u : 32u)) |
-                             (std::uint64_t{error_register_of(code)} << detail::byte_shift<8>(4));
-  drive_outputs out;
-  std::memcpy(static_cast<void*>(&out), &head_out, 8);
-  std::memcpy(reinterpret_cast<unsigned char*>(&out) + 8, &tail, 8);
-  return out;
+  return detail::outputs_of(head_out, (actions & compiled_profile::clears) != 0, a.error_code);
 }
 
 }  // namespace cia402

@@ -60,6 +60,9 @@ probe make_probe(const profile& p, unsigned key, std::uint8_t word, unsigned v) 
 }  // namespace
 
 compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
+  // The stop table is empty while the ordinary table is checked: its rare path is the full step.
+  stop_block_.fill(no_block);
+  slot_of_row_.fill(no_slot);
   has_speed_limit_ = p.speed_limit_rpm > 0;
   speed_span_ = has_speed_limit_ ? static_cast<std::uint64_t>(2 * std::int64_t{p.speed_limit_rpm} - 2) : 0u;
   for (unsigned bits = 0; bits < 256; ++bits) {
@@ -136,6 +139,194 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
       }
     }
   }
+  compile_stops();
+}
+
+namespace {
+
+// A probe of the stop table: an axis with the profile's default option codes.
+struct stop_probe {
+  axis a;
+  drive_inputs in;
+};
+
+constexpr unsigned stop_variant_count = 16;  // 3 flags, status bits
+
+stop_probe make_stop_probe(const profile& p, unsigned key, std::uint8_t word, unsigned sub,
+                           std::uint8_t pending, std::int8_t code, unsigned v) noexcept {
+  stop_probe r{make_axis(p), drive_inputs{}};
+  r.a.current = static_cast<state>(key & 0xFu);
+  r.a.flags = static_cast<std::uint8_t>(((key >> 8) & 3u) | ((v & 1u) ? axis_flag::entered_by_fault : 0u) |
+                                        ((v & 2u) ? axis_flag::fault_latched : 0u) |
+                                        ((v & 4u) ? axis_flag::coast_reaction : 0u));
+  r.a.pending_row = pending;
+  r.a.stop_code = code;
+  r.a.error_code = 0x1234;  // shows whether the step clears it
+  r.a.last_transition = 9;  // and whether it keeps the last transition
+  r.in.control_word = static_cast<std::uint16_t>(word | (key & 0x80u));
+  r.in.standstill = (sub & 1u) != 0;
+  r.in.brake_engaged = (sub & 2u) != 0;
+  r.in.status_bits = (v & 8u) ? 0xFFFFu : 0u;
+  return r;
+}
+
+}  // namespace
+
+void compiled_profile::compile_stops() noexcept {
+  const profile& p = *profile_;
+  const axis defaults = make_axis(p);
+  std::memcpy(default_options_, defaults.options, sizeof default_options_);
+  slot_of_row_[no_pending_row] = 0;
+  const std::array<std::uint8_t, 8> words = word_of_command(p);
+  const auto valid = [&](unsigned key) {
+    const unsigned command = (key >> 4) & 7u;
+    return (key & 0xFu) < static_cast<unsigned>(state_count) &&
+           command < static_cast<unsigned>(command_count) && words[command] != no_word;
+  };
+
+  // The pending rows, the stop code each runs by and the state it runs in, and the stop code each
+  // state is entered with: as the full step leaves them, from every key, with the defaults.
+  std::uint8_t slot_row[4] = {no_pending_row, no_pending_row, no_pending_row, no_pending_row};
+  std::int8_t slot_code[4] = {};
+  state slot_state[4] = {};
+  unsigned slots = 1;
+  std::int8_t entry_code[16] = {};
+  for (unsigned from = 0; from < slots; ++from) {  // pending rows found from pending rows too
+    for (unsigned key = 0; key < entry_count; ++key) {
+      if (!valid(key) || (from != 0 && static_cast<state>(key & 0xFu) != slot_state[from])) continue;
+      for (unsigned sub = 0; sub < 4; ++sub) {
+        stop_probe pr = make_stop_probe(p, key, words[(key >> 4) & 7u], sub, slot_row[from],
+                                        slot_code[from], 0);
+        const drive_outputs out = detail::full_step(p, pr.a, pr.in);
+        if (pr.a.pending_row != no_pending_row && slot_of_row_[pr.a.pending_row] == no_slot &&
+            slots < 4) {
+          slot_row[slots] = pr.a.pending_row;
+          slot_code[slots] = pr.a.stop_code;
+          slot_state[slots] = pr.a.current;
+          slot_of_row_[pr.a.pending_row] = static_cast<std::uint8_t>(slots++);
+        }
+        if (out.transition != no_transition && pr.a.pending_row == no_pending_row) {
+          entry_code[static_cast<unsigned>(pr.a.current)] = pr.a.stop_code;
+        }
+      }
+    }
+  }
+
+  std::size_t next_block = 0;
+  for (unsigned key = 0; key < entry_count; ++key) {
+    if (!valid(key) || next_block + stop_block > stop_capacity) continue;
+    const state s = static_cast<state>(key & 0xFu);
+    if (p.info(s).activity == state_activity::idle) continue;  // no stop runs without torque
+    stop_block_[key] = static_cast<std::uint16_t>(next_block);
+    for (unsigned sub = 0; sub < stop_block; ++sub) {
+      stop_entry& e = stops_[next_block + sub];
+      const unsigned slot = sub >> 2;
+      if (slot >= slots || (slot != 0 && slot_state[slot] != s)) continue;
+      const std::int8_t code = slot != 0 ? slot_code[slot] : entry_code[static_cast<unsigned>(s)];
+      const std::uint8_t word = words[(key >> 4) & 7u];
+      stop_probe first = make_stop_probe(p, key, word, sub, slot_row[slot], code, 0);
+      const axis before = first.a;
+      const drive_outputs out = detail::full_step(p, first.a, first.in);
+      const bool committed = out.transition != no_transition;
+      unsigned same_after = 0x1Fu, kept = 0x1Fu;
+      bool shows_target = false;
+      for (unsigned v = 0; v < stop_variant_count; ++v) {
+        stop_probe pr = make_stop_probe(p, key, word, sub, slot_row[slot], code, v);
+        const std::uint8_t was = pr.a.flags;
+        const drive_outputs o = detail::full_step(p, pr.a, pr.in);
+        same_after &= ~static_cast<unsigned>(pr.a.flags ^ first.a.flags);
+        kept &= ~static_cast<unsigned>(pr.a.flags ^ was);
+        if ((v & 8u) && (o.status_word & ~out.status_word & status_bit::target_reached)) {
+          shows_target = true;
+        }
+      }
+      if ((same_after | kept) != 0x1Fu) continue;
+      stop_entry made;
+      const std::uint8_t keep[4] = {0, static_cast<std::uint8_t>(kept & ~same_after), 0,
+                                    static_cast<std::uint8_t>(committed ? 0x00 : 0xFF)};
+      const std::uint8_t set[4] = {static_cast<std::uint8_t>(first.a.current),
+                                   static_cast<std::uint8_t>(first.a.flags & same_after),
+                                   first.a.pending_row,
+                                   static_cast<std::uint8_t>(committed ? out.transition : 0)};
+      std::memcpy(&made.keep, keep, 4);
+      std::memcpy(&made.set, set, 4);
+      drive_outputs image;
+      std::memset(static_cast<void*>(&image), 0, sizeof image);
+      image.current = out.current;
+      image.status_word = out.status_word;
+      image.transition = out.transition;
+      image.ramp = out.ramp;
+      image.torque = out.torque;
+      image.brake_released = out.brake_released;
+      std::memcpy(&made.image, &image, 8);
+      made.code_before = code;
+      made.code_after = first.a.stop_code;
+      made.actions = 0;
+      if (committed && first.a.error_code == 0 && before.error_code != 0) made.actions |= resets_error;
+      if (out.clear_setpoints) made.actions |= clears;
+      if (shows_target) made.actions |= runs;
+      // The entry stands only if the rare path with it equals the full step on every probe.
+      e = made;
+      for (unsigned v = 0; v < stop_variant_count; ++v) {
+        stop_probe full = make_stop_probe(p, key, word, sub, slot_row[slot], code, v);
+        stop_probe table = full;
+        const drive_outputs want = detail::full_step(p, full.a, full.in);
+        const drive_outputs got = rare_step(table.a, table.in);
+        if (!same(want, got) || std::memcmp(&full.a, &table.a, sizeof(axis)) != 0) {
+          e = stop_entry{};
+          break;
+        }
+      }
+    }
+    next_block += stop_block;
+  }
+}
+
+drive_outputs compiled_profile::rare_step(axis& a, const drive_inputs& in) const noexcept {
+  std::uint64_t head;
+  std::memcpy(&head, &in, 8);
+  const unsigned cw = in.control_word;
+  bool table = (head == detail::ordinary_head()) & !(cw & control_bit::halt) &
+               (std::memcmp(a.options, default_options_, sizeof default_options_) == 0);
+  if (table && has_speed_limit_) {
+    const std::int64_t limit = profile_->speed_limit_rpm;
+    table = static_cast<std::uint64_t>(std::int64_t{in.actual_speed_rpm} + limit - 1) <= speed_span_;
+  }
+  if (table) {
+    std::uint32_t word;
+    std::memcpy(&word, &a, 4);
+    const unsigned state_and_flags =
+        detail::little_endian ? word : (((word >> 24) & 0xFFu) | ((word >> 8) & 0xFF00u));
+    const unsigned key = (state_and_flags & 0x30Fu) | command_key_[cw & 0xFFu];
+    const std::uint16_t block = stop_block_[key];
+    const std::uint8_t slot = slot_of_row_[a.pending_row];
+    if (block != no_block && slot != no_slot) {
+      const stop_entry& e = stops_[block + (static_cast<unsigned>(in.standstill) |
+                                            (static_cast<unsigned>(in.brake_engaged) << 1) |
+                                            (static_cast<unsigned>(slot) << 2))];
+      if (!(e.actions & fallback) && a.stop_code == e.code_before) {
+        const std::uint32_t after = (word & e.keep) | e.set;
+        std::memcpy(static_cast<void*>(&a), &after, 4);
+        a.stop_code = e.code_after;
+        if (e.actions & resets_error) a.error_code = 0;
+        const unsigned reported =
+            in.status_bits & ((status_bit::reported & ~unsigned{status_bit::target_reached}) |
+                              ((e.actions & runs) << 8));
+        return detail::outputs_of(e.image | (std::uint64_t{reported} << detail::status_shift),
+                                  (e.actions & clears) != 0, a.error_code);
+      }
+    }
+  }
+  return detail::full_step(*profile_, a, in);
+}
+
+std::size_t compiled_profile::stops_covered() const noexcept {
+  std::size_t n = 0;
+  for (std::size_t key = 0; key < entry_count; ++key) {
+    if (stop_block_[key] == no_block) continue;
+    for (std::size_t i = 0; i < stop_block; ++i) n += (stops_[stop_block_[key] + i].actions & fallback) == 0;
+  }
+  return n;
 }
 
 std::size_t compiled_profile::covered() const noexcept {

@@ -45,10 +45,14 @@ void check_profile(const char* name) {
                                 << int(options[4]) << "," << int(options[5]) << ":" << first;
   }
   std::printf("model check %s: %zu option sets, %zu reachable states, %zu (state, input) pairs, "
-              "%zu inputs, rest within %d steps; compiled table answers %zu of %zu entries\n",
+              "%zu inputs, rest within %d steps; compiled table answers %zu of %zu entries, its "
+              "stop table %zu\n",
               name, sets.size(), states, pairs, model_check::alphabet(*p).size(), deepest,
-              compiled.covered(), std::size_t{state_count} * 64u);
+              compiled.covered(), std::size_t{state_count} * 64u, compiled.stops_covered());
   EXPECT_LE(deepest, model_check::settle_bound);
+  // Every built-in profile has stops with torque on (T5/T8 ramps, a quick stop or a fault
+  // reaction), so a stop table with no entry standing would mean its derivation broke.
+  EXPECT_GT(compiled.stops_covered(), 0u) << name;
 }
 
 TEST(model_check, cia402) { check_profile("cia402"); }
