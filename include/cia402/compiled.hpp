@@ -93,16 +93,19 @@ class compiled_profile {
   static constexpr std::uint16_t no_block = 0xFFFF;
   static constexpr std::uint8_t no_slot = 0xFF;
 
-  // Everything the ordinary table does not answer: the stop table, else detail::full_step.
-  drive_outputs rare_step(axis& a, const drive_inputs& in) const noexcept;
-  // The rare path on a copy of the inputs. It is the only place the inputs' address is taken; on a
+  // The full step on a copy of the inputs. It is the only place the inputs' address is taken; on a
   // copy made there, a caller's inputs built in locals stay in registers on the table's path
   // instead of being stored to memory every cycle for a call that seldom comes (10,000 axes: 2.45x
   // the bare table's time where passing them on was 3.01x, docs/compiled-step.md).
-  drive_outputs rare_on_copy(axis& a, const drive_inputs& in) const noexcept {
+  drive_outputs full_on_copy(axis& a, const drive_inputs& in) const noexcept {
     const drive_inputs copy = in;
-    return rare_step(a, copy);
+    return detail::full_step(*profile_, a, copy);
   }
+  // A cycle with ordinary inputs that the ordinary table leaves out: the stop table, else the full
+  // step. `word` is the axis's first four bytes, `key` the ordinary key. Inline: a call here cost
+  // the transition sequence 0.5 ns a step (docs/compiled-step.md).
+  inline drive_outputs stop_step(axis& a, const drive_inputs& in, std::uint32_t word,
+                                 unsigned key) const noexcept;
   void compile_stops() noexcept;
 
   std::array<stop_entry, stop_capacity> stops_{};
@@ -123,6 +126,15 @@ inline constexpr bool little_endian = true;
 template <unsigned Size>
 constexpr unsigned byte_shift(unsigned i) noexcept {
   return little_endian ? 8u * i : 8u * (Size - 1u - i);
+}
+
+/// A condition the ordinary cycle does not meet: its code is laid out away from the table's path.
+inline constexpr bool seldom(bool condition) noexcept {
+#if defined(__GNUC__)
+  return __builtin_expect(condition, false);
+#else
+  return condition;
+#endif
 }
 
 /// Where the status word's lowest bit sits in the outputs' first 8 bytes read as one integer.
@@ -158,19 +170,41 @@ inline std::uint64_t ordinary_head() noexcept {
 
 }  // namespace detail
 
+inline drive_outputs compiled_profile::stop_step(axis& a, const drive_inputs& in,
+                                                std::uint32_t word, unsigned key) const noexcept {
+  const std::uint16_t block = stop_block_[key];
+  const std::uint8_t slot = slot_of_row_[(word >> detail::byte_shift<4>(2)) & 0xFFu];
+  if ((block != no_block) & (slot != no_slot) & !(in.control_word & control_bit::halt) &&
+      std::memcmp(a.options, default_options_, sizeof default_options_) == 0) {
+    const stop_entry& e = stops_[block + (static_cast<unsigned>(in.standstill) |
+                                          (static_cast<unsigned>(in.brake_engaged) << 1) |
+                                          (static_cast<unsigned>(slot) << 2))];
+    if (!(e.actions & fallback) && a.stop_code == e.code_before) {
+      const std::uint32_t after = (word & e.keep) | e.set;
+      std::memcpy(static_cast<void*>(&a), &after, 4);
+      a.stop_code = e.code_after;
+      if (e.actions & resets_error) a.error_code = 0;
+      const unsigned reported =
+          in.status_bits & ((status_bit::reported & ~unsigned{status_bit::target_reached}) |
+                            ((e.actions & runs) << 8));
+      return detail::outputs_of(e.image | (std::uint64_t{reported} << detail::status_shift),
+                                (e.actions & clears) != 0, a.error_code);
+    }
+  }
+  return full_on_copy(a, in);
+}
+
 /// Runs one cycle: one table load for an ordinary cycle, detail::full_step for the rest. The same
 /// outputs and axis as cia402::step(profile, ...), byte for byte.
 inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs& in) noexcept {
   std::uint64_t head;
   std::memcpy(&head, &in, 8);
-  if ((head != detail::ordinary_head()) | (a.pending_row != no_pending_row)) {
-    return c.rare_on_copy(a, in);
-  }
+  if (head != detail::ordinary_head()) return c.full_on_copy(a, in);
   if (c.has_speed_limit_) {
     // |speed| < limit as one unsigned compare, in 64 bits so no limit or speed can overflow it.
     const std::int64_t limit = c.profile_->speed_limit_rpm;
     if (static_cast<std::uint64_t>(std::int64_t{in.actual_speed_rpm} + limit - 1) > c.speed_span_) {
-      return c.rare_on_copy(a, in);
+      return c.full_on_copy(a, in);
     }
   }
   static_assert(offsetof(axis, flags) == 1 && offsetof(axis, pending_row) == 2 &&
@@ -188,6 +222,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   // between the axis word and the load of the entry.
   const unsigned command = c.command_key_[cw & 0xFFu];
   const unsigned state_key = state_and_flags & 0x30Fu;
+  const bool pending = ((word >> detail::byte_shift<4>(2)) & 0xFFu) != no_pending_row;
   const compiled_entry* entries = c.table_.data() + command;
   const std::uint64_t* images = c.outputs_.data() + command;
 #if defined(__GNUC__)
@@ -205,10 +240,14 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
                         ((actions & compiled_profile::runs) << 8));
   static_assert(compiled_profile::runs << 8 == status_bit::target_reached, "runs passes bit 10");
   std::uint64_t head_out = image | (std::uint64_t{reported} << detail::status_shift);
-  // One test for the rare cases: the full step decides, the state runs and the control word halts
-  // (bit 8), or a fault reset clears the error code.
-  if (actions & (((cw >> 8) & 1u) | compiled_profile::fallback | compiled_profile::resets_error)) {
-    if (actions & compiled_profile::fallback) return c.rare_on_copy(a, in);
+  // One test for the rare cases: a stop runs or the entry falls back (the stop table, else the
+  // full step decides), the state runs and the control word halts (bit 8), or a fault reset
+  // clears the error code.
+  if (detail::seldom((actions & (((cw >> 8) & 1u) | compiled_profile::fallback |
+                                 compiled_profile::resets_error)) | pending)) {
+    if ((actions & compiled_profile::fallback) | pending) {
+      return c.stop_step(a, in, word, state_key | command);
+    }
     if (actions & compiled_profile::resets_error) a.error_code = 0;
     if ((actions & compiled_profile::halt_possible) && (cw & control_bit::halt)) {
       // 0x605D: 1 slow-down, 2 quick-stop, 3 current limit, 4 voltage limit (stop_ramp's values,

@@ -265,13 +265,13 @@ void compiled_profile::compile_stops() noexcept {
       if (committed && first.a.error_code == 0 && before.error_code != 0) made.actions |= resets_error;
       if (out.clear_setpoints) made.actions |= clears;
       if (shows_target) made.actions |= runs;
-      // The entry stands only if the rare path with it equals the full step on every probe.
+      // The entry stands only if the compiled step with it equals the full step on every probe.
       e = made;
       for (unsigned v = 0; v < stop_variant_count; ++v) {
         stop_probe full = make_stop_probe(p, key, word, sub, slot_row[slot], code, v);
         stop_probe table = full;
         const drive_outputs want = detail::full_step(p, full.a, full.in);
-        const drive_outputs got = rare_step(table.a, table.in);
+        const drive_outputs got = step(*this, table.a, table.in);
         if (!same(want, got) || std::memcmp(&full.a, &table.a, sizeof(axis)) != 0) {
           e = stop_entry{};
           break;
@@ -280,44 +280,6 @@ void compiled_profile::compile_stops() noexcept {
     }
     next_block += stop_block;
   }
-}
-
-drive_outputs compiled_profile::rare_step(axis& a, const drive_inputs& in) const noexcept {
-  std::uint64_t head;
-  std::memcpy(&head, &in, 8);
-  const unsigned cw = in.control_word;
-  bool table = (head == detail::ordinary_head()) & !(cw & control_bit::halt) &
-               (std::memcmp(a.options, default_options_, sizeof default_options_) == 0);
-  if (table && has_speed_limit_) {
-    const std::int64_t limit = profile_->speed_limit_rpm;
-    table = static_cast<std::uint64_t>(std::int64_t{in.actual_speed_rpm} + limit - 1) <= speed_span_;
-  }
-  if (table) {
-    std::uint32_t word;
-    std::memcpy(&word, &a, 4);
-    const unsigned state_and_flags =
-        detail::little_endian ? word : (((word >> 24) & 0xFFu) | ((word >> 8) & 0xFF00u));
-    const unsigned key = (state_and_flags & 0x30Fu) | command_key_[cw & 0xFFu];
-    const std::uint16_t block = stop_block_[key];
-    const std::uint8_t slot = slot_of_row_[a.pending_row];
-    if (block != no_block && slot != no_slot) {
-      const stop_entry& e = stops_[block + (static_cast<unsigned>(in.standstill) |
-                                            (static_cast<unsigned>(in.brake_engaged) << 1) |
-                                            (static_cast<unsigned>(slot) << 2))];
-      if (!(e.actions & fallback) && a.stop_code == e.code_before) {
-        const std::uint32_t after = (word & e.keep) | e.set;
-        std::memcpy(static_cast<void*>(&a), &after, 4);
-        a.stop_code = e.code_after;
-        if (e.actions & resets_error) a.error_code = 0;
-        const unsigned reported =
-            in.status_bits & ((status_bit::reported & ~unsigned{status_bit::target_reached}) |
-                              ((e.actions & runs) << 8));
-        return detail::outputs_of(e.image | (std::uint64_t{reported} << detail::status_shift),
-                                  (e.actions & clears) != 0, a.error_code);
-      }
-    }
-  }
-  return detail::full_step(*profile_, a, in);
 }
 
 std::size_t compiled_profile::stops_covered() const noexcept {
