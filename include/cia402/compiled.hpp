@@ -79,7 +79,7 @@ class compiled_profile {
   // row's ramp, QUICK STOP ACTIVE) or starts (T5, T8 or a quick stop whose outcome the option codes
   // decide). Its entries hold for an axis with the profile's default option codes, so the option
   // codes need not be in the key; standstill, the brake and the pending row are. Reached on the
-  // rare path only, so the ordinary cycle does not pay for it.
+  // branch the ordinary cycle does not take.
   struct stop_entry {
     std::uint32_t keep = 0;  ///< the axis's first four bytes: (before & keep) | set
     std::uint32_t set = 0;
@@ -194,8 +194,9 @@ inline drive_outputs compiled_profile::stop_step(axis& a, const drive_inputs& in
   return full_on_copy(a, in);
 }
 
-/// Runs one cycle: one table load for an ordinary cycle, detail::full_step for the rest. The same
-/// outputs and axis as cia402::step(profile, ...), byte for byte.
+/// Runs one cycle: one table load for an ordinary cycle, the stop table for a stop that runs or
+/// starts, detail::full_step for the rest. The same outputs and axis as cia402::step(profile, ...),
+/// byte for byte.
 inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs& in) noexcept {
   std::uint64_t head;
   std::memcpy(&head, &in, 8);
