@@ -156,6 +156,14 @@ inline drive_outputs outputs_of(std::uint64_t head, bool clears, std::uint16_t c
   return out;
 }
 
+/// The motion side's reported status bits an entry with these actions shows: target reached only
+/// where the state runs (compiled_profile::runs).
+inline unsigned reported_bits(unsigned status_bits, unsigned actions) noexcept {
+  static_assert(compiled_profile::runs << 8 == status_bit::target_reached, "runs passes bit 10");
+  return status_bits & ((status_bit::reported & ~unsigned{status_bit::target_reached}) |
+                        ((actions & compiled_profile::runs) << 8));
+}
+
 /// The first 8 bytes of drive_inputs as an ordinary cycle has them: no fault code, DC link, no STO,
 /// remote, link up, no local request. One compare tells an ordinary cycle from one the table does
 /// not hold.
@@ -184,9 +192,7 @@ inline drive_outputs compiled_profile::stop_step(axis& a, const drive_inputs& in
       std::memcpy(static_cast<void*>(&a), &after, 4);
       a.stop_code = e.code_after;
       if (e.actions & resets_error) a.error_code = 0;
-      const unsigned reported =
-          in.status_bits & ((status_bit::reported & ~unsigned{status_bit::target_reached}) |
-                            ((e.actions & runs) << 8));
+      const unsigned reported = detail::reported_bits(in.status_bits, e.actions);
       return detail::outputs_of(e.image | (std::uint64_t{reported} << detail::status_shift),
                                 (e.actions & clears) != 0, a.error_code);
     }
@@ -235,11 +241,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   const std::uint64_t image = images[state_key];
   const std::uint32_t set = e.set;
   const unsigned actions = (set >> detail::byte_shift<4>(2)) & 0xFFu;
-  // The reported bits the status word shows: target reached only in a running state.
-  const unsigned reported =
-      in.status_bits & ((status_bit::reported & ~unsigned{status_bit::target_reached}) |
-                        ((actions & compiled_profile::runs) << 8));
-  static_assert(compiled_profile::runs << 8 == status_bit::target_reached, "runs passes bit 10");
+  const unsigned reported = detail::reported_bits(in.status_bits, actions);
   std::uint64_t head_out = image | (std::uint64_t{reported} << detail::status_shift);
   // One test for the rare cases: a stop runs or the entry falls back (the stop table, else the
   // full step decides), the state runs and the control word halts (bit 8), or a fault reset

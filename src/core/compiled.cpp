@@ -28,15 +28,78 @@ bool same(const drive_outputs& x, const drive_outputs& y) noexcept {
          x.error_register == y.error_register;
 }
 
-// The facts an ordinary cycle leaves open: an entry holds only where the full step answers the
-// same for every one of them.
-constexpr unsigned variant_bits = 8;  // halt, standstill, 3 flags, 2 option codes, status bits
-constexpr unsigned variant_count = 3u << variant_bits;  // times 0x605A: coasts, ends, holds (S5)
+// A key whose state and command exist, with a control word the profile decodes to its command.
+bool usable(const std::array<std::uint8_t, 8>& words, unsigned key) noexcept {
+  const unsigned command = (key >> 4) & 7u;
+  return (key & 0xFu) < static_cast<unsigned>(state_count) &&
+         command < static_cast<unsigned>(command_count) && words[command] != no_word;
+}
+
+// Four axis bytes as the word the compiled step reads and writes.
+std::uint32_t axis_word(const std::uint8_t (&bytes)[4]) noexcept {
+  std::uint32_t w;
+  std::memcpy(&w, bytes, 4);
+  return w;
+}
+
+// The first 8 bytes of `o`, padding zero: an entry's image of the outputs.
+std::uint64_t image_of(const drive_outputs& o) noexcept {
+  drive_outputs image;
+  std::memset(static_cast<void*>(&image), 0, sizeof image);
+  image.current = o.current;
+  image.status_word = o.status_word;
+  image.transition = o.transition;
+  image.ramp = o.ramp;
+  image.torque = o.torque;
+  image.brake_released = o.brake_released;
+  std::uint64_t bytes;
+  std::memcpy(&bytes, &image, 8);
+  return bytes;
+}
+
+// What a cycle does to the axis flags across probes: a bit every probe ends with the same value as
+// `first` is set (or cleared), one that keeps what it was is kept; any other cannot be a table's.
+struct flag_rule {
+  unsigned same_after = 0x1Fu;
+  unsigned kept = 0x1Fu;
+  bool holds() const noexcept { return (same_after | kept) == 0x1Fu; }
+};
 
 struct probe {
   axis a;
   drive_inputs in;
 };
+
+template <typename MakeProbe>
+flag_rule flags_across(const profile& p, unsigned count, std::uint8_t first, MakeProbe make) noexcept {
+  flag_rule r;
+  for (unsigned v = 0; v < count; ++v) {
+    probe pr = make(v);
+    const std::uint8_t was = pr.a.flags;
+    detail::full_step(p, pr.a, pr.in);
+    r.same_after &= ~static_cast<unsigned>(pr.a.flags ^ first);
+    r.kept &= ~static_cast<unsigned>(pr.a.flags ^ was);
+  }
+  return r;
+}
+
+// The compiled step equals the full step, outputs and axis, on every probe.
+template <typename MakeProbe>
+bool agrees(const compiled_profile& c, unsigned count, MakeProbe make) noexcept {
+  for (unsigned v = 0; v < count; ++v) {
+    probe full = make(v);
+    probe table = full;
+    const drive_outputs want = detail::full_step(c.source(), full.a, full.in);
+    const drive_outputs got = step(c, table.a, table.in);
+    if (!same(want, got) || std::memcmp(&full.a, &table.a, sizeof(axis)) != 0) return false;
+  }
+  return true;
+}
+
+// The facts an ordinary cycle leaves open: an entry holds only where the full step answers the
+// same for every one of them.
+constexpr unsigned variant_bits = 8;  // halt, standstill, 3 flags, 2 option codes, status bits
+constexpr unsigned variant_count = 3u << variant_bits;  // times 0x605A: coasts, ends, holds (S5)
 
 probe make_probe(const profile& p, unsigned key, std::uint8_t word, unsigned v) noexcept {
   probe r{make_axis(p), drive_inputs{}};
@@ -75,29 +138,17 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
   std::memcpy(&fall_back.set, fall_back_set, 4);
   table_.fill(fall_back);
   for (unsigned key = 0; key < entry_count; ++key) {
-    const unsigned s = key & 0xFu;
-    const unsigned command = (key >> 4) & 7u;
-    if (s >= static_cast<unsigned>(state_count) || command >= static_cast<unsigned>(command_count) ||
-        words[command] == no_word || !resting(p, static_cast<state>(s))) {
-      continue;
-    }
+    if (!usable(words, key) || !resting(p, static_cast<state>(key & 0xFu))) continue;
+    const std::uint8_t word = words[(key >> 4) & 7u];
+    const auto probe_of = [&](unsigned v) { return make_probe(p, key, word, v); };
     // What the full step does with the first probe makes the entry; every probe then checks it.
-    probe first = make_probe(p, key, words[command], 0);
+    probe first = probe_of(0);
     const axis before = first.a;
     const drive_outputs out = detail::full_step(p, first.a, first.in);
     if (stop_running(first.a) || !resting(p, first.a.current)) continue;
     const bool committed = out.transition != no_transition;
-    // The flags: a bit every probe ends with the same value is set (or cleared); one that keeps
-    // what it was is kept; any other cannot be a table's.
-    unsigned same_after = 0x1Fu, kept = 0x1Fu;
-    for (unsigned v = 0; v < variant_count; ++v) {
-      probe pr = make_probe(p, key, words[command], v);
-      const std::uint8_t was = pr.a.flags;
-      detail::full_step(p, pr.a, pr.in);
-      same_after &= ~static_cast<unsigned>(pr.a.flags ^ first.a.flags);
-      kept &= ~static_cast<unsigned>(pr.a.flags ^ was);
-    }
-    if ((same_after | kept) != 0x1Fu) continue;
+    const flag_rule flags = flags_across(p, variant_count, first.a.flags, probe_of);
+    if (!flags.holds()) continue;
     const state_info info = p.info(first.a.current);
     const bool running = info.activity == state_activity::run;
     std::uint8_t actions = 0;
@@ -108,53 +159,35 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
     compiled_entry e;
     // Bytes 0..3 of the axis: the state, the flags, the pending row (none, and none after: the
     // actions ride in set's byte, OR-ed into 0xFF), the last transition (kept unless a row fires).
-    const std::uint8_t keep[4] = {0, static_cast<std::uint8_t>(kept & ~same_after), 0xFF,
-                                  static_cast<std::uint8_t>(committed ? 0x00 : 0xFF)};
-    const std::uint8_t set[4] = {static_cast<std::uint8_t>(first.a.current),
-                                 static_cast<std::uint8_t>(first.a.flags & same_after), actions,
-                                 static_cast<std::uint8_t>(committed ? out.transition : 0)};
-    std::memcpy(&e.keep, keep, 4);
-    std::memcpy(&e.set, set, 4);
-    // The outputs' first 8 bytes, padding zero: the reported status bits are OR-ed in per cycle.
+    e.keep = axis_word({0, static_cast<std::uint8_t>(flags.kept & ~flags.same_after), 0xFF,
+                        static_cast<std::uint8_t>(committed ? 0x00 : 0xFF)});
+    e.set = axis_word({static_cast<std::uint8_t>(first.a.current),
+                       static_cast<std::uint8_t>(first.a.flags & flags.same_after), actions,
+                       static_cast<std::uint8_t>(committed ? out.transition : 0)});
+    // The image without the reported status bits (OR-ed in per cycle), halt or ramp.
     drive_outputs image;
-    std::memset(static_cast<void*>(&image), 0, sizeof image);
     image.current = first.a.current;
     image.status_word = static_cast<std::uint16_t>(info.status_pattern | status_bit::voltage_enabled |
                                                    status_bit::remote);
     image.transition = out.transition;
-    image.ramp = stop_ramp::none;
     image.torque = info.activity != state_activity::idle;
     image.brake_released = image.torque;
     // The entry stands only if the compiled step with it equals the full step on every probe.
     table_[key] = e;
-    std::memcpy(&outputs_[key], &image, 8);
-    for (unsigned v = 0; v < variant_count; ++v) {
-      probe full = make_probe(p, key, words[command], v);
-      probe table = full;
-      const drive_outputs want = detail::full_step(p, full.a, full.in);
-      const drive_outputs got = step(*this, table.a, table.in);
-      if (!same(want, got) || std::memcmp(&full.a, &table.a, sizeof(axis)) != 0) {
-        table_[key] = fall_back;
-        break;
-      }
-    }
+    outputs_[key] = image_of(image);
+    if (!agrees(*this, variant_count, probe_of)) table_[key] = fall_back;
   }
   compile_stops();
 }
 
 namespace {
 
-// A probe of the stop table: an axis with the profile's default option codes.
-struct stop_probe {
-  axis a;
-  drive_inputs in;
-};
-
 constexpr unsigned stop_variant_count = 16;  // 3 flags, status bits
 
-stop_probe make_stop_probe(const profile& p, unsigned key, std::uint8_t word, unsigned sub,
-                           std::uint8_t pending, std::int8_t code, unsigned v) noexcept {
-  stop_probe r{make_axis(p), drive_inputs{}};
+// A probe of the stop table: an axis with the profile's default option codes.
+probe make_stop_probe(const profile& p, unsigned key, std::uint8_t word, unsigned sub,
+                      std::uint8_t pending, std::int8_t code, unsigned v) noexcept {
+  probe r{make_axis(p), drive_inputs{}};
   r.a.current = static_cast<state>(key & 0xFu);
   r.a.flags = static_cast<std::uint8_t>(((key >> 8) & 3u) | ((v & 1u) ? axis_flag::entered_by_fault : 0u) |
                                         ((v & 2u) ? axis_flag::fault_latched : 0u) |
@@ -178,11 +211,6 @@ void compiled_profile::compile_stops() noexcept {
   std::memcpy(default_options_, defaults.options, sizeof default_options_);
   slot_of_row_[no_pending_row] = 0;
   const std::array<std::uint8_t, 8> words = word_of_command(p);
-  const auto valid = [&](unsigned key) {
-    const unsigned command = (key >> 4) & 7u;
-    return (key & 0xFu) < static_cast<unsigned>(state_count) &&
-           command < static_cast<unsigned>(command_count) && words[command] != no_word;
-  };
 
   // The pending rows, the stop code each runs by and the state it runs in, and the stop code each
   // state is entered with: as the full step leaves them, from every key, with the defaults.
@@ -193,9 +221,9 @@ void compiled_profile::compile_stops() noexcept {
   std::int8_t entry_code[16] = {};
   for (unsigned from = 0; from < slots; ++from) {  // pending rows found from pending rows too
     for (unsigned key = 0; key < entry_count; ++key) {
-      if (!valid(key) || (from != 0 && static_cast<state>(key & 0xFu) != slot_state[from])) continue;
+      if (!usable(words, key) || (from != 0 && static_cast<state>(key & 0xFu) != slot_state[from])) continue;
       for (unsigned sub = 0; sub < 4; ++sub) {
-        stop_probe pr = make_stop_probe(p, key, words[(key >> 4) & 7u], sub, slot_row[from],
+        probe pr = make_stop_probe(p, key, words[(key >> 4) & 7u], sub, slot_row[from],
                                         slot_code[from], 0);
         const drive_outputs out = detail::full_step(p, pr.a, pr.in);
         if (pr.a.pending_row != no_pending_row && slot_of_row_[pr.a.pending_row] == no_slot &&
@@ -214,7 +242,7 @@ void compiled_profile::compile_stops() noexcept {
 
   std::size_t next_block = 0;
   for (unsigned key = 0; key < entry_count; ++key) {
-    if (!valid(key) || next_block + stop_block > stop_capacity) continue;
+    if (!usable(words, key) || next_block + stop_block > stop_capacity) continue;
     const state s = static_cast<state>(key & 0xFu);
     if (p.info(s).activity == state_activity::idle) continue;  // no stop runs without torque
     stop_block_[key] = static_cast<std::uint16_t>(next_block);
@@ -224,59 +252,35 @@ void compiled_profile::compile_stops() noexcept {
       if (slot >= slots || (slot != 0 && slot_state[slot] != s)) continue;
       const std::int8_t code = slot != 0 ? slot_code[slot] : entry_code[static_cast<unsigned>(s)];
       const std::uint8_t word = words[(key >> 4) & 7u];
-      stop_probe first = make_stop_probe(p, key, word, sub, slot_row[slot], code, 0);
+      const auto probe_of = [&](unsigned v) {
+        return make_stop_probe(p, key, word, sub, slot_row[slot], code, v);
+      };
+      probe first = probe_of(0);
       const axis before = first.a;
       const drive_outputs out = detail::full_step(p, first.a, first.in);
       const bool committed = out.transition != no_transition;
-      unsigned same_after = 0x1Fu, kept = 0x1Fu;
-      bool shows_target = false;
-      for (unsigned v = 0; v < stop_variant_count; ++v) {
-        stop_probe pr = make_stop_probe(p, key, word, sub, slot_row[slot], code, v);
-        const std::uint8_t was = pr.a.flags;
-        const drive_outputs o = detail::full_step(p, pr.a, pr.in);
-        same_after &= ~static_cast<unsigned>(pr.a.flags ^ first.a.flags);
-        kept &= ~static_cast<unsigned>(pr.a.flags ^ was);
-        if ((v & 8u) && (o.status_word & ~out.status_word & status_bit::target_reached)) {
-          shows_target = true;
-        }
-      }
-      if ((same_after | kept) != 0x1Fu) continue;
+      const flag_rule flags = flags_across(p, stop_variant_count, first.a.flags, probe_of);
+      if (!flags.holds()) continue;
+      // Whether the motion side's target reached shows: with every reported bit set.
+      probe reporting = probe_of(8);
+      const drive_outputs all = detail::full_step(p, reporting.a, reporting.in);
       stop_entry made;
-      const std::uint8_t keep[4] = {0, static_cast<std::uint8_t>(kept & ~same_after), 0,
-                                    static_cast<std::uint8_t>(committed ? 0x00 : 0xFF)};
-      const std::uint8_t set[4] = {static_cast<std::uint8_t>(first.a.current),
-                                   static_cast<std::uint8_t>(first.a.flags & same_after),
-                                   first.a.pending_row,
-                                   static_cast<std::uint8_t>(committed ? out.transition : 0)};
-      std::memcpy(&made.keep, keep, 4);
-      std::memcpy(&made.set, set, 4);
-      drive_outputs image;
-      std::memset(static_cast<void*>(&image), 0, sizeof image);
-      image.current = out.current;
-      image.status_word = out.status_word;
-      image.transition = out.transition;
-      image.ramp = out.ramp;
-      image.torque = out.torque;
-      image.brake_released = out.brake_released;
-      std::memcpy(&made.image, &image, 8);
+      made.keep = axis_word({0, static_cast<std::uint8_t>(flags.kept & ~flags.same_after), 0,
+                             static_cast<std::uint8_t>(committed ? 0x00 : 0xFF)});
+      made.set = axis_word({static_cast<std::uint8_t>(first.a.current),
+                            static_cast<std::uint8_t>(first.a.flags & flags.same_after),
+                            first.a.pending_row,
+                            static_cast<std::uint8_t>(committed ? out.transition : 0)});
+      made.image = image_of(out);
       made.code_before = code;
       made.code_after = first.a.stop_code;
       made.actions = 0;
       if (committed && first.a.error_code == 0 && before.error_code != 0) made.actions |= resets_error;
       if (out.clear_setpoints) made.actions |= clears;
-      if (shows_target) made.actions |= runs;
+      if (all.status_word & ~out.status_word & status_bit::target_reached) made.actions |= runs;
       // The entry stands only if the compiled step with it equals the full step on every probe.
       e = made;
-      for (unsigned v = 0; v < stop_variant_count; ++v) {
-        stop_probe full = make_stop_probe(p, key, word, sub, slot_row[slot], code, v);
-        stop_probe table = full;
-        const drive_outputs want = detail::full_step(p, full.a, full.in);
-        const drive_outputs got = step(*this, table.a, table.in);
-        if (!same(want, got) || std::memcmp(&full.a, &table.a, sizeof(axis)) != 0) {
-          e = stop_entry{};
-          break;
-        }
-      }
+      if (!agrees(*this, stop_variant_count, probe_of)) e = stop_entry{};
     }
     next_block += stop_block;
   }
