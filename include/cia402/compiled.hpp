@@ -29,9 +29,9 @@ class compiled_profile;
 
 /// What an ordinary cycle with a key does to the axis: its first four bytes (state, flags, pending
 /// row, last transition) after the cycle are (before & keep) | set, in the axis's own byte order.
-/// The pending row is none before (tested) and kept, so set's third byte is free: it carries the
-/// actions (compiled_profile::fallback, ...), which come with the load of `set` and OR into a byte
-/// that stays 0xFF.
+/// The pending row is none before (tested) and after, so set's third byte is 0xFF and keep's is
+/// free: it carries the actions (compiled_profile::fallback, ...), which one test reads in the word
+/// that is loaded anyway, and which an OR with 0xFF leaves no trace of.
 struct compiled_entry {
   std::uint32_t keep = 0;
   std::uint32_t set = 0;
@@ -59,21 +59,36 @@ class compiled_profile {
   static constexpr std::uint8_t fallback = 1u << 1;       ///< detail::full_step decides
   static constexpr std::uint8_t runs = 1u << 2;           ///< the status word shows target reached
   static constexpr std::uint8_t resets_error = 1u << 3;   ///< a fault reset (T15, seed 001 T16)
-  static constexpr std::uint8_t clears = 1u << 4;         ///< it clears the set-points
 
  private:
   friend drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs& in) noexcept;
 
-  // Two tables of 8-byte entries under one key, so the key indexes both with the CPU's own scale
-  // and no shift lies on the path from one cycle's axis word to the next.
-  std::array<compiled_entry, entry_count> table_{};
-  /// Bytes 0..7 of the drive_outputs of each key (state, status word without the reported bits,
-  /// transition, no ramp, torque, brake; padding zero): the outputs are one load and one OR.
-  std::array<std::uint64_t, entry_count> outputs_{};
-  std::array<std::uint8_t, 256> command_key_{};  ///< control-word bits 0..7 to key bits 4..7
+  // The two 8-byte tables of a key, one after the other: a command's row is one offset from their
+  // start, and the key indexes both with the CPU's own scale, so no shift or add lies on the path
+  // from one cycle's axis word to the next.
+  struct tables {
+    std::array<compiled_entry, entry_count> entries{};
+    /// Bytes 0..7 of the drive_outputs of each key (state, status word without the reported bits,
+    /// transition, no ramp, torque, brake; padding zero): the outputs are one load and one OR.
+    std::array<std::uint64_t, entry_count> images{};
+  };
+  tables tables_;
+  /// Control-word bits 0..7 to the byte offset of the command's row in `tables_`: key bits 4..7
+  /// (the decoded command and bit 7) times the entry size.
+  std::array<std::uint16_t, 256> row_offset_{};
+  /// The same as key bits 4..7, for the rare paths: their own bytes, so the ordinary cycle does
+  /// not keep the row offset in a register for them.
+  std::array<std::uint8_t, 256> command_key_{};
   const profile* profile_;
-  std::uint64_t speed_span_ = 0;  ///< 2 * limit - 2: |speed| < limit is (speed + limit - 1) <= this
+  std::int64_t speed_offset_ = 0;          ///< limit - 1 (0 without a limit)
+  std::uint64_t speed_span_ = ~0ull;       ///< 2 * limit - 2 (every value without a limit)
   bool has_speed_limit_ = false;
+
+  // Whether the speed leaves the range every entry was built for (|speed| < limit, or any speed
+  // without a limit). One unsigned compare, in 64 bits so no limit or speed can overflow it.
+  bool beyond_speed_limit(const drive_inputs& in) const noexcept {
+    return static_cast<std::uint64_t>(std::int64_t{in.actual_speed_rpm} + speed_offset_) > speed_span_;
+  }
 
   // The stop table: what the ordinary table leaves to the full step because a stop runs (a pending
   // row's ramp, QUICK STOP ACTIVE) or starts (T5, T8 or a quick stop whose outcome the option codes
@@ -83,7 +98,7 @@ class compiled_profile {
   struct stop_entry {
     std::uint32_t keep = 0;  ///< the axis's first four bytes: (before & keep) | set
     std::uint32_t set = 0;
-    std::uint64_t image = 0;  ///< the outputs' first 8 bytes, as outputs_
+    std::uint64_t image = 0;  ///< the outputs' first 8 bytes, as tables::images
     std::int8_t code_before = 0;  ///< the stop code the axis must have (S16)
     std::int8_t code_after = 0;   ///< its stop code after the cycle
     std::uint8_t actions = fallback;
@@ -140,16 +155,21 @@ inline constexpr bool seldom(bool condition) noexcept {
 /// Where the status word's lowest bit sits in the outputs' first 8 bytes read as one integer.
 inline constexpr unsigned status_shift = little_endian ? 16u : 32u;
 
-/// The outputs from their first 8 bytes (`head`) and what fills the second: clear the set-points
-/// (byte 8), 0x603F (bytes 10, 11) and its 0x1001 (byte 12). Two whole words, no field stores.
-inline drive_outputs outputs_of(std::uint64_t head, bool clears, std::uint16_t code) noexcept {
-  static_assert(sizeof(drive_outputs) == 16 && offsetof(drive_outputs, status_word) == 2 &&
-                    offsetof(drive_outputs, ramp) == 5 && offsetof(drive_outputs, clear_setpoints) == 8 &&
-                    offsetof(drive_outputs, error_code) == 10 && offsetof(drive_outputs, error_register) == 12,
+/// The outputs from their first 8 bytes (`head`: all an entry decides) and what fills the second:
+/// 0x603F (bytes 8, 9) and its 0x1001 (byte 10). Two whole words, no field stores.
+inline drive_outputs outputs_of(std::uint64_t head, std::uint16_t code) noexcept {
+  static_assert(sizeof(drive_outputs) == 16 && offsetof(drive_outputs, clear_setpoints) == 1 &&
+                    offsetof(drive_outputs, status_word) == 2 && offsetof(drive_outputs, ramp) == 5 &&
+                    offsetof(drive_outputs, error_code) == 8 && offsetof(drive_outputs, error_register) == 10,
                 "the outputs are two 8-byte words");
-  const std::uint64_t tail = (std::uint64_t{clears} << byte_shift<8>(0)) |
-                             (std::uint64_t{code} << (little_endian ? 16u : 32u)) |
-                             (std::uint64_t{error_register_of(code)} << byte_shift<8>(4));
+  std::uint64_t tail = std::uint64_t{code} << (little_endian ? 0u : 48u);
+  // No error is the rule: its register (0) costs no branch the ordinary cycle takes.
+  if (seldom(code != 0)) tail |= std::uint64_t{error_register_of(code)} << byte_shift<8>(2);
+#if defined(__GNUC__)
+  // One register for both ways: GCC would otherwise build the no-error tail (0) in memory and
+  // load it back into the vector register that carries the outputs.
+  __asm__("" : "+r"(tail));
+#endif
   drive_outputs out;
   std::memcpy(static_cast<void*>(&out), &head, 8);
   std::memcpy(reinterpret_cast<unsigned char*>(&out) + 8, &tail, 8);
@@ -180,6 +200,7 @@ inline std::uint64_t ordinary_head() noexcept {
 
 inline drive_outputs compiled_profile::stop_step(axis& a, const drive_inputs& in,
                                                 std::uint32_t word, unsigned key) const noexcept {
+  if (beyond_speed_limit(in)) return full_on_copy(a, in);
   const std::uint16_t block = stop_block_[key];
   const std::uint8_t slot = slot_of_row_[(word >> detail::byte_shift<4>(2)) & 0xFFu];
   if ((block != no_block) & (slot != no_slot) & !(in.control_word & control_bit::halt) &&
@@ -194,7 +215,7 @@ inline drive_outputs compiled_profile::stop_step(axis& a, const drive_inputs& in
       if (e.actions & resets_error) a.error_code = 0;
       const unsigned reported = detail::reported_bits(in.status_bits, e.actions);
       return detail::outputs_of(e.image | (std::uint64_t{reported} << detail::status_shift),
-                                (e.actions & clears) != 0, a.error_code);
+                                a.error_code);
     }
   }
   return full_on_copy(a, in);
@@ -207,13 +228,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   std::uint64_t head;
   std::memcpy(&head, &in, 8);
   if (head != detail::ordinary_head()) return c.full_on_copy(a, in);
-  if (c.has_speed_limit_) {
-    // |speed| < limit as one unsigned compare, in 64 bits so no limit or speed can overflow it.
-    const std::int64_t limit = c.profile_->speed_limit_rpm;
-    if (static_cast<std::uint64_t>(std::int64_t{in.actual_speed_rpm} + limit - 1) > c.speed_span_) {
-      return c.full_on_copy(a, in);
-    }
-  }
+  if (detail::seldom(c.has_speed_limit_) && c.beyond_speed_limit(in)) return c.full_on_copy(a, in);
   static_assert(offsetof(axis, flags) == 1 && offsetof(axis, pending_row) == 2 &&
                     offsetof(axis, last_transition) == 3,
                 "the table rewrites the axis's first four bytes as one word");
@@ -223,33 +238,42 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   // wait for all of them (store forwarding).
   std::uint32_t word;
   std::memcpy(&word, &a, 4);
-  const unsigned state_and_flags =
-      detail::little_endian ? word : (((word >> 24) & 0xFFu) | ((word >> 8) & 0xFF00u));
-  // The command's part of the key first: it does not depend on the last cycle, so only a mask lies
-  // between the axis word and the load of the entry.
-  const unsigned command = c.command_key_[cw & 0xFFu];
-  const unsigned state_key = state_and_flags & 0x30Fu;
-  const bool pending = ((word >> detail::byte_shift<4>(2)) & 0xFFu) != no_pending_row;
-  const compiled_entry* entries = c.table_.data() + command;
-  const std::uint64_t* images = c.outputs_.data() + command;
+  const std::size_t state_key =
+      (detail::little_endian ? word : (((word >> 24) & 0xFFu) | ((word >> 8) & 0xFF00u))) & 0x30Fu;
+  // The command's row first: it does not depend on the last cycle, so only a mask lies between the
+  // axis word and the load of the entry, and one base serves both tables.
+  const unsigned char* row =
+      reinterpret_cast<const unsigned char*>(&c.tables_) + c.row_offset_[cw & 0xFFu];
 #if defined(__GNUC__)
-  // Keeps the compiler from folding the command back into the axis's index (a shift and two adds
-  // more between one cycle's axis word and the next).
-  __asm__("" : "+r"(entries), "+r"(images));
+  // Keeps the compiler from folding the row back into the axis's index (an add more between one
+  // cycle's axis word and the next).
+  __asm__("" : "+r"(row));
 #endif
-  const compiled_entry& e = entries[state_key];
-  const std::uint64_t image = images[state_key];
-  const std::uint32_t set = e.set;
-  const unsigned actions = (set >> detail::byte_shift<4>(2)) & 0xFFu;
+  std::uint64_t entry;
+  std::memcpy(&entry, row + state_key * sizeof entry, sizeof entry);
+  std::uint64_t image;
+  std::memcpy(&image, row + offsetof(compiled_profile::tables, images) + state_key * sizeof image,
+              sizeof image);
+  static_assert(sizeof(compiled_entry) == 8 && offsetof(compiled_entry, set) == 4, "keep, then set");
+  const std::uint32_t keep = static_cast<std::uint32_t>(entry >> (detail::little_endian ? 0u : 32u));
+  const std::uint32_t set = static_cast<std::uint32_t>(entry >> (detail::little_endian ? 32u : 0u));
+  // Byte 2: the pending row's in the axis word, the actions' in keep.
+  constexpr unsigned actions_shift = detail::byte_shift<4>(2);
+  const unsigned actions = (keep >> actions_shift) & 0xFFu;
   const unsigned reported = detail::reported_bits(in.status_bits, actions);
   std::uint64_t head_out = image | (std::uint64_t{reported} << detail::status_shift);
-  // One test for the rare cases: a stop runs or the entry falls back (the stop table, else the
-  // full step decides), the state runs and the control word halts (bit 8), or a fault reset
-  // clears the error code.
-  if (detail::seldom((actions & (((cw >> 8) & 1u) | compiled_profile::fallback |
-                                 compiled_profile::resets_error)) | pending)) {
-    if ((actions & compiled_profile::fallback) | pending) {
-      return c.stop_step(a, in, word, state_key | command);
+  // A stop runs (the pending row is not 0xFF: adding one to its byte leaves it nonzero).
+  if (detail::seldom(((word + (1u << actions_shift)) & (0xFFu << actions_shift)) != 0)) {
+    return c.stop_step(a, in, word, static_cast<unsigned>(state_key) | c.command_key_[cw & 0xFFu]);
+  }
+  // One test of the entry's keep word for the rare entries: it falls back (the stop table, else the
+  // full step decides), the state runs and the control word halts (bit 8), or a fault reset clears
+  // the error code.
+  if (detail::seldom(keep & ((((cw >> 8) & 1u) | compiled_profile::fallback |
+                              compiled_profile::resets_error)
+                             << actions_shift))) {
+    if (actions & compiled_profile::fallback) {
+      return c.stop_step(a, in, word, static_cast<unsigned>(state_key) | c.command_key_[cw & 0xFFu]);
     }
     if (actions & compiled_profile::resets_error) a.error_code = 0;
     if ((actions & compiled_profile::halt_possible) && (cw & control_bit::halt)) {
@@ -264,11 +288,11 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   }
   // A committed row's stop code needs no clearing: outside a stop it is 0 (S16; the model check
   // holds every reachable axis to it).
-  const std::uint32_t after = (word & e.keep) | set;
+  const std::uint32_t after = (word & keep) | set;
   // Stored every cycle, whole: a store only on a change would be a branch that a command changing
   // at random mispredicts, and the next cycle's load of the same word is forwarded from this store.
   std::memcpy(static_cast<void*>(&a), &after, 4);
-  return detail::outputs_of(head_out, (actions & compiled_profile::clears) != 0, a.error_code);
+  return detail::outputs_of(head_out, a.error_code);
 }
 
 }  // namespace cia402

@@ -47,16 +47,16 @@ enum class stop_ramp : std::uint8_t {
 const char* stop_ramp_name(stop_ramp r) noexcept;
 
 /// Everything the drive decides in one cycle. Two whole 8-byte words (aligned, 16 bytes): the
-/// compiled step builds the first from one table load, and a caller's copy moves two words, not
-/// seven fields.
+/// compiled step builds the first, all a transition decides, from one table load, and the second,
+/// the error, from the axis's error code; a caller's copy moves two words, not nine fields.
 struct alignas(8) drive_outputs {
   state current = state::start;
+  bool clear_setpoints = false;             ///< the motion side must drop its set-points now
   std::uint16_t status_word = 0;            ///< 0x6041
   std::uint8_t transition = no_transition;  ///< the transition taken this cycle (0..17)
   stop_ramp ramp = stop_ramp::none;
   bool torque = false;                      ///< power stage on, drive function enabled
   bool brake_released = false;              ///< holding brake released
-  bool clear_setpoints = false;             ///< the motion side must drop its set-points now
   std::uint16_t error_code = 0;             ///< 0x603F
   std::uint8_t error_register = 0;          ///< 0x1001
 };

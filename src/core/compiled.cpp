@@ -1,5 +1,7 @@
 #include "cia402/compiled.hpp"
 
+#include <cstdint>
+
 namespace cia402 {
 namespace {
 
@@ -52,6 +54,7 @@ std::uint64_t image_of(const drive_outputs& o) noexcept {
   image.ramp = o.ramp;
   image.torque = o.torque;
   image.brake_released = o.brake_released;
+  image.clear_setpoints = o.clear_setpoints;
   std::uint64_t bytes;
   std::memcpy(&bytes, &image, 8);
   return bytes;
@@ -127,16 +130,19 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
   stop_block_.fill(no_block);
   slot_of_row_.fill(no_slot);
   has_speed_limit_ = p.speed_limit_rpm > 0;
-  speed_span_ = has_speed_limit_ ? static_cast<std::uint64_t>(2 * std::int64_t{p.speed_limit_rpm} - 2) : 0u;
+  speed_offset_ = has_speed_limit_ ? std::int64_t{p.speed_limit_rpm} - 1 : 0;
+  speed_span_ = has_speed_limit_ ? static_cast<std::uint64_t>(2 * std::int64_t{p.speed_limit_rpm} - 2) : ~0ull;
   for (unsigned bits = 0; bits < 256; ++bits) {
-    command_key_[bits] = static_cast<std::uint8_t>((p.command_of_bits[bits & 0x1Fu] << 4) | (bits & 0x80u));
+    const unsigned command_key = (p.command_of_bits[bits & 0x1Fu] << 4) | (bits & 0x80u);
+    command_key_[bits] = static_cast<std::uint8_t>(command_key);
+    row_offset_[bits] = static_cast<std::uint16_t>(command_key * sizeof(compiled_entry));
   }
   const bool has_halt = p.spec(option::halt).exists();
   const std::array<std::uint8_t, 8> words = word_of_command(p);
   compiled_entry fall_back;
-  const std::uint8_t fall_back_set[4] = {0, 0, fallback, 0};
-  std::memcpy(&fall_back.set, fall_back_set, 4);
-  table_.fill(fall_back);
+  fall_back.keep = axis_word({0, 0, fallback, 0});
+  fall_back.set = axis_word({0, 0, no_pending_row, 0});
+  tables_.entries.fill(fall_back);
   for (unsigned key = 0; key < entry_count; ++key) {
     if (!usable(words, key) || !resting(p, static_cast<state>(key & 0xFu))) continue;
     const std::uint8_t word = words[(key >> 4) & 7u];
@@ -153,16 +159,16 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
     const bool running = info.activity == state_activity::run;
     std::uint8_t actions = 0;
     if (committed && first.a.error_code == 0 && before.error_code != 0) actions |= resets_error;
-    if (out.clear_setpoints) actions |= clears;
     if (running) actions |= runs;
     if (running && has_halt) actions |= halt_possible;
     compiled_entry e;
     // Bytes 0..3 of the axis: the state, the flags, the pending row (none, and none after: the
-    // actions ride in set's byte, OR-ed into 0xFF), the last transition (kept unless a row fires).
-    e.keep = axis_word({0, static_cast<std::uint8_t>(flags.kept & ~flags.same_after), 0xFF,
+    // actions ride in keep's byte, their trace OR-ed away by set's 0xFF), the last transition
+    // (kept unless a row fires).
+    e.keep = axis_word({0, static_cast<std::uint8_t>(flags.kept & ~flags.same_after), actions,
                         static_cast<std::uint8_t>(committed ? 0x00 : 0xFF)});
     e.set = axis_word({static_cast<std::uint8_t>(first.a.current),
-                       static_cast<std::uint8_t>(first.a.flags & flags.same_after), actions,
+                       static_cast<std::uint8_t>(first.a.flags & flags.same_after), no_pending_row,
                        static_cast<std::uint8_t>(committed ? out.transition : 0)});
     // The image without the reported status bits (OR-ed in per cycle), halt or ramp.
     drive_outputs image;
@@ -172,10 +178,11 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
     image.transition = out.transition;
     image.torque = info.activity != state_activity::idle;
     image.brake_released = image.torque;
+    image.clear_setpoints = out.clear_setpoints;
     // The entry stands only if the compiled step with it equals the full step on every probe.
-    table_[key] = e;
-    outputs_[key] = image_of(image);
-    if (!agrees(*this, variant_count, probe_of)) table_[key] = fall_back;
+    tables_.entries[key] = e;
+    tables_.images[key] = image_of(image);
+    if (!agrees(*this, variant_count, probe_of)) tables_.entries[key] = fall_back;
   }
   compile_stops();
 }
@@ -276,7 +283,6 @@ void compiled_profile::compile_stops() noexcept {
       made.code_after = first.a.stop_code;
       made.actions = 0;
       if (committed && first.a.error_code == 0 && before.error_code != 0) made.actions |= resets_error;
-      if (out.clear_setpoints) made.actions |= clears;
       if (all.status_word & ~out.status_word & status_bit::target_reached) made.actions |= runs;
       // The entry stands only if the compiled step with it equals the full step on every probe.
       e = made;
@@ -297,7 +303,7 @@ std::size_t compiled_profile::stops_covered() const noexcept {
 
 std::size_t compiled_profile::covered() const noexcept {
   std::size_t n = 0;
-  for (const compiled_entry& e : table_) n += ((e.set >> detail::byte_shift<4>(2)) & fallback) == 0;
+  for (const compiled_entry& e : tables_.entries) n += ((e.keep >> detail::byte_shift<4>(2)) & fallback) == 0;
   return n;
 }
 
