@@ -118,8 +118,10 @@ class compiled_profile {
   }
   // A cycle with ordinary inputs that the ordinary table leaves out: the stop table, else the full
   // step. `word` is the axis's first four bytes, `key` the ordinary key. Inline: a call here cost
-  // the transition sequence 0.5 ns a step (docs/compiled-step.md).
-  inline drive_outputs stop_step(axis& a, const drive_inputs& in, std::uint32_t word,
+  // the transition sequence 0.5 ns a step (docs/compiled-step.md). The inputs come by value for
+  // the same reason as full_on_copy's copy: where the compiler calls it rather than inlining it
+  // (g++ -O2), a reference would put the caller's inputs in memory on every cycle.
+  inline drive_outputs stop_step(axis& a, drive_inputs in, std::uint32_t word,
                                  unsigned key) const noexcept;
   void compile_stops() noexcept;
 
@@ -198,9 +200,9 @@ inline std::uint64_t ordinary_head() noexcept {
 
 }  // namespace detail
 
-inline drive_outputs compiled_profile::stop_step(axis& a, const drive_inputs& in,
-                                                std::uint32_t word, unsigned key) const noexcept {
-  if (beyond_speed_limit(in)) return full_on_copy(a, in);
+inline drive_outputs compiled_profile::stop_step(axis& a, drive_inputs in, std::uint32_t word,
+                                                unsigned key) const noexcept {
+  if (beyond_speed_limit(in)) return detail::full_step(*profile_, a, in);
   const std::uint16_t block = stop_block_[key];
   const std::uint8_t slot = slot_of_row_[(word >> detail::byte_shift<4>(2)) & 0xFFu];
   if ((block != no_block) & (slot != no_slot) & !(in.control_word & control_bit::halt) &&
@@ -218,7 +220,7 @@ inline drive_outputs compiled_profile::stop_step(axis& a, const drive_inputs& in
                                 a.error_code);
     }
   }
-  return full_on_copy(a, in);
+  return detail::full_step(*profile_, a, in);  // `in` is a copy already
 }
 
 /// Runs one cycle: one table load for an ordinary cycle, the stop table for a stop that runs or
