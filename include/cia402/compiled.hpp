@@ -202,7 +202,6 @@ inline std::uint64_t ordinary_head() noexcept {
 
 inline drive_outputs compiled_profile::stop_step(axis& a, drive_inputs in, std::uint32_t word,
                                                 unsigned key) const noexcept {
-  if (beyond_speed_limit(in)) return detail::full_step(*profile_, a, in);
   const std::uint16_t block = stop_block_[key];
   const std::uint8_t slot = slot_of_row_[(word >> detail::byte_shift<4>(2)) & 0xFFu];
   if ((block != no_block) & (slot != no_slot) & !(in.control_word & control_bit::halt) &&
