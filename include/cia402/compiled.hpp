@@ -231,8 +231,8 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   if (head != detail::ordinary_head()) return c.full_on_copy(a, in);
   if (detail::seldom(c.has_speed_limit_) && c.beyond_speed_limit(in)) return c.full_on_copy(a, in);
   static_assert(offsetof(axis, flags) == 1 && offsetof(axis, pending_row) == 2 &&
-                    offsetof(axis, last_transition) == 3,
-                "the table rewrites the axis's first four bytes as one word");
+                    offsetof(axis, last_transition) == 3 && alignof(axis) >= 4,
+                "the table rewrites the axis's first four bytes as one aligned word");
   const unsigned cw = in.control_word;
   // The first four bytes of the axis are read, and written back, as one word: no branch on
   // whether a row fires, and a wide load of what the last cycle stored in narrow stores would

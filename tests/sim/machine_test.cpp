@@ -87,8 +87,8 @@ TEST(machine, ten_thousand_axes_enable_together) {
 }
 
 TEST(machine, an_axis_is_small) {
-  // The core's axis (14 bytes) plus the plant, the objects of every operation mode, the profile
-  // position generator and homing, the injected inputs, and the settled core's 60-byte snapshot
+  // The core's axis (16 bytes) plus the plant, the objects of every operation mode, the profile
+  // position generator and homing, the injected inputs, and the settled core's 62-byte snapshot
   // (which lets a cycle skip the core): 1,000 axes in a third of a megabyte.
   EXPECT_EQ(machine::bytes_per_axis, sizeof(axis_state));
   EXPECT_LE(sizeof(axis_state), 336u);

@@ -155,12 +155,12 @@ struct axis_state {
   // by one comparison that they are as they were in a cycle whose step changed nothing: the core is
   // a function of its axis and its inputs, so it would decide again what `last` holds.
   axis core;                          ///< the core state machine's memory
-  std::uint16_t control_word = 0;     ///< 0x6040, read by the next cycle
   drive_outputs last;                 ///< what the core decided in the last cycle
   std::int64_t velocity = 0;          ///< actual velocity, micro-rpm (0x606C = velocity / 1e6)
   std::int32_t target_velocity = 0;   ///< 0x60FF, rpm
   /// The mode-specific status bits (10..13) this cycle's motion produced, shown by the next cycle.
   std::uint16_t mode_status = 0;
+  std::uint16_t control_word = 0;     ///< 0x6040, read by the next cycle
   /// Present fault causes, oldest first; a free slot holds code 0. The newest is the one the drive
   /// sees (drive_inputs.fault_code, fault_class).
   std::uint16_t fault_codes[max_fault_causes] = {};
@@ -172,7 +172,7 @@ struct axis_state {
   /// step_axis() only: the core's sources as the last cycle whose step left the core's axis as it
   /// was found them (valid while settled_valid).
   bool settled_valid = false;
-  std::uint8_t settled[60] = {};
+  std::uint8_t settled[62] = {};
   /// step_axis() only: with those bytes the axis is a csp axis running with its brake released
   /// (what step_axis() asks of the settled core before it takes its path with no call).
   bool settled_csp_runs = false;
