@@ -229,7 +229,9 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   std::uint64_t head;
   std::memcpy(&head, &in, 8);
   if (head != detail::ordinary_head()) return c.full_on_copy(a, in);
-  if (detail::seldom(c.has_speed_limit_) && c.beyond_speed_limit(in)) return c.full_on_copy(a, in);
+  // Without a limit a short jump skips the check; with one (lexium32) it is in line. Laid out off
+  // the path instead, it cost lexium32's quiet cycle two taken jumps and 0.1 to 0.2 ns.
+  if (c.has_speed_limit_ && detail::seldom(c.beyond_speed_limit(in))) return c.full_on_copy(a, in);
   static_assert(offsetof(axis, flags) == 1 && offsetof(axis, pending_row) == 2 &&
                     offsetof(axis, last_transition) == 3 && alignof(axis) >= 4,
                 "the table rewrites the axis's first four bytes as one aligned word");
