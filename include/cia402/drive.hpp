@@ -72,7 +72,7 @@ inline constexpr std::uint8_t fault_latched = 1u << 4;     ///< class-4 error: o
 
 /// One axis's state between cycles: 16 bytes. The profile is passed to each call, so many axes
 /// share one profile. Aligned to 4: the compiled step (compiled.hpp) reads and writes the first
-/// four bytes as one word, and a word at an odd half-word address cost it 0.1 to 0.3 ns a cycle
+/// four bytes as one word, and a word at an address 2 mod 4 cost it about 0.25 ns a cycle
 /// (docs/compiled-step.md); in an array, no axis's word then straddles a cache line.
 struct alignas(4) axis {
   state current = state::start;
