@@ -1,7 +1,5 @@
 #include "cia402/compiled.hpp"
 
-#include <cstdint>
-
 namespace cia402 {
 namespace {
 
