@@ -27,7 +27,7 @@ namespace cia402 {
 
 class compiled_profile;
 
-/// What an ordinary cycle with a key does to the axis: its first four bytes (state, flags, pending
+/// What an ordinary cycle with a key does to the axis: its first four bytes (flags, state, pending
 /// row, last transition) after the cycle are (before & keep) | set, in the axis's own byte order.
 /// The pending row is none before (tested) and after, so set's third byte is 0xFF and keep's is
 /// free: it carries the actions (compiled_profile::fallback, ...), which one test reads in the word
@@ -43,7 +43,19 @@ class compiled_profile {
   /// and 9 the axis flags fault_reset_bit (bit 7 before) and torque_on. So the state and the flags,
   /// adjacent in `axis`, come with the one load of the axis's first word and one mask, and bits
   /// 0..7 of the control word with one byte load and one lookup. 9 of 16 state slots are used.
+  /// An entry's place in the tables is not the key itself but offset_of(key).
   static constexpr std::size_t entry_count = 1024;
+
+  /// The byte offset of a key's entry in each of the two tables: the state times 256, the
+  /// command's three bits times 32, the two flags times 8, control-word bit 7 times 4,096. The
+  /// axis keeps the flags in bits 3 and 4 of the byte before the state, so the axis's part of the
+  /// offset is its word under one mask, already a multiple of the entry's 8 bytes: the load of the
+  /// entry takes a base and an index, with no scale, which is a cycle shorter on the path from one
+  /// cycle's axis word to the next (docs/compiled-step.md).
+  static constexpr std::size_t offset_of(unsigned key) noexcept {
+    return ((key & 0xFu) << 8) | (((key >> 4) & 7u) << 5) | (((key >> 8) & 3u) << 3) |
+           (((key >> 7) & 1u) << 12);
+  }
 
   explicit compiled_profile(const profile& p) noexcept;
 
@@ -63,9 +75,9 @@ class compiled_profile {
  private:
   friend drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs& in) noexcept;
 
-  // The two 8-byte tables of a key, one after the other: a command's row is one offset from their
-  // start, and the key indexes both with the CPU's own scale, so no shift or add lies on the path
-  // from one cycle's axis word to the next.
+  // The two 8-byte tables of a key, one after the other, each laid out by offset_of: a command's
+  // row is one offset from their start, and the axis word under a mask indexes both, so no shift,
+  // add or scale lies on the path from one cycle's axis word to the next.
   struct tables {
     std::array<compiled_entry, entry_count> entries{};
     /// Bytes 0..7 of the drive_outputs of each key (state, status word without the reported bits,
@@ -73,8 +85,8 @@ class compiled_profile {
     std::array<std::uint64_t, entry_count> images{};
   };
   tables tables_;
-  /// Control-word bits 0..7 to the byte offset of the command's row in `tables_`: key bits 4..7
-  /// (the decoded command and bit 7) times the entry size.
+  /// Control-word bits 0..7 to the byte offset of the command's row in `tables_`: offset_of key
+  /// bits 4..7 (the decoded command and bit 7).
   std::array<std::uint16_t, 256> row_offset_{};
   /// The same as key bits 4..7, for the rare paths: their own bytes, so the ordinary cycle does
   /// not keep the row offset in a register for them.
@@ -129,6 +141,9 @@ class compiled_profile {
   std::array<std::uint16_t, entry_count> stop_block_{};  ///< key -> first of its 16, or no_block
   std::array<std::uint8_t, 256> slot_of_row_{};  ///< pending row -> 1..3 (none: 0), or no_slot
   std::int8_t default_options_[option_count] = {};
+
+  // The axis's part of the key (the state, and the flags as key bits 8 and 9), for the rare paths.
+  static unsigned axis_key(std::uint32_t word) noexcept;
 };
 
 namespace detail {
@@ -200,6 +215,14 @@ inline std::uint64_t ordinary_head() noexcept {
 
 }  // namespace detail
 
+inline unsigned compiled_profile::axis_key(std::uint32_t word) noexcept {
+  const unsigned flags = (word >> detail::byte_shift<4>(0)) & 0xFFu;
+  const unsigned current = (word >> detail::byte_shift<4>(1)) & 0xFu;
+  static_assert(axis_flag::fault_reset_bit == 1u << 3 && axis_flag::torque_on == 1u << 4,
+                "the key's flags are bits 3 and 4 of axis::flags");
+  return current | (((flags >> 3) & 3u) << 8);
+}
+
 inline drive_outputs compiled_profile::stop_step(axis& a, drive_inputs in, std::uint32_t word,
                                                 unsigned key) const noexcept {
   const std::uint16_t block = stop_block_[key];
@@ -232,8 +255,9 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   // Without a limit a short jump skips the check; with one (lexium32) it is in line. Laid out off
   // the path instead, it cost lexium32's quiet cycle two taken jumps and 0.1 to 0.2 ns.
   if (c.has_speed_limit_ && detail::seldom(c.beyond_speed_limit(in))) return c.full_on_copy(a, in);
-  static_assert(offsetof(axis, flags) == 1 && offsetof(axis, pending_row) == 2 &&
-                    offsetof(axis, last_transition) == 3 && alignof(axis) >= 4,
+  static_assert(offsetof(axis, flags) == 0 && offsetof(axis, current) == 1 &&
+                    offsetof(axis, pending_row) == 2 && offsetof(axis, last_transition) == 3 &&
+                    alignof(axis) >= 4,
                 "the table rewrites the axis's first four bytes as one aligned word");
   const unsigned cw = in.control_word;
   // The first four bytes of the axis are read, and written back, as one word: no branch on
@@ -241,8 +265,11 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   // wait for all of them (store forwarding).
   std::uint32_t word;
   std::memcpy(&word, &a, 4);
-  const std::size_t state_key =
-      (detail::little_endian ? word : (((word >> 24) & 0xFFu) | ((word >> 8) & 0xFF00u))) & 0x30Fu;
+  // The axis's part of the entry's offset (compiled_profile::offset_of): the state's byte times
+  // 256 and the two flags times 8, as they lie in the word.
+  static_assert(compiled_profile::offset_of(0x30Fu) == 0xF18u, "the axis's part is the word & 0xF18");
+  const std::size_t axis_offset =
+      (detail::little_endian ? word : (((word >> 24) & 0xFFu) | ((word >> 8) & 0xFF00u))) & 0xF18u;
   // The command's row first: it does not depend on the last cycle, so only a mask lies between the
   // axis word and the load of the entry, and one base serves both tables.
   const unsigned char* row =
@@ -253,10 +280,9 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   __asm__("" : "+r"(row));
 #endif
   std::uint64_t entry;
-  std::memcpy(&entry, row + state_key * sizeof entry, sizeof entry);
+  std::memcpy(&entry, row + axis_offset, sizeof entry);
   std::uint64_t image;
-  std::memcpy(&image, row + offsetof(compiled_profile::tables, images) + state_key * sizeof image,
-              sizeof image);
+  std::memcpy(&image, row + offsetof(compiled_profile::tables, images) + axis_offset, sizeof image);
   static_assert(sizeof(compiled_entry) == 8 && offsetof(compiled_entry, set) == 4, "keep, then set");
   const std::uint32_t keep = static_cast<std::uint32_t>(entry >> (detail::little_endian ? 0u : 32u));
   const std::uint32_t set = static_cast<std::uint32_t>(entry >> (detail::little_endian ? 32u : 0u));
@@ -267,7 +293,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   std::uint64_t head_out = image | (std::uint64_t{reported} << detail::status_shift);
   // A stop runs (the pending row is not 0xFF: adding one to its byte leaves it nonzero).
   if (detail::seldom(((word + (1u << actions_shift)) & (0xFFu << actions_shift)) != 0)) {
-    return c.stop_step(a, in, word, static_cast<unsigned>(state_key) | c.command_key_[cw & 0xFFu]);
+    return c.stop_step(a, in, word, compiled_profile::axis_key(word) | c.command_key_[cw & 0xFFu]);
   }
   // One test of the entry's keep word for the rare entries: it falls back (the stop table, else the
   // full step decides), the state runs and the control word halts (bit 8), or a fault reset clears
@@ -276,7 +302,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
                               compiled_profile::resets_error)
                              << actions_shift))) {
     if (actions & compiled_profile::fallback) {
-      return c.stop_step(a, in, word, static_cast<unsigned>(state_key) | c.command_key_[cw & 0xFFu]);
+      return c.stop_step(a, in, word, compiled_profile::axis_key(word) | c.command_key_[cw & 0xFFu]);
     }
     if (actions & compiled_profile::resets_error) a.error_code = 0;
     if ((actions & compiled_profile::halt_possible) && (cw & control_bit::halt)) {

@@ -61,13 +61,16 @@ struct alignas(8) drive_outputs {
   std::uint8_t error_register = 0;          ///< 0x1001
 };
 
-/// Bits of `axis::flags`: what the drive remembers from the previous cycle.
+/// Bits of `axis::flags`: what the drive remembers from the previous cycle. The two that every
+/// cycle reads are bits 3 and 4, so that with the state in the next byte they are a multiple of 8:
+/// the compiled step (compiled.hpp) indexes its table of 8-byte entries with the axis word and one
+/// mask, and no scaling.
 namespace axis_flag {
-inline constexpr std::uint8_t fault_reset_bit = 1u << 0;   ///< bit 7 of the previous control word (S2)
-inline constexpr std::uint8_t torque_on = 1u << 1;         ///< torque was on in the previous cycle
-inline constexpr std::uint8_t entered_by_fault = 1u << 2;  ///< the state came from a fault fact
-inline constexpr std::uint8_t coast_reaction = 1u << 3;    ///< the running fault reaction coasts
-inline constexpr std::uint8_t fault_latched = 1u << 4;     ///< class-4 error: only power-off clears
+inline constexpr std::uint8_t entered_by_fault = 1u << 0;  ///< the state came from a fault fact
+inline constexpr std::uint8_t coast_reaction = 1u << 1;    ///< the running fault reaction coasts
+inline constexpr std::uint8_t fault_latched = 1u << 2;     ///< class-4 error: only power-off clears
+inline constexpr std::uint8_t fault_reset_bit = 1u << 3;   ///< bit 7 of the previous control word (S2)
+inline constexpr std::uint8_t torque_on = 1u << 4;         ///< torque was on in the previous cycle
 }  // namespace axis_flag
 
 /// One axis's state between cycles: 16 bytes. The profile is passed to each call, so many axes
@@ -75,8 +78,8 @@ inline constexpr std::uint8_t fault_latched = 1u << 4;     ///< class-4 error: o
 /// four bytes as one word, and a word at an address 2 mod 4 cost it about 0.25 ns a cycle
 /// (docs/compiled-step.md); in an array, no axis's word then straddles a cache line.
 struct alignas(4) axis {
+  std::uint8_t flags = 0;               ///< axis_flag bits (before `current`: compiled.hpp reads both)
   state current = state::start;
-  std::uint8_t flags = 0;               ///< axis_flag bits (next to `current`: compiled.hpp reads both)
   std::uint8_t pending_row = 0xFF;      ///< row whose stop is running (S7), 0xFF = none
   std::uint8_t last_transition = no_transition;  ///< the last transition taken, ever
   std::uint16_t error_code = 0;         ///< 0x603F

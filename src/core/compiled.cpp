@@ -35,7 +35,8 @@ bool usable(const std::array<std::uint8_t, 8>& words, unsigned key) noexcept {
          command < static_cast<unsigned>(command_count) && words[command] != no_word;
 }
 
-// Four axis bytes as the word the compiled step reads and writes.
+// Four axis bytes (flags, state, pending row, last transition) as the word the compiled step reads
+// and writes.
 std::uint32_t axis_word(const std::uint8_t (&bytes)[4]) noexcept {
   std::uint32_t w;
   std::memcpy(&w, bytes, 4);
@@ -97,6 +98,12 @@ bool agrees(const compiled_profile& c, unsigned count, MakeProbe make) noexcept 
   return true;
 }
 
+// The axis flags of a key's bits 8 and 9.
+std::uint8_t key_flags(unsigned key) noexcept {
+  return static_cast<std::uint8_t>(((key & 0x100u) ? axis_flag::fault_reset_bit : 0u) |
+                                   ((key & 0x200u) ? axis_flag::torque_on : 0u));
+}
+
 // The facts an ordinary cycle leaves open: an entry holds only where the full step answers the
 // same for every one of them.
 constexpr unsigned variant_bits = 8;  // halt, standstill, 3 flags, 2 option codes, status bits
@@ -109,7 +116,7 @@ probe make_probe(const profile& p, unsigned key, std::uint8_t word, unsigned v) 
   r.a.options[static_cast<int>(option::quick_stop)] = quick_stop_codes[v >> variant_bits];
   r.a.options[static_cast<int>(option::shutdown)] = static_cast<std::int8_t>((v >> 5) & 1u);
   r.a.options[static_cast<int>(option::disable_operation)] = static_cast<std::int8_t>((v >> 6) & 1u);
-  r.a.flags = static_cast<std::uint8_t>(((key >> 8) & 3u) | ((v & 4u) ? axis_flag::entered_by_fault : 0u) |
+  r.a.flags = static_cast<std::uint8_t>(key_flags(key) | ((v & 4u) ? axis_flag::entered_by_fault : 0u) |
                                         ((v & 8u) ? axis_flag::fault_latched : 0u) |
                                         ((v & 16u) ? axis_flag::coast_reaction : 0u));
   r.a.error_code = 0x1234;  // shows whether the step clears it
@@ -133,12 +140,12 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
   for (unsigned bits = 0; bits < 256; ++bits) {
     const unsigned command_key = (p.command_of_bits[bits & 0x1Fu] << 4) | (bits & 0x80u);
     command_key_[bits] = static_cast<std::uint8_t>(command_key);
-    row_offset_[bits] = static_cast<std::uint16_t>(command_key * sizeof(compiled_entry));
+    row_offset_[bits] = static_cast<std::uint16_t>(offset_of(command_key));
   }
   const bool has_halt = p.spec(option::halt).exists();
   const std::array<std::uint8_t, 8> words = word_of_command(p);
   compiled_entry fall_back;
-  fall_back.keep = axis_word({0, 0, fallback, 0});
+  fall_back.keep = axis_word({0, 0, fallback, 0});  // flags, state, pending row, last transition
   fall_back.set = axis_word({0, 0, no_pending_row, 0});
   tables_.entries.fill(fall_back);
   for (unsigned key = 0; key < entry_count; ++key) {
@@ -160,13 +167,13 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
     if (running) actions |= runs;
     if (running && has_halt) actions |= halt_possible;
     compiled_entry e;
-    // Bytes 0..3 of the axis: the state, the flags, the pending row (none, and none after: the
+    // Bytes 0..3 of the axis: the flags, the state, the pending row (none, and none after: the
     // actions ride in keep's byte, their trace OR-ed away by set's 0xFF), the last transition
     // (kept unless a row fires).
-    e.keep = axis_word({0, static_cast<std::uint8_t>(flags.kept & ~flags.same_after), actions,
+    e.keep = axis_word({static_cast<std::uint8_t>(flags.kept & ~flags.same_after), 0, actions,
                         static_cast<std::uint8_t>(committed ? 0x00 : 0xFF)});
-    e.set = axis_word({static_cast<std::uint8_t>(first.a.current),
-                       static_cast<std::uint8_t>(first.a.flags & flags.same_after), no_pending_row,
+    e.set = axis_word({static_cast<std::uint8_t>(first.a.flags & flags.same_after),
+                       static_cast<std::uint8_t>(first.a.current), no_pending_row,
                        static_cast<std::uint8_t>(committed ? out.transition : 0)});
     // The image without the reported status bits (OR-ed in per cycle), halt or ramp.
     drive_outputs image;
@@ -178,9 +185,10 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
     image.brake_released = image.torque;
     image.clear_setpoints = out.clear_setpoints;
     // The entry stands only if the compiled step with it equals the full step on every probe.
-    tables_.entries[key] = e;
-    tables_.images[key] = image_of(image);
-    if (!agrees(*this, variant_count, probe_of)) tables_.entries[key] = fall_back;
+    const std::size_t at = offset_of(key) / sizeof(compiled_entry);
+    tables_.entries[at] = e;
+    tables_.images[at] = image_of(image);
+    if (!agrees(*this, variant_count, probe_of)) tables_.entries[at] = fall_back;
   }
   compile_stops();
 }
@@ -194,7 +202,7 @@ probe make_stop_probe(const profile& p, unsigned key, std::uint8_t word, unsigne
                       std::uint8_t pending, std::int8_t code, unsigned v) noexcept {
   probe r{make_axis(p), drive_inputs{}};
   r.a.current = static_cast<state>(key & 0xFu);
-  r.a.flags = static_cast<std::uint8_t>(((key >> 8) & 3u) | ((v & 1u) ? axis_flag::entered_by_fault : 0u) |
+  r.a.flags = static_cast<std::uint8_t>(key_flags(key) | ((v & 1u) ? axis_flag::entered_by_fault : 0u) |
                                         ((v & 2u) ? axis_flag::fault_latched : 0u) |
                                         ((v & 4u) ? axis_flag::coast_reaction : 0u));
   r.a.pending_row = pending;
@@ -270,11 +278,10 @@ void compiled_profile::compile_stops() noexcept {
       probe reporting = probe_of(8);
       const drive_outputs all = detail::full_step(p, reporting.a, reporting.in);
       stop_entry made;
-      made.keep = axis_word({0, static_cast<std::uint8_t>(flags.kept & ~flags.same_after), 0,
+      made.keep = axis_word({static_cast<std::uint8_t>(flags.kept & ~flags.same_after), 0, 0,
                              static_cast<std::uint8_t>(committed ? 0x00 : 0xFF)});
-      made.set = axis_word({static_cast<std::uint8_t>(first.a.current),
-                            static_cast<std::uint8_t>(first.a.flags & flags.same_after),
-                            first.a.pending_row,
+      made.set = axis_word({static_cast<std::uint8_t>(first.a.flags & flags.same_after),
+                            static_cast<std::uint8_t>(first.a.current), first.a.pending_row,
                             static_cast<std::uint8_t>(committed ? out.transition : 0)});
       made.image = image_of(out);
       made.code_before = code;

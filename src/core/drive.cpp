@@ -155,9 +155,14 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   drive_outputs out;
   // Facts of this cycle.
   const std::uint16_t cw = in.control_word;
+  // The axis keeps bit 7 in fault_reset_bit (bit 3, where compiled.hpp's key needs it); the edge is
+  // taken in bit 0, which on a Cortex-M4 costs 40 bytes of flash less than working in bit 3.
+  constexpr unsigned reset_flag_shift = 3;
+  static_assert(axis_flag::fault_reset_bit == 1u << reset_flag_shift);
   const std::uint32_t reset_bit = (cw >> 7) & 1u;
-  const std::uint32_t reset_edge = reset_bit & ~static_cast<std::uint32_t>(a.flags);
-  a.flags = static_cast<std::uint8_t>((a.flags & ~axis_flag::fault_reset_bit) | reset_bit);  // S2
+  const std::uint32_t reset_edge = reset_bit & ~(static_cast<std::uint32_t>(a.flags) >> reset_flag_shift);
+  a.flags = static_cast<std::uint8_t>((a.flags & ~axis_flag::fault_reset_bit) |
+                                      (reset_bit << reset_flag_shift));  // S2
   const bool torque_was_on = (a.flags & axis_flag::torque_on) != 0;
   const state_activity act_before = p.info(a.current).activity;
 
@@ -172,10 +177,10 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
                     quick_stop_facts(act_before == state_activity::quick_stop
                                          ? a.stop_code
                                          : a.options[static_cast<int>(option::quick_stop)]) |
-                    ((static_cast<std::uint32_t>(a.flags) & axis_flag::entered_by_fault) << 16) |
-                    ((static_cast<std::uint32_t>(a.flags) & axis_flag::fault_latched) << 17);
-  static_assert(axis_flag::entered_by_fault << 16 == static_cast<std::uint32_t>(fact::entered_by_fault));
-  static_assert(axis_flag::fault_latched << 17 == static_cast<std::uint32_t>(fact::fault_latched));
+                    ((static_cast<std::uint32_t>(a.flags) & axis_flag::entered_by_fault) << 18) |
+                    ((static_cast<std::uint32_t>(a.flags) & axis_flag::fault_latched) << 19);
+  static_assert(axis_flag::entered_by_fault << 18 == static_cast<std::uint32_t>(fact::entered_by_fault));
+  static_assert(axis_flag::fault_latched << 19 == static_cast<std::uint32_t>(fact::fault_latched));
 
   const int abort_code = option_value(a, option::abort_connection);
   const bool link_fault = in.connection_lost && abort_code == 1;

@@ -22,7 +22,8 @@ inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_
   const bool unusual_inputs = (in.fault_code != 0) | !in.dc_link | in.sto | !in.remote |
                               in.connection_lost | in.local_enable | in.local_disable;
   const std::uint16_t cw = in.control_word;
-  const unsigned reset_bit = (cw >> 7) & 1u;
+  // Bit 7 as the axis keeps it (axis_flag::fault_reset_bit).
+  const unsigned reset_bit = (cw >> 4) & axis_flag::fault_reset_bit;
   const unsigned flags = a.flags;
   const std::int32_t limit = p.speed_limit_rpm;  // seed 001: T2/T7 watch the speed
   const bool overspeed = limit != 0 && (in.actual_speed_rpm > limit || in.actual_speed_rpm < -limit);
