@@ -252,9 +252,10 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   std::uint64_t head;
   std::memcpy(&head, &in, 8);
   if (head != detail::ordinary_head()) return c.full_on_copy(a, in);
-  // Without a limit a short jump skips the check; with one (lexium32) it is in line. Laid out off
-  // the path instead, it cost lexium32's quiet cycle two taken jumps and 0.1 to 0.2 ns.
-  if (c.has_speed_limit_ && detail::seldom(c.beyond_speed_limit(in))) return c.full_on_copy(a, in);
+  // A profile with a limit (lexium32) checks the speed off the path. In line, with the loads below,
+  // it cost lexium32's quiet cycle about 0.2 ns at -O2 and no one anything at -O3 (measured both
+  // ways, docs/compiled-step.md: the loop is near what the front end delivers in its 7 cycles).
+  if (detail::seldom(c.has_speed_limit_) && c.beyond_speed_limit(in)) return c.full_on_copy(a, in);
   static_assert(offsetof(axis, flags) == 0 && offsetof(axis, current) == 1 &&
                     offsetof(axis, pending_row) == 2 && offsetof(axis, last_transition) == 3 &&
                     alignof(axis) >= 4,
@@ -279,13 +280,16 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   // cycle's axis word and the next).
   __asm__("" : "+r"(row));
 #endif
-  std::uint64_t entry;
-  std::memcpy(&entry, row + axis_offset, sizeof entry);
+  // Keep and set as two loads: keep's is a base and an index (4 cycles before the AND), set's has a
+  // displacement too (5 cycles, but it is needed a cycle later, for the OR), and no shift splits
+  // them: one instruction less in a loop that the front end bounds about as much as the chain.
+  static_assert(sizeof(compiled_entry) == 8 && offsetof(compiled_entry, set) == 4, "keep, then set");
+  std::uint32_t keep;
+  std::memcpy(&keep, row + axis_offset, sizeof keep);
+  std::uint32_t set;
+  std::memcpy(&set, row + axis_offset + offsetof(compiled_entry, set), sizeof set);
   std::uint64_t image;
   std::memcpy(&image, row + offsetof(compiled_profile::tables, images) + axis_offset, sizeof image);
-  static_assert(sizeof(compiled_entry) == 8 && offsetof(compiled_entry, set) == 4, "keep, then set");
-  const std::uint32_t keep = static_cast<std::uint32_t>(entry >> (detail::little_endian ? 0u : 32u));
-  const std::uint32_t set = static_cast<std::uint32_t>(entry >> (detail::little_endian ? 32u : 0u));
   // Byte 2: the pending row's in the axis word, the actions' in keep.
   constexpr unsigned actions_shift = detail::byte_shift<4>(2);
   const unsigned actions = (keep >> actions_shift) & 0xFFu;
