@@ -35,6 +35,22 @@ bool usable(const std::array<std::uint8_t, 8>& words, unsigned key) noexcept {
          command < static_cast<unsigned>(command_count) && words[command] != no_word;
 }
 
+// Whether offset_of gives every key a slot of its own in the tables: the table is filled key by
+// key, and two keys in one slot would leave the first answered by the second's entry.
+constexpr bool offsets_are_a_permutation() noexcept {
+  bool taken[compiled_profile::entry_count] = {};
+  for (unsigned key = 0; key < compiled_profile::entry_count; ++key) {
+    const std::size_t at = compiled_profile::offset_of(key);
+    const std::size_t slot = at / sizeof(compiled_entry);
+    if (at % sizeof(compiled_entry) != 0 || slot >= compiled_profile::entry_count || taken[slot]) {
+      return false;
+    }
+    taken[slot] = true;
+  }
+  return true;
+}
+static_assert(offsets_are_a_permutation(), "offset_of must place the 1,024 keys in 1,024 slots");
+
 // Four axis bytes (flags, state, pending row, last transition) as the word the compiled step reads
 // and writes.
 std::uint32_t axis_word(const std::uint8_t (&bytes)[4]) noexcept {
