@@ -248,6 +248,11 @@ inline drive_outputs compiled_profile::stop_step(axis& a, drive_inputs in, std::
 /// Runs one cycle: one table load for an ordinary cycle, the stop table for a stop that runs or
 /// starts, detail::full_step for the rest. The same outputs and axis as cia402::step(profile, ...),
 /// byte for byte.
+///
+/// Meant to be inlined into the caller's loop, and g++ 12 does so at -O2 and -O3. At -O2 it is at
+/// the size where the inliner stops: one branch more and the bench's loop called it, which doubled
+/// the quiet cycle. Forcing it with always_inline was no cure: GCC then built the outputs field by
+/// field, as slow (docs/compiled-step.md). Whoever changes this function measures at -O2 too.
 inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs& in) noexcept {
   std::uint64_t head;
   std::memcpy(&head, &in, 8);
