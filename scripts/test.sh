@@ -5,7 +5,8 @@
 #   on the dev build; the tsan preset: the page, CANopen and machine-thread tests under ThreadSanitizer;
 #   no-exceptions preset: build the core
 #   alone as C++17 without exceptions or RTTI; release preset: benchmarks (a short run, ratios to the
-#   baseline), instructions per step (callgrind), the Cortex-M4 flash and RAM, the state diagrams
+#   baseline), instructions per step (callgrind), whether g++ inlines the compiled step at -O2 and
+#   -O3, the Cortex-M4 flash and RAM, the state diagrams
 #   against docs/diagrams; the libFuzzer targets for 30 s each (tests/fuzz/run.sh); then
 #   scripts/test-consumer.sh.
 set -euo pipefail
@@ -76,13 +77,14 @@ cmake --preset release
 cmake --build --preset release
 build/release/bench/cia402_bench --benchmark_min_time=0.05
 bash bench/instructions/instructions.sh build/release/bench/cia402_instructions
+bash bench/inlining/inlined.sh
 bash bench/cortex_m4/size.sh build/cortex-m4
 # 1,000 csp axes at 1 kHz: realtime_factor on one thread and on two (printed; the machine is shared),
 # and the instructions per axis-step, which are not.
 build/release/bench/cia402_sim_bench --benchmark_filter=sim_1000_axes_csp
 bash bench/instructions/sim_instructions.sh build/release/bench/cia402_sim_bench
 bash scripts/diagrams.sh build/release/tools/cia402 --check
-done_steps+=("release: bench, sim bench, cortex-m4 size, diagrams")
+done_steps+=("release: bench, inlining, sim bench, cortex-m4 size, diagrams")
 
 banner fuzz
 bash tests/fuzz/run.sh 30

@@ -252,7 +252,8 @@ inline drive_outputs compiled_profile::stop_step(axis& a, drive_inputs in, std::
 /// Meant to be inlined into the caller's loop, and g++ 12 does so at -O2 and -O3. At -O2 it is at
 /// the size where the inliner stops: one branch more and the bench's loop called it, which doubled
 /// the quiet cycle. Forcing it with always_inline was no cure: GCC then built the outputs field by
-/// field, as slow (docs/compiled-step.md). Whoever changes this function measures at -O2 too.
+/// field, about as slow (docs/compiled-step.md). bench/inlining/inlined.sh fails when g++ stops
+/// inlining it into the bench's loops at -O2 or -O3.
 inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs& in) noexcept {
   std::uint64_t head;
   std::memcpy(&head, &in, 8);
