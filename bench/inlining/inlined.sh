@@ -12,6 +12,13 @@ cxx=${1:-g++}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 step='cia402::step(cia402::compiled_profile const&, cia402::axis&, cia402::drive_inputs const&)'
+# At -O0 nothing is inlined, so the step must show there: otherwise the name above no longer
+# matches the step's and the checks below would pass whatever the compiler did.
+"$cxx" -std=c++20 -O0 -I"$root/include" -I"$root/bench" -c "$root/bench/compiled_bench.cpp" -o "$out/unoptimized.o"
+if ! grep -qF "$step" <<<"$(nm -C "$out/unoptimized.o")"; then
+  echo "inlining: the step's name '$step' is not in an -O0 object; update it here" >&2
+  exit 1
+fi
 status=0
 for level in -O2 -O3; do
   for source in bench/compiled_bench.cpp bench/instructions/instructions.cpp; do
