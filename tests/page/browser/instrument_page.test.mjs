@@ -129,8 +129,26 @@ async function stopServer(server) {
 
 // --- reading the page ------------------------------------------------------------------------
 
-function waitPresent(page, state, timeout = patience) {
-  return page.waitForSelector(`#diagram [id="state.${state}"].present`, { timeout });
+async function waitPresent(page, state, timeout = patience) {
+  try {
+    return await page.waitForSelector(`#diagram [id="state.${state}"].present`, { timeout });
+  } catch (e) {
+    // A timeout alone does not tell a slow browser from a drive in another state or a link that
+    // never reported one: say what the page showed and what its server says now.
+    const shown = await page.evaluate(() => ({
+      present: [...document.querySelectorAll('#diagram .present')].map((x) => x.id),
+      remote: document.getElementById('remote')?.dataset.status ?? null,
+      banner: document.getElementById('remote')?.textContent ?? null,
+    })).catch((why) => String(why));
+    let server;
+    try {
+      server = JSON.stringify(await (await fetch(new URL('api/state', page.url()))).json());
+    } catch (why) {
+      server = String(why);
+    }
+    throw new Error(`${e.message}\nthe page showed ${JSON.stringify(shown)}\n` +
+      `its server says ${server.slice(0, 3000)}`);
+  }
 }
 
 function waitResult(page, text, timeout = patience) {
