@@ -9,7 +9,7 @@
 //
 // Where the table lives: in RAM, built by the constructor: 1,024 keys of 16 bytes (an 8-byte axis
 // word entry and an 8-byte image of the outputs), 16 KiB a profile, of which the 576 keys of the
-// nine states are used (the gaps buy a key of one mask), and 98 KiB for the stop table.
+// nine states are used (the gaps buy a key of one mask), and 148 KiB for the stop table.
 // Built at run time because a profile loaded from a file can only be compiled then, and because
 // on a Cortex-M4 16 KiB of flash for each profile would cost more than the whole interpreter: a
 // firmware there runs cia402::step(profile, ...) and keeps its flash. Build it once at start-up,
@@ -66,6 +66,9 @@ class compiled_profile {
   /// Entries the stop table answers (cycles with a stop running or starting, on an axis whose
   /// option codes are the profile's defaults).
   std::size_t stops_covered() const noexcept;
+  /// Whether the stop table had room for every key with a stop to answer (true for the built-in
+  /// profiles); where it had not, the full step answers those keys.
+  bool stops_complete() const noexcept { return stops_complete_; }
 
   static constexpr std::uint8_t halt_possible = 1u << 0;  ///< running, and the profile has 0x605D
   static constexpr std::uint8_t fallback = 1u << 1;       ///< detail::full_step decides
@@ -105,8 +108,11 @@ class compiled_profile {
   // The stop table: what the ordinary table leaves to the full step because a stop runs (a pending
   // row's ramp, QUICK STOP ACTIVE) or starts (T5, T8 or a quick stop whose outcome the option codes
   // decide). Its entries hold for an axis with the profile's default option codes, so the option
-  // codes need not be in the key; standstill, the brake and the pending row are. Reached on the
-  // branch the ordinary cycle does not take.
+  // codes need not be in the key; standstill, the brake and the pending row are. Its key is the
+  // ordinary key and whether a fault brought the axis to its state (axis_key): seed 001's T16
+  // leaves QUICK STOP ACTIVE on Enable Operation only after a quick stop the fieldbus asked for.
+  // Reached on the branch the ordinary cycle does not take, so the larger key costs that cycle
+  // nothing.
   struct stop_entry {
     std::uint32_t keep = 0;  ///< the axis's first four bytes: (before & keep) | set
     std::uint32_t set = 0;
@@ -116,7 +122,8 @@ class compiled_profile {
     std::uint8_t actions = fallback;
   };
   static constexpr std::size_t stop_block = 16;  ///< per key: standstill, brake, 4 pending slots
-  static constexpr std::size_t stop_capacity = 4096;
+  /// 384 blocks of 16: ax2000-profibus fills them all (stops_complete()).
+  static constexpr std::size_t stop_capacity = 6144;
   static constexpr std::uint16_t no_block = 0xFFFF;
   static constexpr std::uint8_t no_slot = 0xFF;
 
@@ -129,20 +136,24 @@ class compiled_profile {
     return detail::full_step(*profile_, a, copy);
   }
   // A cycle with ordinary inputs that the ordinary table leaves out: the stop table, else the full
-  // step. `word` is the axis's first four bytes, `key` the ordinary key. Inline: a call here cost
+  // step. `word` is the axis's first four bytes; the key is found here, off the step's own code,
+  // which g++ -O2 inlines only below a size it is at (step()). Inline: a call here cost
   // the transition sequence 0.5 ns a step (docs/compiled-step.md). The inputs come by value for
   // the same reason as full_on_copy's copy: where the compiler calls it rather than inlining it
   // (g++ -O2), a reference would put the caller's inputs in memory on every cycle.
-  inline drive_outputs stop_step(axis& a, drive_inputs in, std::uint32_t word,
-                                 unsigned key) const noexcept;
+  inline drive_outputs stop_step(axis& a, drive_inputs in, std::uint32_t word) const noexcept;
   void compile_stops() noexcept;
 
   std::array<stop_entry, stop_capacity> stops_{};
-  std::array<std::uint16_t, entry_count> stop_block_{};  ///< key -> first of its 16, or no_block
+  /// The stop table's keys: the ordinary key's ten bits, and bit 10 axis_flag::entered_by_fault.
+  static constexpr std::size_t stop_key_count = 2048;
+  std::array<std::uint16_t, stop_key_count> stop_block_{};  ///< key -> first of its 16, or no_block
   std::array<std::uint8_t, 256> slot_of_row_{};  ///< pending row -> 1..3 (none: 0), or no_slot
   std::int8_t default_options_[option_count] = {};
+  bool stops_complete_ = true;
 
-  // The axis's part of the key (the state, and the flags as key bits 8 and 9), for the rare paths.
+  // The axis's part of the stop table's key (the state, the flags fault_reset_bit and torque_on as
+  // bits 8 and 9, entered_by_fault as bit 10), for the rare paths.
   static unsigned axis_key(std::uint32_t word) noexcept;
 };
 
@@ -218,14 +229,15 @@ inline std::uint64_t ordinary_head() noexcept {
 inline unsigned compiled_profile::axis_key(std::uint32_t word) noexcept {
   const unsigned flags = (word >> detail::byte_shift<4>(0)) & 0xFFu;
   const unsigned current = (word >> detail::byte_shift<4>(1)) & 0xFu;
-  static_assert(axis_flag::fault_reset_bit == 1u << 3 && axis_flag::torque_on == 1u << 4,
-                "the key's flags are bits 3 and 4 of axis::flags");
-  return current | (((flags >> 3) & 3u) << 8);
+  static_assert(axis_flag::fault_reset_bit == 1u << 3 && axis_flag::torque_on == 1u << 4 &&
+                    axis_flag::entered_by_fault == 1u << 0,
+                "the key's flags are bits 3, 4 and 0 of axis::flags");
+  return current | (((flags >> 3) & 3u) << 8) | ((flags & 1u) << 10);
 }
 
-inline drive_outputs compiled_profile::stop_step(axis& a, drive_inputs in, std::uint32_t word,
-                                                unsigned key) const noexcept {
-  const std::uint16_t block = stop_block_[key];
+inline drive_outputs compiled_profile::stop_step(axis& a, drive_inputs in,
+                                                std::uint32_t word) const noexcept {
+  const std::uint16_t block = stop_block_[axis_key(word) | command_key_[in.control_word & 0xFFu]];
   const std::uint8_t slot = slot_of_row_[(word >> detail::byte_shift<4>(2)) & 0xFFu];
   if ((block != no_block) & (slot != no_slot) & !(in.control_word & control_bit::halt) &&
       std::memcmp(a.options, default_options_, sizeof default_options_) == 0) {
@@ -303,7 +315,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
   std::uint64_t head_out = image | (std::uint64_t{reported} << detail::status_shift);
   // A stop runs (the pending row is not 0xFF: adding one to its byte leaves it nonzero).
   if (detail::seldom(((word + (1u << actions_shift)) & (0xFFu << actions_shift)) != 0)) {
-    return c.stop_step(a, in, word, compiled_profile::axis_key(word) | c.command_key_[cw & 0xFFu]);
+    return c.stop_step(a, in, word);
   }
   // One test of the entry's keep word for the rare entries: it falls back (the stop table, else the
   // full step decides), the state runs and the control word halts (bit 8), or a fault reset clears
@@ -312,7 +324,7 @@ inline drive_outputs step(const compiled_profile& c, axis& a, const drive_inputs
                               compiled_profile::resets_error)
                              << actions_shift))) {
     if (actions & compiled_profile::fallback) {
-      return c.stop_step(a, in, word, compiled_profile::axis_key(word) | c.command_key_[cw & 0xFFu]);
+      return c.stop_step(a, in, word);
     }
     if (actions & compiled_profile::resets_error) a.error_code = 0;
     if ((actions & compiled_profile::halt_possible) && (cw & control_bit::halt)) {

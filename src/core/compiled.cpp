@@ -211,16 +211,18 @@ compiled_profile::compiled_profile(const profile& p) noexcept : profile_(&p) {
 
 namespace {
 
-constexpr unsigned stop_variant_count = 16;  // 3 flags, status bits
+constexpr unsigned stop_variant_count = 8;  // 2 flags, status bits
+constexpr unsigned reporting_variant = 4;   // every reported status bit set
 
 // A probe of the stop table: an axis with the profile's default option codes.
 probe make_stop_probe(const profile& p, unsigned key, std::uint8_t word, unsigned sub,
                       std::uint8_t pending, std::int8_t code, unsigned v) noexcept {
   probe r{make_axis(p), drive_inputs{}};
   r.a.current = static_cast<state>(key & 0xFu);
-  r.a.flags = static_cast<std::uint8_t>(key_flags(key) | ((v & 1u) ? axis_flag::entered_by_fault : 0u) |
-                                        ((v & 2u) ? axis_flag::fault_latched : 0u) |
-                                        ((v & 4u) ? axis_flag::coast_reaction : 0u));
+  r.a.flags = static_cast<std::uint8_t>(key_flags(key) |
+                                        ((key & 0x400u) ? axis_flag::entered_by_fault : 0u) |
+                                        ((v & 1u) ? axis_flag::fault_latched : 0u) |
+                                        ((v & 2u) ? axis_flag::coast_reaction : 0u));
   r.a.pending_row = pending;
   r.a.stop_code = code;
   r.a.error_code = 0x1234;  // shows whether the step clears it
@@ -228,7 +230,7 @@ probe make_stop_probe(const profile& p, unsigned key, std::uint8_t word, unsigne
   r.in.control_word = static_cast<std::uint16_t>(word | (key & 0x80u));
   r.in.standstill = (sub & 1u) != 0;
   r.in.brake_engaged = (sub & 2u) != 0;
-  r.in.status_bits = (v & 8u) ? 0xFFFFu : 0u;
+  r.in.status_bits = (v & reporting_variant) ? 0xFFFFu : 0u;
   return r;
 }
 
@@ -249,7 +251,7 @@ void compiled_profile::compile_stops() noexcept {
   unsigned slots = 1;
   std::int8_t entry_code[16] = {};
   for (unsigned from = 0; from < slots; ++from) {  // pending rows found from pending rows too
-    for (unsigned key = 0; key < entry_count; ++key) {
+    for (unsigned key = 0; key < stop_key_count; ++key) {
       if (!usable(words, key) || (from != 0 && static_cast<state>(key & 0xFu) != slot_state[from])) continue;
       for (unsigned sub = 0; sub < 4; ++sub) {
         probe pr = make_stop_probe(p, key, words[(key >> 4) & 7u], sub, slot_row[from],
@@ -270,10 +272,14 @@ void compiled_profile::compile_stops() noexcept {
   }
 
   std::size_t next_block = 0;
-  for (unsigned key = 0; key < entry_count; ++key) {
-    if (!usable(words, key) || next_block + stop_block > stop_capacity) continue;
+  for (unsigned key = 0; key < stop_key_count; ++key) {
+    if (!usable(words, key)) continue;
     const state s = static_cast<state>(key & 0xFu);
     if (p.info(s).activity == state_activity::idle) continue;  // no stop runs without torque
+    if (next_block + stop_block > stop_capacity) {
+      stops_complete_ = false;
+      continue;
+    }
     stop_block_[key] = static_cast<std::uint16_t>(next_block);
     for (unsigned sub = 0; sub < stop_block; ++sub) {
       stop_entry& e = stops_[next_block + sub];
@@ -291,7 +297,7 @@ void compiled_profile::compile_stops() noexcept {
       const flag_rule flags = flags_across(p, stop_variant_count, first.a.flags, probe_of);
       if (!flags.holds()) continue;
       // Whether the motion side's target reached shows: with every reported bit set.
-      probe reporting = probe_of(8);
+      probe reporting = probe_of(reporting_variant);
       const drive_outputs all = detail::full_step(p, reporting.a, reporting.in);
       stop_entry made;
       made.keep = axis_word({static_cast<std::uint8_t>(flags.kept & ~flags.same_after), 0, 0,
@@ -309,13 +315,21 @@ void compiled_profile::compile_stops() noexcept {
       e = made;
       if (!agrees(*this, stop_variant_count, probe_of)) e = stop_entry{};
     }
-    next_block += stop_block;
+    // A block that answers nothing is given back: the keys with a stop to answer fit the table.
+    bool answers = false;
+    for (unsigned sub = 0; sub < stop_block; ++sub) answers |= (stops_[next_block + sub].actions & fallback) == 0;
+    if (answers) {
+      next_block += stop_block;
+    } else {
+      stop_block_[key] = no_block;
+      for (unsigned sub = 0; sub < stop_block; ++sub) stops_[next_block + sub] = stop_entry{};
+    }
   }
 }
 
 std::size_t compiled_profile::stops_covered() const noexcept {
   std::size_t n = 0;
-  for (std::size_t key = 0; key < entry_count; ++key) {
+  for (std::size_t key = 0; key < stop_key_count; ++key) {
     if (stop_block_[key] == no_block) continue;
     for (std::size_t i = 0; i < stop_block; ++i) n += (stops_[stop_block_[key] + i].actions & fallback) == 0;
   }

@@ -53,6 +53,8 @@ void check_profile(const char* name) {
   // Every built-in profile has stops with torque on (T5/T8 ramps, a quick stop or a fault
   // reaction), so a stop table with no entry standing would mean its derivation broke.
   EXPECT_GT(compiled.stops_covered(), 0u) << name;
+  // And every key with a stop to answer found room: none is left to the full step for lack of it.
+  EXPECT_TRUE(compiled.stops_complete()) << name;
 }
 
 TEST(model_check, cia402) { check_profile("cia402"); }
