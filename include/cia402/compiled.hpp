@@ -66,8 +66,9 @@ class compiled_profile {
   /// Entries the stop table answers (cycles with a stop running or starting, on an axis whose
   /// option codes are the profile's defaults).
   std::size_t stops_covered() const noexcept;
-  /// Whether the stop table had room for every key with a stop to answer (true for the built-in
-  /// profiles); where it had not, the full step answers those keys.
+  /// Whether the stop table had room for every key it tried (true for the built-in profiles). Where
+  /// it had not, the full step answers the keys left over; a key whose entries would all have
+  /// fallen back counts as left over too, so false is the cautious answer.
   bool stops_complete() const noexcept { return stops_complete_; }
 
   static constexpr std::uint8_t halt_possible = 1u << 0;  ///< running, and the profile has 0x605D
