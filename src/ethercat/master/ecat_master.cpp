@@ -32,6 +32,14 @@ constexpr std::uint64_t eeprom_us = 100'000;
 constexpr std::uint64_t mailbox_us = 1'000'000;
 constexpr std::uint32_t poll_us = 200;
 constexpr std::size_t sii_max_bytes = 8192;
+// A mailbox: 6 bytes of header, then CoE's 2 and an SDO's 8 at least, so an expedited SDO fits.
+constexpr std::size_t mailbox_header_size = 6;
+constexpr std::size_t smallest_coe_mailbox = mailbox_header_size + 2 + 8;
+// A mailbox is read or written in one datagram of one frame.
+constexpr std::size_t largest_mailbox = maximum_frame_size - ethernet_header_size - ethercat_header_size -
+                                        datagram_header_size - working_counter_size;
+// The most PDO entries a direction may bring (the learnt mapping stops there, whatever a slave says).
+constexpr std::size_t max_mapped_entries = 512;
 
 const std::array<std::uint8_t, 6> broadcast{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
 const std::array<std::uint8_t, 6> master_mac{0x02, 0x00, 0x00, 0x00, 0x00, 0x01};
@@ -56,9 +64,15 @@ std::string hex(std::uint32_t v, int digits) {
   return s;
 }
 
-// Bits of the process image, little-endian as EtherCAT carries them.
+// Bits of the process image, little-endian as EtherCAT carries them. A place outside the image
+// reads 0 and takes no write: the layout comes from a slave and is checked where it is learnt, so
+// this is the last line of defence, not the check.
+bool inside(const std::vector<std::uint8_t>& image, std::size_t bit, unsigned bits) {
+  return bits <= 64 && bit + bits <= image.size() * 8;
+}
 std::uint64_t get_bits(const std::vector<std::uint8_t>& image, std::size_t bit, unsigned bits) {
   std::uint64_t v = 0;
+  if (!inside(image, bit, bits)) return v;
   for (unsigned i = 0; i < bits; ++i) {
     const std::size_t b = bit + i;
     if ((image[b / 8] >> (b % 8)) & 1u) v |= std::uint64_t{1} << i;
@@ -66,6 +80,7 @@ std::uint64_t get_bits(const std::vector<std::uint8_t>& image, std::size_t bit, 
   return v;
 }
 void put_bits(std::vector<std::uint8_t>& image, std::size_t bit, unsigned bits, std::uint64_t v) {
+  if (!inside(image, bit, bits)) return;
   for (unsigned i = 0; i < bits; ++i) {
     const std::size_t b = bit + i;
     const auto mask = static_cast<std::uint8_t>(1u << (b % 8));
@@ -262,29 +277,41 @@ bool ecat_master::request_state(line_state target, bool cycling) {
       return fail(slave_text(s) + " did not take the request for " + line_state_name(want));
     }
   }
+  // A slave is there when a status read made after the request shows the state: what was recorded
+  // before it (the state already held, say) proves nothing, and neither does a read that was lost.
+  std::vector<bool> confirmed(slaves_.size(), false);
+  std::vector<bool> answered(slaves_.size(), false);
   const std::uint64_t start = link_->now_us();
   for (;;) {
     bool all = true;
-    for (ecat_slave& s : slaves_) {
+    for (std::size_t i = 0; i < slaves_.size(); ++i) {
+      ecat_slave& s = slaves_[i];
       if (cycling) pause(0);
       if (!read_al_status(s)) {
-        all = false;
+        all = all && confirmed[i];
         continue;
       }
+      answered[i] = true;
       if (s.al_state & al_error_bit) {
         return fail(slave_text(s) + " refused " + line_state_name(want) + ": AL status code " + hex(s.al_code, 4) +
                     " (" + al_status_code_text(s.al_code) + "), stays in " + line_state_name(s.al_state));
       }
-      if ((s.al_state & 0x0F) != want) all = false;
+      confirmed[i] = (s.al_state & 0x0F) == want;
+      all = all && confirmed[i];
     }
     if (all) return true;
     if (link_->now_us() - start > state_change_us) {
-      for (const ecat_slave& s : slaves_) {
-        if ((s.al_state & 0x0F) != want) {
-          return fail(slave_text(s) + " did not reach " + line_state_name(want) + " in time (still " +
-                      line_state_name(s.al_state) + ")");
+      for (std::size_t i = 0; i < slaves_.size(); ++i) {
+        if (confirmed[i]) continue;
+        const ecat_slave& s = slaves_[i];
+        if (!answered[i]) {
+          return fail(slave_text(s) + " did not answer a read of its AL status while going to " +
+                      line_state_name(want) + " (" + std::to_string(state_change_us / 1000) + " ms)");
         }
+        return fail(slave_text(s) + " did not reach " + line_state_name(want) + " in time (still " +
+                    line_state_name(s.al_state) + ")");
       }
+      return fail(std::string("the line did not reach ") + line_state_name(want) + " in time");  // not reached: all was true
     }
     if (cycling) {
       (void)cycle();
@@ -298,6 +325,15 @@ bool ecat_master::request_state(line_state target, bool cycling) {
 bool ecat_master::configure_mailbox(ecat_slave& s) {
   const slave_description& d = s.sii;
   if (!d.coe || d.mailbox_out_size == 0 || d.mailbox_in_size == 0) return true;  // no CoE: SII only
+  // Sizes from the slave's SII: a mailbox that cannot hold an SDO, or one datagram cannot carry,
+  // is a slave the master cannot talk to, said now rather than found out reading past a reply.
+  for (const auto& [what, size] : {std::pair{"receive", d.mailbox_out_size}, std::pair{"send", d.mailbox_in_size}}) {
+    if (size < smallest_coe_mailbox || size > largest_mailbox) {
+      return fail(slave_text(s) + ": its SII gives a " + what + " mailbox of " + std::to_string(size) +
+                  " bytes; CoE needs " + std::to_string(smallest_coe_mailbox) + " to " +
+                  std::to_string(largest_mailbox));
+    }
+  }
   const auto sm_control = [&](int n, std::uint8_t fallback) {
     return n < static_cast<int>(d.sync_managers.size()) && d.sync_managers[static_cast<std::size_t>(n)].control != 0
                ? d.sync_managers[static_cast<std::size_t>(n)].control
@@ -377,8 +413,10 @@ ecat_sdo_result ecat_master::sdo(ecat_slave& s, const std::vector<std::uint8_t>&
       return result;
     }
     const std::vector<std::uint8_t>& m = *reply;
+    // Every length is the slave's word: the reply must hold its own header and what it claims.
+    if (m.size() < mailbox_header_size + 2) continue;
     const std::size_t length = le16(m.data());
-    if (m.size() < 8 || length < 2 || 6 + length > m.size()) continue;
+    if (length < 2 || mailbox_header_size + length > m.size()) continue;
     const std::uint8_t type = m[5] & 0x0F;
     const unsigned service = m[7] >> 4;
     if (type == 0x03 && service == 1 && length >= 2 + 8) {  // an emergency on the way: note it, go on
@@ -386,7 +424,9 @@ ecat_sdo_result ecat_master::sdo(ecat_slave& s, const std::vector<std::uint8_t>&
       continue;
     }
     if (type == 0x00) {
-      result.error = slave_text(s) + " answered with a mailbox error " + hex(le16(m.data() + 8), 4);
+      // A mailbox error: type 1 and a 2-byte code after the header (ETG.1000.6 table 29).
+      const std::string code = length >= 4 ? hex(le16(m.data() + 8), 4) : std::string("without a code");
+      result.error = slave_text(s) + " answered with a mailbox error " + code;
       return result;
     }
     if (type != 0x03 || service != 3 || length < 2 + 8) continue;  // not ours
@@ -457,6 +497,7 @@ bool ecat_master::learn_mapping(ecat_slave& s) {
   std::vector<entry> outputs, inputs;
   const std::size_t i = static_cast<std::size_t>(&s - slaves_.data());
   bool from_coe = s.mailbox;
+  bool too_many = false;
   const auto read_assigned = [&](std::uint16_t assign, std::vector<entry>& out) {
     const ecat_sdo_result count = sdo_read(i, assign, 0);
     if (!count.ok || count.value(false) > 254) return false;  // sub-indices 1..254 at most
@@ -467,6 +508,11 @@ bool ecat_master::learn_mapping(ecat_slave& s) {
       const ecat_sdo_result n = sdo_read(i, pdo_index, 0);
       if (!n.ok || n.value(false) > 254) return false;
       for (std::int64_t e = 1; e <= n.value(false); ++e) {
+        // 254 PDOs of 254 entries are 64,516 SDOs: a mapping longer than any frame ends here.
+        if (out.size() >= max_mapped_entries) {
+          too_many = true;
+          return false;
+        }
         const ecat_sdo_result m = sdo_read(i, pdo_index, static_cast<std::uint8_t>(e));
         if (!m.ok) return false;
         const auto v = static_cast<std::uint32_t>(m.value(false));
@@ -477,6 +523,10 @@ bool ecat_master::learn_mapping(ecat_slave& s) {
     return true;
   };
   if (from_coe && (!read_assigned(0x1C12, outputs) || !read_assigned(0x1C13, inputs))) {
+    if (too_many) {
+      return fail(slave_text(s) + ": its PDO assignment maps more than " + std::to_string(max_mapped_entries) +
+                  " entries in one direction");
+    }
     // A slave without SDO access to its assignment: the SII's default PDOs are what it runs.
     outputs.clear();
     inputs.clear();
@@ -591,6 +641,9 @@ bool ecat_master::configure_process_data(ecat_slave& s, std::uint32_t& logical) 
 
 bool ecat_master::bring_to_pre_operational() {
   if (slaves_.empty()) return fail("no slaves: scan first");
+  // PRE-OP has no process data, and the mapping may change in it: the image is left behind with
+  // OP, so no cycle (nor an SDO's pause) writes a layout into an image it was not built for.
+  stop_cycling();
   for (ecat_slave& s : slaves_) {
     if (!configure_mailbox(s)) return false;
   }
@@ -601,6 +654,7 @@ bool ecat_master::bring_to_pre_operational() {
 bool ecat_master::bring_to_operational() {
   if (!pre_operational_ && !bring_to_pre_operational()) return false;
   pre_operational_ = false;
+  stop_cycling();
   std::uint32_t logical = logical_base;
   expected_wkc_ = 0;
   for (ecat_slave& s : slaves_) {
@@ -703,7 +757,17 @@ bool ecat_master::all_operational() const noexcept {
   return true;
 }
 
+void ecat_master::stop_cycling() {
+  cycling_ = false;
+  image_.clear();
+  line_was_operational_ = false;
+}
+
 bool ecat_master::cycle() {
+  if (!cycling_) {
+    error_ = "no process data to exchange: bring the line to OP first";
+    return false;
+  }
   const std::uint64_t now = link_->now_us();
   last_cycle_us_ = now;
   for (ecat_slave& s : slaves_) {

@@ -114,7 +114,8 @@ class ecat_master {
   bool bring_to_operational();
   /// One cycle: the LRW of every slave's process data and each AL status; each drive's master step
   /// runs on what came back. False when the frame did not come back or the working counter was
-  /// short (the cycle still counts; error() says which).
+  /// short (the cycle still counts; error() says which), and, sending nothing, when no bring-up to
+  /// OP has configured the process data since the last scan or PRE-OP.
   bool cycle();
 
   /// Steer drive `i` (index into slaves()) to a state, or hold a command (quick stop).
@@ -166,6 +167,8 @@ class ecat_master {
   std::optional<std::vector<std::uint8_t>> mailbox_receive(ecat_slave& s);
   ecat_sdo_result sdo(ecat_slave& s, const std::vector<std::uint8_t>& request, std::uint16_t index, std::uint8_t sub);
   bool fail(std::string text);
+  // Forgets the process image: no cycle runs until bring_to_operational() builds the next.
+  void stop_cycling();
   // Waits `us` (0: not at all), running a cycle first when one is due: set-up and SDO transfers
   // keep the process data flowing once it is configured.
   void pause(std::uint32_t us);

@@ -1,0 +1,188 @@
+// Our EtherCAT master against slaves that are faulty or hostile (hostile_line.hpp): an SII that
+// gives mailboxes too small for an SDO, AL status reads that get lost slave by slave, a mapping
+// changed in PRE-OP after the line ran, a cycle asked for before any bring-up. Each of these read or
+// wrote outside a buffer, or never returned, before the master checked what a slave says.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "cia402/ethercat/master/ecat_master.hpp"
+#include "hostile_line.hpp"
+
+namespace cia402::ethercat {
+namespace {
+
+using testing::al_status_read;
+using testing::hostile_line;
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// The first datagram's command and offset in a frame the master sent.
+struct first_datagram {
+  command cmd;
+  std::uint16_t offset;
+};
+first_datagram first_of(const std::vector<std::uint8_t>& frame) {
+  return {static_cast<command>(frame[16]), static_cast<std::uint16_t>(frame[20] | (frame[21] << 8))};
+}
+
+TEST(ecat_master_hostile, a_send_mailbox_of_1_byte_in_the_sii_is_refused_with_the_slave_and_the_size) {
+  hostile_line line(1);
+  line.describe(0, [](slave_description& d) { d.mailbox_in_size = 1; });
+  ecat_master m(line, standard_profile());
+  ASSERT_TRUE(m.scan()) << m.error();
+  EXPECT_EQ(m.slaves()[0].sii.mailbox_in_size, 1);
+  EXPECT_FALSE(m.bring_to_operational());
+  EXPECT_TRUE(contains(m.error(), "slave 0")) << m.error();
+  EXPECT_TRUE(contains(m.error(), "send mailbox of 1 bytes")) << m.error();
+  EXPECT_FALSE(m.slaves()[0].mailbox) << "no mailbox was set up";
+}
+
+TEST(ecat_master_hostile, a_send_mailbox_of_8_bytes_is_refused_before_any_reply_is_read) {
+  // 8 bytes pass "a mailbox header and a CoE header", and then a mailbox error's code lies past them.
+  hostile_line line(2);
+  line.describe(1, [](slave_description& d) { d.mailbox_in_size = 8; });
+  ecat_master m(line, standard_profile());
+  ASSERT_TRUE(m.scan()) << m.error();
+  EXPECT_FALSE(m.bring_to_pre_operational());
+  EXPECT_TRUE(contains(m.error(), "slave 1")) << m.error();
+  EXPECT_TRUE(contains(m.error(), "send mailbox of 8 bytes")) << m.error();
+  // The same for the receive mailbox, and one larger than a datagram can carry.
+  hostile_line big(1);
+  big.describe(0, [](slave_description& d) { d.mailbox_out_size = 4000; });
+  ecat_master m2(big, standard_profile());
+  ASSERT_TRUE(m2.scan()) << m2.error();
+  EXPECT_FALSE(m2.bring_to_pre_operational());
+  EXPECT_TRUE(contains(m2.error(), "receive mailbox of 4000 bytes")) << m2.error();
+}
+
+TEST(ecat_master_hostile, status_reads_lost_by_turns_then_a_dead_line_end_the_bring_up) {
+  // Two drives: slave 1's first AL status read is lost, then slave 0's second, then the line goes
+  // dead. No pass has both reads succeed, yet each slave was seen in PRE-OP after the request: the
+  // request is met. What follows on the dead line fails with a reason instead of waiting for ever.
+  hostile_line line(2);
+  line.time_limit_us = 120'000'000;
+  ecat_master m(line, standard_profile());
+  ASSERT_TRUE(m.scan()) << m.error();
+  std::array<int, 2> reads{};
+  bool dead = false;
+  line.lose = [&](std::size_t i, const datagram& d) {
+    if (!dead && reads[0] >= 2 && reads[1] >= 2) dead = true;
+    if (dead) return true;
+    if (!al_status_read(d, static_cast<std::uint16_t>(0x1001 + i))) return false;
+    const int n = reads[i]++;
+    return (i == 1 && n == 0) || (i == 0 && n == 1);
+  };
+  line.lose_frame = [&] { return dead; };
+  bool ended = false;
+  bool pre_op = false;
+  try {
+    pre_op = m.bring_to_pre_operational();
+    ended = true;
+  } catch (const hostile_line::master_did_not_end&) {
+  }
+  ASSERT_TRUE(ended) << "request_state() never returned";
+  EXPECT_TRUE(pre_op) << m.error();
+  EXPECT_EQ(reads[0], 2);
+  EXPECT_EQ(reads[1], 2);
+  dead = true;
+  ended = false;
+  try {
+    EXPECT_FALSE(m.bring_to_operational());
+    ended = true;
+  } catch (const hostile_line::master_did_not_end&) {
+  }
+  EXPECT_TRUE(ended) << "the bring-up on a dead line never returned";
+  EXPECT_TRUE(contains(m.error(), "slave 0")) << m.error();
+}
+
+TEST(ecat_master_hostile, a_state_already_recorded_is_not_taken_for_an_answer) {
+  // One slave, already in PRE-OP as the master recorded it: asked again with its status reads lost,
+  // the master must not wait for ever, and names the slave and why.
+  hostile_line line(1);
+  line.time_limit_us = 120'000'000;
+  ecat_master m(line, standard_profile());
+  ASSERT_TRUE(m.scan()) << m.error();
+  ASSERT_TRUE(m.bring_to_pre_operational()) << m.error();
+  line.lose = [](std::size_t, const datagram& d) { return al_status_read(d, 0x1001); };
+  bool ended = false;
+  bool ok = true;
+  try {
+    ok = m.bring_to_pre_operational();
+    ended = true;
+  } catch (const hostile_line::master_did_not_end&) {
+  }
+  ASSERT_TRUE(ended) << "request_state() never returned";
+  EXPECT_FALSE(ok);
+  EXPECT_TRUE(contains(m.error(), "slave 0")) << m.error();
+  EXPECT_TRUE(contains(m.error(), "did not answer a read of its AL status")) << m.error();
+}
+
+TEST(ecat_master_hostile, a_mapping_changed_in_pre_op_is_never_cycled_with_the_old_image) {
+  // Scan, OP, cycles, back to PRE-OP, drive 0's outputs remapped larger (0x1C12 reassigned to
+  // 0x1601 with three entries), OP again. The old image was 2 + 2 bytes of outputs; a cycle run
+  // during the new mapping step wrote the new layout into it.
+  hostile_line line(2);
+  ecat_master m(line, standard_profile());
+  ASSERT_TRUE(m.scan()) << m.error();
+  ASSERT_TRUE(m.bring_to_operational()) << m.error();
+  for (int i = 0; i < 10; ++i) {
+    (void)m.cycle();
+    line.wait_us(1000);
+  }
+  ASSERT_TRUE(m.bring_to_pre_operational()) << m.error();
+  std::vector<std::size_t> lrw_lengths;
+  m.on_frame = [&](const std::vector<std::uint8_t>& sent, const std::vector<std::uint8_t>&) {
+    if (first_of(sent).cmd == command::lrw) lrw_lengths.push_back(sent[22] | ((sent[23] & 0x07) << 8));
+  };
+  for (const auto& [index, sub, value, bytes] :
+       std::vector<std::tuple<std::uint16_t, std::uint8_t, std::int64_t, unsigned>>{
+           {0x1C12, 0, 0, 1}, {0x1601, 0, 0, 1}, {0x1601, 1, 0x60400010, 4}, {0x1601, 2, 0x60600008, 4},
+           {0x1601, 3, 0x607A0020, 4}, {0x1601, 0, 3, 1}, {0x1C12, 1, 0x1601, 2}, {0x1C12, 0, 1, 1}}) {
+    const ecat_sdo_result r = m.sdo_write(0, index, sub, value, bytes);
+    ASSERT_TRUE(r.ok) << std::hex << index << ":" << int(sub) << " " << r.error;
+  }
+  ASSERT_TRUE(m.bring_to_operational()) << m.error();
+  const ecat_slave& s = m.slaves()[0];
+  EXPECT_EQ(s.output_bytes, 7);
+  const std::size_t image = 7u + s.input_bytes + m.slaves()[1].output_bytes + m.slaves()[1].input_bytes;
+  ASSERT_FALSE(lrw_lengths.empty());
+  for (const std::size_t length : lrw_lengths) EXPECT_EQ(length, image) << "a cycle ran on the image of the mapping before";
+  ASSERT_TRUE(m.set_output(0, 0x607A, 12345));
+  // Leaving OP counted as a lost connection (0x6007): reset that fault on the way.
+  for (const state target : {state::switch_on_disabled, state::operation_enabled}) {
+    m.set_target(0, target);
+    for (int i = 0; i < 200 && m.slaves()[0].steering.outcome() != master_outcome::reached; ++i) {
+      (void)m.cycle();
+      line.wait_us(1000);
+    }
+  }
+  EXPECT_TRUE(m.slaves()[0].last_status & 0x0004) << "enabled through the new layout: status " << std::hex
+                                                   << m.slaves()[0].last_status << " error code " << m.slaves()[0].last_error_code << " " << m.error();
+  std::int64_t target = 0;
+  ASSERT_EQ(line.slaves[0]->device().read(0x607A, 0, target), sdo_abort::none);
+  EXPECT_EQ(target, 12345) << "the new entry reaches the drive";
+}
+
+TEST(ecat_master_hostile, a_cycle_before_any_bring_up_is_refused_and_sends_nothing) {
+  hostile_line line(1);
+  ecat_master m(line, standard_profile());
+  EXPECT_FALSE(m.cycle());
+  EXPECT_TRUE(contains(m.error(), "bring the line to OP first")) << m.error();
+  EXPECT_EQ(line.frames, 0u);
+  ASSERT_TRUE(m.scan()) << m.error();
+  const std::uint64_t after_scan = line.frames;
+  EXPECT_FALSE(m.cycle()) << "scanned, not brought up";
+  EXPECT_EQ(line.frames, after_scan);
+  ASSERT_TRUE(m.bring_to_pre_operational()) << m.error();
+  const std::uint64_t in_pre_op = line.frames;
+  EXPECT_FALSE(m.cycle()) << "PRE-OP has no process data";
+  EXPECT_EQ(line.frames, in_pre_op);
+  EXPECT_EQ(m.cycles(), 0u);
+}
+
+}  // namespace
+}  // namespace cia402::ethercat
