@@ -113,7 +113,7 @@ TEST(esc, read_only_registers_keep_their_value) {
 
 TEST(esc, armw_reads_at_one_slave_and_writes_the_rest) {
   bus b(3);
-  b.escs[0].write16(reg::dc_receive_time, 0x4242);
+  b.write16(command::apwr, ap(0, reg::dc_receive_time), 0x4242);
   const result r = b.send(command::armw, ap(0, reg::dc_receive_time), {0, 0});
   EXPECT_EQ(r.wkc, 3);
   EXPECT_EQ(b.value16(r), 0x4242);
@@ -220,7 +220,7 @@ TEST(esc, a_mailbox_is_handed_over_whole_and_a_full_one_takes_nothing) {
 
 TEST(esc, outputs_arrive_whole_and_feed_the_watchdog) {
   bus b(1);
-  b.escs[0].write16(reg::watchdog_time_process_data, 100);  // 100 x 100 us = 10 ms
+  b.write16(command::apwr, ap(0, reg::watchdog_time_process_data), 100);  // 100 x 100 us = 10 ms
   sync_manager(b, 2, 0x1100, 4, 0x64);  // buffered, ECAT writes, watchdog trigger
   EXPECT_EQ(b.send(command::apwr, ap(0, 0x1100), {1, 2}).wkc, 1);
   EXPECT_FALSE(b.escs[0].take_sync_manager_event(2)) << "half a buffer is no new data";
@@ -385,7 +385,7 @@ TEST(esc_commands, nop_and_unknown_commands_pass_untouched) {
 TEST(esc_commands, frmw_reads_at_the_station_and_writes_the_others) {
   bus b(3);
   for (std::uint16_t i = 0; i < 3; ++i) b.write16(command::apwr, ap(i, reg::station_address), 0x1001 + i);
-  b.escs[1].write16(reg::dc_receive_time, 0x5150);
+  b.write16(command::apwr, ap(1, reg::dc_receive_time), 0x5150);
   const result r = b.send(command::frmw, fp(0x1002, reg::dc_receive_time), {0, 0});
   EXPECT_EQ(r.wkc, 3);
   EXPECT_EQ(b.value16(r), 0x5150);
@@ -448,10 +448,55 @@ TEST(esc_commands, the_application_may_deactivate_a_sync_manager) {
   EXPECT_TRUE(b.escs[0].sm(0).enabled);
 }
 
+TEST(esc_commands, a_sync_manager_set_over_the_registers_locks_no_master_out) {
+  // One APWR of 128 bytes at 0x0810 sets SM2 to start 0x00FF, 0xFF41 bytes long, slave-writes,
+  // activated: it would cover every register from 0x00FF up. A sync manager covers process RAM
+  // only, so this one is not enabled and every register stays the master's.
+  bus b(1);
+  std::vector<std::uint8_t> block(128, 0);
+  block[0] = 0xFF;  // SM2 start 0x00FF
+  block[1] = 0x00;
+  block[2] = 0x41;  // length 0xFF41
+  block[3] = 0xFF;
+  block[4] = 0x20;  // control: buffered, the slave writes (the master reads)
+  block[6] = 0x01;  // activate
+  EXPECT_EQ(b.send(command::apwr, ap(0, reg::sync_manager0 + 16), block).wkc, 1);
+  EXPECT_FALSE(b.escs[0].sm(2).enabled);
+  EXPECT_EQ(b.write16(command::apwr, ap(0, reg::al_control), 0x0002).wkc, 1) << "AL control";
+  EXPECT_EQ(b.escs[0].read16(reg::al_control), 0x0002);
+  EXPECT_EQ(b.send(command::apwr, ap(0, reg::fmmu0), std::vector<std::uint8_t>(16, 0)).wkc, 1) << "FMMUs";
+  EXPECT_EQ(b.send(command::apwr, ap(0, reg::sync_manager0 + 16), std::vector<std::uint8_t>(8, 0)).wkc, 1)
+      << "the sync manager itself";
+  sync_manager(b, 0, 0x1000, 128, 0x26);
+  EXPECT_TRUE(b.escs[0].sm(0).enabled) << "a mailbox in process RAM still works";
+  // Past the memory's end is no better than the registers.
+  sync_manager(b, 3, 0x1F00, 0x200, 0x20);
+  EXPECT_FALSE(b.escs[0].sm(3).enabled);
+}
+
+TEST(esc_commands, the_application_writes_process_ram_and_its_own_registers_only) {
+  bus b(1);
+  b.write16(command::apwr, ap(0, reg::station_address), 0x1001);
+  const std::uint8_t type = b.escs[0].read8(reg::type);
+  b.escs[0].write16(reg::station_address, 0x0000);
+  b.escs[0].write8(reg::type, 0x00);
+  b.escs[0].write16(reg::sync_manager0, 0x0000);
+  b.escs[0].write16(reg::fmmu0, 0x1234);
+  EXPECT_EQ(b.escs[0].errors().pdi_refused, 7u) << "each byte refused and counted";
+  EXPECT_EQ(b.escs[0].read16(reg::station_address), 0x1001);
+  EXPECT_EQ(b.escs[0].read8(reg::type), type);
+  EXPECT_EQ(b.escs[0].read16(reg::fmmu0), 0);
+  b.escs[0].set_al_status(0x14, 0x001B);
+  b.escs[0].write16(0x1800, 0xBEEF);
+  EXPECT_EQ(b.escs[0].errors().pdi_refused, 7u) << "AL status, its code and process RAM are the application's";
+  EXPECT_EQ(b.escs[0].read16(reg::al_status_code), 0x001B);
+  EXPECT_EQ(b.escs[0].read16(0x1800), 0xBEEF);
+}
+
 TEST(esc, the_watchdog_counts_in_units_of_40_ns_times_divider_plus_2) {
   bus b(1);
-  b.escs[0].write16(reg::watchdog_divider, 98);               // (98 + 2) x 40 ns = 4 us
-  b.escs[0].write16(reg::watchdog_time_process_data, 250);    // 1 ms
+  b.write16(command::apwr, ap(0, reg::watchdog_divider), 98);             // (98 + 2) x 40 ns = 4 us
+  b.write16(command::apwr, ap(0, reg::watchdog_time_process_data), 250);  // 1 ms
   sync_manager(b, 2, 0x1100, 2, 0x64);
   b.send(command::apwr, ap(0, 0x1100), {1, 2});
   b.escs[0].advance(999'000);
@@ -461,7 +506,7 @@ TEST(esc, the_watchdog_counts_in_units_of_40_ns_times_divider_plus_2) {
   EXPECT_EQ(b.escs[0].read16(reg::watchdog_status_process_data) & 1, 0);
   b.escs[0].advance(10'000'000);
   EXPECT_FALSE(b.escs[0].take_watchdog_event()) << "expired once, until outputs come again";
-  b.escs[0].write16(reg::watchdog_time_process_data, 0);     // 0: the watchdog is off
+  b.write16(command::apwr, ap(0, reg::watchdog_time_process_data), 0);  // 0: the watchdog is off
   b.send(command::apwr, ap(0, 0x1100), {1, 2});
   b.escs[0].advance(1'000'000'000);
   EXPECT_FALSE(b.escs[0].take_watchdog_event());

@@ -59,12 +59,12 @@ esc::esc(std::vector<std::uint8_t> eeprom) : eeprom_(std::move(eeprom)) {
     memory_[reg::station_alias] = eeprom_[8];
     memory_[reg::station_alias + 1] = eeprom_[9];
   }
-  write16(reg::dl_status, dl_pdi_operational | dl_link_port0 | dl_communication_port0 | dl_loop_port1);
-  write16(reg::al_status, static_cast<std::uint16_t>(al_state::init));
-  write16(reg::watchdog_divider, 2498);           // 100 us units: (2498 + 2) x 40 ns
-  write16(reg::watchdog_time_process_data, 1000); // 100 ms
-  write16(reg::watchdog_status_process_data, 1);  // 1 = active or not triggered yet
-  write16(reg::eeprom_control, eeprom_read_8_bytes);
+  set_register16(reg::dl_status, dl_pdi_operational | dl_link_port0 | dl_communication_port0 | dl_loop_port1);
+  set_register16(reg::al_status, static_cast<std::uint16_t>(al_state::init));
+  set_register16(reg::watchdog_divider, 2498);           // 100 us units: (2498 + 2) x 40 ns
+  set_register16(reg::watchdog_time_process_data, 1000); // 100 ms
+  set_register16(reg::watchdog_status_process_data, 1);  // 1 = active or not triggered yet
+  set_register16(reg::eeprom_control, eeprom_read_8_bytes);
 }
 
 // ---- three buffers ---------------------------------------------------------------------------
@@ -137,15 +137,16 @@ void esc::configure_sync_manager(int n, bool reset) noexcept {
   c.length = static_cast<std::uint16_t>(memory_[base + 2] | (memory_[base + 3] << 8));
   c.control = memory_[base + reg::sm_control];
   // Enabled by the master (activate bit 0) and not deactivated by the application (PDI control bit 0).
+  // A sync manager's area is process RAM: one set over the registers (or past the memory) is not
+  // enabled, so no master can lock itself out of the registers that would undo it.
   c.enabled = (memory_[base + reg::sm_activate] & 1u) != 0 && (memory_[base + reg::sm_pdi_control] & 1u) == 0 &&
-              c.length != 0;
+              c.length != 0 && c.start >= reg::process_ram && std::uint32_t{c.start} + c.length <= memory_size;
   const bool changed = c.start != s.config.start || c.length != s.config.length || c.control != s.config.control ||
                        c.enabled != s.config.enabled;
   if (!reset && !changed) return;
   s = sm_state{};
   s.config = c;
-  s.triple = c.enabled && c.buffered() && c.start >= reg::process_ram &&
-             std::uint32_t{c.start} + c.length <= memory_size;
+  s.triple = c.enabled && c.buffered();
   memory_[base + reg::sm_status] = 0;
   memory_[reg::al_event_request + 1] = static_cast<std::uint8_t>(memory_[reg::al_event_request + 1] & ~(1u << n));
   if (s.triple) {
@@ -177,8 +178,21 @@ std::uint32_t esc::read32(std::uint16_t a) const noexcept {
   return read16(a) | (static_cast<std::uint32_t>(read16(static_cast<std::uint16_t>(a + 2))) << 16);
 }
 
+bool esc::pdi_writable(std::uint16_t a) noexcept {
+  if (a >= reg::process_ram) return a < memory_size;
+  if (a >= reg::sync_manager0 && a < reg::sync_manager0 + 8 * sync_manager_count) {
+    return (a - reg::sync_manager0) % 8u == reg::sm_pdi_control;
+  }
+  // AL status and its code, and the AL event mask: the rest is the master's or the controller's.
+  return (a >= reg::al_status && a <= reg::al_status + 1) || (a >= reg::al_status_code && a <= reg::al_status_code + 1) ||
+         (a >= reg::al_event_mask && a <= reg::al_event_mask + 3);
+}
+
 void esc::write8(std::uint16_t a, std::uint8_t v) noexcept {
-  if (a >= memory_size) return;
+  if (!pdi_writable(a)) {
+    ++errors_.pdi_refused;
+    return;
+  }
   if (a >= reg::process_ram) {
     for (int n = 0; n < sync_manager_count; ++n) {
       sm_state& s = sms_[static_cast<std::size_t>(n)];
@@ -206,6 +220,11 @@ void esc::write16(std::uint16_t a, std::uint16_t v) noexcept {
   write8(static_cast<std::uint16_t>(a + 1), static_cast<std::uint8_t>(v >> 8));
 }
 
+void esc::set_register16(std::uint16_t a, std::uint16_t v) noexcept {
+  memory_[a] = static_cast<std::uint8_t>(v);
+  memory_[a + 1u] = static_cast<std::uint8_t>(v >> 8);
+}
+
 void esc::set_al_status(std::uint8_t status, std::uint16_t code) noexcept {
   write16(reg::al_status, status);
   write16(reg::al_status_code, code);
@@ -215,7 +234,7 @@ void esc::set_next_port_open(bool open) noexcept {
   std::uint16_t dl = read16(reg::dl_status);
   dl = static_cast<std::uint16_t>(dl & ~(dl_link_port1 | dl_communication_port1 | dl_loop_port1));
   dl |= open ? (dl_link_port1 | dl_communication_port1) : dl_loop_port1;
-  write16(reg::dl_status, dl);
+  set_register16(reg::dl_status, dl);
 }
 
 bool esc::take_al_control_event() noexcept {
@@ -372,7 +391,7 @@ void esc::register_written(std::uint16_t address, std::uint16_t length) noexcept
     } else if (cmd != 0 && cmd != 0x0400) {
       control |= eeprom_error_command;  // writes are not offered: the image is the drive's own
     }
-    write16(reg::eeprom_control, control);
+    set_register16(reg::eeprom_control, control);
   }
 }
 
@@ -568,9 +587,9 @@ void esc::advance(std::uint64_t ns) noexcept {
   }
   since_trigger_ns_ += ns;
   if (since_trigger_ns_ > limit && (read16(reg::watchdog_status_process_data) & 1u)) {
-    write16(reg::watchdog_status_process_data, 0);  // expired
-    write16(reg::watchdog_counter_process_data,
-            static_cast<std::uint16_t>(read16(reg::watchdog_counter_process_data) + 1));
+    set_register16(reg::watchdog_status_process_data, 0);  // expired
+    set_register16(reg::watchdog_counter_process_data,
+                   static_cast<std::uint16_t>(read16(reg::watchdog_counter_process_data) + 1));
     watchdog_event_ = true;
   }
 }

@@ -54,6 +54,7 @@ inline constexpr std::uint16_t al_status = 0x0130;
 inline constexpr std::uint16_t al_status_code = 0x0134;
 inline constexpr std::uint16_t pdi_control = 0x0140;
 inline constexpr std::uint16_t event_mask = 0x0200;
+inline constexpr std::uint16_t al_event_mask = 0x0204;
 inline constexpr std::uint16_t event_request = 0x0210;
 inline constexpr std::uint16_t al_event_request = 0x0220;  ///< PDI side: bit 0 AL control, bit 8+n SM n
 inline constexpr std::uint16_t rx_errors = 0x0300;
@@ -108,7 +109,10 @@ class esc {
   std::uint8_t read8(std::uint16_t address) const noexcept;
   std::uint16_t read16(std::uint16_t address) const noexcept;
   std::uint32_t read32(std::uint16_t address) const noexcept;
-  /// PDI writes: any register the application owns (AL status and code, process RAM, ...).
+  /// PDI writes, to what an application owns: process RAM, the AL status (0x0130) and its code
+  /// (0x0134), the AL event mask (0x0204) and a sync manager's PDI control (0x0807 + 8 n). Any other
+  /// address is refused and counted (errors().pdi_refused): an application cannot write over the
+  /// identity, the station address or a sync manager's configuration.
   /// Inside a buffered sync manager both go to the application's buffer: reads see the outputs it
   /// took last, writes fill the inputs the master reads next (see the top of this file).
   void write8(std::uint16_t address, std::uint8_t v) noexcept;
@@ -125,7 +129,8 @@ class esc {
   /// The process data watchdog expired (the master stopped writing outputs).
   bool take_watchdog_event() noexcept;
 
-  /// Sync manager n as the master configured it.
+  /// Sync manager n as the master configured it. Enabled only when activated (and not deactivated
+  /// by the application) with an area inside process RAM (0x1000..0x1FFF), as on an ESC.
   struct sync_manager {
     std::uint16_t start = 0;
     std::uint16_t length = 0;
@@ -155,10 +160,11 @@ class esc {
     std::uint32_t past_memory = 0;      ///< a physical access (or an FMMU's target) beyond 0x1FFF
     std::uint32_t sync_manager = 0;     ///< a full mailbox written, an empty one read, a read-only buffer written
     std::uint32_t unknown_command = 0;  ///< a command byte no command has
+    std::uint32_t pdi_refused = 0;      ///< an application write outside what the PDI may write
   };
   const error_counters& errors() const noexcept { return errors_; }
   std::uint32_t refused_accesses() const noexcept {
-    return errors_.past_memory + errors_.sync_manager + errors_.unknown_command;
+    return errors_.past_memory + errors_.sync_manager + errors_.unknown_command;  // the master's, not the PDI's
   }
   /// Tells the controller whether a slave follows it (the DL status shows port 1 open or closed).
   void set_next_port_open(bool open) noexcept;
@@ -177,6 +183,9 @@ class esc {
     bool published = false;   // any buffer was published since the configuration
   };
 
+  static bool pdi_writable(std::uint16_t address) noexcept;
+  // The controller's own register updates (status it shows, its constructor's values).
+  void set_register16(std::uint16_t address, std::uint16_t v) noexcept;
   std::uint8_t* buffer(const sm_state& s, std::uint8_t which) noexcept;
   const std::uint8_t* buffer(const sm_state& s, std::uint8_t which) const noexcept;
   // The sync manager (three-buffer) whose area holds this byte, or nullptr.
