@@ -208,5 +208,78 @@ TEST(drive_slave, a_silent_master_trips_the_watchdog_and_0x6007_acts) {
   EXPECT_EQ(mbx.data[8] | (mbx.data[9] << 8), 0x8130);
 }
 
+TEST(drive_slave, a_mapping_entry_of_0_bits_is_refused_when_it_is_counted_in) {
+  // 0x1600:1 = the control word, 0x1600:2 = 0, then 0x1600:0 = 2: the second entry maps nothing
+  // of no length, which OP would have decoded with a shift by -1.
+  bench b;
+  b.to_pre_op();
+  const auto count = static_cast<std::uint8_t>(b.upload(0x1600, 0));
+  std::vector<std::uint32_t> entries;
+  for (std::uint8_t k = 1; k <= count; ++k) entries.push_back(static_cast<std::uint32_t>(b.upload(0x1600, k)));
+  EXPECT_EQ(b.download(0x1600, 0, 0, 1), 0u);
+  EXPECT_EQ(b.download(0x1600, 1, 0x60400010, 4), 0u);
+  EXPECT_EQ(b.download(0x1600, 2, 0, 4), 0u) << "an entry may be cleared while it is not counted";
+  EXPECT_EQ(b.download(0x1600, 0, 2, 1), 0x06040041u);
+  EXPECT_EQ(b.upload(0x1600, 0), 0) << "refused whole: the count stays";
+  EXPECT_EQ(b.download(0x1600, 2, 0x60400000, 4), 0x06040041u) << "an object of 0 bits";
+  // The default mapping back, which the SII's sync manager length is made for.
+  for (std::uint8_t k = 1; k <= count; ++k) EXPECT_EQ(b.download(0x1600, k, entries[k - 1u], 4), 0u);
+  EXPECT_EQ(b.download(0x1600, 0, count, 1), 0u);
+  b.to_op();
+  std::uint16_t sw = 0;
+  for (std::uint16_t cw : {0x0006, 0x0007, 0x000F}) {
+    for (int i = 0; i < 40; ++i) sw = b.cycle(cw);
+  }
+  EXPECT_EQ(sw & 0x6F, 0x27) << "the one entry left runs the drive";
+}
+
+TEST(drive_slave, a_sync_manager_moved_in_op_takes_the_slave_back_and_never_its_registers) {
+  // In OP, one APRW of four zero bytes at 0x0816: SM2's activate and PDI control, and SM3's start
+  // (low word) now 0x0000. The drive's inputs would have gone over the identity, the station
+  // address and the alias. The slave leaves the state that checked them instead.
+  bench b;
+  b.to_op();
+  for (int i = 0; i < 5; ++i) b.cycle(0x0006);
+  const std::uint16_t alias = b.read16(reg::station_alias);
+  const std::uint16_t type = b.read16(reg::type);
+  EXPECT_EQ(b.send(command::aprw, static_cast<std::uint32_t>(reg::sync_manager0 + 0x16) << 16, {0, 0, 0, 0}).wkc, 3);
+  b.run(5);
+  EXPECT_EQ(b.read16(reg::station_address), station);
+  EXPECT_EQ(b.read16(reg::station_alias), alias);
+  EXPECT_EQ(b.read16(reg::type), type);
+  EXPECT_EQ(b.read16(reg::al_status), 0x12) << "PRE-OP with the error flag";
+  const std::uint16_t code = b.read16(reg::al_status_code);
+  EXPECT_TRUE(code == al_code::invalid_output_configuration || code == al_code::invalid_input_configuration) << code;
+  EXPECT_EQ(b.slave.controller().errors().pdi_refused, 0u) << "the application never tried a register";
+  EXPECT_EQ(b.request(8), 0x12) << "OP is not taken back without the checks of SAFE-OP";
+}
+
+TEST(drive_slave, each_sync_manager_change_after_its_check_has_its_own_al_status_code) {
+  struct change {
+    int sm;
+    std::uint16_t start_or_length;  // written to the start (SM0/SM3) or the length (SM2)
+    std::uint16_t offset;
+    std::uint16_t code;
+    std::uint16_t status;  // where the slave goes, with the error flag
+  };
+  for (const change& c : {change{3, 0x1190, 0, al_code::invalid_input_configuration, 0x12},
+                          change{2, 1, 2, al_code::invalid_output_configuration, 0x12},
+                          change{0, 0x1010, 0, al_code::invalid_mailbox_configuration, 0x11}}) {
+    bench b;
+    b.to_op();
+    for (int i = 0; i < 5; ++i) b.cycle(0x0006);
+    b.write16(static_cast<std::uint16_t>(reg::sync_manager0 + 8 * c.sm + c.offset), c.start_or_length);
+    b.run(2);
+    EXPECT_EQ(b.read16(reg::al_status), c.status) << "SM" << c.sm;
+    EXPECT_EQ(b.read16(reg::al_status_code), c.code) << "SM" << c.sm;
+    // Acknowledged and set up again as it was checked, the way up is open again.
+    if (c.status == 0x11) continue;
+    const slave_description& d = b.slave.description();
+    b.sync_manager(c.sm, d.sync_managers[static_cast<std::size_t>(c.sm)]);
+    EXPECT_EQ(b.request(0x14), 4);
+    EXPECT_EQ(b.request(8), 8);
+  }
+}
+
 }  // namespace
 }  // namespace cia402::ethercat

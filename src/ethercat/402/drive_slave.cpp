@@ -1,6 +1,8 @@
 #include "cia402/ethercat/402/drive_slave.hpp"
 
 #include <algorithm>
+#include <array>
+#include <span>
 
 #include "cia402/ethercat/402/drive_description.hpp"
 
@@ -76,6 +78,16 @@ sdo_abort drive_slave::read_value(const canopen::object_dictionary::slot& s, std
   return sdo_abort::none;
 }
 
+bool drive_slave::entry_mappable(std::uint16_t mapping, std::uint32_t m) const {
+  // An entry names an object of the dictionary, mappable in this direction, of its own size.
+  const canopen::object_dictionary::slot* target = od_.find(static_cast<std::uint16_t>(m >> 16),
+                                                              static_cast<std::uint8_t>(m >> 8));
+  const bool rx = mapping < 0x1A00;
+  return target != nullptr && target->entry->pdo_mappable &&
+         (rx ? canopen::writable(target->entry->acc) : !canopen::writable(target->entry->acc)) &&
+         canopen::type_size(target->entry->type) * 8 == (m & 0xFFu) && (m & 0xFFu) != 0;
+}
+
 sdo_abort drive_slave::write_value(canopen::object_dictionary::slot& s, std::int64_t v) {
   const std::uint16_t index = s.object->index;
   const std::uint8_t sub = s.entry->sub;
@@ -83,21 +95,18 @@ sdo_abort drive_slave::write_value(canopen::object_dictionary::slot& s, std::int
   if (mapping_object(index) || assignment_object(index)) {
     // The process data are configured in PRE-OP only.
     if (state_ != al_state::pre_operational) return sdo_abort::cannot_store_in_present_state;
-    if (mapping_object(index) && sub != 0 && v != 0) {
-      // An entry names an object of the dictionary, mappable in this direction, of its own size.
-      const auto m = static_cast<std::uint32_t>(v);
-      const canopen::object_dictionary::slot* target = od_.find(static_cast<std::uint16_t>(m >> 16),
-                                                                  static_cast<std::uint8_t>(m >> 8));
-      const bool rx = index < 0x1A00;
-      if (target == nullptr || !target->entry->pdo_mappable ||
-          (rx ? !canopen::writable(target->entry->acc) : canopen::writable(target->entry->acc)) ||
-          canopen::type_size(target->entry->type) * 8 != (m & 0xFFu)) {
-        return sdo_abort::cannot_map_to_pdo;
-      }
+    if (mapping_object(index) && sub != 0 && v != 0 && !entry_mappable(index, static_cast<std::uint32_t>(v))) {
+      return sdo_abort::cannot_map_to_pdo;
     }
     if (mapping_object(index) && sub == 0) {
+      // The entries it counts in are checked again: one left 0 (or never written) maps nothing of
+      // no length, which the process data cannot carry.
       unsigned bits = 0;
-      for (std::int64_t k = 1; k <= v; ++k) bits += static_cast<std::uint32_t>(od_.number(index, static_cast<std::uint8_t>(k))) & 0xFFu;
+      for (std::int64_t k = 1; k <= v; ++k) {
+        const auto m = static_cast<std::uint32_t>(od_.number(index, static_cast<std::uint8_t>(k)));
+        if (!entry_mappable(index, m)) return sdo_abort::cannot_map_to_pdo;
+        bits += m & 0xFFu;
+      }
       if ((bits + 7) / 8 > max_process_data) return sdo_abort::pdo_length_exceeded;
     }
     if (assignment_object(index) && sub != 0 && v != 0) {
@@ -175,6 +184,8 @@ void drive_slave::handle_al_control() {
         if (!process_data_sync_manager_sound(sm_inputs, input_bytes(), false)) {
           return refuse(al_code::invalid_input_configuration);
         }
+        outputs_checked_ = esc_.sm(sm_outputs);
+        inputs_checked_ = esc_.sm(sm_inputs);
       }
       enter(al_state::safe_operational);
       return;
@@ -183,6 +194,30 @@ void drive_slave::handle_al_control() {
       enter(al_state::operational);
       return;
     default: refuse(al_code::unknown_state); return;
+  }
+}
+
+bool drive_slave::same(const esc::sync_manager& a, const esc::sync_manager& b) noexcept {
+  return a.start == b.start && a.length == b.length && a.control == b.control && a.enabled == b.enabled;
+}
+
+void drive_slave::watch_sync_managers() {
+  // A sync manager the master changes after the state that checked it takes the slave back to where
+  // it is checked again, with the code that says which (as the ETG's slave code does): the mailbox
+  // to INIT, the process data to PRE-OP. Until then nothing is read from it or written to it.
+  if (state_ == al_state::init) return;
+  if (!mailbox_sync_managers_sound()) {
+    refuse(al_code::invalid_mailbox_configuration);
+    return enter(al_state::init);
+  }
+  if (state_ != al_state::safe_operational && state_ != al_state::operational) return;
+  if (!same(esc_.sm(sm_outputs), outputs_checked_)) {
+    refuse(al_code::invalid_output_configuration);
+    return enter(al_state::pre_operational);
+  }
+  if (!same(esc_.sm(sm_inputs), inputs_checked_)) {
+    refuse(al_code::invalid_input_configuration);
+    return enter(al_state::pre_operational);
   }
 }
 
@@ -195,17 +230,18 @@ void drive_slave::serve_mailbox() {
 
 void drive_slave::exchange_process_data() {
   if (state_ != al_state::safe_operational && state_ != al_state::operational) return;
-  // Outputs: a whole buffer from the master, in OP only.
+  // Whole buffers through the sync managers checked on the way to SAFE-OP: the application reaches
+  // process RAM only, in the buffer the controller gives it.
+  std::array<std::uint8_t, max_process_data> buffer{};
   const bool outputs_arrived = esc_.take_sync_manager_event(sm_outputs);
-  if (state_ == al_state::operational && outputs_arrived) {
-    const esc::sync_manager sm = esc_.sm(sm_outputs);
+  const std::size_t out_bytes = outputs_checked_.enabled ? outputs_checked_.length : 0;
+  if (state_ == al_state::operational && outputs_arrived && out_bytes <= buffer.size() &&
+      esc_.read_buffer(sm_outputs, std::span(buffer.data(), out_bytes))) {
     unsigned bit = 0;
     for (const mapped& m : mapping(0x1C12)) {
+      if (m.bits == 0 || m.bits > 64 || bit + m.bits > 8 * out_bytes) break;
       std::uint64_t raw = 0;
-      for (unsigned b = 0; b < m.bits; ++b, ++bit) {
-        const std::uint8_t byte = esc_.read8(static_cast<std::uint16_t>(sm.start + bit / 8));
-        raw |= static_cast<std::uint64_t>((byte >> (bit % 8)) & 1u) << b;
-      }
+      for (unsigned b = 0; b < m.bits; ++b, ++bit) raw |= static_cast<std::uint64_t>((buffer[bit / 8] >> (bit % 8)) & 1u) << b;
       std::int64_t value = static_cast<std::int64_t>(raw);
       if (m.bits < 64 && (raw >> (m.bits - 1)) & 1u) {
         // Signed objects come sign-extended: the dictionary's type decides.
@@ -216,25 +252,25 @@ void drive_slave::exchange_process_data() {
     }
   }
   // Inputs: every cycle, so the master always reads the present values.
-  const esc::sync_manager sm = esc_.sm(sm_inputs);
-  if (!sm.enabled) return;
+  const std::size_t in_bytes = inputs_checked_.enabled ? inputs_checked_.length : 0;
+  if (in_bytes == 0 || in_bytes > buffer.size()) return;
+  buffer.fill(0);
   unsigned bit = 0;
   for (const mapped& m : mapping(0x1C13)) {
+    if (m.bits == 0 || m.bits > 64 || bit + m.bits > 8 * in_bytes) break;
     std::int64_t value = 0;
     if (m.index != 0) (void)read(m.index, m.sub, value);
     const auto raw = static_cast<std::uint64_t>(value);
     for (unsigned b = 0; b < m.bits; ++b, ++bit) {
-      const auto address = static_cast<std::uint16_t>(sm.start + bit / 8);
-      std::uint8_t byte = esc_.read8(address);
-      const auto mask = static_cast<std::uint8_t>(1u << (bit % 8));
-      byte = static_cast<std::uint8_t>(((raw >> b) & 1u) ? (byte | mask) : (byte & ~mask));
-      esc_.write8(address, byte);
+      if ((raw >> b) & 1u) buffer[bit / 8] = static_cast<std::uint8_t>(buffer[bit / 8] | (1u << (bit % 8)));
     }
   }
+  (void)esc_.write_buffer(sm_inputs, std::span<const std::uint8_t>(buffer.data(), in_bytes));
 }
 
 void drive_slave::step(std::uint32_t elapsed_us) {
   if (esc_.take_al_control_event()) handle_al_control();
+  watch_sync_managers();
   serve_mailbox();
   exchange_process_data();
   device_.step(elapsed_us);

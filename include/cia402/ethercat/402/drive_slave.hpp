@@ -13,7 +13,12 @@
 // Process data: in SAFE-OP and OP the inputs (SM3) carry the assigned TxPDOs' objects every cycle;
 // in OP the outputs (SM2) are written to the drive when a whole buffer arrived. PDO mappings and
 // assignments are written in PRE-OP only (0x08000022 otherwise), and only with objects that are PDO
-// mappable the right way and fit the process data room.
+// mappable the right way and fit the process data room; an entry of 0 bits, or a count that takes
+// in an entry left empty, is refused (0x06040041).
+//
+// Sync managers changed under a state that checked them take the slave back (with the error flag):
+// SM0/SM1 in PRE-OP or above to INIT (0x0016), SM2/SM3 in SAFE-OP or OP to PRE-OP (0x001D / 0x001E).
+// The application moves process data through the controller's buffers only, never into registers.
 #pragma once
 
 #include <cstdint>
@@ -74,6 +79,9 @@ class drive_slave final : private canopen::dictionary_access, private canopen::d
   void enter(al_state s);
   bool mailbox_sync_managers_sound() const;
   bool process_data_sync_manager_sound(int n, std::uint16_t bytes, bool outputs) const;
+  bool entry_mappable(std::uint16_t mapping, std::uint32_t entry) const;
+  static bool same(const esc::sync_manager& a, const esc::sync_manager& b) noexcept;
+  void watch_sync_managers();
   void exchange_process_data();
   void serve_mailbox();
 
@@ -92,6 +100,9 @@ class drive_slave final : private canopen::dictionary_access, private canopen::d
   al_state state_ = al_state::init;
   bool error_ = false;
   std::uint16_t code_ = al_code::none;
+  // SM2 and SM3 as the way to SAFE-OP found them sound: the only layout process data moves through.
+  esc::sync_manager outputs_checked_{};
+  esc::sync_manager inputs_checked_{};
 };
 
 }  // namespace cia402::ethercat
