@@ -44,8 +44,12 @@ class hostile_line final : public master_link {
   std::vector<std::optional<std::vector<std::uint8_t>>> sii;
   /// Whether this datagram never reaches slave `i`: it passes that slave untouched.
   std::function<bool(std::size_t i, const datagram& d)> lose;
+  /// Changes a datagram just before slave `i` serves it (a slave that does what its SII did not say).
+  std::function<void(std::size_t i, datagram& d)> rewrite;
   /// The whole frame is lost (before any slave sees it).
   std::function<bool()> lose_frame;
+  /// Changes the frame on its way back, after every slave served it.
+  std::function<void(std::vector<std::uint8_t>& frame)> tamper;
   std::uint64_t time_limit_us = 3'600'000'000ull;
   std::uint32_t exchange_us = 20;  // a frame takes time on any line: every loop of the master moves on
 
@@ -54,16 +58,19 @@ class hostile_line final : public master_link {
     ++frames;
     if (lose_frame && lose_frame()) return false;
     parsed_frame parsed;
-    if (parse_frame(frame, parsed) != frame_error::none) return true;  // a frame no slave takes comes back as sent
-    for (std::size_t k = 0; k < parsed.count; ++k) {
-      datagram& d = parsed.datagrams[k];
-      for (std::size_t i = 0; i < escs_.size(); ++i) {
-        if (lose && lose(i, d)) continue;
-        const bool mine = d.position() == escs_[i]->read16(reg::station_address);
-        escs_[i]->process(d);
-        if (mine && d.cmd == command::fprd) serve_sii(i, d);
+    if (parse_frame(frame, parsed) == frame_error::none) {  // a frame no slave takes comes back as sent
+      for (std::size_t k = 0; k < parsed.count; ++k) {
+        datagram& d = parsed.datagrams[k];
+        for (std::size_t i = 0; i < escs_.size(); ++i) {
+          if (lose && lose(i, d)) continue;
+          const bool mine = d.position() == escs_[i]->read16(reg::station_address);
+          if (mine && rewrite) rewrite(i, d);
+          escs_[i]->process(d);
+          if (mine && d.cmd == command::fprd) serve_sii(i, d);
+        }
       }
     }
+    if (tamper) tamper(frame);
     return true;
   }
   std::uint64_t now_us() override { return now; }

@@ -381,9 +381,14 @@ std::optional<std::vector<std::uint8_t>> ecat_master::mailbox_receive(ecat_slave
   }
 }
 
-ecat_sdo_result ecat_master::sdo(ecat_slave& s, const std::vector<std::uint8_t>& request, std::uint16_t index,
+ecat_sdo_result ecat_master::sdo(std::size_t i, const std::vector<std::uint8_t>& request, std::uint16_t index,
                                  std::uint8_t sub) {
   ecat_sdo_result result;
+  if (i >= slaves_.size()) {
+    result.error = "no slave " + std::to_string(i) + ": the line has " + std::to_string(slaves_.size());
+    return result;
+  }
+  ecat_slave& s = slaves_[i];
   if (!s.mailbox) {
     result.error = slave_text(s) + " has no CoE mailbox";
     return result;
@@ -472,7 +477,7 @@ ecat_sdo_result ecat_master::sdo_read(std::size_t i, std::uint16_t index, std::u
   put_le(r, index, 2);
   r.push_back(sub);
   put_le(r, 0, 4);
-  return sdo(slaves_.at(i), r, index, sub);
+  return sdo(i, r, index, sub);
 }
 
 ecat_sdo_result ecat_master::sdo_write(std::size_t i, std::uint16_t index, std::uint8_t sub, std::int64_t value,
@@ -483,7 +488,7 @@ ecat_sdo_result ecat_master::sdo_write(std::size_t i, std::uint16_t index, std::
   r.push_back(sub);
   put_le(r, static_cast<std::uint64_t>(value), bytes);
   r.resize(8, 0);
-  return sdo(slaves_.at(i), r, index, sub);
+  return sdo(i, r, index, sub);
 }
 
 // --- process data ------------------------------------------------------------------------------------

@@ -134,6 +134,7 @@ class ecat_master {
   /// Whether every slave shows OP (as the last cycle or status read saw it).
   bool all_operational() const noexcept;
 
+  /// SDO transfers with slave `i` (an error result, not an exception, for one the line does not have).
   ecat_sdo_result sdo_read(std::size_t i, std::uint16_t index, std::uint8_t sub);
   ecat_sdo_result sdo_write(std::size_t i, std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes);
 
@@ -165,7 +166,7 @@ class ecat_master {
   bool configure_process_data(ecat_slave& s, std::uint32_t& logical);
   bool mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe);
   std::optional<std::vector<std::uint8_t>> mailbox_receive(ecat_slave& s);
-  ecat_sdo_result sdo(ecat_slave& s, const std::vector<std::uint8_t>& request, std::uint16_t index, std::uint8_t sub);
+  ecat_sdo_result sdo(std::size_t i, const std::vector<std::uint8_t>& request, std::uint16_t index, std::uint8_t sub);
   bool fail(std::string text);
   // Forgets the process image: no cycle runs until bring_to_operational() builds the next.
   void stop_cycling();
