@@ -4,7 +4,8 @@
 // whatever the SII said), then, frame by frame, whether the line passes the answers, changes or
 // replaces their bytes, loses the frame, loses one slave's datagrams, delays the answer, or loses a
 // slave's AL status reads for a while. The master is asked for everything a tool does with it: a
-// cycle before any bring-up, scan, SDOs, OP, cycles, back to PRE-OP, a remap, OP again.
+// cycle before any bring-up, scan, SDOs, OP, cycles, back to PRE-OP, a remap of drive 0's outputs
+// (up to 12 entries, the control word anywhere among them), OP again.
 // Promise: no crash, no sanitizer report, and every step of the master ends (link time bounds each
 // wait; libFuzzer's -timeout catches one that does not): whatever the line says, a master never
 // hangs on it or reads or writes outside its buffers.
@@ -126,6 +127,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   line.time_limit_us = 36'000'000'000ull;  // 10 h of link time: far past any wait's limit; the wall-clock -timeout comes first
   const std::size_t drives = line.slaves.size();
   const bool lying_mailbox = (shape & 0x08) != 0;
+  // The remap after the first OP: how many entries 0x1601 gets (the control word among 32-bit
+  // set-points), and how many 0x1600 gets ahead of it in 0x1C12 (none: 0x1601 alone).
+  const std::uint8_t remap = in.byte();
+  const std::uint8_t entries = static_cast<std::uint8_t>(1 + remap % 12);
+  const std::uint8_t control_at = static_cast<std::uint8_t>(1 + (remap >> 4) % entries);
+  const std::uint8_t ahead = static_cast<std::uint8_t>(in.byte() % 13);
   for (std::size_t i = 0; i < drives; ++i) {
     if (shape & (0x02u << i)) line.describe(i, [&](slave_description& d) { lie_about(d, in); });
   }
@@ -158,11 +165,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!m.bring_to_pre_operational()) return 0;
   (void)m.sdo_write(0, 0x1C12, 0, 0, 1);
   (void)m.sdo_write(0, 0x1601, 0, 0, 1);
-  (void)m.sdo_write(0, 0x1601, 1, 0x60400010, 4);
-  (void)m.sdo_write(0, 0x1601, 2, 0x607A0020, 4);
-  (void)m.sdo_write(0, 0x1601, 0, 2, 1);
-  (void)m.sdo_write(0, 0x1C12, 1, 0x1601, 2);
-  (void)m.sdo_write(0, 0x1C12, 0, 1, 1);
+  for (std::uint8_t k = 1; k <= entries; ++k) {
+    (void)m.sdo_write(0, 0x1601, k, k == control_at ? 0x60400010 : 0x607A0020, 4);
+  }
+  (void)m.sdo_write(0, 0x1601, 0, entries, 1);
+  std::uint8_t assigned = 0;
+  if (ahead > 0) {
+    (void)m.sdo_write(0, 0x1600, 0, 0, 1);
+    for (std::uint8_t k = 1; k <= ahead; ++k) (void)m.sdo_write(0, 0x1600, k, 0x607A0020, 4);
+    (void)m.sdo_write(0, 0x1600, 0, ahead, 1);
+    (void)m.sdo_write(0, 0x1C12, ++assigned, 0x1600, 2);
+  }
+  (void)m.sdo_write(0, 0x1C12, ++assigned, 0x1601, 2);
+  (void)m.sdo_write(0, 0x1C12, 0, assigned, 1);
   if (!m.bring_to_operational()) return 0;
   (void)m.set_output(0, 0x607A, 1000);
   for (int i = 0; i < 20; ++i) {
