@@ -140,6 +140,7 @@ TEST(eds_reader, a_file_that_does_not_parse_is_refused_with_its_line) {
       {"[1000]\nDataType=0x0007\nAccessType=rx\n", 3, "AccessType 'rx'"},
       {"[2000]\nObjectType=0x8\nDataType=0x0005\nCompactSubObj=300\n", 1, "CompactSubObj above 254"},
       {"[DeviceComissioning]\nNodeID=128\n", 2, "NodeID '128' is not 1..127"},
+      {"[1A00sub1]\nDataType=0x0007\n", 1, "[1A00sub1] has no object section [1A00]"},
   };
   for (const auto& b : bad) {
     const auto r = read_eds(b.text);

@@ -14,6 +14,7 @@ struct value_line {
 
 // One section: its keys (lower case) with their values and lines.
 struct section {
+  std::string written;  // the name as the file spells it
   std::size_t line = 0;
   std::map<std::string, value_line> keys;
 };
@@ -88,6 +89,13 @@ class reader {
     if (!split()) return error_;
     eds_contents out;
     for (const auto& [name, s] : sections_) {
+      const bool sub_section = name.size() > 7 && name.compare(4, 3, "sub") == 0 && hex_number(name.substr(0, 4), 4) &&
+                               hex_number(std::string_view(name).substr(7), 2);
+      if (sub_section && sections_.count(name.substr(0, 4)) == 0) {
+        return eds_error{s.line, "[" + s.written + "] has no object section [" + s.written.substr(0, 4) + "]"};
+      }
+    }
+    for (const auto& [name, s] : sections_) {
       if (name.size() != 4) continue;
       const auto index = hex_number(name, 4);
       if (!index) continue;
@@ -137,6 +145,7 @@ class reader {
         auto [it, fresh] = sections_.try_emplace(name);
         if (!fresh) return fail(number, "section [" + std::string(line.substr(1, line.size() - 2)) + "] appears twice");
         it->second.line = number;
+        it->second.written = std::string(trim(line.substr(1, line.size() - 2)));
         current = &it->second;
         continue;
       }

@@ -116,26 +116,31 @@ bool parse_data(std::string_view text, frame& f, std::string& why) {
 
 }  // namespace
 
+std::string format_frame(const frame& f) {
+  char id[16];
+  std::snprintf(id, sizeof id, f.extended ? "%08X#" : "%03X#", static_cast<unsigned>(f.id));
+  std::string text = id;
+  if (f.rtr) {
+    text += 'R';
+    if (f.len != 0) text += static_cast<char>('0' + (f.len > 8 ? 8 : f.len));
+    return text;
+  }
+  static constexpr char digits[] = "0123456789ABCDEF";
+  for (std::size_t i = 0; i < f.len && i < f.data.size(); ++i) {
+    text += digits[f.data[i] >> 4];
+    text += digits[f.data[i] & 0x0F];
+  }
+  return text;
+}
+
 std::string format_line(const frame& f, std::uint64_t time_us, std::string_view interface) {
   char head[48];
   std::snprintf(head, sizeof head, "(%llu.%06llu) ", static_cast<unsigned long long>(time_us / 1000000),
                 static_cast<unsigned long long>(time_us % 1000000));
   std::string line = head;
   line.append(interface);
-  char id[16];
-  std::snprintf(id, sizeof id, f.extended ? " %08X#" : " %03X#", static_cast<unsigned>(f.id));
-  line += id;
-  if (f.rtr) {
-    line += 'R';
-    if (f.len != 0) line += static_cast<char>('0' + (f.len > 8 ? 8 : f.len));
-    return line;
-  }
-  static constexpr char digits[] = "0123456789ABCDEF";
-  for (std::size_t i = 0; i < f.len && i < f.data.size(); ++i) {
-    line += digits[f.data[i] >> 4];
-    line += digits[f.data[i] & 0x0F];
-  }
-  return line;
+  line += ' ';
+  return line + format_frame(f);
 }
 
 bool parse_line(std::string_view line, log_entry& out, std::string& why) {

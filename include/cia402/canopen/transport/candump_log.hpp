@@ -27,6 +27,8 @@ struct log_entry {
   frame f;
 };
 
+/// The frame as candump writes it: "183#3706", "01ABCDEF#DEAD", "701#R".
+std::string format_frame(const frame& f);
 /// The line for one frame, without the newline: "(1700000000.123456) can0 183#3706".
 std::string format_line(const frame& f, std::uint64_t time_us, std::string_view interface);
 
