@@ -56,9 +56,9 @@ class printer {
   }
 
  private:
-  static nlohmann::json json(const decoded_frame& d, double since) {
+  static nlohmann::ordered_json json(const decoded_frame& d, double since) {
     using canopen::monitor::frame_kind;
-    nlohmann::json j;
+    nlohmann::ordered_json j;
     j["time"] = static_cast<double>(d.time_us) / 1e6;
     j["time_us"] = d.time_us;
     j["t"] = since;
@@ -90,11 +90,11 @@ class printer {
       if (!d.code_text.empty()) j["code_text"] = d.code_text;
     }
     if (!d.values.empty()) {
-      nlohmann::json values = nlohmann::json::array();
+      nlohmann::ordered_json values = nlohmann::ordered_json::array();
       for (const auto& v : d.values) {
         char object[16];
         std::snprintf(object, sizeof object, "0x%04X:%u", v.index, v.sub);
-        nlohmann::json e{{"object", object}, {"shown", v.shown}};
+        nlohmann::ordered_json e{{"object", object}, {"shown", v.shown}};
         if (v.is_number) e["value"] = v.number;
         if (!v.name.empty()) e["name"] = v.name;
         if (!v.unit.empty()) e["unit"] = v.unit;
