@@ -36,7 +36,10 @@ class printer {
   printer(const monitor_args& a, std::ostream& out) : args_(a), out_(out) {}
 
   void print(const decoded_frame& d) {
-    if (!started_) first_us_ = d.time_us, started_ = true;
+    if (!started_) {
+      first_us_ = d.time_us;
+      started_ = true;
+    }
     const double since = static_cast<double>(d.time_us - std::min(d.time_us, first_us_)) / 1e6;
     if (args_.json) {
       out_ << json(d, since).dump() << "\n";
@@ -52,7 +55,7 @@ class printer {
                                           : "node " + std::to_string(d.node);
       out_ << who << std::string(who.size() < 9 ? 9 - who.size() : 1, ' ') << d.text << "\n";
     }
-    if (args_.url.size() != 0) out_.flush();  // a live bus: each frame as it comes
+    if (!args_.url.empty()) out_.flush();  // a live bus: each frame as it comes
   }
 
  private:
