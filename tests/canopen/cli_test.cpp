@@ -227,6 +227,14 @@ TEST(cli_bus, bad_options_are_refused_before_listening) {
   EXPECT_NE(remote.err.find("--allow-remote"), std::string::npos) << remote.err;
 }
 
+TEST(cli_bus, a_log_file_that_cannot_be_created_is_refused_before_listening) {
+  const result r = run_tool({"bus", "--listen", "127.0.0.1:0", "--log", "/nonexistent-folder/bus.log"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--log /nonexistent-folder/bus.log: cannot create the file"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.out.find("socketcand on"), std::string::npos) << r.out;
+}
+
 TEST(cli_bus, node_lists_parse_ranges_and_singles) {
   std::vector<std::uint8_t> ids;
   std::string why;

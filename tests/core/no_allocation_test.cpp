@@ -6,6 +6,8 @@
 
 #include "test_support.hpp"
 
+#include "cia402/error_codes.hpp"
+
 #include "counting_allocator.hpp"
 
 namespace cia402 {
@@ -104,6 +106,9 @@ TEST(no_allocation, profile_checks_names_and_custom_profiles_never_allocate) {
     state parsed{};
     sink += parse_state("operation_enabled", parsed);
     sink += sdo_abort_text(sdo_abort::invalid_value)[0];
+    for (unsigned code = 0; code <= 0xFFFF; code += 0x0101) {
+      sink += error_code_text(static_cast<std::uint16_t>(code))[0];
+    }
   });
   EXPECT_EQ(calls, 0);
   EXPECT_NE(sink, 0u);

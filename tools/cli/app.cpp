@@ -15,6 +15,7 @@
 #include "cli/ecat_slave.hpp"
 #include "cli/esi.hpp"
 #include "cli/master.hpp"
+#include "cli/monitor.hpp"
 #include "cli/path.hpp"
 #include "cli/replay.hpp"
 #include "cli/serve.hpp"
@@ -111,6 +112,8 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   auto* bus = add_bus_subcommand(app, bus_options);
   master_args master_options;
   auto* master = add_master_subcommand(app, master_options);
+  monitor_args monitor_options;
+  auto* monitor = add_monitor_subcommand(app, monitor_options);
   eds_args eds_options;
   auto* eds = add_eds_subcommand(app, eds_options);
   esi_args esi_options;
@@ -141,6 +144,7 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   if (serve->parsed()) return run_serve(serve_options, out, err);
   if (bus->parsed()) return run_bus(bus_options, out, err);
   if (master->parsed()) return run_master(master_options, out, err);
+  if (monitor->parsed()) return run_monitor(monitor_options, in, out, err);
   if (eds->parsed()) return run_eds(eds_options, out, err);
   if (esi->parsed()) return run_esi(esi_options, out, err);
   if (ecat_slave->parsed()) return run_ecat_slave(ecat_slave_options, out, err);

@@ -85,6 +85,11 @@ CLI::App* add_bus_subcommand(CLI::App& app, bus_args& args) {
   cmd->add_option("--bus-name", args.bus_name, "the bus name clients open")->default_str("can0");
   cmd->add_option("--heartbeat", args.heartbeat_ms, "each drive's heartbeat period in ms (0x1017), 0 = off")
       ->default_str("0");
+  cmd->add_option("--log", args.log,
+                  "write every frame on the bus to FILE in candump's log format "
+                  "((SECONDS.MICROS) BUS ID#DATA), readable by canplayer, python-can and "
+                  "`cia402 monitor --log`")
+      ->type_name("FILE");
   return cmd;
 }
 
@@ -112,6 +117,14 @@ int run_bus(const bus_args& args, std::ostream& out, std::ostream& err) {
   if (!choice.resolve(args.profile, args.profile_file, err)) return usage_error;
 
   apps::bus_host host(config);
+  // The log first: a path that cannot be written is refused before anything listens, and the
+  // drives' boot-up messages are on it.
+  if (!args.log.empty()) {
+    if (const auto ec = host.log_frames(args.log, args.bus_name)) {
+      err << "cia402 bus: --log " << args.log << ": cannot create the file: " << ec.message() << "\n";
+      return usage_error;
+    }
+  }
   for (std::uint8_t id : ids) {
     canopen::slave_config sc = canopen::drive_node_config(id);
     sc.heartbeat_ms = args.heartbeat_ms;
@@ -132,11 +145,17 @@ int run_bus(const bus_args& args, std::ostream& out, std::ostream& err) {
 
   out << "cia402 bus: socketcand on " << config.host << ":" << host.server().port() << " bus "
       << config.bus_name << ", " << host.drives().size() << " drive(s) (profile " << choice.get().name
-      << "), nodes " << args.nodes << std::endl;
+      << "), nodes " << args.nodes << (args.log.empty() ? "" : ", log " + args.log) << std::endl;
 
   host.run(stop_requested);
   sigaction(SIGINT, &old_int, nullptr);
   sigaction(SIGTERM, &old_term, nullptr);
+  if (const auto ec = host.log_failure()) {
+    err << "cia402 bus: --log " << args.log << ": writing failed after " << host.frames_logged()
+        << " frames: " << ec.message() << "\n";
+    out << "cia402 bus: stopped" << std::endl;
+    return 1;
+  }
   out << "cia402 bus: stopped" << std::endl;
   return 0;
 }

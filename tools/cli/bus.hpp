@@ -23,12 +23,14 @@ struct bus_args {
   std::string profile_file;
   std::string bus_name = "can0";
   std::uint16_t heartbeat_ms = 0;          ///< default of every drive's 0x1017
+  std::string log;                         ///< candump log of every frame; "" = none
 };
 
 CLI::App* add_bus_subcommand(CLI::App& app, bus_args& args);
 
-/// Runs until SIGINT or SIGTERM. Exit status 0 after a signal; 2 for a refused option (bad node list,
-/// unknown profile, address in use).
+/// Runs until SIGINT or SIGTERM. Exit status 0 after a signal (1 if the log could not be written to
+/// the end); 2 for a refused option (bad node list, unknown profile, address in use, a log file that
+/// cannot be created).
 int run_bus(const bus_args& args, std::ostream& out, std::ostream& err);
 
 /// "1-4" -> {1,2,3,4}; "1,5" -> {1,5}. False with a reason for anything outside 1..127 or repeated.

@@ -1,12 +1,20 @@
-// The wall clock as the layers below take time: microseconds passed since the last call. The only
-// clock the project's loops read (the page's cycle thread and HTTP keep-alive aside); everything
-// below the apps layer is handed time and never reads it.
+// The wall clock as the layers below take time: microseconds passed since the last call, and the
+// time of day a log line carries. The only clock the project's loops read (the page's cycle thread
+// and HTTP keep-alive aside); everything below the apps layer is handed time and never reads it.
 #pragma once
 
 #include <chrono>
 #include <cstdint>
 
 namespace cia402::apps {
+
+/// Microseconds since the Unix epoch (the system clock): the time stamped on a frame in a log.
+inline std::uint64_t unix_time_us() {
+  const auto us = std::chrono::duration_cast<std::chrono::microseconds>(
+                      std::chrono::system_clock::now().time_since_epoch())
+                      .count();
+  return us < 0 ? 0 : static_cast<std::uint64_t>(us);
+}
 
 class elapsed_clock {
  public:

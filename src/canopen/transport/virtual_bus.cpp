@@ -56,6 +56,7 @@ void virtual_bus::deliver(const frame& f, const virtual_channel* from) noexcept 
   for (virtual_channel* c : channels_) {
     if (c != from && c->accepts(f)) c->push(f);
   }
+  if (observer_) observer_(f);
 }
 
 void virtual_bus::detach(virtual_channel* c) noexcept {

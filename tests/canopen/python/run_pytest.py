@@ -1,5 +1,6 @@
 """Runs the python tests of `cia402 bus`, or skips (exit 77) saying why when python3-can or
-python3-pytest is missing. Usage: run_pytest.py CIA402_BINARY [pytest args]."""
+python3-pytest is missing. Usage: run_pytest.py CIA402_BINARY [TEST_FILE.py ...] [pytest args]:
+the named files of this folder, or every test file in it."""
 import os
 import sys
 
@@ -19,4 +20,6 @@ import pytest  # noqa: E402
 
 os.environ["CIA402_BIN"] = sys.argv[1]
 here = os.path.dirname(os.path.abspath(__file__))
-sys.exit(pytest.main(["-q", "-p", "no:cacheprovider", here] + sys.argv[2:]))
+files = [os.path.join(here, a) for a in sys.argv[2:] if a.endswith(".py")]
+rest = [a for a in sys.argv[2:] if not a.endswith(".py")]
+sys.exit(pytest.main(["-q", "-p", "no:cacheprovider"] + (files or [here]) + rest))

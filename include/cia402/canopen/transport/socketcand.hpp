@@ -19,7 +19,9 @@
 // separator it would cut the '<' off a frame split between two reads): each frame element is
 // preceded by one newline, and the frames that arrive in the first `join_grace_us` after a client's
 // rawmode "< ok >" are held on its channel (up to the channel's capacity) and sent after it, so that
-// "< ok >" reaches the client alone.
+// "< ok >" reaches the client alone. And since that client does not set TCP_NODELAY, its second small
+// write (a SYNC after an RPDO) waits until the first is ACKed: the server ACKs at once
+// (TCP_QUICKACK, armed again after every read) instead of delaying its ACK by up to 40 ms.
 #pragma once
 
 #include <cstdint>

@@ -7,6 +7,7 @@
 #include <bitset>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -67,6 +68,10 @@ class virtual_bus {
 
   std::unique_ptr<virtual_channel> attach();
 
+  /// Called with every frame the bus carries, once, after the channels have it queued: a tap for a
+  /// log (`cia402 bus --log`), which sees the frames no channel's filter takes as well. Empty: none.
+  void observe(std::function<void(const frame&)> observer) { observer_ = std::move(observer); }
+
   /// Frames sent on the bus so far (each counted once, however many channels receive it).
   std::uint64_t frames() const noexcept { return frames_; }
   std::size_t channels() const noexcept { return channels_.size(); }
@@ -79,6 +84,7 @@ class virtual_bus {
   std::size_t capacity_;
   std::vector<virtual_channel*> channels_;
   std::uint64_t frames_ = 0;
+  std::function<void(const frame&)> observer_;
 };
 
 }  // namespace cia402::canopen

@@ -1,0 +1,305 @@
+#include "cia402/canopen/306/eds_reader.hpp"
+
+#include <algorithm>
+#include <map>
+#include <optional>
+
+namespace cia402::canopen {
+namespace {
+
+struct value_line {
+  std::string text;
+  std::size_t line = 0;
+};
+
+// One section: its keys (lower case) with their values and lines.
+struct section {
+  std::string written;  // the name as the file spells it
+  std::size_t line = 0;
+  std::map<std::string, value_line> keys;
+};
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) {
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  }
+  return out;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+std::optional<std::uint32_t> hex_number(std::string_view s, std::size_t max_digits) {
+  if (s.empty() || s.size() > max_digits) return std::nullopt;
+  std::uint32_t v = 0;
+  for (char c : s) {
+    const int d = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
+    if (d < 0) return std::nullopt;
+    v = v * 16 + static_cast<std::uint32_t>(d);
+  }
+  return v;
+}
+
+// CiA 306 §4.6.3: decimal, 0x-hexadecimal, or octal with a leading 0; an optional sign.
+std::optional<std::int64_t> integer(std::string_view s) {
+  s = trim(s);
+  bool negative = false;
+  if (!s.empty() && (s[0] == '-' || s[0] == '+')) {
+    negative = s[0] == '-';
+    s.remove_prefix(1);
+  }
+  unsigned base = 10;
+  if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
+    base = 16;
+    s.remove_prefix(2);
+  } else if (s.size() > 1 && s[0] == '0') {
+    base = 8;
+  }
+  if (s.empty() || s.size() > 20) return std::nullopt;
+  std::uint64_t v = 0;
+  for (char c : s) {
+    unsigned d = 99;
+    if (c >= '0' && c <= '9') d = static_cast<unsigned>(c - '0');
+    else if (c >= 'a' && c <= 'f') d = static_cast<unsigned>(c - 'a' + 10);
+    else if (c >= 'A' && c <= 'F') d = static_cast<unsigned>(c - 'A' + 10);
+    if (d >= base) return std::nullopt;
+    if (v > (0x7FFFFFFFFFFFFFFFull - d) / base) return std::nullopt;  // beyond INT64
+    v = v * base + d;
+  }
+  return negative ? -static_cast<std::int64_t>(v) : static_cast<std::int64_t>(v);
+}
+
+bool known_type(std::int64_t t) {
+  switch (t) {
+    case 0x0001: case 0x0002: case 0x0003: case 0x0004: case 0x0005: case 0x0006: case 0x0007:
+    case 0x0009: case 0x0015: case 0x001B: return true;
+    default: return false;
+  }
+}
+
+class reader {
+ public:
+  explicit reader(std::string_view text) : text_(text) {}
+
+  std::variant<eds_contents, eds_error> run() {
+    if (!split()) return error_;
+    eds_contents out;
+    for (const auto& [name, s] : sections_) {
+      const bool sub_section = name.size() > 7 && name.compare(4, 3, "sub") == 0 && hex_number(name.substr(0, 4), 4) &&
+                               hex_number(std::string_view(name).substr(7), 2);
+      if (sub_section && sections_.count(name.substr(0, 4)) == 0) {
+        return eds_error{s.line, "[" + s.written + "] has no object section [" + s.written.substr(0, 4) + "]"};
+      }
+    }
+    for (const auto& [name, s] : sections_) {
+      if (name.size() != 4) continue;
+      const auto index = hex_number(name, 4);
+      if (!index) continue;
+      object_entry o;
+      if (!object(static_cast<std::uint16_t>(*index), s, o)) return error_;
+      if (!o.subs.empty()) out.objects.push_back(std::move(o));
+    }
+    std::sort(out.objects.begin(), out.objects.end(),
+              [](const object_entry& a, const object_entry& b) { return a.index < b.index; });
+    const auto commissioning = sections_.find("devicecomissioning");
+    if (commissioning != sections_.end()) {
+      if (const value_line* v = find(commissioning->second, "NodeID")) {
+        const auto id = integer(v->text);
+        if (!id || *id < 1 || *id > 127) {
+          return eds_error{v->line, "NodeID '" + v->text + "' is not 1..127"};
+        }
+        out.node_id = static_cast<std::uint8_t>(*id);
+      }
+    }
+    return out;
+  }
+
+ private:
+  bool fail(std::size_t line, std::string reason) {
+    error_ = eds_error{line, std::move(reason)};
+    return false;
+  }
+
+  static const value_line* find(const section& s, const char* key) {
+    const auto it = s.keys.find(lower(key));
+    return it == s.keys.end() ? nullptr : &it->second;
+  }
+
+  bool split() {
+    section* current = nullptr;
+    std::size_t number = 0;
+    std::size_t start = 0;
+    while (start <= text_.size()) {
+      const auto end = text_.find('\n', start);
+      const std::string_view line = trim(text_.substr(start, end == std::string_view::npos ? end : end - start));
+      ++number;
+      start = end == std::string_view::npos ? text_.size() + 1 : end + 1;
+      if (line.empty() || line[0] == ';') continue;
+      if (line[0] == '[') {
+        if (line.back() != ']' || line.size() < 3) return fail(number, "a section name needs [ and ]");
+        const std::string name = lower(trim(line.substr(1, line.size() - 2)));
+        auto [it, fresh] = sections_.try_emplace(name);
+        if (!fresh) return fail(number, "section [" + std::string(line.substr(1, line.size() - 2)) + "] appears twice");
+        it->second.line = number;
+        it->second.written = std::string(trim(line.substr(1, line.size() - 2)));
+        current = &it->second;
+        continue;
+      }
+      const auto eq = line.find('=');
+      if (eq == std::string_view::npos || eq == 0) return fail(number, "expected [SECTION] or KEY=VALUE");
+      if (current == nullptr) return fail(number, "KEY=VALUE before the first section");
+      const std::string key = lower(trim(line.substr(0, eq)));
+      if (!current->keys.try_emplace(key, value_line{std::string(trim(line.substr(eq + 1))), number}).second) {
+        return fail(number, "key " + std::string(trim(line.substr(0, eq))) + " appears twice in its section");
+      }
+    }
+    return true;
+  }
+
+  // A number key of a section: false (and error_) when present and not a number.
+  bool number_key(const section& s, const char* key, std::optional<std::int64_t>& out) {
+    out.reset();
+    const value_line* v = find(s, key);
+    if (v == nullptr || v->text.empty()) return true;
+    out = integer(v->text);
+    if (!out) return fail(v->line, std::string(key) + " '" + v->text + "' is not a number");
+    return true;
+  }
+
+  // One sub-index from its section (the object's own for a VAR). `keep` is false for a data type
+  // the dictionary cannot hold.
+  bool entry(const section& s, std::uint8_t sub, sub_entry& e, bool& keep) {
+    e.sub = sub;
+    if (const value_line* v = find(s, "ParameterName")) e.name = v->text;
+    std::optional<std::int64_t> type;
+    if (!number_key(s, "DataType", type)) return false;
+    if (!type) return fail(s.line, "no DataType");
+    keep = known_type(*type);
+    if (!keep) return true;
+    e.type = static_cast<data_type>(*type);
+    if (const value_line* v = find(s, "AccessType")) {
+      const std::string a = lower(v->text);
+      if (a == "ro") e.acc = access::ro;
+      else if (a == "wo") e.acc = access::wo;
+      else if (a == "rw" || a == "rwr" || a == "rww") e.acc = access::rw;
+      else if (a == "const") e.acc = access::constant;
+      else return fail(v->line, "AccessType '" + v->text + "' is not ro, wo, rw, rwr, rww or const");
+    }
+    std::optional<std::int64_t> mapping;
+    if (!number_key(s, "PDOMapping", mapping)) return false;
+    e.pdo_mappable = mapping.value_or(0) != 0;
+    std::optional<std::int64_t> low, high;
+    if (!number_key(s, "LowLimit", low) || !number_key(s, "HighLimit", high)) return false;
+    if (low || high) {
+      e.has_limits = true;
+      e.low = low.value_or(type_min(e.type));
+      e.high = high.value_or(type_max(e.type));
+    }
+    const value_line* value = find(s, "ParameterValue");
+    if (value == nullptr || value->text.empty()) value = find(s, "DefaultValue");
+    if (value == nullptr) return true;
+    return default_value(*value, e);
+  }
+
+  bool default_value(const value_line& v, sub_entry& e) {
+    if (e.type == data_type::visible_string) {
+      e.default_text = v.text;
+      e.capacity = v.text.size();
+      return true;
+    }
+    std::string text = lower(v.text);
+    constexpr std::string_view node = "$nodeid";
+    if (const auto at = text.find(node); at != std::string::npos) {
+      e.plus_node_id = true;
+      text.erase(at, node.size());
+      text = std::string(trim(text));
+      if (!text.empty() && text.front() == '+') text.erase(0, 1);
+      else if (!text.empty() && text.back() == '+') text.pop_back();
+      else if (!text.empty()) return fail(v.line, "value '" + v.text + "' is not $NODEID+X or X+$NODEID");
+    }
+    if (text.empty()) return true;
+    const auto n = integer(text);
+    if (!n) return fail(v.line, "value '" + v.text + "' is not a number");
+    if (*n < type_min(e.type) || *n > type_max(e.type)) {
+      return fail(v.line, "value '" + v.text + "' is outside its data type");
+    }
+    e.default_value = *n;
+    return true;
+  }
+
+  bool object(std::uint16_t index, const section& s, object_entry& o) {
+    o.index = index;
+    if (const value_line* v = find(s, "ParameterName")) o.name = v->text;
+    std::optional<std::int64_t> code;
+    if (!number_key(s, "ObjectType", code)) return false;
+    const std::int64_t c = code.value_or(7);
+    if (c != 7 && c != 8 && c != 9) return true;  // NULL, DOMAIN, DEFTYPE, DEFSTRUCT: no values
+    o.code = static_cast<object_code>(c);
+    o.category = index >= 0x2000 && index <= 0x5FFF ? object_category::manufacturer : object_category::optional;
+    if (c == 7) {
+      sub_entry e;
+      bool keep = false;
+      if (!entry(s, 0, e, keep)) return false;
+      if (keep) o.subs.push_back(std::move(e));
+      return true;
+    }
+    std::optional<std::int64_t> compact;
+    if (!number_key(s, "CompactSubObj", compact)) return false;
+    if (compact && *compact > 0) return compact_subs(s, *compact, o);
+    const std::string prefix = lower(hex_name(index)) + "sub";
+    for (const auto& [name, sub_section] : sections_) {
+      if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+      const auto sub = hex_number(std::string_view(name).substr(prefix.size()), 2);
+      if (!sub) continue;
+      sub_entry e;
+      bool keep = false;
+      if (!entry(sub_section, static_cast<std::uint8_t>(*sub), e, keep)) return false;
+      if (keep) o.subs.push_back(std::move(e));
+    }
+    std::sort(o.subs.begin(), o.subs.end(), [](const sub_entry& a, const sub_entry& b) { return a.sub < b.sub; });
+    return true;
+  }
+
+  // CiA 306 compact storage: sub-index 0 holds the count, subs 1..N share the object's keys.
+  bool compact_subs(const section& s, std::int64_t count, object_entry& o) {
+    if (count > 254) return fail(s.line, "CompactSubObj above 254");
+    sub_entry e;
+    bool keep = false;
+    if (!entry(s, 1, e, keep)) return false;
+    sub_entry highest;
+    highest.sub = 0;
+    highest.name = "Highest sub-index supported";
+    highest.type = data_type::unsigned8;
+    highest.default_value = count;
+    o.subs.push_back(highest);
+    if (!keep) return true;
+    for (std::int64_t i = 1; i <= count; ++i) {
+      sub_entry sub = e;
+      sub.sub = static_cast<std::uint8_t>(i);
+      sub.name = o.name + " " + std::to_string(i);
+      o.subs.push_back(std::move(sub));
+    }
+    return true;
+  }
+
+  static std::string hex_name(std::uint16_t index) {
+    static constexpr char digits[] = "0123456789ABCDEF";
+    std::string s(4, '0');
+    for (int i = 3; i >= 0; --i, index = static_cast<std::uint16_t>(index >> 4)) s[static_cast<std::size_t>(i)] = digits[index & 0xF];
+    return s;
+  }
+
+  std::string_view text_;
+  std::map<std::string, section> sections_;
+  eds_error error_;
+};
+
+}  // namespace
+
+std::variant<eds_contents, eds_error> read_eds(std::string_view text) { return reader(text).run(); }
+
+}  // namespace cia402::canopen
