@@ -93,6 +93,7 @@ frame_error parse_frame(std::span<std::uint8_t> frame, parsed_frame& out) noexce
 
 frame_builder::frame_builder(const std::array<std::uint8_t, 6>& destination,
                              const std::array<std::uint8_t, 6>& source) {
+  bytes_.reserve(maximum_frame_size);
   bytes_.insert(bytes_.end(), destination.begin(), destination.end());
   bytes_.insert(bytes_.end(), source.begin(), source.end());
   bytes_.push_back(0x88);
@@ -116,9 +117,9 @@ long frame_builder::add(command cmd, std::uint8_t index, std::uint32_t address, 
   put16(h + 6, length);
   bytes_.insert(bytes_.end(), h, h + datagram_header_size);
   const long data_at = static_cast<long>(bytes_.size());
-  for (std::uint16_t i = 0; i < length; ++i) bytes_.push_back(i < data.size() ? data[i] : 0);
-  bytes_.push_back(0);
-  bytes_.push_back(0);
+  const std::size_t given = std::min<std::size_t>(data.size(), length);
+  bytes_.insert(bytes_.end(), data.begin(), data.begin() + static_cast<std::ptrdiff_t>(given));
+  bytes_.resize(bytes_.size() + (length - given) + working_counter_size, 0);  // zeros, then the working counter
   return data_at;
 }
 

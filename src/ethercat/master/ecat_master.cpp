@@ -150,7 +150,8 @@ ecat_master::single ecat_master::one(command cmd, std::uint32_t address, std::ve
   single r;
   if (at < 0) return r;
   std::vector<std::uint8_t> f = b.finish();
-  const std::vector<std::uint8_t> sent = f;
+  std::vector<std::uint8_t> sent;
+  if (on_frame) sent = f;  // a copy only for a capture
   if (!link_->exchange(f) || f.size() < static_cast<std::size_t>(at) + length + 2) {
     ++lost_frames_;
     return r;
@@ -798,7 +799,8 @@ bool ecat_master::cycle() {
                                     : b.add(command::fprd, ++index_,
                                             asked->station | (static_cast<std::uint32_t>(reg_sm0 + 8 + 5) << 16), {}, 1);
   std::vector<std::uint8_t> f = b.finish();
-  const std::vector<std::uint8_t> sent = f;
+  std::vector<std::uint8_t> sent;
+  if (on_frame) sent = f;
   ++cycles_;
   if (lrw < 0 || al < 0 || !link_->exchange(f) || f.size() < static_cast<std::size_t>(al) + 4) {
     ++lost_frames_;
