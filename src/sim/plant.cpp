@@ -15,6 +15,14 @@ namespace {
 
 using namespace detail;
 
+// A cyclic mode's interpolation starts again from where the shaft is (csp), how fast it turns
+// (csv) or the torque it has (cst).
+void restart_cyclic(axis_state& a) noexcept {
+  restart_interpolation(a, a.operation_mode == cia402::mode::cyclic_synchronous_velocity ? a.velocity
+                           : a.operation_mode == cia402::mode::cyclic_synchronous_torque ? a.torque_demand
+                                                                                          : a.position);
+}
+
 // A mode change takes effect at the start of the next cycle's motion: the new mode takes the shaft
 // over as it is (pp with no set-point brakes it, homing waits for its start), and 0x6061 shows it.
 [[gnu::noinline]] void enter_mode(axis_state& a) noexcept {
@@ -24,7 +32,10 @@ using namespace detail;
   a.demand = a.position;
   a.torque_demand = a.torque;
   a.following_error_us = 0;
+  a.in_velocity_window_us = 0;
+  a.above_velocity_threshold_us = 0;
   a.mode_status = 0;
+  restart_cyclic(a);
 }
 
 // One cycle of the shaft in a mode other than profile velocity, while the drive runs. Returns the
@@ -58,12 +69,13 @@ inline void brake_follow(const plant_constants& k, axis_state& a, const drive_ou
 }
 
 void shaft_follow(const profile& p, const plant_constants& k, axis_state& a, const drive_outputs& out,
-                  bool run, bool mode_moves, bool brake_holds) noexcept;
+                  bool mode_moves, bool brake_holds) noexcept;
 
 // The plant over one cycle under the outputs the drive just decided: first the shaft (with the
 // brake as it was at the start of the cycle), then the brake.
 void follow(const profile& p, const plant_constants& k, axis_state& a,
             const drive_outputs& out) noexcept {
+  a.previous_position = a.position;
   if (a.requested_mode != a.operation_mode) enter_mode(a);  // out of line
   const std::int64_t v_old = a.velocity;
   const bool brake_holds = k.brake_fitted && (a.flags & sim_flag::brake_closed);
@@ -79,14 +91,13 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
     brake_follow(k, a, out);
     return;
   }
-  shaft_follow(p, k, a, out, run, mode_moves, brake_holds);
+  shaft_follow(p, k, a, out, mode_moves, brake_holds);
 }
 
 // Every mode but a running csp. Out of line: the cycle of a csp axis, which a master streams to
 // many at once, does not pay for this one's registers.
 [[gnu::noinline]] void shaft_follow(const profile& p, const plant_constants& k, axis_state& a,
-                                    const drive_outputs& out, bool run, bool mode_moves,
-                                    bool brake_holds) noexcept {
+                                    const drive_outputs& out, bool mode_moves, bool brake_holds) noexcept {
   const std::int64_t v_old = a.velocity;
   motion::shaft s{a.position, a.position_fraction, a.velocity};
   std::uint16_t status = 0;
@@ -94,20 +105,21 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
   if (mode_moves && a.operation_mode != cia402::mode::profile_velocity) {
     status = move_in_mode(k, a, out, s, torque_set);
   } else {
-    velocity_follow(p, k, a, out, s, brake_holds);
+    status = velocity_follow(p, k, a, out, s, brake_holds);
     if (a.operation_mode == cia402::mode::profile_position) a.pp.reset(s);  // no set-point survives a stop
     if (a.operation_mode == cia402::mode::homing) a.homing.interrupt();
     a.demand = s.position;
     a.torque_demand = 0;
     a.following_error_us = 0;
-    if (a.operation_mode == cia402::mode::profile_velocity && run && out.ramp == stop_ramp::none &&
-        beyond_limit(a, s.position, effective_target(a))) {
-      status |= status_bit::internal_limit_active;
-    }
   }
   a.position = s.position;
   a.position_fraction = s.fraction;
   a.velocity = s.velocity;
+  if (a.operation_mode == cia402::mode::profile_velocity) {
+    status |= pv_timed_bits(k, a);
+  } else if (!mode_moves) {
+    restart_cyclic(a);  // a cyclic mode resumes from here
+  }
   a.mode_status = status;
   if (!torque_set) a.torque = out.torque ? torque_of_motion(k, a, v_old, s.velocity) : 0;
   brake_follow(k, a, out);
@@ -155,14 +167,19 @@ inline void feedback_of(const plant_constants& k, const axis_state& a, drive_inp
   const bool standstill = magnitude(a.velocity) <= k.standstill_window;
   in.standstill = standstill;
   in.brake_engaged = brake_engaged(k, a);
-  // Profile velocity shows target reached and bit 12 "speed = 0" from the velocity; every other
-  // mode what its motion produced last cycle (move_in_mode).
+  // Profile velocity shows target reached and bit 12 "speed = 0" from the velocity now, held by the
+  // times 0x606E and 0x6070 its last cycle counted (pv_timed_bits); every other mode what its
+  // motion produced last cycle (move_in_mode).
   std::uint16_t mode_bits = a.mode_status;
   if (a.operation_mode == cia402::mode::profile_velocity) {
+    const mode_objects& o = a.objects;
+    const bool in_window = magnitude(a.velocity - pv_set_point(k, a)) <= std::int64_t{o.velocity_window} * micro;
     const bool target_reached =
-        magnitude(a.velocity - std::int64_t{effective_target(a)} * micro) <= k.target_window;
+        in_window && (o.velocity_window_time == 0 || (a.mode_status & status_bit::target_reached) != 0);
+    const bool speed_zero = magnitude(a.velocity) <= std::int64_t{o.velocity_threshold} * micro ||
+                            (o.velocity_threshold_time != 0 && (a.mode_status & status_bit::speed_zero) != 0);
     mode_bits = static_cast<std::uint16_t>((target_reached ? status_bit::target_reached : 0u) |
-                                           (standstill ? status_bit::speed_zero : 0u) |
+                                           (speed_zero ? status_bit::speed_zero : 0u) |
                                            (a.mode_status & status_bit::internal_limit_active));
   }
   // Status bit 11 while a stop at the current or voltage limit is still braking.
@@ -285,12 +302,20 @@ namespace {
   // settled (last, flags and operation_mode are among the compared bytes; only decide() writes last).
   constexpr std::uint8_t brake_bits = sim_flag::brake_commanded_open | sim_flag::brake_closed;
   const drive_outputs& out = a.last;
+  // The objects it reads here are written only through write_any_object(), which drops the settled
+  // copy, so they too stay as they are while the axis is settled.
+  const mode_objects& o = a.objects;
   a.settled_csp_runs =
-      a.operation_mode == cia402::mode::cyclic_synchronous_position && out.torque &&
-      out.ramp == stop_ramp::none && !out.clear_setpoints &&
+      a.operation_mode == cia402::mode::cyclic_synchronous_position && a.requested_mode == a.operation_mode &&
+      out.torque && out.ramp == stop_ramp::none && !out.clear_setpoints &&
       (a.flags & sim_flag::following_error_raised) == 0 &&
       (!k.brake_fitted || (out.brake_released && (a.flags & brake_bits) == sim_flag::brake_commanded_open)) &&
-      p.info(out.current).activity == state_activity::run;
+      p.info(out.current).activity == state_activity::run &&
+      o.increments_per_rev == k.usual_increments_per_rev && o.interpolation_period_us <= k.cycle_us &&
+      speed_limit_rpm(k, a) == k.max_velocity_rpm;
+  // Within the following error window and a cycle's travel: no check to count, no cut to make.
+  const std::int64_t window = o.following_error_window == 0xFFFFFFFFu ? INT64_MAX : std::int64_t{o.following_error_window};
+  a.settled_csp_reach = static_cast<std::uint32_t>(window < k.usual_csp_reach ? window : k.usual_csp_reach);
 }
 
 }  // namespace
@@ -312,20 +337,23 @@ namespace {
 const drive_outputs& step_axis(const profile& p, const plant_constants& k, axis_state& a) noexcept {
   // The common cycle of a machine whose master streams csp set-points, handled here with no call:
   // the core settled as a running csp axis (nothing for after_decision(), no stop, the brake where
-  // it was commanded: decide() worked that out), no mode change, the usual resolution, and the
-  // demand within the following error window. It does what full_cycle() does for it, byte for
-  // byte. Any other cycle goes there.
+  // it was commanded, no mode change, the usual resolution, no interpolation, no speed limit below
+  // the motor's: decide() worked that out), and the demand within the following error window and a
+  // cycle's travel. It does what full_cycle() does for it, byte for byte. Any other cycle goes
+  // there.
   const bool settled = core_settled(a);
-  const bool usual = settled & a.settled_csp_runs & (a.requested_mode == a.operation_mode) &
-                     (a.objects.increments_per_rev == k.usual_increments_per_rev);
-  if (!usual) return full_cycle(p, k, a, settled);
+  if (!(settled & a.settled_csp_runs)) return full_cycle(p, k, a, settled);
   std::uint16_t status = status_bit::drive_follows_command;
   const std::int64_t demand = csp_demand(a, status);
-  if (!within_window(a, demand)) return full_cycle(p, k, a, settled);
+  const std::int64_t step = demand - a.position;
+  if (magnitude(step) > std::int64_t{a.settled_csp_reach}) return full_cycle(p, k, a, settled);
   a.demand = demand;
   a.following_error_us = 0;
   const std::int64_t v_old = a.velocity;
-  csp_move_usual(k, a, demand);
+  a.previous_position = a.position;
+  a.position = demand;
+  a.position_fraction = 0;
+  a.velocity = step * k.usual_velocity_per_increment;
   a.mode_status = status;
   a.torque = torque_of_motion(k, a, v_old, a.velocity);
   return a.last;

@@ -35,7 +35,7 @@ const char* check_plant_config(const plant_config& c) noexcept {
     return "voltage limit percent must be 1..1000";
   }
   if (c.standstill_window_rpm > 1000000) return "standstill window must be at most 1000000 rpm";
-  if (c.target_window_rpm > 1000000) return "target window must be at most 1000000 rpm";
+  if (c.target_window_rpm > 65535) return "target window must be at most 65535 rpm (0x606D is UNSIGNED16)";
   if (c.max_velocity_rpm < 1 || c.max_velocity_rpm > 100000) return "max velocity must be 1..100000 rpm";
   if (c.max_acceleration_rpm_s < 1 || c.max_acceleration_rpm_s > 100000000) {
     return "max acceleration must be 1..100000000 rpm/s";
@@ -46,9 +46,17 @@ const char* check_plant_config(const plant_config& c) noexcept {
   if (c.friction_permille > 1000) return "friction must be 0..1000 permille";
   if (c.load_permille < -1000 || c.load_permille > 1000) return "load must be -1000..1000 permille";
   constexpr std::int64_t reach = std::int64_t{1} << 40;
-  if (c.home_switch_position < -reach || c.home_switch_position > reach ||
+  const auto out_of_reach = [](const std::optional<std::int64_t>& at) { return at && (*at < -reach || *at > reach); };
+  if (out_of_reach(c.home_switch_position) || out_of_reach(c.home_switch_end) ||
+      out_of_reach(c.negative_limit_switch) || out_of_reach(c.positive_limit_switch) ||
       c.index_position < -reach || c.index_position > reach) {
-    return "home switch and index positions must be within +-2^40 increments";
+    return "switch and index positions must be within +-2^40 increments";
+  }
+  if (c.home_switch_position && c.home_switch_end && *c.home_switch_end < *c.home_switch_position) {
+    return "the home switch must end at or above where it begins";
+  }
+  if (c.negative_limit_switch && c.positive_limit_switch && *c.positive_limit_switch < *c.negative_limit_switch) {
+    return "the positive limit switch must lie at or above the negative one";
   }
   return nullptr;
 }
@@ -59,19 +67,27 @@ plant_constants plant_constants::from(const plant_config& c) noexcept {
   k.coast_step = std::int64_t{c.coast_deceleration} * c.cycle_us;
   k.brake_step = std::int64_t{c.brake_deceleration} * c.cycle_us;
   k.standstill_window = std::int64_t{c.standstill_window_rpm} * micro;
-  k.target_window = std::int64_t{c.target_window_rpm} * micro;
+  k.target_window_rpm = static_cast<std::uint16_t>(c.target_window_rpm);
+  k.standstill_window_rpm = static_cast<std::uint16_t>(c.standstill_window_rpm < 65535 ? c.standstill_window_rpm : 65535);
   k.engage_cycles = delay_cycles(c.brake_engage_delay_us, c.cycle_us);
   k.release_cycles = delay_cycles(c.brake_release_delay_us, c.cycle_us);
   k.current_limit_percent = static_cast<std::uint16_t>(c.current_limit_percent);
   k.voltage_limit_percent = static_cast<std::uint16_t>(c.voltage_limit_percent);
   k.brake_fitted = c.brake_fitted;
   k.max_velocity = std::int64_t{c.max_velocity_rpm} * micro;
+  k.max_velocity_rpm = c.max_velocity_rpm;
   k.max_acceleration_step = std::int64_t{c.max_acceleration_rpm_s} * c.cycle_us;
   k.torque_acceleration = c.torque_acceleration_rpm_s;
   k.friction = static_cast<std::int32_t>(c.friction_permille);
   k.load = c.load_permille;
-  k.home_switch_position = c.home_switch_position;
-  k.index_position = c.index_position;
+  motion::homing_machine& m = k.machine;
+  m.negative_limit = c.negative_limit_switch.value_or(motion::homing_machine::none_below);
+  m.positive_limit = c.positive_limit_switch.value_or(motion::homing_machine::none_above);
+  m.home_switch_low = c.home_switch_fitted ? c.home_switch_position.value_or(motion::homing_machine::none_below)
+                                           : motion::homing_machine::none_above;
+  m.home_switch_high = c.home_switch_fitted ? c.home_switch_end.value_or(motion::homing_machine::none_above)
+                                            : motion::homing_machine::none_below;
+  m.index_at = c.index_position;
   // The csp velocity of one increment a cycle at the default resolution, when it is an integer.
   const object_description* resolution = find_drive_object(object::position_encoder_resolution, 1);
   const std::uint64_t per_rev_us = (resolution != nullptr ? static_cast<std::uint64_t>(resolution->default_value) : 0) *
@@ -99,7 +115,9 @@ T default_as(std::uint16_t index, std::uint8_t sub = 0) noexcept {
 
 }  // namespace
 
-axis_state make_axis_state(const profile& p) noexcept {
+axis_state make_axis_state(const profile& p) noexcept { return make_axis_state(p, plant_constants::from({})); }
+
+axis_state make_axis_state(const profile& p, const plant_constants& k) noexcept {
   axis_state a;
   a.core = make_axis(p);
   a.acceleration = default_as<std::uint32_t>(object::profile_acceleration);
@@ -123,6 +141,15 @@ axis_state make_axis_state(const profile& p) noexcept {
   o.homing_method = default_as<std::int8_t>(object::homing_method);
   o.interpolation_value = default_as<std::uint8_t>(object::interpolation_time_period, 1);
   o.interpolation_index = default_as<std::int8_t>(object::interpolation_time_period, 2);
+  o.interpolation_period_us = detail::interpolation_period_us(o.interpolation_value, o.interpolation_index);
+  o.max_profile_velocity = default_as<std::uint32_t>(object::max_profile_velocity);
+  o.max_torque = default_as<std::uint16_t>(object::max_torque);
+  o.velocity_window_time = default_as<std::uint16_t>(object::velocity_window_time);
+  o.velocity_threshold_time = default_as<std::uint16_t>(object::velocity_threshold_time);
+  // The plant's own figures: its top speed, its target and standstill windows.
+  o.max_motor_speed = k.max_velocity_rpm;
+  o.velocity_window = k.target_window_rpm;
+  o.velocity_threshold = k.standstill_window_rpm;
   a.pp.reset(0);
   return a;
 }

@@ -75,6 +75,37 @@ inline bool beyond_limit(const axis_state& a, std::int64_t position, std::int64_
                           (position <= a.objects.min_position && velocity < 0));
 }
 
+// 0x60C2 (value x 10^index s, index -6..0) in microseconds.
+inline std::uint32_t interpolation_period_us(std::uint8_t value, std::int8_t index) noexcept {
+  std::uint32_t us = value;
+  for (int i = -6; i < index; ++i) us *= 10;
+  return us;
+}
+
+// Adds a cycle to a timer, saturating.
+inline std::uint32_t add_cycle(std::uint32_t us, std::uint32_t cycle_us) noexcept {
+  const std::uint32_t room = UINT32_MAX - us;
+  return us + (cycle_us < room ? cycle_us : room);
+}
+
+// The set-point profile velocity follows (micro-rpm): 0x60FF (0 after T4 until written again), cut
+// to the speed limit.
+inline std::int64_t pv_set_point(const plant_constants& k, const axis_state& a) noexcept {
+  const std::int64_t limit = std::int64_t{speed_limit_rpm(k, a)} * micro;
+  return clamp(std::int64_t{effective_target(a)} * micro, -limit, limit);
+}
+
+// The cyclic modes' interpolation over 0x60C2 (CiA 402-2): a new set-point is taken at the start of
+// each period and approached linearly from the last one over the period; with a period of one cycle
+// or less each cycle's set-point is taken as it is. The next cycle starts a period from `value`.
+inline void restart_interpolation(axis_state& a, std::int64_t value) noexcept {
+  a.interpolation_from = value;
+  a.interpolation_to = value;
+  a.interpolation_elapsed_us = a.objects.interpolation_period_us;
+}
+// This cycle's set-point on the way to `sample` (plant_modes/cyclic.cpp).
+std::int64_t interpolate(const plant_constants& k, axis_state& a, std::int64_t sample) noexcept;
+
 // The fault causes of an axis (plant_objects.cpp): how many are present, one taken out, one added
 // as the newest (false when the oldest had to go, or for code 0).
 int fault_count(const axis_state& a) noexcept;
@@ -135,9 +166,13 @@ inline void csp_move_usual(const plant_constants& k, axis_state& a, std::int64_t
 // Each returns the mode's status bits (10..13) and keeps a.demand.
 
 /// Profile velocity, and every mode while a stop runs or torque is off: the velocity approaches its
-/// goal on the ramps, the position integrates it (plant_modes/velocity.cpp).
-void velocity_follow(const profile& p, const plant_constants& k, axis_state& a,
-                     const drive_outputs& out, motion::shaft& s, bool brake_holds) noexcept;
+/// goal on the ramps, the position integrates it (plant_modes/velocity.cpp). Returns bit 11 while
+/// profile velocity's set-point is cut (speed limit, software position limit).
+std::uint16_t velocity_follow(const profile& p, const plant_constants& k, axis_state& a,
+                              const drive_outputs& out, motion::shaft& s, bool brake_holds) noexcept;
+/// Profile velocity's timed status bits after the cycle's move: 10 once within 0x606D for 0x606E,
+/// 12 until beyond 0x606F for longer than 0x6070 (plant_modes/velocity.cpp).
+std::uint16_t pv_timed_bits(const plant_constants& k, axis_state& a) noexcept;
 /// Cyclic synchronous velocity (plant_modes/velocity.cpp).
 std::uint16_t csv_cycle(const plant_constants& k, axis_state& a, motion::shaft& s) noexcept;
 /// Profile position (plant_modes/position.cpp).

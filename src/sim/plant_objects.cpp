@@ -86,6 +86,10 @@ sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_
   const object_description* o = nullptr;
   if (const sdo_abort r = describe(p, index, sub, o); r != sdo_abort::none) return r;
   if (const sdo_abort r = check_write(*o, value); r != sdo_abort::none) return r;
+  // Any object but the control word (itself a source of the core's inputs) may change what the next
+  // cycle decides from, or what a settled csp axis's cycle may skip (decide() reads the objects):
+  // the settled copy goes, and the next cycle decides in full.
+  if (index != object::control_word) a.settled_valid = false;
   if (is_option_index(index)) return write_option(p, a.core, index, static_cast<std::int32_t>(value));
   mode_objects& m = a.objects;
   const auto i32 = static_cast<std::int32_t>(value);
@@ -142,14 +146,26 @@ sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_
     case object::interpolation_time_period:
       if (sub == 1) m.interpolation_value = static_cast<std::uint8_t>(value);
       else m.interpolation_index = static_cast<std::int8_t>(value);
+      m.interpolation_period_us = detail::interpolation_period_us(m.interpolation_value, m.interpolation_index);
+      // A new period starts from the set-point the axis has now.
+      detail::restart_interpolation(a, a.operation_mode == cia402::mode::cyclic_synchronous_velocity ? a.velocity
+                                       : a.operation_mode == cia402::mode::cyclic_synchronous_torque ? a.torque_demand
+                                                                                                      : a.demand);
       break;
+    case object::max_profile_velocity: m.max_profile_velocity = u32; break;
+    case object::max_motor_speed: m.max_motor_speed = u32; break;
+    case object::max_torque: m.max_torque = static_cast<std::uint16_t>(value); break;
+    case object::velocity_window: m.velocity_window = static_cast<std::uint16_t>(value); break;
+    case object::velocity_window_time: m.velocity_window_time = static_cast<std::uint16_t>(value); break;
+    case object::velocity_threshold: m.velocity_threshold = static_cast<std::uint16_t>(value); break;
+    case object::velocity_threshold_time: m.velocity_threshold_time = static_cast<std::uint16_t>(value); break;
     default: return sdo_abort::object_does_not_exist;
   }
   return sdo_abort::none;
 }
 
-sdo_abort read_object(const profile& p, const axis_state& a, std::uint16_t index, std::uint8_t sub,
-                      std::int64_t& value) noexcept {
+sdo_abort read_object(const profile& p, const plant_constants& k, const axis_state& a, std::uint16_t index,
+                      std::uint8_t sub, std::int64_t& value) noexcept {
   if (index == object::error_register) {
     if (sub != 0) return sdo_abort::sub_index_does_not_exist;
     value = error_register_of(a.core.error_code);
@@ -208,6 +224,15 @@ sdo_abort read_object(const profile& p, const axis_state& a, std::uint16_t index
     case object::interpolation_time_period:
       value = sub == 1 ? m.interpolation_value : m.interpolation_index;
       break;
+    case object::max_profile_velocity: value = m.max_profile_velocity; break;
+    case object::max_motor_speed: value = m.max_motor_speed; break;
+    case object::max_torque: value = m.max_torque; break;
+    case object::velocity_window: value = m.velocity_window; break;
+    case object::velocity_window_time: value = m.velocity_window_time; break;
+    case object::velocity_threshold: value = m.velocity_threshold; break;
+    case object::velocity_threshold_time: value = m.velocity_threshold_time; break;
+    case object::supported_homing_methods: value = o->default_value; break;  // the table's own list
+    case object::digital_inputs: value = digital_inputs(k, a); break;
     default: return sdo_abort::object_does_not_exist;
   }
   return sdo_abort::none;
@@ -240,10 +265,12 @@ std::uint16_t drive_view::fault_cause() const noexcept {
   return n > 0 ? axis_->fault_codes[n - 1] : std::uint16_t{0};
 }
 
-virtual_drive::virtual_drive(const profile& p, const plant_config& config)
-    : profile_(&p), axis_(make_axis_state(p)) {
+plant_constants checked_constants(const plant_config& config) {
   if (const char* why = check_plant_config(config)) throw std::invalid_argument(why);
-  constants_ = plant_constants::from(config);
+  return plant_constants::from(config);
 }
+
+virtual_drive::virtual_drive(const profile& p, const plant_config& config)
+    : profile_(&p), constants_(checked_constants(config)), axis_(make_axis_state(p, constants_)) {}
 
 }  // namespace cia402::sim

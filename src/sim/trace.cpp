@@ -24,7 +24,7 @@ bool same_but_velocity(const trace_row& a, const trace_row& b) {
          a.fault_cause == b.fault_cause && a.current == b.current &&
          b.transition == no_transition && a.ramp == b.ramp && a.torque == b.torque &&
          a.brake_released == b.brake_released && a.brake_engaged == b.brake_engaged &&
-         a.dc_link == b.dc_link && a.sto == b.sto && a.mode == b.mode;
+         a.dc_link == b.dc_link && a.sto == b.sto && a.mode == b.mode && a.digital_inputs == b.digital_inputs;
 }
 
 // Control-word and status-word bits as VCD signal names (cia402-reference.md §1.2, §2.1; bits 12
@@ -77,6 +77,7 @@ trace_row begin_row(std::uint64_t time_us, const plant_constants& k, const axis_
   r.position_demand = a.demand;
   r.torque_permille = a.torque;
   r.mode = a.operation_mode;
+  r.digital_inputs = digital_inputs(k, a);
   return r;
 }
 
@@ -125,7 +126,7 @@ std::vector<std::size_t> kept_rows(const std::vector<trace_row>& rows, std::size
 void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_t every) {
   out << "time_us,controlword,statusword,state,transition,velocity_rpm,target_rpm,torque,"
          "brake_released,brake_engaged,ramp,error_code,fault_cause,dc_link,sto,position,position_demand,"
-         "torque_permille,mode\n";
+         "torque_permille,mode,digital_inputs\n";
   for (std::size_t i : kept_rows(rows, every)) {
     const trace_row& r = rows[i];
     out << r.time_us << ',' << hex(r.control_word, 4) << ',' << hex(r.status_word, 4) << ','
@@ -135,7 +136,7 @@ void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_
         << int{r.brake_released} << ',' << int{r.brake_engaged} << ',' << stop_ramp_name(r.ramp)
         << ',' << hex(r.error_code, 4) << ',' << hex(r.fault_cause, 4) << ',' << int{r.dc_link} << ','
         << int{r.sto} << ',' << r.position << ',' << r.position_demand << ',' << r.torque_permille << ','
-        << int{r.mode} << '\n';
+        << int{r.mode} << ',' << hex(r.digital_inputs, 8) << '\n';
   }
 }
 
@@ -155,7 +156,7 @@ void write_jsonl(std::ostream& out, const std::vector<trace_row>& rows, std::siz
         << "\",\"fault_cause\":\"" << hex(r.fault_cause, 4) << "\",\"dc_link\":" << b(r.dc_link)
         << ",\"sto\":" << b(r.sto) << ",\"position\":" << r.position << ",\"position_demand\":"
         << r.position_demand << ",\"torque_permille\":" << r.torque_permille << ",\"mode\":" << int{r.mode}
-        << "}\n";
+        << ",\"digital_inputs\":\"" << hex(r.digital_inputs, 8) << "\"}\n";
   }
 }
 
@@ -220,6 +221,14 @@ void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trac
       {"", "mode", type::vector, 8,
        [](const trace_row& r, int) { return binary(static_cast<std::uint8_t>(r.mode), 8); }, 0},
   };
+  // 0x60FD's inputs, one wire each: what a scope of the machine's switches shows.
+  const value_fn input_bit = [](const trace_row& r, int bit) {
+    return std::string(((r.digital_inputs >> bit) & 1u) ? "1" : "0");
+  };
+  signals.push_back({"", "negative_limit_switch", type::wire, 1, input_bit, 0});
+  signals.push_back({"", "positive_limit_switch", type::wire, 1, input_bit, 1});
+  signals.push_back({"", "home_switch", type::wire, 1, input_bit, 2});
+  signals.push_back({"", "index_pulse", type::wire, 1, input_bit, 16});
   for (int b = 0; b < 16; ++b) signals.push_back({"cw", control_bit_names[b], type::wire, 1, cw_bit, b});
   for (int b = 0; b < 16; ++b) signals.push_back({"sw", status_bit_names[b], type::wire, 1, sw_bit, b});
   if (info.vcd_standard) {

@@ -208,9 +208,11 @@ TEST(homing, method_3_homes_on_the_index_pulse_left_of_the_home_switch_edge) {
   EXPECT_EQ(status(d) & bit13, 0);
 }
 
-TEST(homing, an_unsupported_method_is_refused) {
+TEST(homing, a_reserved_method_is_refused) {
   virtual_drive d(standard_profile());
-  EXPECT_EQ(d.write(0x6098, 0, 1), sdo_abort::invalid_value);
+  for (const int reserved : {0, 15, 16, 31, 32, 36, 38, -1}) {
+    EXPECT_EQ(d.write(0x6098, 0, reserved), sdo_abort::invalid_value) << reserved;
+  }
   EXPECT_EQ(read(d, 0x6098), 35);
 }
 

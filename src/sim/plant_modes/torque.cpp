@@ -19,7 +19,12 @@ void torque_follow(const plant_constants& k, axis_state& a, motion::shaft& s,
   if (v != 0 && sign_of(v_new) != sign_of(v) && sign_of(torque - k.load) != sign_of(v_new)) {
     v_new = 0;  // friction stops the shaft; it does not turn it back
   }
-  v_new = clamp(v_new, -k.max_velocity, k.max_velocity);
+  // The shaft saturates at the speed limit (0x607F, 0x6080, the motor's top speed): bit 11.
+  const std::int64_t limit = std::int64_t{speed_limit_rpm(k, a)} * micro;
+  if (v_new > limit || v_new < -limit) {
+    v_new = clamp(v_new, -limit, limit);
+    a.mode_status |= status_bit::internal_limit_active;
+  }
   if (beyond_limit(a, s.position, v_new)) {
     v_new = approach(v, 0, 0, std::int64_t{a.quick_stop_deceleration} * k.cycle_us);
     a.mode_status |= status_bit::internal_limit_active;
@@ -33,16 +38,22 @@ std::uint16_t torque_cycle(const plant_constants& k, axis_state& a, motion::shaf
   const mode_objects& o = a.objects;
   const bool cleared = (a.flags & sim_flag::setpoints_cleared) != 0;
   std::uint16_t status = 0;
-  const std::int64_t target = cleared ? 0 : o.target_torque;
+  // The set-point is cut to the max torque 0x6072 (bit 11 then).
+  const std::int64_t most = o.max_torque < 32767 ? o.max_torque : 32767;
   std::int64_t demand;
   if (a.operation_mode == cia402::mode::profile_torque) {
     // The demand ramps to the target at the torque slope 0x6087.
+    const std::int64_t wanted = cleared ? 0 : o.target_torque;
+    const std::int64_t target = clamp(wanted, -most, most);
+    if (target != wanted) status |= status_bit::internal_limit_active;
     const std::int64_t slope = std::int64_t{o.torque_slope} * k.cycle_us / 1'000'000;
     const std::int64_t step_max = slope > 0 ? slope : 1;
     demand = a.torque_demand + clamp(target - a.torque_demand, -step_max, step_max);
     if (demand == target) status |= status_bit::target_reached;
   } else {
-    demand = clamp(target + o.torque_offset, -32768, 32767);
+    const std::int64_t wanted = interpolate(k, a, std::int64_t{cleared ? 0 : o.target_torque} + o.torque_offset);
+    demand = clamp(wanted, -most, most);
+    if (demand != wanted) status |= status_bit::internal_limit_active;
     status |= status_bit::drive_follows_command;
   }
   a.torque_demand = static_cast<std::int32_t>(demand);
