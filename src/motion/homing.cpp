@@ -25,9 +25,10 @@ constexpr std::int64_t sign_of(std::int64_t v) noexcept { return (v > 0) - (v < 
 bool homing_machine::index_pulse_between(std::int64_t from, std::int64_t to,
                                          std::uint32_t increments_per_rev) const noexcept {
   const std::int64_t r = increments_per_rev ? increments_per_rev : 1;
-  const std::int64_t lo = from < to ? from : to;
-  const std::int64_t hi = from < to ? to : from;
-  // The last pulse at or below hi lies at or above lo.
+  if (from == to) return floor_div(to - index_at, r) * r == to - index_at;
+  // (from, to] going up, [to, from) going down: a pulse counts in the cycle the shaft reaches it.
+  const std::int64_t lo = from < to ? from + 1 : to;
+  const std::int64_t hi = from < to ? to : from - 1;
   return index_at + floor_div(hi - index_at, r) * r >= lo;
 }
 
@@ -166,7 +167,7 @@ void homing::start(const homing_parameters& par, const homing_machine& m, shaft&
   if (method_ == 33 || method_ == 34) {
     final_direction_ = method_ == 34 ? 1 : -1;
     index_after_edge_ = true;
-    edge_found(m, par.increments_per_rev ? par.increments_per_rev : 1);
+    edge_found(m, par.increments_per_rev ? par.increments_per_rev : 1, s.position);
     return;
   }
   if (!supports(method_)) {
@@ -178,14 +179,14 @@ void homing::start(const homing_parameters& par, const homing_machine& m, shaft&
 }
 
 // Home is measured from `home_at_` (the edge, or for 33 / 34 the start): the edge itself, or the
-// first index pulse at or beyond it in the final direction.
-void homing::edge_found(const homing_machine& m, std::int64_t resolution) noexcept {
+// first index pulse at or beyond it in the final direction, which the search then runs to unless the
+// shaft is there already (or past it).
+void homing::edge_found(const homing_machine& m, std::int64_t resolution, std::int64_t here) noexcept {
+  stage_ = stage::stopping;
   if (index_after_edge_) {
     const std::int64_t below = m.index_at + floor_div(home_at_ - m.index_at, resolution) * resolution;
     home_at_ = final_direction_ < 0 || below == home_at_ ? below : below + resolution;
-    stage_ = stage::index;
-  } else {
-    stage_ = stage::stopping;
+    if (final_direction_ > 0 ? here < home_at_ : here > home_at_) stage_ = stage::index;
   }
 }
 
@@ -208,7 +209,7 @@ void homing::search(const homing_parameters& par, const homing_machine& m, const
     } else {
       home_at_ = l.what == 1 ? m.negative_limit : m.positive_limit;
     }
-    edge_found(m, par.increments_per_rev ? par.increments_per_rev : 1);
+    edge_found(m, par.increments_per_rev ? par.increments_per_rev : 1, s.position);
   } else if (limit_met(m, s, l.direction)) {
     if (plan_ == plan_inactive && leg_at_ == 0 && shape_of(method_).after_limit.count > 0) {
       follow_plan(method_, m, s.position, true);

@@ -256,7 +256,7 @@ TEST(homing, the_speeds_are_cut_to_the_speed_limit_and_say_so) {
   EXPECT_EQ(s.position, 5000);
 }
 
-TEST(homing_machine, an_index_pulse_is_seen_where_the_shaft_passed_or_stands_on_one) {
+TEST(homing_machine, an_index_pulse_is_seen_in_the_cycle_the_shaft_reaches_it_or_while_it_stands_on_it) {
   homing_machine m;
   m.index_at = 3000;
   EXPECT_TRUE(m.index_pulse_between(2990, 3010, 10000));
@@ -266,6 +266,9 @@ TEST(homing_machine, an_index_pulse_is_seen_where_the_shaft_passed_or_stands_on_
   EXPECT_FALSE(m.index_pulse_between(3001, 12999, 10000));
   EXPECT_FALSE(m.index_pulse_between(-6999, 2999, 10000));
   EXPECT_TRUE(m.index_pulse_between(-6999, 3000, 10000));
+  EXPECT_FALSE(m.index_pulse_between(3000, 3100, 10000)) << "counted in the cycle that reached it";
+  EXPECT_FALSE(m.index_pulse_between(3000, 2900, 10000));
+  EXPECT_TRUE(m.index_pulse_between(3100, 3000, 10000));
 }
 
 }  // namespace

@@ -63,7 +63,8 @@ struct homing_machine {
   bool home_switch_active(std::int64_t at) const noexcept {
     return at >= home_switch_low && at <= home_switch_high;
   }
-  /// An index pulse lies in [from, to] (either order), or at `from` when the shaft stands there.
+  /// A shaft that moved from `from` to `to` reached an index pulse: one lies in (from, to] going up,
+  /// [to, from) going down, or at `from` when it stands still.
   bool index_pulse_between(std::int64_t from, std::int64_t to, std::uint32_t increments_per_rev) const noexcept;
 };
 
@@ -126,7 +127,7 @@ class homing {
 
   void start(const homing_parameters& par, const homing_machine& m, shaft& s, std::int64_t& offset) noexcept;
   void follow_plan(std::int8_t method, const homing_machine& m, std::int64_t here, bool after_limit) noexcept;
-  void edge_found(const homing_machine& m, std::int64_t resolution) noexcept;
+  void edge_found(const homing_machine& m, std::int64_t resolution, std::int64_t here) noexcept;
   void search(const homing_parameters& par, const homing_machine& m, const shaft& s) noexcept;
 
   stage stage_ = stage::idle;
