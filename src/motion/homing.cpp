@@ -97,7 +97,11 @@ constexpr method_shape shapes[15] = {
 
 enum plan_choice : std::uint8_t { plan_inactive, plan_active, plan_after_limit };
 
-const method_shape& shape_of(std::int8_t method) noexcept { return shapes[method > 16 ? method - 16 : method]; }
+// Methods 1..14 and 17..30 (the same without the index pulse); any other method has no moves.
+const method_shape& shape_of(std::int8_t method) noexcept {
+  const int base = method > 16 ? method - 16 : method;
+  return shapes[base >= 1 && base <= 14 ? base : 0];
+}
 
 const plan_code& plan_of(std::int8_t method, std::uint8_t plan) noexcept {
   const method_shape& shape = shape_of(method);
@@ -201,14 +205,16 @@ void homing::search(const homing_parameters& par, const homing_machine& m, const
       ++leg_at_;
       return;
     }
-    // The edge: the first position in the switch's new state.
+    // The edge: the first position in the switch's new state. A switch that reaches to the end of
+    // travel (or is not fitted) has no edge there: its state holds, the search goes on.
     const bool up = l.direction > 0;
-    if (l.what == 0) {
-      home_at_ = up ? (l.becomes_active ? m.home_switch_low : m.home_switch_high + 1)
-                    : (l.becomes_active ? m.home_switch_high : m.home_switch_low - 1);
-    } else {
-      home_at_ = l.what == 1 ? m.negative_limit : m.positive_limit;
-    }
+    const bool low_edge = l.what == 0 && up == l.becomes_active;
+    const std::int64_t bound = l.what == 1 ? m.negative_limit
+                               : l.what == 2 ? m.positive_limit
+                               : low_edge    ? m.home_switch_low
+                                             : m.home_switch_high;
+    if (bound == homing_machine::none_below || bound == homing_machine::none_above) return;
+    home_at_ = l.what != 0 ? bound : (l.becomes_active ? bound : (up ? bound + 1 : bound - 1));
     edge_found(m, par.increments_per_rev ? par.increments_per_rev : 1, s.position);
   } else if (limit_met(m, s, l.direction)) {
     if (plan_ == plan_inactive && leg_at_ == 0 && shape_of(method_).after_limit.count > 0) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -180,6 +181,28 @@ TEST(homing, a_limit_switch_where_the_method_expects_none_is_a_homing_error) {
     ASSERT_TRUE(r.status.error);
     EXPECT_FALSE(r.status.attained);
     EXPECT_EQ(r.offset, 0) << "nothing redefined";
+  }
+}
+
+TEST(homing, a_switch_the_machine_lacks_is_searched_for_1000_revolutions_then_a_homing_error) {
+  homing_machine bare;  // no limit switches, no home switch
+  bare.home_switch_low = homing_machine::none_above;
+  bare.home_switch_high = homing_machine::none_below;
+  homing_machine endless = bare;  // a home switch from 50,000 to the positive end, nothing else
+  endless.home_switch_low = 50000;
+  endless.home_switch_high = homing_machine::none_above;
+  struct lacking {
+    int method;
+    const homing_machine* machine;
+  };
+  for (const lacking c : {lacking{1, &bare}, lacking{2, &bare}, lacking{17, &bare}, lacking{18, &bare},
+                          lacking{3, &bare}, lacking{19, &bare}, lacking{14, &bare}, lacking{30, &bare},
+                          lacking{10, &endless}, lacking{26, &endless}, lacking{11, &endless}, lacking{5, &endless}}) {
+    SCOPED_TRACE(c.method);
+    const run r = home(c.method, *c.machine, 0, 0, 2000000);
+    ASSERT_TRUE(r.status.error);
+    EXPECT_LE(std::llabs(r.s.position), (homing::max_search_revolutions + 10) * revolution);
+    EXPECT_EQ(r.offset, 0);
   }
 }
 
