@@ -126,7 +126,7 @@ std::vector<std::size_t> kept_rows(const std::vector<trace_row>& rows, std::size
 void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_t every) {
   out << "time_us,controlword,statusword,state,transition,velocity_rpm,target_rpm,torque,"
          "brake_released,brake_engaged,ramp,error_code,fault_cause,dc_link,sto,position,position_demand,"
-         "torque_permille,mode,digital_inputs\n";
+         "torque_permille,mode\n";
   for (std::size_t i : kept_rows(rows, every)) {
     const trace_row& r = rows[i];
     out << r.time_us << ',' << hex(r.control_word, 4) << ',' << hex(r.status_word, 4) << ','
@@ -136,7 +136,7 @@ void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_
         << int{r.brake_released} << ',' << int{r.brake_engaged} << ',' << stop_ramp_name(r.ramp)
         << ',' << hex(r.error_code, 4) << ',' << hex(r.fault_cause, 4) << ',' << int{r.dc_link} << ','
         << int{r.sto} << ',' << r.position << ',' << r.position_demand << ',' << r.torque_permille << ','
-        << int{r.mode} << ',' << hex(r.digital_inputs, 8) << '\n';
+        << int{r.mode} << '\n';
   }
 }
 
@@ -156,7 +156,7 @@ void write_jsonl(std::ostream& out, const std::vector<trace_row>& rows, std::siz
         << "\",\"fault_cause\":\"" << hex(r.fault_cause, 4) << "\",\"dc_link\":" << b(r.dc_link)
         << ",\"sto\":" << b(r.sto) << ",\"position\":" << r.position << ",\"position_demand\":"
         << r.position_demand << ",\"torque_permille\":" << r.torque_permille << ",\"mode\":" << int{r.mode}
-        << ",\"digital_inputs\":\"" << hex(r.digital_inputs, 8) << "\"}\n";
+        << "}\n";
   }
 }
 

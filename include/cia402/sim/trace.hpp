@@ -38,8 +38,8 @@ struct trace_row {
   std::int64_t position_demand = 0;   ///< 0x6062
   std::int32_t torque_permille = 0;   ///< 0x6077, permille of rated torque
   std::int8_t mode = 3;               ///< 0x6061
-  /// 0x60FD: the limit switches (bits 0, 1), the home switch (bit 2) and an index pulse passed in
-  /// the cycle before (bit 16), as sampled at time_us.
+  /// 0x60FD: the limit switches (bits 0, 1), the home switch (bit 2) and an index pulse reached in
+  /// the cycle before (bit 16), as sampled at time_us (the VCD's input wires).
   std::uint32_t digital_inputs = 0;
 };
 
@@ -71,7 +71,7 @@ struct trace_info {
 /// CSV with a header line: time_us, controlword, statusword, state, transition, velocity_rpm,
 /// target_rpm, torque, brake_released, brake_engaged, ramp, error_code, fault_cause, dc_link, sto,
 /// then (added with the operation modes, so tools that read the first fifteen keep working)
-/// position, position_demand, torque_permille, mode, and digital_inputs (0x60FD in hex).
+/// position, position_demand, torque_permille, mode.
 void write_csv(std::ostream& out, const std::vector<trace_row>& rows, std::size_t every = 1);
 /// One JSON object per line with the same fields (transition null when none was taken).
 void write_jsonl(std::ostream& out, const std::vector<trace_row>& rows, std::size_t every = 1);
