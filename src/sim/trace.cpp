@@ -24,7 +24,7 @@ bool same_but_velocity(const trace_row& a, const trace_row& b) {
          a.fault_cause == b.fault_cause && a.current == b.current &&
          b.transition == no_transition && a.ramp == b.ramp && a.torque == b.torque &&
          a.brake_released == b.brake_released && a.brake_engaged == b.brake_engaged &&
-         a.dc_link == b.dc_link && a.sto == b.sto && a.mode == b.mode && a.digital_inputs == b.digital_inputs;
+         a.dc_link == b.dc_link && a.sto == b.sto && a.mode == b.mode;
 }
 
 // Control-word and status-word bits as VCD signal names (cia402-reference.md §1.2, §2.1; bits 12
