@@ -232,6 +232,93 @@ struct loader {
     s.events.insert(s.events.end(), actions.begin(), actions.end());
   }
 
+  // `always = "rule"`: a rule checked on every cycle of the run.
+  void load_rule(const toml::table& t, const toml::node& rule, expectation base, bool timed) {
+    const toml::node* always = &rule;
+    if (timed) refuse(*always, "'always' holds for the whole run: leave out at/between");
+    if (t.size() != 1) refuse(t, "'always' stands alone in its expectation");
+    const std::string_view name = get_string(*always, "always");
+    expectation e = base;
+    e.what = expectation::kind::always;
+    bool found = false;
+    for (invariant i : {invariant::brake_engaged_before_torque_off,
+                        invariant::motion_waits_for_brake_release,
+                        invariant::coast_removes_torque_at_once}) {
+      if (name == invariant_name(i)) {
+        e.rule = i;
+        found = true;
+      }
+    }
+    if (!found) {
+      refuse(*always, "unknown rule " + toml_reading::quoted(name) +
+                          " (brake_engaged_before_torque_off, motion_waits_for_brake_release, "
+                          "coast_removes_torque_at_once)");
+    }
+    if (e.rule == invariant::motion_waits_for_brake_release && !s.plant.brake_fitted) {
+      refuse(*always, "motion_waits_for_brake_release needs a brake ([plant] brake = true)");
+    }
+    e.first_cycle = 0;
+    e.last_cycle = s.cycles - 1;
+    e.window = true;
+    s.expectations.push_back(e);
+  }
+
+  // velocity = V, or { below = V }, { above = V }, { within = [LOW, HIGH] } (rpm).
+  void velocity_claim(const toml::node& claim, expectation base) {
+    const toml::node* n = &claim;
+    expectation e = base;
+    e.what = expectation::kind::velocity;
+    if (const auto* cmp = n->as_table()) {
+      if (cmp->size() != 1) {
+        refuse(*n, "velocity takes one comparison: { below = V }, { above = V } or "
+                   "{ within = [LOW, HIGH] }");
+      }
+      check_keys(*cmp, {"below", "above", "within"}, "a velocity comparison");
+      if (const auto* b = cmp->get("below")) {
+        e.how = expectation::compare::below;
+        e.low = get_velocity(*b, "below");
+      } else if (const auto* ab = cmp->get("above")) {
+        e.how = expectation::compare::above;
+        e.low = get_velocity(*ab, "above");
+      } else {
+        const toml::node& w = *cmp->get("within");
+        const toml::array& range = get_array(w, "within");
+        if (range.size() != 2) refuse(w, "within takes [LOW, HIGH]");
+        e.how = expectation::compare::within;
+        e.low = get_velocity(*range.get(0), "the low end of within");
+        e.high = get_velocity(*range.get(1), "the high end of within");
+        if (e.high < e.low) refuse(w, "within [LOW, HIGH] needs LOW <= HIGH");
+      }
+    } else {
+      e.how = expectation::compare::equal;
+      e.low = get_velocity(*n, "velocity");
+    }
+    s.expectations.push_back(e);
+  }
+
+  // position = P, or { within = [LOW, HIGH] } (increments).
+  void position_claim(const toml::node& claim, expectation base) {
+    const toml::node* n = &claim;
+    expectation e = base;
+    e.what = expectation::kind::position;
+    constexpr std::int64_t reach = std::int64_t{1} << 40;
+    if (const auto* cmp = n->as_table()) {
+      check_keys(*cmp, {"within"}, "a position comparison");
+      const toml::node* w = cmp->get("within");
+      if (w == nullptr) refuse(*n, "position takes an increment count or { within = [LOW, HIGH] }");
+      const toml::array& range = get_array(*w, "within");
+      if (range.size() != 2) refuse(*w, "within takes [LOW, HIGH]");
+      e.how = expectation::compare::within;
+      e.low = get_int(*range.get(0), "the low end of within", -reach, reach);
+      e.high = get_int(*range.get(1), "the high end of within", -reach, reach);
+      if (e.high < e.low) refuse(*w, "within [LOW, HIGH] needs LOW <= HIGH");
+    } else {
+      e.how = expectation::compare::equal;
+      e.low = get_int(*n, "position", -reach, reach);
+    }
+    s.expectations.push_back(e);
+  }
+
   void load_expectation(const toml::table& t) {
     check_keys(t,
                {"at", "between", "state", "velocity", "statusword", "torque", "brake",
@@ -244,32 +331,7 @@ struct loader {
     const toml::node* between = t.get("between");
     const toml::node* always = t.get("always");
     if (always) {
-      if (at || between) refuse(*always, "'always' holds for the whole run: leave out at/between");
-      if (t.size() != 1) refuse(t, "'always' stands alone in its expectation");
-      const std::string_view name = get_string(*always, "always");
-      expectation e = base;
-      e.what = expectation::kind::always;
-      bool found = false;
-      for (invariant i : {invariant::brake_engaged_before_torque_off,
-                          invariant::motion_waits_for_brake_release,
-                          invariant::coast_removes_torque_at_once}) {
-        if (name == invariant_name(i)) {
-          e.rule = i;
-          found = true;
-        }
-      }
-      if (!found) {
-        refuse(*always, "unknown rule " + toml_reading::quoted(name) +
-                            " (brake_engaged_before_torque_off, motion_waits_for_brake_release, "
-                            "coast_removes_torque_at_once)");
-      }
-      if (e.rule == invariant::motion_waits_for_brake_release && !s.plant.brake_fitted) {
-        refuse(*always, "motion_waits_for_brake_release needs a brake ([plant] brake = true)");
-      }
-      e.first_cycle = 0;
-      e.last_cycle = s.cycles - 1;
-      e.window = true;
-      s.expectations.push_back(e);
+      load_rule(t, *always, base, at || between);
       return;
     }
     if (at && between) refuse(*between, "give either 'at' or 'between', not both");
@@ -298,36 +360,7 @@ struct loader {
       }
       s.expectations.push_back(e);
     }
-    if (const auto* n = t.get("velocity")) {
-      expectation e = base;
-      e.what = expectation::kind::velocity;
-      if (const auto* cmp = n->as_table()) {
-        if (cmp->size() != 1) {
-          refuse(*n, "velocity takes one comparison: { below = V }, { above = V } or "
-                     "{ within = [LOW, HIGH] }");
-        }
-        check_keys(*cmp, {"below", "above", "within"}, "a velocity comparison");
-        if (const auto* b = cmp->get("below")) {
-          e.how = expectation::compare::below;
-          e.low = get_velocity(*b, "below");
-        } else if (const auto* ab = cmp->get("above")) {
-          e.how = expectation::compare::above;
-          e.low = get_velocity(*ab, "above");
-        } else {
-          const toml::node& w = *cmp->get("within");
-          const toml::array& range = get_array(w, "within");
-          if (range.size() != 2) refuse(w, "within takes [LOW, HIGH]");
-          e.how = expectation::compare::within;
-          e.low = get_velocity(*range.get(0), "the low end of within");
-          e.high = get_velocity(*range.get(1), "the high end of within");
-          if (e.high < e.low) refuse(w, "within [LOW, HIGH] needs LOW <= HIGH");
-        }
-      } else {
-        e.how = expectation::compare::equal;
-        e.low = get_velocity(*n, "velocity");
-      }
-      s.expectations.push_back(e);
-    }
+    if (const auto* n = t.get("velocity")) velocity_claim(*n, base);
     if (const auto* n = t.get("statusword")) {
       expectation e = base;
       e.what = expectation::kind::statusword;
@@ -359,26 +392,7 @@ struct loader {
       e.flag = v == "engaged";
       s.expectations.push_back(e);
     }
-    if (const auto* n = t.get("position")) {
-      expectation e = base;
-      e.what = expectation::kind::position;
-      constexpr std::int64_t reach = std::int64_t{1} << 40;
-      if (const auto* cmp = n->as_table()) {
-        check_keys(*cmp, {"within"}, "a position comparison");
-        const toml::node* w = cmp->get("within");
-        if (w == nullptr) refuse(*n, "position takes an increment count or { within = [LOW, HIGH] }");
-        const toml::array& range = get_array(*w, "within");
-        if (range.size() != 2) refuse(*w, "within takes [LOW, HIGH]");
-        e.how = expectation::compare::within;
-        e.low = get_int(*range.get(0), "the low end of within", -reach, reach);
-        e.high = get_int(*range.get(1), "the high end of within", -reach, reach);
-        if (e.high < e.low) refuse(*w, "within [LOW, HIGH] needs LOW <= HIGH");
-      } else {
-        e.how = expectation::compare::equal;
-        e.low = get_int(*n, "position", -reach, reach);
-      }
-      s.expectations.push_back(e);
-    }
+    if (const auto* n = t.get("position")) position_claim(*n, base);
     if (const auto* n = t.get("mode")) {
       expectation e = base;
       e.what = expectation::kind::mode;

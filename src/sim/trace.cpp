@@ -3,6 +3,7 @@
 
 #include <ostream>
 #include <string>
+#include <utility>
 
 #include "cia402/support/text.hpp"
 
@@ -225,10 +226,10 @@ void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trac
   const value_fn input_bit = [](const trace_row& r, int bit) {
     return std::string(((r.digital_inputs >> bit) & 1u) ? "1" : "0");
   };
-  signals.push_back({"", "negative_limit_switch", type::wire, 1, input_bit, 0});
-  signals.push_back({"", "positive_limit_switch", type::wire, 1, input_bit, 1});
-  signals.push_back({"", "home_switch", type::wire, 1, input_bit, 2});
-  signals.push_back({"", "index_pulse", type::wire, 1, input_bit, 16});
+  for (const auto& [name, bit] : {std::pair{"negative_limit_switch", 0}, std::pair{"positive_limit_switch", 1},
+                                  std::pair{"home_switch", 2}, std::pair{"index_pulse", 16}}) {
+    signals.push_back({"", name, type::wire, 1, input_bit, bit});
+  }
   for (int b = 0; b < 16; ++b) signals.push_back({"cw", control_bit_names[b], type::wire, 1, cw_bit, b});
   for (int b = 0; b < 16; ++b) signals.push_back({"sw", status_bit_names[b], type::wire, 1, sw_bit, b});
   if (info.vcd_standard) {
