@@ -223,12 +223,10 @@ void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trac
        [](const trace_row& r, int) { return binary(static_cast<std::uint8_t>(r.mode), 8); }, 0},
   };
   // 0x60FD's inputs, one wire each: what a scope of the machine's switches shows.
-  const value_fn input_bit = [](const trace_row& r, int bit) {
-    return std::string(((r.digital_inputs >> bit) & 1u) ? "1" : "0");
-  };
+  const value_fn input = [](const trace_row& r, int bit) { return std::string((r.digital_inputs >> bit) & 1u ? "1" : "0"); };
   for (const auto& [name, bit] : {std::pair{"negative_limit_switch", 0}, std::pair{"positive_limit_switch", 1},
                                   std::pair{"home_switch", 2}, std::pair{"index_pulse", 16}}) {
-    signals.push_back({"", name, type::wire, 1, input_bit, bit});
+    signals.push_back({"", name, type::wire, 1, input, bit});
   }
   for (int b = 0; b < 16; ++b) signals.push_back({"cw", control_bit_names[b], type::wire, 1, cw_bit, b});
   for (int b = 0; b < 16; ++b) signals.push_back({"sw", status_bit_names[b], type::wire, 1, sw_bit, b});
