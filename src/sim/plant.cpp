@@ -54,6 +54,77 @@ std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_
   }
 }
 
+// Profile velocity towards a software position limit (0x607D): no faster than the shaft can still
+// stop at the limit on the quick-stop ramp 0x6085, and standing exactly there once it arrives.
+// Returns true while the limit cuts the goal.
+bool brake_for_limit(const plant_constants& k, const axis_state& a, const motion::shaft& s,
+                     std::int64_t& goal, std::int64_t& down, std::int64_t& edge) noexcept {
+  const mode_objects& o = a.objects;
+  const std::int64_t quick_stop = std::int64_t{a.quick_stop_deceleration} * k.cycle_us;
+  if (beyond_limit(a, s.position, goal)) {  // at or past the limit: stop (and stay) there
+    goal = 0;
+    down = quick_stop;
+    return true;
+  }
+  if (goal == 0) return false;
+  edge = goal > 0 ? o.max_position : o.min_position;
+  // Farther from the limit than the braking distance from the top speed (and a cycle's travel)
+  // there is nothing to cut: no 128-bit root in the cycles of a shaft far away.
+  if (magnitude(edge - s.position) > std::int64_t{a.pv_braking_reach}) return false;
+  const std::int64_t cap = motion::stopping_speed(s, edge, a.quick_stop_deceleration, k.cycle_us, o.increments_per_rev);
+  if (magnitude(goal) <= cap) return false;
+  goal = sign_of(goal) * cap;
+  if (down < quick_stop) down = quick_stop;
+  return true;
+}
+
+// Profile velocity, and every mode while a stop runs or torque is off: the velocity approaches its
+// goal on the ramps, the position integrates it. Returns bit 11 while profile velocity's set-point
+// is cut (speed limit, software position limit). Here, not in plant_modes/: every cycle of every
+// mode but a running one runs it, inlined into shaft_follow().
+std::uint16_t velocity_follow(const profile& p, const plant_constants& k, axis_state& a,
+                              const drive_outputs& out, motion::shaft& s, bool brake_holds) noexcept {
+  const std::int64_t cycle = k.cycle_us;
+  std::int64_t goal = 0;
+  std::int64_t up = 0;
+  std::int64_t down = 0;
+  std::uint16_t status = 0;
+  bool towards_limit = false;
+  std::int64_t edge = 0;
+  if (!out.torque) {
+    down = k.coast_step;  // coasting: friction only
+  } else if (out.ramp != stop_ramp::none && out.ramp != stop_ramp::coast) {
+    down = ramp_step(k, a, out.ramp);
+  } else if (p.info(out.current).activity == state_activity::run && a.operation_mode == cia402::mode::profile_velocity) {
+    goal = a.pv_set_point;
+    if (a.pv_set_point_cut) status |= status_bit::internal_limit_active;
+    up = std::int64_t{a.acceleration} * cycle;
+    down = std::int64_t{a.deceleration} * cycle;
+    if (limits_on(a) && brake_for_limit(k, a, s, goal, down, edge)) {
+      status |= status_bit::internal_limit_active;
+      towards_limit = goal != 0;
+    }
+  } else {
+    down = std::int64_t{a.deceleration} * cycle;  // torque held without motion (e.g. hold states)
+  }
+  if (brake_holds) {
+    goal = 0;  // an engaged (or still releasing) brake holds the shaft: nothing accelerates
+    up = 0;
+    down += k.brake_step;
+    towards_limit = false;
+  }
+  const std::int64_t v_new = approach(s.velocity, goal, up, down);
+  motion::advance(s, v_new, k.cycle_us, a.objects.increments_per_rev);
+  // Arrived at the limit within a slow last cycle: exactly there, at rest.
+  const bool reached = v_new > 0 ? s.position >= edge : (s.position < edge || (s.position == edge && s.fraction == 0));
+  if (towards_limit && reached && magnitude(v_new) <= down) {
+    s.position = edge;
+    s.fraction = 0;
+    s.velocity = 0;
+  }
+  return status;
+}
+
 [[gnu::noinline]] void brake_moves(const plant_constants& k, axis_state& a, bool open) noexcept;
 
 // The brake over one cycle: it reaches what the drive commands after its delay. Where it was
@@ -116,7 +187,11 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
   a.position_fraction = s.fraction;
   a.velocity = s.velocity;
   if (a.operation_mode == cia402::mode::profile_velocity) {
-    status |= pv_timed_bits(k, a);
+    // The timers count only while 0x606E or 0x6070 asks for them (the default asks for neither).
+    if ((a.objects.velocity_window_time | a.objects.velocity_threshold_time | a.in_velocity_window_us |
+         a.above_velocity_threshold_us) != 0) {
+      status |= pv_timed_bits(k, a);
+    }
   } else if (!mode_moves) {
     restart_cyclic(a);  // a cyclic mode resumes from here
   }
@@ -162,7 +237,9 @@ void unusual_inputs_of(const axis_state& a, drive_inputs& in) noexcept {
 }
 
 // The plant's feedback and the control word into the inputs.
-inline void feedback_of(const plant_constants& k, const axis_state& a, drive_inputs& in) noexcept {
+// `set_point`: profile velocity's (pv_set_point()).
+inline void feedback_of(const plant_constants& k, const axis_state& a, std::int64_t set_point,
+                        drive_inputs& in) noexcept {
   in.control_word = a.control_word;
   const bool standstill = magnitude(a.velocity) <= k.standstill_window;
   in.standstill = standstill;
@@ -173,7 +250,7 @@ inline void feedback_of(const plant_constants& k, const axis_state& a, drive_inp
   std::uint16_t mode_bits = a.mode_status;
   if (a.operation_mode == cia402::mode::profile_velocity) {
     const mode_objects& o = a.objects;
-    const bool in_window = magnitude(a.velocity - pv_set_point(k, a)) <= std::int64_t{o.velocity_window} * micro;
+    const bool in_window = magnitude(a.velocity - set_point) <= std::int64_t{o.velocity_window} * micro;
     const bool target_reached =
         in_window && (o.velocity_window_time == 0 || (a.mode_status & status_bit::target_reached) != 0);
     const bool speed_zero = magnitude(a.velocity) <= std::int64_t{o.velocity_threshold} * micro ||
@@ -190,17 +267,17 @@ inline void feedback_of(const plant_constants& k, const axis_state& a, drive_inp
   in.actual_speed_rpm = velocity_rpm(a);
 }
 
-inline drive_inputs inputs_of(const plant_constants& k, const axis_state& a) noexcept {
+inline drive_inputs inputs_of(const plant_constants& k, const axis_state& a, std::int64_t pv_set_point) noexcept {
   drive_inputs in;
   if (!usual_inputs(a)) unusual_inputs_of(a, in);
-  feedback_of(k, a, in);
+  feedback_of(k, a, pv_set_point, in);
   return in;
 }
 
 }  // namespace
 
 drive_inputs plant_inputs(const plant_constants& k, const axis_state& a) noexcept {
-  return inputs_of(k, a);
+  return inputs_of(k, a, pv_set_point(k, a));
 }
 
 namespace {
@@ -296,7 +373,11 @@ namespace {
 // registers.
 [[gnu::noinline]] void decide(const profile& p, const plant_constants& k, axis_state& a) noexcept {
   std::memcpy(a.settled, &a, core_source_bytes);
-  cia402::step(p, a.core, inputs_of(k, a), a.last);
+  // Profile velocity's set-point, kept for the cycles the axis is settled: 0x60FF and the flags are
+  // among the compared bytes, the objects are written through write_any_object() only.
+  a.pv_set_point = pv_set_point(k, a);
+  a.pv_set_point_cut = a.pv_set_point != std::int64_t{effective_target(a)} * micro;
+  cia402::step(p, a.core, inputs_of(k, a, a.pv_set_point), a.last);
   a.settled_valid = std::memcmp(a.settled, &a.core, sizeof(axis)) == 0;
   // What follow() would ask of a csp cycle, from fields that stay as they are while the axis is
   // settled (last, flags and operation_mode are among the compared bytes; only decide() writes last).
@@ -313,9 +394,20 @@ namespace {
       p.info(out.current).activity == state_activity::run &&
       o.increments_per_rev == k.usual_increments_per_rev && o.interpolation_period_us <= k.cycle_us &&
       speed_limit_rpm(k, a) == k.max_velocity_rpm;
-  // Within the following error window and a cycle's travel: no check to count, no cut to make.
-  const std::int64_t window = o.following_error_window == 0xFFFFFFFFu ? INT64_MAX : std::int64_t{o.following_error_window};
-  a.settled_csp_reach = static_cast<std::uint32_t>(window < k.usual_csp_reach ? window : k.usual_csp_reach);
+  // What depends on the objects alone, worked out when one was written. Profile velocity needs to
+  // brake for a software limit only within the braking distance from the top speed (no mode turns
+  // the motor faster): beyond it, no root to draw (velocity_follow). A settled csp axis's demand
+  // within the following error window and a cycle's travel has no check to count, no cut to make.
+  if (a.objects_written) {
+    a.objects_written = false;
+    const std::uint64_t rpm = std::uint64_t{k.max_velocity_rpm} + 1;
+    const std::uint64_t reach = rpm * rpm * o.increments_per_rev / (120u * std::uint64_t{a.quick_stop_deceleration}) +
+                                rpm * o.increments_per_rev * k.cycle_us / 60'000'000u + 2u;
+    a.pv_braking_reach = reach < UINT32_MAX ? static_cast<std::uint32_t>(reach) : UINT32_MAX;
+    const std::int64_t window =
+        o.following_error_window == 0xFFFFFFFFu ? INT64_MAX : std::int64_t{o.following_error_window};
+    a.settled_csp_reach = static_cast<std::uint32_t>(window < k.usual_csp_reach ? window : k.usual_csp_reach);
+  }
 }
 
 }  // namespace

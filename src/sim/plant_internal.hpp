@@ -165,11 +165,6 @@ inline void csp_move_usual(const plant_constants& k, axis_state& a, std::int64_t
 // The operation modes (plant_modes/): one cycle of the shaft `s` while the drive runs in the mode.
 // Each returns the mode's status bits (10..13) and keeps a.demand.
 
-/// Profile velocity, and every mode while a stop runs or torque is off: the velocity approaches its
-/// goal on the ramps, the position integrates it (plant_modes/velocity.cpp). Returns bit 11 while
-/// profile velocity's set-point is cut (speed limit, software position limit).
-std::uint16_t velocity_follow(const profile& p, const plant_constants& k, axis_state& a,
-                              const drive_outputs& out, motion::shaft& s, bool brake_holds) noexcept;
 /// Profile velocity's timed status bits after the cycle's move: 10 once within 0x606D for 0x606E,
 /// 12 until beyond 0x606F for longer than 0x6070 (plant_modes/velocity.cpp).
 std::uint16_t pv_timed_bits(const plant_constants& k, axis_state& a) noexcept;

@@ -89,7 +89,10 @@ sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_
   // Any object but the control word (itself a source of the core's inputs) may change what the next
   // cycle decides from, or what a settled csp axis's cycle may skip (decide() reads the objects):
   // the settled copy goes, and the next cycle decides in full.
-  if (index != object::control_word) a.settled_valid = false;
+  if (index != object::control_word) {
+    a.settled_valid = false;
+    a.objects_written = true;
+  }
   if (is_option_index(index)) return write_option(p, a.core, index, static_cast<std::int32_t>(value));
   mode_objects& m = a.objects;
   const auto i32 = static_cast<std::int32_t>(value);

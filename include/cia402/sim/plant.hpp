@@ -210,6 +210,9 @@ struct axis_state {
   /// the usual resolution, with no interpolation and no speed limit below the motor's (what
   /// step_axis() asks of the settled core before it takes its path with no call).
   bool settled_csp_runs = false;
+  /// step_axis() only: the set-point profile velocity follows is cut to the speed limit (see
+  /// pv_set_point).
+  bool pv_set_point_cut = false;
   /// step_axis() only: the farthest the demand may lie from the shaft for that path: within the
   /// following error window and one cycle's travel at the motor's top speed (at most 100,000 rpm
   /// for a second at 0x608F's default: it fits).
@@ -218,6 +221,13 @@ struct axis_state {
   std::uint32_t deceleration = 1000;  ///< 0x6084, rpm/s: the slow-down ramp
   std::uint32_t quick_stop_deceleration = 10000;  ///< 0x6085, rpm/s
   std::uint16_t brake_timer = 0;      ///< cycles until the brake reaches its command
+  /// step_axis() only: an object was written since the core last decided, so what it works out
+  /// from the objects (pv_braking_reach, settled_csp_reach) is to be worked out again.
+  bool objects_written = true;
+  /// step_axis() only: how near (increments) a software limit the shaft must be before profile
+  /// velocity works out how hard to brake for it: the quick-stop braking distance from the motor's
+  /// top speed and a cycle's travel (UINT32_MAX: always). Worked out with the core's decision.
+  std::uint32_t pv_braking_reach = UINT32_MAX;
 
   // The operation modes.
   std::int64_t position = 0;           ///< 0x6064, increments
@@ -227,6 +237,7 @@ struct axis_state {
   std::int32_t torque = 0;             ///< 0x6077, permille of rated torque
   std::int32_t torque_demand = 0;      ///< the profile torque mode's ramped demand
   std::uint32_t following_error_us = 0;  ///< how long the following error has been beyond 0x6065
+  std::uint32_t interpolation_elapsed_us = 0;  ///< how far into the running period (interpolation_to)
   /// 0x6064 minus the shaft's own position (shaft_position()): what homing set. The switches and
   /// index pulses are places on the shaft; homing changes this, never them.
   std::int64_t home_shift = 0;
@@ -234,11 +245,14 @@ struct axis_state {
   /// beyond 0x606F.
   std::uint32_t in_velocity_window_us = 0;
   std::uint32_t above_velocity_threshold_us = 0;
-  /// The cyclic modes' interpolation over 0x60C2: the set-point the running period starts from,
-  /// the one it ends at (position, micro-rpm or permille), and how far into it the axis is.
+  /// The cyclic modes' interpolation over 0x60C2: the set-point the running period starts from and
+  /// the one it ends at (position, micro-rpm or permille).
   std::int64_t interpolation_from = 0;
   std::int64_t interpolation_to = 0;
-  std::uint32_t interpolation_elapsed_us = 0;
+  /// step_axis() only: the set-point profile velocity follows (micro-rpm: 0x60FF, 0 after T4, cut to
+  /// the speed limit), worked out with the core's decision from fields that stay as they are while
+  /// the axis is settled.
+  std::int64_t pv_set_point = 0;
   mode_objects objects;
   motion::profile_position pp;
   motion::homing homing;
