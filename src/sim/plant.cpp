@@ -187,11 +187,7 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
   a.position_fraction = s.fraction;
   a.velocity = s.velocity;
   if (a.operation_mode == cia402::mode::profile_velocity) {
-    // The timers count only while 0x606E or 0x6070 asks for them (the default asks for neither).
-    if ((a.objects.velocity_window_time | a.objects.velocity_threshold_time | a.in_velocity_window_us |
-         a.above_velocity_threshold_us) != 0) {
-      status |= pv_timed_bits(k, a);
-    }
+    if (a.pv_timed) status |= pv_timed_bits(k, a);  // only while 0x606E or 0x6070 asks for it
   } else if (!mode_moves) {
     restart_cyclic(a);  // a cyclic mode resumes from here
   }
@@ -400,6 +396,11 @@ namespace {
   // within the following error window and a cycle's travel has no check to count, no cut to make.
   if (a.objects_written) {
     a.objects_written = false;
+    a.pv_timed = (o.velocity_window_time | o.velocity_threshold_time) != 0;
+    if (!a.pv_timed) {
+      a.in_velocity_window_us = 0;
+      a.above_velocity_threshold_us = 0;
+    }
     const std::uint64_t rpm = std::uint64_t{k.max_velocity_rpm} + 1;
     const std::uint64_t reach = rpm * rpm * o.increments_per_rev / (120u * std::uint64_t{a.quick_stop_deceleration}) +
                                 rpm * o.increments_per_rev * k.cycle_us / 60'000'000u + 2u;

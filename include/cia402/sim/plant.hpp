@@ -222,14 +222,17 @@ struct axis_state {
   std::uint32_t quick_stop_deceleration = 10000;  ///< 0x6085, rpm/s
   std::uint16_t brake_timer = 0;      ///< cycles until the brake reaches its command
   /// step_axis() only: an object was written since the core last decided, so what it works out
-  /// from the objects (pv_braking_reach, settled_csp_reach) is to be worked out again.
+  /// from the objects (pv_timed, pv_braking_reach, settled_csp_reach) is to be worked out again.
   bool objects_written = true;
+  /// step_axis() only: 0x606E or 0x6070 asks profile velocity to time its bits 10 and 12.
+  bool pv_timed = false;
   /// step_axis() only: how near (increments) a software limit the shaft must be before profile
   /// velocity works out how hard to brake for it: the quick-stop braking distance from the motor's
   /// top speed and a cycle's travel (UINT32_MAX: always). Worked out with the core's decision.
   std::uint32_t pv_braking_reach = UINT32_MAX;
 
-  // The operation modes.
+  // The operation modes. What a running axis reads every cycle first, in the cache lines after the
+  // ones above; what homing, the timed pv bits and interpolation add, after the objects.
   std::int64_t position = 0;           ///< 0x6064, increments
   std::int64_t previous_position = 0;  ///< 0x6064 before the last cycle's move
   std::int64_t position_fraction = 0;  ///< parts of an increment (motion::shaft::fraction_unit)
@@ -238,6 +241,11 @@ struct axis_state {
   std::int32_t torque_demand = 0;      ///< the profile torque mode's ramped demand
   std::uint32_t following_error_us = 0;  ///< how long the following error has been beyond 0x6065
   std::uint32_t interpolation_elapsed_us = 0;  ///< how far into the running period (interpolation_to)
+  /// step_axis() only: the set-point profile velocity follows (micro-rpm: 0x60FF, 0 after T4, cut to
+  /// the speed limit), worked out with the core's decision from fields that stay as they are while
+  /// the axis is settled.
+  std::int64_t pv_set_point = 0;
+  mode_objects objects;
   /// 0x6064 minus the shaft's own position (shaft_position()): what homing set. The switches and
   /// index pulses are places on the shaft; homing changes this, never them.
   std::int64_t home_shift = 0;
@@ -249,11 +257,6 @@ struct axis_state {
   /// the one it ends at (position, micro-rpm or permille).
   std::int64_t interpolation_from = 0;
   std::int64_t interpolation_to = 0;
-  /// step_axis() only: the set-point profile velocity follows (micro-rpm: 0x60FF, 0 after T4, cut to
-  /// the speed limit), worked out with the core's decision from fields that stay as they are while
-  /// the axis is settled.
-  std::int64_t pv_set_point = 0;
-  mode_objects objects;
   motion::profile_position pp;
   motion::homing homing;
 };

@@ -6,14 +6,6 @@
 namespace cia402::sim::detail {
 std::uint16_t pv_timed_bits(const plant_constants& k, axis_state& a) noexcept {
   const mode_objects& o = a.objects;
-  // With both times 0 (the default) the bits follow the velocity at once (feedback_of): no timer.
-  if ((o.velocity_window_time | o.velocity_threshold_time) == 0) {
-    if ((a.in_velocity_window_us | a.above_velocity_threshold_us) != 0) {
-      a.in_velocity_window_us = 0;
-      a.above_velocity_threshold_us = 0;
-    }
-    return 0;
-  }
   const bool in_window = magnitude(a.velocity - a.pv_set_point) <= std::int64_t{o.velocity_window} * micro;
   a.in_velocity_window_us = in_window ? add_cycle(a.in_velocity_window_us, k.cycle_us) : 0;
   const bool above = magnitude(a.velocity) > std::int64_t{o.velocity_threshold} * micro;
