@@ -118,6 +118,15 @@ inline constexpr std::uint16_t status_word = 0x6041;
 inline constexpr std::uint16_t modes_of_operation = 0x6060;
 inline constexpr std::uint16_t modes_of_operation_display = 0x6061;
 inline constexpr std::uint16_t velocity_actual_value = 0x606C;
+inline constexpr std::uint16_t velocity_window = 0x606D;
+inline constexpr std::uint16_t velocity_window_time = 0x606E;
+inline constexpr std::uint16_t velocity_threshold = 0x606F;
+inline constexpr std::uint16_t velocity_threshold_time = 0x6070;
+inline constexpr std::uint16_t max_torque = 0x6072;
+inline constexpr std::uint16_t max_profile_velocity = 0x607F;
+inline constexpr std::uint16_t max_motor_speed = 0x6080;
+inline constexpr std::uint16_t supported_homing_methods = 0x60E3;  ///< sub 0 count, 1.. one method each
+inline constexpr std::uint16_t digital_inputs = 0x60FD;
 inline constexpr std::uint16_t profile_acceleration = 0x6083;
 inline constexpr std::uint16_t profile_deceleration = 0x6084;
 inline constexpr std::uint16_t quick_stop_deceleration = 0x6085;
@@ -147,6 +156,13 @@ inline constexpr std::uint16_t interpolation_time_period = 0x60C2;  ///< sub 1 v
 inline constexpr std::uint16_t following_error_actual_value = 0x60F4;
 inline constexpr std::uint16_t supported_drive_modes = 0x6502;
 }  // namespace object_index
+
+/// Bits of 0x60FD digital inputs (CiA 402-2); 16..31 are the manufacturer's.
+namespace digital_input {
+inline constexpr std::uint32_t negative_limit_switch = 1u << 0;
+inline constexpr std::uint32_t positive_limit_switch = 1u << 1;
+inline constexpr std::uint32_t home_switch = 1u << 2;
+}  // namespace digital_input
 
 /// Modes of operation (0x6060 / 0x6061) and their bits in 0x6502 (CiA 402-2).
 namespace mode {

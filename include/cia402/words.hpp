@@ -12,6 +12,19 @@ inline constexpr std::uint16_t quick_stop = 1u << 2;  ///< active low
 inline constexpr std::uint16_t enable_operation = 1u << 3;
 inline constexpr std::uint16_t fault_reset = 1u << 7;  ///< acts on its 0->1 edge (S2)
 inline constexpr std::uint16_t halt = 1u << 8;         ///< 0x605D (S8)
+
+// Bits 4..6 and 9 mean what the operation mode 0x6061 makes of them (CiA 402-2; cia402-reference.md
+// §2.1): one name per meaning, several names for one bit.
+/// Bit 4 in profile position: its 0->1 edge offers 0x607A as a new set-point.
+inline constexpr std::uint16_t new_set_point = 1u << 4;
+/// Bit 4 in homing: its 0->1 edge starts a homing run, its fall interrupts one.
+inline constexpr std::uint16_t homing_operation_start = 1u << 4;
+/// Bit 5 in profile position: the offered set-point replaces the running one at once.
+inline constexpr std::uint16_t change_set_immediately = 1u << 5;
+/// Bit 6 in profile position ("abs/rel"): the target is relative to the previous one.
+inline constexpr std::uint16_t relative = 1u << 6;
+/// Bit 9 in profile position: the running set-point is passed at speed into the queued one.
+inline constexpr std::uint16_t change_on_set_point = 1u << 9;
 }  // namespace control_bit
 
 namespace status_bit {
@@ -24,8 +37,34 @@ inline constexpr std::uint16_t quick_stop = 1u << 5;       ///< active low
 inline constexpr std::uint16_t switch_on_disabled = 1u << 6;
 inline constexpr std::uint16_t warning = 1u << 7;
 inline constexpr std::uint16_t remote = 1u << 9;
+/// In profile position and homing: at the target (home) and at rest; in profile velocity: the
+/// velocity within 0x606D of the set-point for 0x606E; in profile torque: the demand at 0x6071.
+/// Also set when a halt or a quick stop with 0x605A = 5..8 has brought the drive to rest.
 inline constexpr std::uint16_t target_reached = 1u << 10;
+/// A set-point or the motion is cut to a limit: 0x607D, 0x607F / 0x6080, 0x6072, or a stop at the
+/// current or voltage limit.
 inline constexpr std::uint16_t internal_limit_active = 1u << 11;
+
+// Bits 12 and 13 mean what the operation mode 0x6061 makes of them (CiA 402-2; cia402-reference.md
+// §1.2): one name per meaning, several names for one bit.
+/// Bit 12 in profile position: the offered set-point was taken (or queued).
+inline constexpr std::uint16_t set_point_acknowledge = 1u << 12;
+/// Bit 12 in profile velocity ("speed"): |velocity| is within 0x606F (the velocity threshold).
+inline constexpr std::uint16_t speed_zero = 1u << 12;
+/// Bit 12 in homing: home was found and the position redefined.
+inline constexpr std::uint16_t homing_attained = 1u << 12;
+/// Bit 12 in the cyclic synchronous modes: the drive follows the command value (0x607A, 0x60FF,
+/// 0x6071).
+inline constexpr std::uint16_t drive_follows_command = 1u << 12;
+/// Bit 13 in profile position and cyclic synchronous position: the following error is beyond 0x6065
+/// for longer than 0x6066.
+inline constexpr std::uint16_t following_error = 1u << 13;
+/// Bit 13 in profile velocity: the slip beyond its maximum (an asynchronous motor's; never set by a
+/// drive without one).
+inline constexpr std::uint16_t max_slippage = 1u << 13;
+/// Bit 13 in homing: the run failed (a limit switch where the method expects none, or nothing found
+/// within the search distance).
+inline constexpr std::uint16_t homing_error = 1u << 13;
 /// The bits the FSA state is shown in: 0..3, 5 and 6.
 inline constexpr std::uint16_t state_bits = 0x006F;
 /// Bits the drive passes through from the motion side unchanged: 8 and 12..15.

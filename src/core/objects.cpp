@@ -35,6 +35,11 @@ constexpr object_description limited(object_description o, std::int64_t low, std
   return o;
 }
 
+constexpr object_description read_only(object_description o) noexcept {
+  o.access = A::read_only;
+  return o;
+}
+
 // Sub-index 0 of an array or record: how many entries follow.
 constexpr object_description highest_sub(std::uint16_t index, std::uint8_t count, const char* name) noexcept {
   return {index, 0, T::unsigned8, A::read_only, false, count, count, count, name, ""};
@@ -76,13 +81,26 @@ constexpr object_description drive_object_table[] = {
     var(0x6067, T::unsigned32, A::read_write, true, "Position window", "inc", 10),
     var(0x6068, T::unsigned16, A::read_write, true, "Position window time", "ms", 0),
     var(0x606C, T::integer32, A::read_only, true, "Velocity actual value", "rpm"),
+    // Profile velocity's status bits: 10 when |velocity - set-point| <= 0x606D for longer than
+    // 0x606E; 12 ("speed") cleared once |velocity| > 0x606F for longer than 0x6070 (CiA 402-2).
+    // The plant's target and standstill windows give their power-on values.
+    var(0x606D, T::unsigned16, A::read_write, true, "Velocity window", "rpm", 10),
+    var(0x606E, T::unsigned16, A::read_write, true, "Velocity window time", "ms", 0),
+    var(0x606F, T::unsigned16, A::read_write, true, "Velocity threshold", "rpm", 1),
+    var(0x6070, T::unsigned16, A::read_write, true, "Velocity threshold time", "ms", 0),
     var(0x6071, T::integer16, A::read_write, true, "Target torque", permille),
+    // The torque modes' demand is cut to +-0x6072 (status bit 11 then).
+    var(0x6072, T::unsigned16, A::read_write, true, "Max torque", permille, 3000),
     var(0x6077, T::integer16, A::read_only, true, "Torque actual value", permille),
     var(0x607A, T::integer32, A::read_write, true, "Target position", "inc"),
     var(0x607C, T::integer32, A::read_write, true, "Home offset", "inc"),
     highest_sub(0x607D, 2, "Software position limit"),
     sub(0x607D, 1, T::integer32, "Min position limit", "inc", -2147483647LL - 1),
     sub(0x607D, 2, T::integer32, "Max position limit", "inc", 2147483647LL),
+    // The lower of the two is the drive's speed limit in every mode (status bit 11 while it cuts);
+    // 0x6080's power-on value is the plant's top speed.
+    var(0x607F, T::unsigned32, A::read_write, true, "Max profile velocity", "rpm", 6000),
+    var(0x6080, T::unsigned32, A::read_write, true, "Max motor speed", "rpm", 6000),
     var(0x6081, T::unsigned32, A::read_write, true, "Profile velocity", "rpm", 1000),
     var(0x6082, T::unsigned32, A::read_write, true, "End velocity", "rpm"),
     ramp(0x6083, "Profile acceleration", 1000),
@@ -96,9 +114,10 @@ constexpr object_description drive_object_table[] = {
     limited(sub(0x608F, 2, T::unsigned32, "Motor revolutions", "", 1), 1, 1),
     var(0x6098, T::integer8, A::read_write, true, "Homing method", "", 35),
     highest_sub(0x6099, 2, "Homing speeds"),
-    sub(0x6099, 1, T::unsigned32, "Speed during search for switch", "rpm", 500),
-    sub(0x6099, 2, T::unsigned32, "Speed during search for zero", "rpm", 50),
-    at_least_1(var(0x609A, T::unsigned32, A::read_write, true, "Homing acceleration", "rpm/s", 1000)),
+    // A default method 3 run on the default plant (home switch 5 revolutions out) takes under 2 s.
+    sub(0x6099, 1, T::unsigned32, "Speed during search for switch", "rpm", 1000),
+    sub(0x6099, 2, T::unsigned32, "Speed during search for zero", "rpm", 100),
+    at_least_1(var(0x609A, T::unsigned32, A::read_write, true, "Homing acceleration", "rpm/s", 10000)),
     var(0x60B0, T::integer32, A::read_write, true, "Position offset", "inc"),
     var(0x60B1, T::integer32, A::read_write, true, "Velocity offset", "rpm"),
     var(0x60B2, T::integer16, A::read_write, true, "Torque offset", permille),
@@ -107,7 +126,46 @@ constexpr object_description drive_object_table[] = {
     highest_sub(0x60C2, 2, "Interpolation time period"),
     sub(0x60C2, 1, T::unsigned8, "Interpolation time period value", "", 1),
     limited(sub(0x60C2, 2, T::integer8, "Interpolation time index", "", -3), -6, 0),
+    // The homing methods motion::homing runs (tests/sim check the two agree), one a sub-index.
+    // 1, 2 limit switch and index pulse; 3..14 home switch (and limit switch) and index pulse; 17..30
+    // the same without the index pulse; 33, 34 index pulse; 35, 37 the present position.
+    highest_sub(0x60E3, 32, "Supported homing methods"),
+    read_only(sub(0x60E3, 1, T::integer8, "Supported homing method 1", "", 1)),
+    read_only(sub(0x60E3, 2, T::integer8, "Supported homing method 2", "", 2)),
+    read_only(sub(0x60E3, 3, T::integer8, "Supported homing method 3", "", 3)),
+    read_only(sub(0x60E3, 4, T::integer8, "Supported homing method 4", "", 4)),
+    read_only(sub(0x60E3, 5, T::integer8, "Supported homing method 5", "", 5)),
+    read_only(sub(0x60E3, 6, T::integer8, "Supported homing method 6", "", 6)),
+    read_only(sub(0x60E3, 7, T::integer8, "Supported homing method 7", "", 7)),
+    read_only(sub(0x60E3, 8, T::integer8, "Supported homing method 8", "", 8)),
+    read_only(sub(0x60E3, 9, T::integer8, "Supported homing method 9", "", 9)),
+    read_only(sub(0x60E3, 10, T::integer8, "Supported homing method 10", "", 10)),
+    read_only(sub(0x60E3, 11, T::integer8, "Supported homing method 11", "", 11)),
+    read_only(sub(0x60E3, 12, T::integer8, "Supported homing method 12", "", 12)),
+    read_only(sub(0x60E3, 13, T::integer8, "Supported homing method 13", "", 13)),
+    read_only(sub(0x60E3, 14, T::integer8, "Supported homing method 14", "", 14)),
+    read_only(sub(0x60E3, 15, T::integer8, "Supported homing method 15", "", 17)),
+    read_only(sub(0x60E3, 16, T::integer8, "Supported homing method 16", "", 18)),
+    read_only(sub(0x60E3, 17, T::integer8, "Supported homing method 17", "", 19)),
+    read_only(sub(0x60E3, 18, T::integer8, "Supported homing method 18", "", 20)),
+    read_only(sub(0x60E3, 19, T::integer8, "Supported homing method 19", "", 21)),
+    read_only(sub(0x60E3, 20, T::integer8, "Supported homing method 20", "", 22)),
+    read_only(sub(0x60E3, 21, T::integer8, "Supported homing method 21", "", 23)),
+    read_only(sub(0x60E3, 22, T::integer8, "Supported homing method 22", "", 24)),
+    read_only(sub(0x60E3, 23, T::integer8, "Supported homing method 23", "", 25)),
+    read_only(sub(0x60E3, 24, T::integer8, "Supported homing method 24", "", 26)),
+    read_only(sub(0x60E3, 25, T::integer8, "Supported homing method 25", "", 27)),
+    read_only(sub(0x60E3, 26, T::integer8, "Supported homing method 26", "", 28)),
+    read_only(sub(0x60E3, 27, T::integer8, "Supported homing method 27", "", 29)),
+    read_only(sub(0x60E3, 28, T::integer8, "Supported homing method 28", "", 30)),
+    read_only(sub(0x60E3, 29, T::integer8, "Supported homing method 29", "", 33)),
+    read_only(sub(0x60E3, 30, T::integer8, "Supported homing method 30", "", 34)),
+    read_only(sub(0x60E3, 31, T::integer8, "Supported homing method 31", "", 35)),
+    read_only(sub(0x60E3, 32, T::integer8, "Supported homing method 32", "", 37)),
     var(0x60F4, T::integer32, A::read_only, true, "Following error actual value", "inc"),
+    // Bit 0 negative limit switch, 1 positive limit switch, 2 home switch (CiA 402-2); bit 16
+    // (manufacturer-specific) an index pulse passed in the last cycle.
+    var(0x60FD, T::unsigned32, A::read_only, true, "Digital inputs"),
     var(0x60FF, T::integer32, A::read_write, true, "Target velocity", "rpm"),
     // pp (bit 0), pv (2), tq (3), hm (5), csp (7), csv (8), cst (9).
     var(0x6502, T::unsigned32, A::read_only, false, "Supported drive modes", "", 0x3AD),

@@ -44,6 +44,19 @@ std::int64_t cap_speed(wide distance, std::uint32_t deceleration_rpm_s, std::int
   return isqrt(squared);
 }
 
+// The fastest the shaft may end a cycle with, `along` (micro-rpm, towards the target; negative
+// moving away) at its start and `distance` (fraction units) to go, so that after the cycle's travel
+// it can still slow to `end` at the deceleration: vn^2 <= e^2 + d (D - (v + vn) R dt) / R, which is
+// vn^2 + b vn - c <= 0 with b = d dt and c = e^2 + d D / R - b v.
+std::int64_t cap_towards(wide distance, std::int64_t along, std::int64_t end, std::uint32_t deceleration_rpm_s,
+                         std::uint32_t dt_us, std::uint32_t resolution) noexcept {
+  const wide b = static_cast<wide>(deceleration_rpm_s) * dt_us;
+  const wide c = static_cast<wide>(end) * end + static_cast<wide>(deceleration_rpm_s) * abs_wide(distance) / resolution -
+                 b * along;
+  const wide disc = b * b + 4 * c;
+  return disc <= b * b ? 0 : static_cast<std::int64_t>((isqrt(disc) - b) / 2);
+}
+
 std::int64_t min3(std::int64_t a, std::int64_t b, std::int64_t c) noexcept {
   const std::int64_t m = a < b ? a : b;
   return m < c ? m : c;
@@ -62,6 +75,13 @@ std::int64_t braking_speed(std::int64_t distance_increments, std::uint32_t decel
                            std::int64_t end_speed, std::uint32_t increments_per_rev) noexcept {
   return cap_speed(static_cast<wide>(distance_increments) * shaft::fraction_unit, deceleration_rpm_s,
                    end_speed, increments_per_rev);
+}
+
+std::int64_t stopping_speed(const shaft& s, std::int64_t target, std::uint32_t deceleration_rpm_s,
+                            std::uint32_t dt_us, std::uint32_t increments_per_rev) noexcept {
+  const wide distance = (static_cast<wide>(target) - s.position) * shaft::fraction_unit - s.fraction;
+  const std::int64_t along = distance < 0 ? -s.velocity : s.velocity;
+  return cap_towards(distance, along, 0, deceleration_rpm_s, dt_us, increments_per_rev ? increments_per_rev : 1u);
 }
 
 void profile_position::reset(std::int64_t position) noexcept {
@@ -132,17 +152,9 @@ pp_status profile_position::step(const pp_command& cmd, const pp_parameters& par
         blend ? (par.end_velocity_rpm ? static_cast<std::int64_t>(par.end_velocity_rpm) * micro : top)
               : 0;
     const std::int64_t along = v_old * sign;  // speed towards the target; negative moving away
-    // The fastest this cycle may end so that, after this cycle's travel, the shaft can still slow
-    // to the end speed at the deceleration: vn^2 <= e^2 + d (D - (v + vn) R dt) / R, which is
-    // vn^2 + b vn - c <= 0 with b = d dt and c = e^2 + d D / R - b v.
+    // The fastest this cycle may end so that the shaft can still slow to the end speed.
     const std::int64_t end = end_speed < top ? end_speed : top;
-    const wide b = decel_step;
-    const wide c = static_cast<wide>(end) * end +
-                   static_cast<wide>(par.deceleration_rpm_s) * abs_wide(distance) / resolution -
-                   b * along;
-    const wide disc = b * b + 4 * c;
-    const std::int64_t cap =
-        disc <= b * b ? 0 : static_cast<std::int64_t>((isqrt(disc) - b) / 2);
+    const std::int64_t cap = cap_towards(distance, along, end, par.deceleration_rpm_s, dt_us, resolution);
     // Moving away, the shaft first brakes; towards the target it speeds up to the profile velocity
     // and no faster than it can still stop.
     const std::int64_t up = along < 0 ? along + decel_step : along + accel_step;

@@ -49,9 +49,7 @@ unsigned threads_for(std::size_t axes, unsigned asked) noexcept {
 }  // namespace
 
 machine::machine(const profile& p, std::size_t axes, const plant_config& config, unsigned threads)
-    : profile_(&p), axes_(axes, make_axis_state(p)) {
-  if (const char* why = check_plant_config(config)) throw std::invalid_argument(why);
-  constants_ = plant_constants::from(config);
+    : profile_(&p), constants_(checked_constants(config)), axes_(axes, make_axis_state(p, constants_)) {
   const unsigned n = threads_for(axes, threads);
   parts_ = n;
   helpers_.reserve(n - 1);

@@ -104,6 +104,7 @@ struct scale {
   double t1 = 1;
   double v0 = 0;
   double v1 = 1;
+  double vstep = 1;  // the velocity axis's tick step
   double x(double t_us) const { return left + (t_us - t0) / (t1 - t0) * (right - left); }
   double y(double rpm) const {
     return plot_bottom - (rpm - v0) / (v1 - v0) * (plot_bottom - plot_top);
@@ -112,20 +113,21 @@ struct scale {
 
 double rpm(std::int64_t micro) { return static_cast<double>(micro) / 1e6; }
 
-}  // namespace
 
-void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const trace_info& info) {
-  // A trace that ran a mode other than profile velocity gets the position 0x6064 (on its own scale
-  // in the plot) and a torque 0x6077 lane; a pv-only trace's plot stays as it was.
-  const bool positions =
-      std::any_of(rows.begin(), rows.end(), [](const trace_row& r) { return r.mode != 3; });
+// Where the lanes, the time axis and the legend sit: a trace of the operation modes moves them down
+// to make room for the torque lane.
+struct layout {
+  double height, torque_top, brake_top, inputs_top, axis_y, legend_top;
+};
+
+layout layout_for(bool positions) {
   const double shift = positions ? torque_lane_room : 0;
-  const double height = 600 + shift;
-  const double torque_top = torque_on_top_pv + shift;
-  const double brake_top = brake_top_pv + shift;
-  const double inputs_top = inputs_top_pv + shift;
-  const double axis_y = axis_y_pv + shift;
-  const double legend_top = legend_top_pv + shift;
+  return {600 + shift,         torque_on_top_pv + shift, brake_top_pv + shift,
+          inputs_top_pv + shift, axis_y_pv + shift,      legend_top_pv + shift};
+}
+
+void write_header(std::ostream& out, const trace_info& info, const layout& at, bool positions) {
+  const double height = at.height;
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(width) << "\" height=\""
       << num(height) << "\" viewBox=\"0 0 " << num(width) << " " << num(height)
       << "\" font-family=\"DejaVu Sans, Arial, sans-serif\" font-size=\"11\">\n"
@@ -136,12 +138,10 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
       << ", cycle " << info.cycle_us << " us; velocity 0x606C (solid), target 0x60FF (dashed); "
       << (positions ? "position 0x6064 (magenta, right scale); torque 0x6077 below; " : "")
       << "bands: state; marks: transitions</text>\n";
-  if (rows.empty()) {
-    out << "<text x=\"" << num(left) << "\" y=\"120\">(empty trace)</text>\n</svg>\n";
-    return;
-  }
+}
 
-  // Scales.
+// The time and velocity scales of the plot, from every row.
+scale scale_for(const std::vector<trace_row>& rows, const trace_info& info) {
   scale s;
   s.t0 = static_cast<double>(rows.front().time_us);
   s.t1 = static_cast<double>(rows.back().time_us + info.cycle_us);
@@ -153,12 +153,16 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
   }
   if (vmax - vmin < 1) vmax = vmin + 1;
   const double vstep = nice_step(vmax - vmin, 6);
+  s.vstep = vstep;
   s.v0 = std::floor(vmin / vstep) * vstep;
   s.v1 = std::ceil(vmax / vstep) * vstep;
   if (s.v1 - vmax < vstep * 0.1) s.v1 += vstep * 0.5;  // room for the band labels
   if (vmin - s.v0 < vstep * 0.05 && s.v0 < 0) s.v0 -= vstep * 0.25;
+  return s;
+}
 
-  // State bands.
+// State bands, each labelled where it is wide enough; which states occur, for the legend.
+std::vector<bool> write_state_bands(std::ostream& out, const std::vector<trace_row>& rows, const scale& s) {
   out << "<g id=\"state-bands\">\n";
   std::vector<bool> present(state_count, false);
   for (std::size_t i = 0; i < rows.size();) {
@@ -188,8 +192,13 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
     i = j;
   }
   out << "</g>\n";
+  return present;
+}
 
-  // Grid and axes.
+void write_axes(std::ostream& out, const scale& s, const layout& at) {
+  const double vstep = s.vstep;
+  const double inputs_top = at.inputs_top;
+  const double axis_y = at.axis_y;
   out << "<g id=\"axes\" stroke=\"#000\" fill=\"none\">\n";
   const int vdec = decimals_for(vstep);
   for (double v = s.v0; v <= s.v1 + vstep * 1e-6; v += vstep) {
@@ -225,7 +234,10 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
       << "\" text-anchor=\"middle\">time [s]</text>\n";
   out << "<text transform=\"translate(22," << num((plot_top + plot_bottom) / 2)
       << ") rotate(-90)\" text-anchor=\"middle\">velocity [rpm]</text>\n";
+}
 
+// Target velocity (a dashed step line) and the velocity.
+void write_velocities(std::ostream& out, const std::vector<trace_row>& rows, const scale& s) {
   // Target velocity: a dashed step line through its changes.
   out << "<polyline id=\"target\" fill=\"none\" stroke=\"#555\" stroke-width=\"1.2\" "
          "stroke-dasharray=\"6 4\" points=\"";
@@ -280,48 +292,50 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
     }
   }
   out << "\"/>\n";
+}
 
-  // Transitions: a dashed line and a triangle at the cycle they happen; numbers above the plot,
-  // grouped when they are closer than a label's width and staggered over three rows.
+// Position 0x6064 on a scale of its own (labels at the right edge, in its colour), when the trace
+// ran a mode other than profile velocity: a pv plot stays as it was.
+void write_position(std::ostream& out, const std::vector<trace_row>& rows, const scale& s) {
+  double pmin = static_cast<double>(rows.front().position);
+  double pmax = pmin;
+  for (const trace_row& r : rows) {
+    pmin = std::min(pmin, static_cast<double>(r.position));
+    pmax = std::max(pmax, static_cast<double>(r.position));
+  }
+  if (pmax - pmin < 1) pmax = pmin + 1;
+  const double pstep = nice_step(pmax - pmin, 5);
+  const double p0 = std::floor(pmin / pstep) * pstep;
+  const double p1 = std::ceil(pmax / pstep) * pstep;
+  const auto yp = [&](double p) { return plot_bottom - (p - p0) / (p1 - p0) * (plot_bottom - plot_top); };
+  out << "<g id=\"position-axis\" fill=\"#b5179e\">\n";
+  for (double p = p0; p <= p1 + pstep * 1e-6; p += pstep) {
+    out << "<text x=\"" << num(right - 4) << "\" y=\"" << num(yp(p) - 3) << "\" text-anchor=\"end\">"
+        << fixed(p, 0) << "</text>\n";
+  }
+  out << "<text transform=\"translate(" << num(width - 8) << "," << num((plot_top + plot_bottom) / 2)
+      << ") rotate(90)\" text-anchor=\"middle\">position 0x6064 [increments]</text>\n</g>\n";
+  // One point a pixel column at most: the position is smooth.
+  out << "<polyline id=\"position\" fill=\"none\" stroke=\"#b5179e\" stroke-width=\"1.6\" "
+         "stroke-linejoin=\"round\" points=\"";
+  const std::size_t every = std::max<std::size_t>(1, rows.size() / 900);
+  for (std::size_t i = 0; i < rows.size(); i += every) {
+    out << (i ? " " : "") << num(s.x(static_cast<double>(rows[i].time_us))) << ","
+        << num(yp(static_cast<double>(rows[i].position)));
+  }
+  out << " " << num(s.x(static_cast<double>(rows.back().time_us))) << ","
+      << num(yp(static_cast<double>(rows.back().position)));
+  out << "\"/>\n";
+}
+
+// Transitions: a dashed line and a triangle at the cycle they happen; numbers above the plot,
+// grouped when they are closer than a label's width and staggered over three rows.
+void write_transitions(std::ostream& out, const std::vector<trace_row>& rows, const scale& s) {
   struct mark {
     double x;
     std::string label;
   };
   std::vector<mark> groups;
-  // Position 0x6064 on a scale of its own (labels at the right edge, in its colour), when the trace
-  // ran a mode other than profile velocity: a pv plot stays as it was.
-  if (positions) {
-    double pmin = static_cast<double>(rows.front().position);
-    double pmax = pmin;
-    for (const trace_row& r : rows) {
-      pmin = std::min(pmin, static_cast<double>(r.position));
-      pmax = std::max(pmax, static_cast<double>(r.position));
-    }
-    if (pmax - pmin < 1) pmax = pmin + 1;
-    const double pstep = nice_step(pmax - pmin, 5);
-    const double p0 = std::floor(pmin / pstep) * pstep;
-    const double p1 = std::ceil(pmax / pstep) * pstep;
-    const auto yp = [&](double p) { return plot_bottom - (p - p0) / (p1 - p0) * (plot_bottom - plot_top); };
-    out << "<g id=\"position-axis\" fill=\"#b5179e\">\n";
-    for (double p = p0; p <= p1 + pstep * 1e-6; p += pstep) {
-      out << "<text x=\"" << num(right - 4) << "\" y=\"" << num(yp(p) - 3) << "\" text-anchor=\"end\">"
-          << fixed(p, 0) << "</text>\n";
-    }
-    out << "<text transform=\"translate(" << num(width - 8) << "," << num((plot_top + plot_bottom) / 2)
-        << ") rotate(90)\" text-anchor=\"middle\">position 0x6064 [increments]</text>\n</g>\n";
-    // One point a pixel column at most: the position is smooth.
-    out << "<polyline id=\"position\" fill=\"none\" stroke=\"#b5179e\" stroke-width=\"1.6\" "
-           "stroke-linejoin=\"round\" points=\"";
-    const std::size_t every = std::max<std::size_t>(1, rows.size() / 900);
-    for (std::size_t i = 0; i < rows.size(); i += every) {
-      out << (i ? " " : "") << num(s.x(static_cast<double>(rows[i].time_us))) << ","
-          << num(yp(static_cast<double>(rows[i].position)));
-    }
-    out << " " << num(s.x(static_cast<double>(rows.back().time_us))) << ","
-        << num(yp(static_cast<double>(rows.back().position)));
-    out << "\"/>\n";
-  }
-
   out << "<g id=\"transitions\">\n";
   for (const trace_row& r : rows) {
     if (r.transition == no_transition) continue;
@@ -352,63 +366,69 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
     row_end[row] = x + w / 2;
   }
   out << "</g>\n";
+}
 
-  // Torque 0x6077 (permille of rated torque) in a lane of its own, zero line and its extremes
-  // labelled; per pixel column the first, lowest, highest and last sample, so no step is lost.
-  if (positions) {
-    double tmin = 0;
-    double tmax = 0;
-    for (const trace_row& r : rows) {
-      tmin = std::min(tmin, static_cast<double>(r.torque_permille));
-      tmax = std::max(tmax, static_cast<double>(r.torque_permille));
-    }
-    if (tmax - tmin < 1) tmax = tmin + 1;
-    const double lane_bottom = torque_lane_top + torque_lane_height;
-    const auto yt = [&](double t) {
-      return lane_bottom - 3 - (t - tmin) / (tmax - tmin) * (torque_lane_height - 6);
-    };
-    out << "<g id=\"torque-lane\">\n";
-    out << "<rect x=\"" << num(left) << "\" y=\"" << num(torque_lane_top) << "\" width=\""
-        << num(right - left) << "\" height=\"" << num(torque_lane_height)
-        << "\" fill=\"#fbfbfb\" stroke=\"#999\" stroke-width=\"0.5\"/>\n";
-    out << "<line x1=\"" << num(left) << "\" y1=\"" << num(yt(0)) << "\" x2=\"" << num(right)
-        << "\" y2=\"" << num(yt(0)) << "\" stroke=\"#bbb\" stroke-width=\"0.5\"/>\n";
-    out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(torque_lane_top + 11)
-        << "\" text-anchor=\"end\">torque 0x6077</text>\n";
-    out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(torque_lane_top + 24)
-        << "\" text-anchor=\"end\" font-size=\"10\" fill=\"#444\">[permille]</text>\n";
-    for (const double t : {tmin, 0.0, tmax}) {
-      if (t != 0.0 && std::fabs(t) < 1) continue;
-      if (t == 0.0 && (tmin == 0.0 || tmax == 0.0)) continue;  // labelled as an extreme
-      out << "<text x=\"" << num(right - 4) << "\" y=\"" << num(yt(t) + 4)
-          << "\" text-anchor=\"end\" font-size=\"10\" fill=\"#2a7f62\">" << fixed(t, 0) << "</text>\n";
-    }
-    out << "<polyline id=\"torque\" fill=\"none\" stroke=\"#2a7f62\" stroke-width=\"1.4\" "
-           "stroke-linejoin=\"round\" points=\"";
-    bool first = true;
-    auto point = [&](const trace_row& r) {
-      out << (first ? "" : " ") << num(s.x(static_cast<double>(r.time_us))) << ","
-          << num(yt(static_cast<double>(r.torque_permille)));
-      first = false;
-    };
-    for (std::size_t i = 0; i < rows.size();) {
-      const long column = std::lround(std::floor(s.x(static_cast<double>(rows[i].time_us))));
-      std::size_t j = i, lo = i, hi = i;
-      while (j < rows.size() && std::lround(std::floor(s.x(static_cast<double>(rows[j].time_us)))) == column) {
-        if (rows[j].torque_permille < rows[lo].torque_permille) lo = j;
-        if (rows[j].torque_permille > rows[hi].torque_permille) hi = j;
-        ++j;
-      }
-      std::vector<std::size_t> picks = {i, lo, hi, j - 1};
-      std::sort(picks.begin(), picks.end());
-      picks.erase(std::unique(picks.begin(), picks.end()), picks.end());
-      for (std::size_t k : picks) point(rows[k]);
-      i = j;
-    }
-    out << "\"/>\n</g>\n";
+// Torque 0x6077 (permille of rated torque) in a lane of its own, zero line and its extremes
+// labelled; per pixel column the first, lowest, highest and last sample, so no step is lost.
+void write_torque_lane(std::ostream& out, const std::vector<trace_row>& rows, const scale& s) {
+  double tmin = 0;
+  double tmax = 0;
+  for (const trace_row& r : rows) {
+    tmin = std::min(tmin, static_cast<double>(r.torque_permille));
+    tmax = std::max(tmax, static_cast<double>(r.torque_permille));
   }
+  if (tmax - tmin < 1) tmax = tmin + 1;
+  const double lane_bottom = torque_lane_top + torque_lane_height;
+  const auto yt = [&](double t) {
+    return lane_bottom - 3 - (t - tmin) / (tmax - tmin) * (torque_lane_height - 6);
+  };
+  out << "<g id=\"torque-lane\">\n";
+  out << "<rect x=\"" << num(left) << "\" y=\"" << num(torque_lane_top) << "\" width=\""
+      << num(right - left) << "\" height=\"" << num(torque_lane_height)
+      << "\" fill=\"#fbfbfb\" stroke=\"#999\" stroke-width=\"0.5\"/>\n";
+  out << "<line x1=\"" << num(left) << "\" y1=\"" << num(yt(0)) << "\" x2=\"" << num(right)
+      << "\" y2=\"" << num(yt(0)) << "\" stroke=\"#bbb\" stroke-width=\"0.5\"/>\n";
+  out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(torque_lane_top + 11)
+      << "\" text-anchor=\"end\">torque 0x6077</text>\n";
+  out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(torque_lane_top + 24)
+      << "\" text-anchor=\"end\" font-size=\"10\" fill=\"#444\">[permille]</text>\n";
+  for (const double t : {tmin, 0.0, tmax}) {
+    if (t != 0.0 && std::fabs(t) < 1) continue;
+    if (t == 0.0 && (tmin == 0.0 || tmax == 0.0)) continue;  // labelled as an extreme
+    out << "<text x=\"" << num(right - 4) << "\" y=\"" << num(yt(t) + 4)
+        << "\" text-anchor=\"end\" font-size=\"10\" fill=\"#2a7f62\">" << fixed(t, 0) << "</text>\n";
+  }
+  out << "<polyline id=\"torque\" fill=\"none\" stroke=\"#2a7f62\" stroke-width=\"1.4\" "
+         "stroke-linejoin=\"round\" points=\"";
+  bool first = true;
+  auto point = [&](const trace_row& r) {
+    out << (first ? "" : " ") << num(s.x(static_cast<double>(r.time_us))) << ","
+        << num(yt(static_cast<double>(r.torque_permille)));
+    first = false;
+  };
+  for (std::size_t i = 0; i < rows.size();) {
+    const long column = std::lround(std::floor(s.x(static_cast<double>(rows[i].time_us))));
+    std::size_t j = i, lo = i, hi = i;
+    while (j < rows.size() && std::lround(std::floor(s.x(static_cast<double>(rows[j].time_us)))) == column) {
+      if (rows[j].torque_permille < rows[lo].torque_permille) lo = j;
+      if (rows[j].torque_permille > rows[hi].torque_permille) hi = j;
+      ++j;
+    }
+    std::vector<std::size_t> picks = {i, lo, hi, j - 1};
+    std::sort(picks.begin(), picks.end());
+    picks.erase(std::unique(picks.begin(), picks.end()), picks.end());
+    for (std::size_t k : picks) point(rows[k]);
+    i = j;
+  }
+  out << "\"/>\n</g>\n";
+}
 
-  // Lanes: torque on; brake released (solid) and changing over (light).
+// Lanes: torque on; brake released (solid) and changing over (light); inputs from outside.
+void write_lanes(std::ostream& out, const std::vector<trace_row>& rows, const scale& s,
+                 const trace_info& info, const layout& places) {
+  const double torque_top = places.torque_top;
+  const double brake_top = places.brake_top;
+  const double inputs_top = places.inputs_top;
   out << "<g id=\"lanes\">\n";
   out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(torque_top + 11)
       << "\" text-anchor=\"end\">torque on</text>\n";
@@ -490,8 +510,11 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
     i = j;
   }
   out << "</g>\n";
+}
 
-  // Legend: the states that occur, then the lines and lanes.
+// Legend: the states that occur, then the lines and lanes.
+void write_legend(std::ostream& out, const std::vector<bool>& present, const layout& at, bool positions) {
+  const double legend_top = at.legend_top;
   out << "<g id=\"legend\">\n";
   double x = left;
   double y = legend_top;
@@ -546,6 +569,30 @@ void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const
       << "<text x=\"" << num(left + 30) << "\" y=\"" << num(y)
       << "\">inputs: STO active, DC-link voltage lost, an injected fault cause (its error code)</text>\n";
   out << "</g>\n</svg>\n";
+}
+
+}  // namespace
+
+void write_svg_plot(std::ostream& out, const std::vector<trace_row>& rows, const trace_info& info) {
+  // A trace that ran a mode other than profile velocity gets the position 0x6064 (on its own scale
+  // in the plot) and a torque 0x6077 lane; a pv-only trace's plot stays as it was.
+  const bool positions =
+      std::any_of(rows.begin(), rows.end(), [](const trace_row& r) { return r.mode != 3; });
+  const layout at = layout_for(positions);
+  write_header(out, info, at, positions);
+  if (rows.empty()) {
+    out << "<text x=\"" << num(left) << "\" y=\"120\">(empty trace)</text>\n</svg>\n";
+    return;
+  }
+  const scale s = scale_for(rows, info);
+  const std::vector<bool> present = write_state_bands(out, rows, s);
+  write_axes(out, s, at);
+  write_velocities(out, rows, s);
+  if (positions) write_position(out, rows, s);
+  write_transitions(out, rows, s);
+  if (positions) write_torque_lane(out, rows, s);
+  write_lanes(out, rows, s, info, at);
+  write_legend(out, present, at, positions);
 }
 
 }  // namespace cia402::sim

@@ -17,6 +17,7 @@
 #include "cia402/sim/virtual_drive.hpp"
 #include "cia402/support/text.hpp"
 #include "cia402/support/toml_reading.hpp"
+#include "scenario_reading.hpp"
 
 static_assert(TOML_EXCEPTIONS, "the loader relies on toml::parse throwing toml::parse_error");
 
@@ -34,120 +35,11 @@ using toml_reading::refuse;
 using toml_reading::refuse_type;
 using toml_reading::type_name;
 
-// A key of the top level written under a [table] is the usual slip: say so.
-void check_keys(const toml::table& t, std::initializer_list<std::string_view> allowed,
-                std::string_view where) {
-  toml_reading::check_keys(t, allowed, where, [where](std::string_view key) {
-    for (std::string_view root_key : {"events", "expect", "objects", "duration", "cycle"}) {
-      if (key == root_key && where != "the scenario") {
-        return "; a [table] lasts until the next one, so write '" + std::string(root_key) +
-               "' before the first [table] header";
-      }
-    }
-    return std::string();
-  });
-}
-
-
-// A decimal or 0x-hexadecimal integer written as a key ("0x605A").
-// "0x605A", or "0x607D:2" for a sub-index (a quoted key: TOML keys cannot hold the colon bare).
-bool parse_index(std::string_view text, std::uint16_t& out, std::uint8_t& sub) {
-  sub = 0;
-  const std::size_t colon = text.find(':');
-  if (colon != std::string_view::npos) {
-    const std::optional<std::int64_t> s = support::parse_integer(text.substr(colon + 1), 0, 0xFF);
-    if (!s) return false;
-    sub = static_cast<std::uint8_t>(*s);
-    text = text.substr(0, colon);
-  }
-  const std::optional<std::int64_t> v = support::parse_integer(text, 0, 0xFFFF);
-  if (v) out = static_cast<std::uint16_t>(*v);
-  return v.has_value();
-}
-
-// "10ms", "1.5s", "250us", "2 s": an exact number of microseconds.
-std::uint64_t get_time_us(const toml::node& n, std::string_view what) {
-  if (n.is_integer() || n.is_floating_point()) {
-    refuse(n, std::string(what) + " must be a string with a unit, e.g. \"10ms\", \"1.5s\" or "
-                                  "\"250us\"");
-  }
-  const std::string text(get_string(n, what));
-  std::size_t i = 0;
-  std::uint64_t whole = 0;
-  std::uint64_t fraction = 0;
-  std::uint64_t scale = 1;  // 10^(fraction digits)
-  auto bad = [&]() {
-    refuse(n, std::string(what) + " " + toml_reading::quoted(text) +
-                  " is not a time: write a number and a unit (s, ms, us), e.g. \"1.5s\"");
-  };
-  const std::size_t digits_start = i;
-  while (i < text.size() && text[i] >= '0' && text[i] <= '9') {
-    whole = whole * 10 + static_cast<std::uint64_t>(text[i] - '0');
-    if (whole > 1000000000ull) bad();
-    ++i;
-  }
-  if (i == digits_start) bad();
-  if (i < text.size() && text[i] == '.') {
-    ++i;
-    const std::size_t frac_start = i;
-    while (i < text.size() && text[i] >= '0' && text[i] <= '9') {
-      if (scale >= 1000000000000ull) bad();
-      fraction = fraction * 10 + static_cast<std::uint64_t>(text[i] - '0');
-      scale *= 10;
-      ++i;
-    }
-    if (i == frac_start) bad();
-  }
-  while (i < text.size() && text[i] == ' ') ++i;
-  const std::string unit = text.substr(i);
-  std::uint64_t us_per_unit = 0;
-  if (unit == "s") us_per_unit = 1000000;
-  else if (unit == "ms") us_per_unit = 1000;
-  else if (unit == "us") us_per_unit = 1;
-  else bad();
-  if ((fraction * us_per_unit) % scale != 0) {
-    refuse(n, std::string(what) + " " + toml_reading::quoted(text) + " is finer than a microsecond");
-  }
-  return whole * us_per_unit + fraction * us_per_unit / scale;
-}
-
-// "2 s", "1.5 s", "1.5 ms", "250 us": a time as a person writes it.
-std::string seconds_text(std::uint64_t us) {
-  auto decimal = [](std::uint64_t value, std::uint64_t unit, int digits, const char* name) {
-    std::string s = std::to_string(value / unit);
-    const std::uint64_t rest = value % unit;
-    if (rest != 0) {
-      std::string frac = std::to_string(rest);
-      frac.insert(0, static_cast<std::size_t>(digits) - frac.size(), '0');
-      while (frac.back() == '0') frac.pop_back();
-      s += "." + frac;
-    }
-    return s + " " + name;
-  };
-  if (us >= 1000000) return decimal(us, 1000000, 6, "s");
-  if (us >= 1000) return decimal(us, 1000, 3, "ms");
-  return std::to_string(us) + " us";
-}
-
-// A velocity in rpm (integer or float) as micro-rpm.
-std::int64_t get_velocity(const toml::node& n, std::string_view what) {
-  constexpr double limit = 2147483647.0;
-  if (const auto* i = n.as_integer()) {
-    const std::int64_t v = i->get();
-    if (v < -2147483648LL || v > 2147483647LL) {
-      refuse(n, std::string(what) + " " + std::to_string(v) + " rpm is outside the INT32 range");
-    }
-    return v * 1000000;
-  }
-  if (const auto* f = n.as_floating_point()) {
-    const double v = f->get();
-    if (!std::isfinite(v) || v < -limit || v > limit) {
-      refuse(n, std::string(what) + " is outside the INT32 range of rpm");
-    }
-    return std::llround(v * 1e6);
-  }
-  refuse_type(n, what, "a number of rpm");
-}
+using scenario_reading::check_keys;
+using scenario_reading::get_time_us;
+using scenario_reading::get_velocity;
+using scenario_reading::parse_index;
+using scenario_reading::seconds_text;
 
 struct loader {
   scenario s;
@@ -201,70 +93,6 @@ struct loader {
              "unknown profile " + toml_reading::quoted(name) + " (built-in: " + list + ")");
     }
     s.drive_profile = custom_profile(*p);
-  }
-
-  std::uint32_t get_u32(const toml::node& n, std::string_view what, std::int64_t lo = 0) {
-    return static_cast<std::uint32_t>(get_int(n, what, lo, std::numeric_limits<std::uint32_t>::max()));
-  }
-
-  void load_plant(const toml::table& t) {
-    check_keys(t,
-               {"brake", "brake_engage_delay", "brake_release_delay", "brake_deceleration",
-                "coast_deceleration", "standstill_window", "target_window",
-                "current_limit_percent", "voltage_limit_percent", "voltage", "sto", "max_velocity",
-                "max_acceleration", "torque_acceleration", "friction", "load", "home_switch", "index_position"},
-               "[plant]");
-    plant_config& c = s.plant;
-    if (const auto* n = t.get("brake")) c.brake_fitted = get_bool(*n, "brake");
-    auto delay = [&](const char* key, std::uint32_t& out) {
-      if (const auto* n = t.get(key)) {
-        const std::uint64_t us = get_time_us(*n, key);
-        if (us > std::uint64_t{c.cycle_us} * 65535) {
-          refuse(*n, std::string(key) + " is longer than 65535 cycles");
-        }
-        out = static_cast<std::uint32_t>(us);
-      }
-    };
-    delay("brake_engage_delay", c.brake_engage_delay_us);
-    delay("brake_release_delay", c.brake_release_delay_us);
-    if (const auto* n = t.get("brake_deceleration")) {
-      c.brake_deceleration = get_u32(*n, "brake_deceleration", 1);
-    }
-    if (const auto* n = t.get("coast_deceleration")) {
-      c.coast_deceleration = get_u32(*n, "coast_deceleration");
-    }
-    if (const auto* n = t.get("standstill_window")) {
-      c.standstill_window_rpm =
-          static_cast<std::uint32_t>(get_int(*n, "standstill_window", 0, 1000000));
-    }
-    if (const auto* n = t.get("target_window")) {
-      c.target_window_rpm = static_cast<std::uint32_t>(get_int(*n, "target_window", 0, 1000000));
-    }
-    if (const auto* n = t.get("current_limit_percent")) {
-      c.current_limit_percent =
-          static_cast<std::uint32_t>(get_int(*n, "current_limit_percent", 1, 1000));
-    }
-    if (const auto* n = t.get("voltage_limit_percent")) {
-      c.voltage_limit_percent =
-          static_cast<std::uint32_t>(get_int(*n, "voltage_limit_percent", 1, 1000));
-    }
-    if (const auto* n = t.get("max_velocity")) {
-      c.max_velocity_rpm = static_cast<std::uint32_t>(get_int(*n, "max_velocity", 1, 100000));
-    }
-    if (const auto* n = t.get("max_acceleration")) {
-      c.max_acceleration_rpm_s = static_cast<std::uint32_t>(get_int(*n, "max_acceleration", 1, 100000000));
-    }
-    if (const auto* n = t.get("torque_acceleration")) {
-      c.torque_acceleration_rpm_s = static_cast<std::uint32_t>(get_int(*n, "torque_acceleration", 1, 100000000));
-    }
-    if (const auto* n = t.get("friction")) c.friction_permille = static_cast<std::uint32_t>(get_int(*n, "friction", 0, 1000));
-    if (const auto* n = t.get("load")) c.load_permille = static_cast<std::int32_t>(get_int(*n, "load", -1000, 1000));
-    constexpr std::int64_t reach = std::int64_t{1} << 40;
-    if (const auto* n = t.get("home_switch")) c.home_switch_position = get_int(*n, "home_switch", -reach, reach);
-    if (const auto* n = t.get("index_position")) c.index_position = get_int(*n, "index_position", -reach, reach);
-    if (const auto* n = t.get("voltage")) s.dc_link_at_start = get_bool(*n, "voltage");
-    if (const auto* n = t.get("sto")) s.sto_at_start = get_bool(*n, "sto");
-    if (const char* why = check_plant_config(c)) refuse(t, std::string("[plant]: ") + why);
   }
 
   // Start-up writes go through the object interface of a scratch axis, so a refusal is known now.
@@ -404,6 +232,93 @@ struct loader {
     s.events.insert(s.events.end(), actions.begin(), actions.end());
   }
 
+  // `always = "rule"`: a rule checked on every cycle of the run.
+  void load_rule(const toml::table& t, const toml::node& rule, expectation base, bool timed) {
+    const toml::node* always = &rule;
+    if (timed) refuse(*always, "'always' holds for the whole run: leave out at/between");
+    if (t.size() != 1) refuse(t, "'always' stands alone in its expectation");
+    const std::string_view name = get_string(*always, "always");
+    expectation e = base;
+    e.what = expectation::kind::always;
+    bool found = false;
+    for (invariant i : {invariant::brake_engaged_before_torque_off,
+                        invariant::motion_waits_for_brake_release,
+                        invariant::coast_removes_torque_at_once}) {
+      if (name == invariant_name(i)) {
+        e.rule = i;
+        found = true;
+      }
+    }
+    if (!found) {
+      refuse(*always, "unknown rule " + toml_reading::quoted(name) +
+                          " (brake_engaged_before_torque_off, motion_waits_for_brake_release, "
+                          "coast_removes_torque_at_once)");
+    }
+    if (e.rule == invariant::motion_waits_for_brake_release && !s.plant.brake_fitted) {
+      refuse(*always, "motion_waits_for_brake_release needs a brake ([plant] brake = true)");
+    }
+    e.first_cycle = 0;
+    e.last_cycle = s.cycles - 1;
+    e.window = true;
+    s.expectations.push_back(e);
+  }
+
+  // velocity = V, or { below = V }, { above = V }, { within = [LOW, HIGH] } (rpm).
+  void velocity_claim(const toml::node& claim, expectation base) {
+    const toml::node* n = &claim;
+    expectation e = base;
+    e.what = expectation::kind::velocity;
+    if (const auto* cmp = n->as_table()) {
+      if (cmp->size() != 1) {
+        refuse(*n, "velocity takes one comparison: { below = V }, { above = V } or "
+                   "{ within = [LOW, HIGH] }");
+      }
+      check_keys(*cmp, {"below", "above", "within"}, "a velocity comparison");
+      if (const auto* b = cmp->get("below")) {
+        e.how = expectation::compare::below;
+        e.low = get_velocity(*b, "below");
+      } else if (const auto* ab = cmp->get("above")) {
+        e.how = expectation::compare::above;
+        e.low = get_velocity(*ab, "above");
+      } else {
+        const toml::node& w = *cmp->get("within");
+        const toml::array& range = get_array(w, "within");
+        if (range.size() != 2) refuse(w, "within takes [LOW, HIGH]");
+        e.how = expectation::compare::within;
+        e.low = get_velocity(*range.get(0), "the low end of within");
+        e.high = get_velocity(*range.get(1), "the high end of within");
+        if (e.high < e.low) refuse(w, "within [LOW, HIGH] needs LOW <= HIGH");
+      }
+    } else {
+      e.how = expectation::compare::equal;
+      e.low = get_velocity(*n, "velocity");
+    }
+    s.expectations.push_back(e);
+  }
+
+  // position = P, or { within = [LOW, HIGH] } (increments).
+  void position_claim(const toml::node& claim, expectation base) {
+    const toml::node* n = &claim;
+    expectation e = base;
+    e.what = expectation::kind::position;
+    constexpr std::int64_t reach = std::int64_t{1} << 40;
+    if (const auto* cmp = n->as_table()) {
+      check_keys(*cmp, {"within"}, "a position comparison");
+      const toml::node* w = cmp->get("within");
+      if (w == nullptr) refuse(*n, "position takes an increment count or { within = [LOW, HIGH] }");
+      const toml::array& range = get_array(*w, "within");
+      if (range.size() != 2) refuse(*w, "within takes [LOW, HIGH]");
+      e.how = expectation::compare::within;
+      e.low = get_int(*range.get(0), "the low end of within", -reach, reach);
+      e.high = get_int(*range.get(1), "the high end of within", -reach, reach);
+      if (e.high < e.low) refuse(*w, "within [LOW, HIGH] needs LOW <= HIGH");
+    } else {
+      e.how = expectation::compare::equal;
+      e.low = get_int(*n, "position", -reach, reach);
+    }
+    s.expectations.push_back(e);
+  }
+
   void load_expectation(const toml::table& t) {
     check_keys(t,
                {"at", "between", "state", "velocity", "statusword", "torque", "brake",
@@ -416,32 +331,7 @@ struct loader {
     const toml::node* between = t.get("between");
     const toml::node* always = t.get("always");
     if (always) {
-      if (at || between) refuse(*always, "'always' holds for the whole run: leave out at/between");
-      if (t.size() != 1) refuse(t, "'always' stands alone in its expectation");
-      const std::string_view name = get_string(*always, "always");
-      expectation e = base;
-      e.what = expectation::kind::always;
-      bool found = false;
-      for (invariant i : {invariant::brake_engaged_before_torque_off,
-                          invariant::motion_waits_for_brake_release,
-                          invariant::coast_removes_torque_at_once}) {
-        if (name == invariant_name(i)) {
-          e.rule = i;
-          found = true;
-        }
-      }
-      if (!found) {
-        refuse(*always, "unknown rule " + toml_reading::quoted(name) +
-                            " (brake_engaged_before_torque_off, motion_waits_for_brake_release, "
-                            "coast_removes_torque_at_once)");
-      }
-      if (e.rule == invariant::motion_waits_for_brake_release && !s.plant.brake_fitted) {
-        refuse(*always, "motion_waits_for_brake_release needs a brake ([plant] brake = true)");
-      }
-      e.first_cycle = 0;
-      e.last_cycle = s.cycles - 1;
-      e.window = true;
-      s.expectations.push_back(e);
+      load_rule(t, *always, base, at || between);
       return;
     }
     if (at && between) refuse(*between, "give either 'at' or 'between', not both");
@@ -470,36 +360,7 @@ struct loader {
       }
       s.expectations.push_back(e);
     }
-    if (const auto* n = t.get("velocity")) {
-      expectation e = base;
-      e.what = expectation::kind::velocity;
-      if (const auto* cmp = n->as_table()) {
-        if (cmp->size() != 1) {
-          refuse(*n, "velocity takes one comparison: { below = V }, { above = V } or "
-                     "{ within = [LOW, HIGH] }");
-        }
-        check_keys(*cmp, {"below", "above", "within"}, "a velocity comparison");
-        if (const auto* b = cmp->get("below")) {
-          e.how = expectation::compare::below;
-          e.low = get_velocity(*b, "below");
-        } else if (const auto* ab = cmp->get("above")) {
-          e.how = expectation::compare::above;
-          e.low = get_velocity(*ab, "above");
-        } else {
-          const toml::node& w = *cmp->get("within");
-          const toml::array& range = get_array(w, "within");
-          if (range.size() != 2) refuse(w, "within takes [LOW, HIGH]");
-          e.how = expectation::compare::within;
-          e.low = get_velocity(*range.get(0), "the low end of within");
-          e.high = get_velocity(*range.get(1), "the high end of within");
-          if (e.high < e.low) refuse(w, "within [LOW, HIGH] needs LOW <= HIGH");
-        }
-      } else {
-        e.how = expectation::compare::equal;
-        e.low = get_velocity(*n, "velocity");
-      }
-      s.expectations.push_back(e);
-    }
+    if (const auto* n = t.get("velocity")) velocity_claim(*n, base);
     if (const auto* n = t.get("statusword")) {
       expectation e = base;
       e.what = expectation::kind::statusword;
@@ -531,26 +392,7 @@ struct loader {
       e.flag = v == "engaged";
       s.expectations.push_back(e);
     }
-    if (const auto* n = t.get("position")) {
-      expectation e = base;
-      e.what = expectation::kind::position;
-      constexpr std::int64_t reach = std::int64_t{1} << 40;
-      if (const auto* cmp = n->as_table()) {
-        check_keys(*cmp, {"within"}, "a position comparison");
-        const toml::node* w = cmp->get("within");
-        if (w == nullptr) refuse(*n, "position takes an increment count or { within = [LOW, HIGH] }");
-        const toml::array& range = get_array(*w, "within");
-        if (range.size() != 2) refuse(*w, "within takes [LOW, HIGH]");
-        e.how = expectation::compare::within;
-        e.low = get_int(*range.get(0), "the low end of within", -reach, reach);
-        e.high = get_int(*range.get(1), "the high end of within", -reach, reach);
-        if (e.high < e.low) refuse(*w, "within [LOW, HIGH] needs LOW <= HIGH");
-      } else {
-        e.how = expectation::compare::equal;
-        e.low = get_int(*n, "position", -reach, reach);
-      }
-      s.expectations.push_back(e);
-    }
+    if (const auto* n = t.get("position")) position_claim(*n, base);
     if (const auto* n = t.get("mode")) {
       expectation e = base;
       e.what = expectation::kind::mode;
@@ -611,7 +453,7 @@ struct loader {
       refuse(*duration_node, "duration is more than 100 million cycles");
     }
     s.cycles = duration_us / s.plant.cycle_us + 1;
-    if (const auto* n = root.get("plant")) load_plant(get_table(*n, "[plant]"));
+    if (const auto* n = root.get("plant")) scenario_reading::load_plant(get_table(*n, "[plant]"), s);
     if (const auto* n = root.get("objects")) load_objects(get_table(*n, "[objects]"));
     if (const auto* n = root.get("events")) {
       load_list(*n, "events", [&](const toml::table& t) { load_event(t); });

@@ -3,6 +3,7 @@
 
 #include <ostream>
 #include <string>
+#include <utility>
 
 #include "cia402/support/text.hpp"
 
@@ -77,6 +78,7 @@ trace_row begin_row(std::uint64_t time_us, const plant_constants& k, const axis_
   r.position_demand = a.demand;
   r.torque_permille = a.torque;
   r.mode = a.operation_mode;
+  r.digital_inputs = digital_inputs(k, a);
   return r;
 }
 
@@ -220,6 +222,12 @@ void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trac
       {"", "mode", type::vector, 8,
        [](const trace_row& r, int) { return binary(static_cast<std::uint8_t>(r.mode), 8); }, 0},
   };
+  // 0x60FD's inputs, one wire each: what a scope of the machine's switches shows.
+  const value_fn input = [](const trace_row& r, int bit) { return std::string((r.digital_inputs >> bit) & 1u ? "1" : "0"); };
+  for (const auto& [name, bit] : {std::pair{"negative_limit_switch", 0}, std::pair{"positive_limit_switch", 1},
+                                  std::pair{"home_switch", 2}, std::pair{"index_pulse", 16}}) {
+    signals.push_back({"", name, type::wire, 1, input, bit});
+  }
   for (int b = 0; b < 16; ++b) signals.push_back({"cw", control_bit_names[b], type::wire, 1, cw_bit, b});
   for (int b = 0; b < 16; ++b) signals.push_back({"sw", status_bit_names[b], type::wire, 1, sw_bit, b});
   if (info.vcd_standard) {

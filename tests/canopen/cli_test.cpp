@@ -79,8 +79,8 @@ TEST(cli_master, home_sets_the_position_to_the_home_offset) {
     ASSERT_EQ(r.status, 0) << method << r.err;
     EXPECT_NE(r.out.find("node 1: homing attained, position 1234"), std::string::npos) << method << r.out;
   }
-  const result refused = run_tool({"master", "--can", "virtual", "home", "--method", "1"});
-  EXPECT_EQ(refused.status, 1) << "method 1 needs a limit switch the virtual drive lacks";
+  const result refused = run_tool({"master", "--can", "virtual", "home", "--method", "15"});
+  EXPECT_EQ(refused.status, 1) << "method 15 is reserved (CiA 402-2): the drive refuses it";
 }
 
 TEST(cli_master, csp_stream_ramps_0x607A_by_rpdo3_and_follows_by_tpdo3) {

@@ -161,7 +161,9 @@ TEST(eds, the_dictionary_holds_every_object_of_the_one_table_as_it_describes_it)
     ASSERT_NE(sub, it->subs.end());
     const cia402::canopen::sub_entry& e = *sub;
     const bool has_subs = cia402::find_drive_object(d.index, 1) != nullptr;
-    EXPECT_EQ(it->subs.size(), has_subs ? 3u : 1u);
+    // An array or record: its count (sub-index 0) and the entries it counts.
+    const std::size_t entries = has_subs ? static_cast<std::size_t>(cia402::find_drive_object(d.index, 0)->default_value) : 0;
+    EXPECT_EQ(it->subs.size(), entries + 1);
     if (has_subs && d.sub == 0) {
       // An array's count is the dictionary's own constant.
       EXPECT_EQ(e.default_value, d.default_value);

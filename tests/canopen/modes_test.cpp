@@ -285,3 +285,35 @@ TEST(modes_master, map_position_streams_rpdo3_and_reads_tpdo3) {
 
 }  // namespace
 }  // namespace cia402::canopen
+
+namespace cia402::canopen {
+namespace {
+
+// Issue 34 over the bus, as python-canopen asked it: the top speed and the homing methods are
+// objects a master reads by SDO, and pv keeps to the top speed with bit 11 while it cuts.
+TEST_F(modes_test, the_speed_limits_and_the_homing_methods_read_by_sdo_and_pv_keeps_to_them_with_bit_11) {
+  constexpr std::uint16_t bit11 = 1u << 11;
+  EXPECT_EQ(sdo_read(0x607F, 0), 6000);
+  EXPECT_EQ(sdo_read(0x6080, 0), 6000);
+  const std::int64_t count = sdo_read(0x60E3, 0, 1);
+  ASSERT_EQ(count, 32);
+  std::vector<std::int64_t> methods;
+  for (int sub = 1; sub <= count; ++sub) methods.push_back(sdo_read(0x60E3, static_cast<std::uint8_t>(sub), 1));
+  EXPECT_EQ(methods.front(), 1);
+  EXPECT_EQ(methods.back(), 37);
+  for (const std::int64_t m : methods) EXPECT_EQ(sdo_write(0x6098, 0, m, 1), 0u) << m;
+  EXPECT_EQ(sdo_write(0x6098, 0, 15, 1), 0x06090030u) << "not in 0x60E3: refused";
+  EXPECT_EQ(sdo_write(0x607F, 0, 2000, 4), 0u);
+  EXPECT_EQ(sdo_write(0x6083, 0, 20000, 4), 0u);
+  ASSERT_EQ(sdo_write(0x6060, 0, 3, 1), 0u);
+  enable();
+  ASSERT_EQ(sdo_write(0x60FF, 0, 20000, 4), 0u);
+  run_ms(500);
+  EXPECT_EQ(sdo_read(0x606C, 0), 2000) << "20,000 rpm asked, 0x607F = 2000 given";
+  EXPECT_NE(status_words.back() & bit11, 0) << "internal limit active";
+  run_ms(500);
+  EXPECT_EQ(sdo_read(0x606C, 0), 2000) << "and it stays there";
+}
+
+}  // namespace
+}  // namespace cia402::canopen

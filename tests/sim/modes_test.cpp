@@ -11,47 +11,11 @@
 #include "cia402/objects.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 #include "cia402/words.hpp"
+#include "mode_support.hpp"
 
 namespace {
 
-using cia402::sdo_abort;
-using cia402::standard_profile;
-using cia402::state;
-using cia402::sim::virtual_drive;
-
-constexpr std::uint16_t bit10 = 1u << 10, bit11 = 1u << 11, bit12 = 1u << 12, bit13 = 1u << 13;
-
-std::int64_t read(virtual_drive& d, std::uint16_t index, std::uint8_t sub = 0) {
-  std::int64_t v = 0;
-  EXPECT_EQ(d.read(index, sub, v), sdo_abort::none) << std::hex << index;
-  return v;
-}
-
-void write(virtual_drive& d, std::uint16_t index, std::int64_t value, std::uint8_t sub = 0) {
-  ASSERT_EQ(d.write(index, sub, value), sdo_abort::none) << std::hex << index << " = " << value;
-}
-
-std::uint16_t status(virtual_drive& d) { return d.view().outputs().status_word; }
-
-// Shutdown, switch on, enable operation: the brake (30 ms) opens within the 60 cycles each gets.
-void enable_in_mode(virtual_drive& d, std::int8_t mode) {
-  write(d, 0x6060, mode);
-  for (int word : {0x06, 0x07, 0x0F}) {
-    write(d, 0x6040, word);
-    for (int i = 0; i < 60; ++i) d.step();
-  }
-  ASSERT_EQ(d.view().current(), state::operation_enabled);
-  ASSERT_EQ(read(d, 0x6061), mode);
-}
-
-// Steps until `done` holds (at most `limit` cycles); the cycles it took, or -1.
-int cycles_until(virtual_drive& d, const std::function<bool()>& done, int limit = 20000) {
-  for (int i = 1; i <= limit; ++i) {
-    d.step();
-    if (done()) return i;
-  }
-  return -1;
-}
+using namespace mode_test;
 
 // A pp set-point: target, bit 4 up with the given bits, wait for bit 12, bit 4 down.
 int offer_setpoint(virtual_drive& d, std::int64_t target, std::uint16_t bits = 0) {
@@ -208,9 +172,11 @@ TEST(homing, method_3_homes_on_the_index_pulse_left_of_the_home_switch_edge) {
   EXPECT_EQ(status(d) & bit13, 0);
 }
 
-TEST(homing, an_unsupported_method_is_refused) {
+TEST(homing, a_reserved_method_is_refused) {
   virtual_drive d(standard_profile());
-  EXPECT_EQ(d.write(0x6098, 0, 1), sdo_abort::invalid_value);
+  for (const int reserved : {0, 15, 16, 31, 32, 36, 38, -1}) {
+    EXPECT_EQ(d.write(0x6098, 0, reserved), sdo_abort::invalid_value) << reserved;
+  }
   EXPECT_EQ(read(d, 0x6098), 35);
 }
 

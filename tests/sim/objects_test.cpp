@@ -100,7 +100,7 @@ INSTANTIATE_TEST_SUITE_P(
         range_case{0x6060, 3, sdo_abort::none}, range_case{0x6060, 1, sdo_abort::none},
         range_case{0x6060, 2, sdo_abort::invalid_value}, range_case{0x6060, 7, sdo_abort::invalid_value},
         range_case{0x6060, 0, sdo_abort::invalid_value}, range_case{0x6098, 37, sdo_abort::none},
-        range_case{0x6098, 1, sdo_abort::invalid_value},
+        range_case{0x6098, 15, sdo_abort::invalid_value}, range_case{0x6098, 36, sdo_abort::invalid_value},
         range_case{0x6060, 128, sdo_abort::value_too_high}),
     [](const auto& info) {
       const auto& c = info.param;

@@ -191,3 +191,49 @@ TEST(scenario_file, a_missing_file_is_refused_without_a_line) {
 }
 
 }  // namespace
+
+namespace {
+
+using namespace cia402;
+using namespace cia402::sim;
+
+TEST(scenario_file, the_plant_takes_limit_switches_and_a_home_switch_with_two_edges_or_none) {
+  const scenario s = accepted(header +
+                              "plant.home_switch = { from = 50000, to = 80000 }\n"
+                              "plant.negative_limit_switch = -200000\n"
+                              "plant.positive_limit_switch = \"none\"\n");
+  EXPECT_TRUE(s.plant.home_switch_fitted);
+  EXPECT_EQ(s.plant.home_switch_position, std::optional<std::int64_t>(50000));
+  EXPECT_EQ(s.plant.home_switch_end, std::optional<std::int64_t>(80000));
+  EXPECT_EQ(s.plant.negative_limit_switch, std::optional<std::int64_t>(-200000));
+  EXPECT_FALSE(s.plant.positive_limit_switch.has_value());
+  // A negative home switch: active from the negative end of travel up to 0.
+  const scenario negative = accepted(header + "plant.home_switch = { to = 0 }\n");
+  EXPECT_FALSE(negative.plant.home_switch_position.has_value());
+  EXPECT_EQ(negative.plant.home_switch_end, std::optional<std::int64_t>(0));
+  const scenario none = accepted(header + "plant.home_switch = \"none\"\n");
+  EXPECT_FALSE(none.plant.home_switch_fitted);
+  // The integer form is today's: from there to the positive end.
+  const scenario from = accepted(header + "plant.home_switch = 1234\n");
+  EXPECT_EQ(from.plant.home_switch_position, std::optional<std::int64_t>(1234));
+  EXPECT_FALSE(from.plant.home_switch_end.has_value());
+  // The defaults leave today's scenarios as they were: a home switch from 50,000 up, limit switches
+  // 100 revolutions either side.
+  const scenario plain = accepted(header);
+  EXPECT_EQ(plain.plant.home_switch_position, std::optional<std::int64_t>(50000));
+  EXPECT_EQ(plain.plant.negative_limit_switch, std::optional<std::int64_t>(-1000000));
+  EXPECT_EQ(plain.plant.positive_limit_switch, std::optional<std::int64_t>(1000000));
+}
+
+TEST(scenario_file, switches_that_cannot_be_are_refused_at_their_line) {
+  expect_refusal(header + "plant.home_switch = { from = 80000, to = 50000 }\n", 4, "'to' >= 'from'");
+  expect_refusal(header + "plant.home_switch = {}\n", 4, "needs from, to or both");
+  expect_refusal(header + "plant.home_switch = { form = 1 }\n", 4, "form");
+  expect_refusal(header + "plant.negative_limit_switch = \"off\"\n", 4, "\"none\"");
+  expect_refusal(header + "plant.positive_limit_switch = 5\nplant.negative_limit_switch = 10\n", 4,
+                 "at or above the negative one");
+  expect_refusal(header + "plant.positive_limit_switch = 2000000000000\n", 4, "positive_limit_switch");
+  expect_refusal(header + "plant.target_window = 70000\n", 4, "target_window");
+}
+
+}  // namespace

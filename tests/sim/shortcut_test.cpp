@@ -30,7 +30,7 @@ std::string observe(const profile& p, const plant_constants& k, const axis_state
   for (std::size_t i = 0; objects && i < drive_object_count(); ++i) {
     const object_description& o = drive_object(i);
     std::int64_t v = 0;
-    const sdo_abort r = read_object(p, a, o.index, o.sub, v);
+    const sdo_abort r = read_object(p, k, a, o.index, o.sub, v);
     s << std::hex << o.index << '.' << int{o.sub} << '=' << std::dec << v << '/'
       << static_cast<std::uint32_t>(r) << ' ';
   }
@@ -46,6 +46,10 @@ std::string observe(const profile& p, const plant_constants& k, const axis_state
   s << "\nlast " << int(out.current) << ' ' << out.status_word << ' ' << int{out.transition} << ' '
     << int(out.ramp) << ' ' << out.torque << out.brake_released << out.clear_setpoints << ' '
     << out.error_code << ' ' << int{out.error_register};
+  s << "\nshaft " << a.home_shift << ' ' << a.previous_position << ' ' << a.in_velocity_window_us << ' '
+    << a.above_velocity_threshold_us << ' ' << a.interpolation_from << ' ' << a.interpolation_to << ' '
+    << a.interpolation_elapsed_us << ' ' << int(a.homing.phase()) << ' ' << digital_inputs(k, a) << ' '
+    << a.pv_set_point << a.pv_set_point_cut << ' ' << a.pv_braking_reach;
   s << "\nplant " << a.velocity << ' ' << a.position << ' ' << a.position_fraction << ' ' << a.demand
     << ' ' << a.torque << ' ' << a.torque_demand << ' ' << a.following_error_us << ' '
     << a.mode_status << ' ' << int{a.flags} << ' ' << a.brake_timer << ' ' << int{a.operation_mode};
@@ -94,7 +98,7 @@ void disturb(drive_view d, std::mt19937& rng, stream& st) {
     return;
   }
   if (pick(1000) >= 8) return;
-  switch (pick(30)) {
+  switch (pick(33)) {
     case 0: case 1: case 2:
       d.write(0x6040, 0, words[pick(sizeof words / sizeof words[0])]);
       break;
@@ -119,12 +123,17 @@ void disturb(drive_view d, std::mt19937& rng, stream& st) {
     case 20: d.write(0x608F, 1, pick(2) ? 10000 : 4096 + pick(3)); break;  // off the usual resolution
     case 21: d.write(0x6007, 0, pick(4)); break;
     case 22: d.write(0x60B0, 0, static_cast<std::int64_t>(pick(201)) - 100); break;
-    case 23: d.write(0x6098, 0, pick(2) ? 35 : 37); break;
+    case 23: d.write(0x6098, 0, pick(2) ? 35 : (pick(2) ? 3 : 34)); break;
     case 24:  // a halt on the current or voltage limit ramp (status bit 11 while it brakes)
       d.write(0x605D, 0, 3 + pick(2));
       d.write(0x6040, 0, st.enable | 0x0100);
       break;
     case 25: d.write(0x6040, 0, st.enable); break;  // the halt ends
+    case 26:  // a set-point period of 1..4 cycles: interpolation, off the path with no call
+      d.write(0x60C2, 1, 1 + pick(4));
+      break;
+    case 27: d.write(pick(2) ? 0x607F : 0x6080, 0, pick(2) ? 6000 : 300 + pick(5000)); break;  // a speed limit
+    case 28: d.write(0x6040, 0, st.enable | 0x0010); break;  // bit 4: a homing start, a pp set-point
     default:  // profile velocity, its target written while the brake may still hold the shaft
       d.write(0x6060, 0, 3);
       d.write(0x60FF, 0, pick(3) == 0 ? 0 : static_cast<std::int64_t>(pick(3001)) - 1500);

@@ -197,10 +197,15 @@ TEST(vcd, signals_are_named_per_bit_and_their_values_follow_the_trace) {
   EXPECT_EQ(v.type_of.at("drive.sw.10_target_reached"), "wire");
   EXPECT_EQ(v.type_of.at("drive.sw.4_voltage_enabled"), "wire");
   EXPECT_EQ(v.type_of.at("drive.position"), "wire");
-  EXPECT_EQ(v.type_of.size(), 15u + 4u + 16u + 16u) << "15 drive signals, 4 of the operation modes, 32 bits";
+  EXPECT_EQ(v.type_of.at("drive.index_pulse"), "wire");
+  EXPECT_EQ(v.type_of.size(), 15u + 4u + 4u + 16u + 16u)
+      << "15 drive signals, 4 of the operation modes, 4 inputs of 0x60FD, 32 bits";
+  bool pulses = false;
   for (const trace_row& row : r.trace) {
     const std::uint64_t t = row.time_us;
     ASSERT_EQ(v.value_at("drive.state", t), state_name(row.current)) << t;
+    ASSERT_EQ(v.value_at("drive.index_pulse", t), (row.digital_inputs >> 16) & 1u ? "1" : "0") << t;
+    pulses = pulses || (row.digital_inputs >> 16) & 1u;
     ASSERT_EQ(v.value_at("drive.torque", t), row.torque ? "1" : "0") << t;
     ASSERT_EQ(v.value_at("drive.sw.2_operation_enabled", t), (row.status_word & 4) ? "1" : "0") << t;
     ASSERT_EQ(v.value_at("drive.cw.2_quick_stop", t), (row.control_word & 4) ? "1" : "0") << t;
@@ -208,6 +213,7 @@ TEST(vcd, signals_are_named_per_bit_and_their_values_follow_the_trace) {
     ASSERT_EQ(v.value_at("drive.position", t), std::bitset<32>(static_cast<std::uint32_t>(row.position)).to_string())
         << t;
   }
+  EXPECT_TRUE(pulses) << "the shaft turns over index pulses";
   EXPECT_EQ(v.value_at("drive.last_transition", 700000), "00001011");  // T11
   EXPECT_EQ(v.value_at("drive.last_transition", 800000), "00001100");  // T12
 }
@@ -227,7 +233,8 @@ TEST(vcd, the_standard_form_has_no_string_variables_and_names_its_codes) {
   EXPECT_EQ(v.type_of.at("drive.state"), "integer");
   EXPECT_EQ(v.type_of.at("drive.ramp"), "integer");
   EXPECT_EQ(v.type_of.at("drive.position"), "wire");
-  EXPECT_EQ(v.type_of.size(), 15u + 4u + 16u + 16u) << "15 drive signals, 4 of the operation modes, 32 bits";
+  EXPECT_EQ(v.type_of.size(), 15u + 4u + 4u + 16u + 16u)
+      << "15 drive signals, 4 of the operation modes, 4 inputs of 0x60FD, 32 bits";
   for (const trace_row& row : r.trace) {
     const std::uint64_t t = row.time_us;
     ASSERT_EQ(std::stoul(v.value_at("drive.state", t), nullptr, 2), static_cast<unsigned>(row.current)) << t;

@@ -785,7 +785,7 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
   cmd->add_option("--sync-us", args.sync_us, "csp-stream: SYNC period in microseconds (one set-point each); --ecat: the cycle (one LRW each)")
       ->check(CLI::Range(100, 1000000))
       ->default_str("1000");
-  cmd->add_option("--method", args.homing_method, "home: the homing method 0x6098 (3, 33, 34, 35, 37)");
+  cmd->add_option("--method", args.homing_method, "home: the homing method 0x6098 (one of 0x60E3: 1..14, 17..30, 33, 34, 35, 37)");
   cmd->add_option("--offset", args.home_offset, "home: the home offset 0x607C, in increments");
   cmd->add_flag("--hold", args.hold, "after reaching the target, keep the drive there until SIGINT");
   return cmd;

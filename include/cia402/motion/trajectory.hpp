@@ -39,6 +39,13 @@ void advance(shaft& s, std::int64_t velocity_end, std::uint32_t dt_us,
 std::int64_t braking_speed(std::int64_t distance_increments, std::uint32_t deceleration_rpm_s,
                            std::int64_t end_speed, std::uint32_t increments_per_rev) noexcept;
 
+/// The fastest the shaft may move towards `target` at the end of a cycle of `dt_us` (micro-rpm, 0
+/// if it cannot stop there any more) so that, after that cycle's travel, it can still stop at the
+/// target at `deceleration_rpm_s`: the speed profile position brakes into its target with, for a
+/// mode that must not pass a place (a software position limit).
+std::int64_t stopping_speed(const shaft& s, std::int64_t target, std::uint32_t deceleration_rpm_s,
+                            std::uint32_t dt_us, std::uint32_t increments_per_rev) noexcept;
+
 /// The profile position mode's parameters (0x6081, 0x6082, 0x6083, 0x6084, 0x6067, 0x6068).
 struct pp_parameters {
   std::uint32_t profile_velocity_rpm = 1000;   ///< 0x6081

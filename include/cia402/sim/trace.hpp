@@ -38,6 +38,9 @@ struct trace_row {
   std::int64_t position_demand = 0;   ///< 0x6062
   std::int32_t torque_permille = 0;   ///< 0x6077, permille of rated torque
   std::int8_t mode = 3;               ///< 0x6061
+  /// 0x60FD: the limit switches (bits 0, 1), the home switch (bit 2) and an index pulse reached in
+  /// the cycle before (bit 16), as sampled at time_us (the VCD's input wires).
+  std::uint32_t digital_inputs = 0;
 };
 
 /// The row for the cycle about to run at time_us: call before step_axis() with the axis, then
@@ -77,7 +80,8 @@ void write_jsonl(std::ostream& out, const std::vector<trace_row>& rows, std::siz
 /// with info.vcd_standard 8-bit integer codes the header's $comment names),
 /// last_transition (integer) with a transition_taken pulse in the cycle one is taken, torque,
 /// brake_released, brake_engaged, dc_link, sto (wires), error_code, position and position_demand
-/// (32-bit vectors, two's complement as 0x6064 travels), torque_permille (16), mode (8);
+/// (32-bit vectors, two's complement as 0x6064 travels), torque_permille (16), mode (8),
+/// negative_limit_switch, positive_limit_switch, home_switch and index_pulse (wires, 0x60FD);
 /// sub-scopes `cw` and `sw` with one wire per control-word and status-word bit, named by number and
 /// meaning (cw.0_switch_on ... sw.10_target_reached). Only changes are written.
 void write_vcd(std::ostream& out, const std::vector<trace_row>& rows, const trace_info& info);

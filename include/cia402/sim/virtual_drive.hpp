@@ -63,9 +63,10 @@ inline sdo_abort write_object(const profile& p, axis_state& a, std::uint16_t ind
   return detail::write_any_object(p, a, index, sub, value);
 }
 
-/// Reads an object of one axis; on success `value` holds it (sign-extended for signed types).
-sdo_abort read_object(const profile& p, const axis_state& a, std::uint16_t index, std::uint8_t sub,
-                      std::int64_t& value) noexcept;
+/// Reads an object of one axis on a plant; on success `value` holds it (sign-extended for signed
+/// types).
+sdo_abort read_object(const profile& p, const plant_constants& k, const axis_state& a, std::uint16_t index,
+                      std::uint8_t sub, std::int64_t& value) noexcept;
 
 /// One axis, seen from outside: a handle into a machine or a virtual_drive. Cheap to copy; valid
 /// while its owner lives.
@@ -79,7 +80,7 @@ class drive_view {
     return write_object(*profile_, *axis_, index, sub, value);
   }
   sdo_abort read(std::uint16_t index, std::uint8_t sub, std::int64_t& value) const noexcept {
-    return read_object(*profile_, *axis_, index, sub, value);
+    return read_object(*profile_, *constants_, *axis_, index, sub, value);
   }
 
   /// A fault cause appears (error code 0x0001..0xFFFF, error class 0..4 for profiles with classes).
@@ -116,6 +117,12 @@ class drive_view {
   std::int8_t operation_mode() const noexcept { return axis_->operation_mode; }
   std::int8_t requested_mode() const noexcept { return axis_->requested_mode; }
   std::int64_t position() const noexcept { return axis_->position; }
+  /// The shaft's own position, where the switches and index pulses are (0x6064 minus what homing
+  /// set), and 0x60FD.
+  std::int64_t shaft_position() const noexcept { return sim::shaft_position(*axis_); }
+  std::uint32_t digital_inputs() const noexcept { return sim::digital_inputs(*constants_, *axis_); }
+  /// What a homing run is doing (homing_phase_name() says it in words).
+  motion::homing_phase homing_phase() const noexcept { return axis_->homing.phase(); }
   std::int64_t position_demand() const noexcept { return axis_->demand; }
   std::int64_t following_error() const noexcept { return sim::following_error(*axis_); }
   std::int32_t torque() const noexcept { return axis_->torque; }
@@ -164,7 +171,7 @@ class virtual_drive {
     return view().write(index, sub, value);
   }
   sdo_abort read(std::uint16_t index, std::uint8_t sub, std::int64_t& value) const noexcept {
-    return read_object(*profile_, axis_, index, sub, value);
+    return read_object(*profile_, constants_, axis_, index, sub, value);
   }
 
  private:
