@@ -74,7 +74,9 @@ TEST(error_codes, the_table_is_ascending_and_every_code_finds_its_own_entry) {
     const error_code_description& e = error_code_entry(i);
     ASSERT_NE(e.text, nullptr);
     EXPECT_GT(std::strlen(e.text), 0u);
-    if (i > 0) EXPECT_LT(error_code_entry(i - 1).code, e.code);
+    if (i > 0) {
+      EXPECT_LT(error_code_entry(i - 1).code, e.code);
+    }
     EXPECT_EQ(error_code_text(e.code), e.text) << std::hex << e.code;
   }
 }
