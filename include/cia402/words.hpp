@@ -12,6 +12,13 @@ inline constexpr std::uint16_t quick_stop = 1u << 2;  ///< active low
 inline constexpr std::uint16_t enable_operation = 1u << 3;
 inline constexpr std::uint16_t fault_reset = 1u << 7;  ///< acts on its 0->1 edge (S2)
 inline constexpr std::uint16_t halt = 1u << 8;         ///< 0x605D (S8)
+// Operation-mode bits (CiA 402-2; docs/modes.md): bit 4 is the new set-point in pp and the homing
+// operation start in hm; 5, 6 and 9 belong to pp.
+inline constexpr std::uint16_t new_set_point = 1u << 4;           ///< pp
+inline constexpr std::uint16_t homing_operation_start = 1u << 4;  ///< hm
+inline constexpr std::uint16_t change_set_immediately = 1u << 5;  ///< pp
+inline constexpr std::uint16_t relative = 1u << 6;                ///< pp
+inline constexpr std::uint16_t change_on_set_point = 1u << 9;     ///< pp
 }  // namespace control_bit
 
 namespace status_bit {
@@ -26,6 +33,13 @@ inline constexpr std::uint16_t warning = 1u << 7;
 inline constexpr std::uint16_t remote = 1u << 9;
 inline constexpr std::uint16_t target_reached = 1u << 10;
 inline constexpr std::uint16_t internal_limit_active = 1u << 11;
+// Operation-mode bits (CiA 402-2; docs/modes.md): bit 12 and 13 mean one thing per mode.
+inline constexpr std::uint16_t set_point_acknowledge = 1u << 12;   ///< pp
+inline constexpr std::uint16_t speed_zero = 1u << 12;              ///< pv
+inline constexpr std::uint16_t homing_attained = 1u << 12;         ///< hm
+inline constexpr std::uint16_t drive_follows_command = 1u << 12;   ///< csp, csv, cst
+inline constexpr std::uint16_t homing_error = 1u << 13;            ///< hm
+inline constexpr std::uint16_t following_error = 1u << 13;         ///< csp (and pp)
 /// The bits the FSA state is shown in: 0..3, 5 and 6.
 inline constexpr std::uint16_t state_bits = 0x006F;
 /// Bits the drive passes through from the motion side unchanged: 8 and 12..15.
