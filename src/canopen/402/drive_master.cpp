@@ -149,13 +149,42 @@ bool drive_master::write(std::uint16_t index, std::uint8_t sub, std::int64_t val
   return true;
 }
 
+bool drive_master::upload(std::uint16_t index, std::uint8_t sub, std::function<void(const sdo_result&)> done) {
+  return read(index, sub, false, std::move(done));
+}
+
+bool drive_master::download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes,
+                            std::function<void(const sdo_result&)> done) {
+  if (phase_ != master_phase::running) return false;
+  sdo_job j;
+  j.write = true;
+  j.index = index;
+  j.sub = sub;
+  j.raw = std::move(bytes);
+  j.done = std::move(done);
+  requests_.push_back(std::move(j));
+  return true;
+}
+
+std::vector<std::pair<std::uint16_t, std::uint8_t>> drive_master::objects_written() const {
+  std::vector<std::pair<std::uint16_t, std::uint8_t>> out;
+  for (const sdo_job& j : script_) {
+    if (!j.write) continue;
+    const std::pair<std::uint16_t, std::uint8_t> at{j.index, j.sub};
+    if (std::find(out.begin(), out.end(), at) == out.end()) out.push_back(at);
+  }
+  return out;
+}
+
 bool drive_master::request_pending() const noexcept {
   return !requests_.empty() || (current_ && current_->done);
 }
 
 void drive_master::start_transfer(const sdo_job& j) {
   sdo_.clear();
-  if (j.write) {
+  if (j.write && j.raw) {
+    (void)sdo_.start_download(j.index, j.sub, *j.raw);
+  } else if (j.write) {
     (void)sdo_.start_download(j.index, j.sub, j.value(), j.bytes);
   } else {
     (void)sdo_.start_upload(j.index, j.sub);
@@ -239,6 +268,7 @@ void drive_master::complete_current() {
     sdo_result r;
     r.abort = abort;
     if (ok) r.value = sdo_.value(job.is_signed);
+    if (ok && !job.write) r.data = sdo_.data();
     job.done(r);
     // A node that lets an SDO request time out is silent, whatever its heartbeat did last.
     if (timed_out) lose();
