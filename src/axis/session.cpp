@@ -84,6 +84,11 @@ std::uint32_t session::poll(std::uint32_t elapsed_us) {
   std::vector<std::function<void()>> due;
   due.swap(deferred_);
   for (auto& f : due) f();
+  if (!after_settled_.empty() && settled()) {
+    std::vector<std::function<void()>> settled_now;
+    settled_now.swap(after_settled_);
+    for (auto& f : settled_now) f();
+  }
   note_status();
   check_lease();
   run_operation();
@@ -158,7 +163,8 @@ void session::run_operation() {
     }
     if (!op.fault_ok && status_known() &&
         (observed_ == state::fault || observed_ == state::fault_reaction_active)) {
-      return finish(outcome::failed, fault_text());
+      // Before its first step a request is refused; later the fault ended it.
+      return finish(outcome::failed, fault_text() + (op.at == 0 ? "; reset it first" : ""));
     }
     if (op.at >= op.steps.size()) return finish(outcome::done, {});
     step& s = op.steps[op.at];

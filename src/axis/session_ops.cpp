@@ -182,11 +182,19 @@ std::uint64_t session::halt(bool on, completion done) {
     if (!on) halt_by_stop_ = false;
   };
   if (control_ != control::none && status_known()) {
+    // Beside the running operation (a halted move resumes when the halt goes): done once the drive
+    // has had the word.
     apply();
-    return refuse_now({}, [done = std::move(done)](result r) {
-      r.end = outcome::done;
+    word_changed_us_ = now_us_;
+    word_changed_count_ = link_->status_count();
+    const std::uint64_t id = next_id_++;
+    after_settled_.push_back([this, id, done = std::move(done)] {
+      result r;
+      r.id = id;
+      fill_result(r);
       if (done) done(r);
     });
+    return id;
   }
   std::vector<step> steps{need_prepared(), need_cyclic(), check(false), step{[this, apply] {
                             apply();

@@ -339,6 +339,7 @@ class session {
   // The operation, and completions said at the next poll.
   std::unique_ptr<operation> op_;
   std::vector<std::function<void()>> deferred_;
+  std::vector<std::function<void()>> after_settled_;  // said once the drive has had the last word
 
   // Streams.
   setpoint_source source_;
