@@ -9,24 +9,6 @@
 
 namespace cia402::axes {
 
-const char* link_phase_name(link_phase p) noexcept {
-  switch (p) {
-    case link_phase::connecting: return "connecting";
-    case link_phase::running: return "running";
-    case link_phase::failed: return "failed";
-  }
-  return "unknown";
-}
-
-const char* outcome_name(outcome o) noexcept {
-  switch (o) {
-    case outcome::done: return "done";
-    case outcome::failed: return "failed";
-    case outcome::superseded: return "superseded";
-  }
-  return "unknown";
-}
-
 std::string word_hex(std::uint16_t w) {
   static const char* d = "0123456789ABCDEF";
   std::string s = "0x";

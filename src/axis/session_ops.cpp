@@ -262,42 +262,37 @@ std::uint64_t session::move(const move_request& r, completion done) {
   return begin("move", std::move(steps), std::move(done), true);
 }
 
-std::uint64_t session::velocity(std::int32_t rpm, completion done) {
-  std::vector<step> steps = motion_start(mode::profile_velocity);
-  steps.push_back(write_step(object_index::target_velocity, 0, rpm));
+// Profile velocity and torque alike: the mode, the set-point written after OPERATION ENABLED, then
+// the actual value within 1 % (at least 1) of it, from a status word after the write.
+std::uint64_t session::reach(const char* name, std::int8_t m, std::uint16_t set_point, std::uint16_t actual_index,
+                             std::int64_t target, progress_kind kind, std::optional<std::int64_t> result::*field,
+                             completion done) {
+  std::vector<step> steps = motion_start(m);
+  steps.push_back(write_step(set_point, 0, target));
   auto since = std::make_shared<moment>();
-  steps.push_back(call_step([this, rpm, since] {
+  steps.push_back(call_step([this, since, actual_index, target, kind, field] {
     *since = now_moment();
-    need(object_index::velocity_actual_value);
-    op_->res.velocity = rpm;
-    progress(progress_kind::target_velocity);
+    need(actual_index);
+    op_->res.*field = target;
+    progress(kind);
   }));
-  steps.push_back(wait_step([this, rpm, since] {
-    const auto v = fresh(object_index::velocity_actual_value, *since);
+  steps.push_back(wait_step([this, since, actual_index, target, field] {
+    const auto v = fresh(actual_index, *since);
     if (!v) return false;
-    op_->res.velocity = *v;
-    return std::abs(*v - rpm) <= window_of(rpm);
+    op_->res.*field = *v;
+    return std::abs(*v - target) <= window_of(target);
   }, 0, [] { return std::string(); }));
-  return begin("velocity", std::move(steps), std::move(done), true);
+  return begin(name, std::move(steps), std::move(done), true);
+}
+
+std::uint64_t session::velocity(std::int32_t rpm, completion done) {
+  return reach("velocity", mode::profile_velocity, object_index::target_velocity, object_index::velocity_actual_value, rpm,
+               progress_kind::target_velocity, &result::velocity, std::move(done));
 }
 
 std::uint64_t session::torque(std::int16_t permille, completion done) {
-  std::vector<step> steps = motion_start(mode::profile_torque);
-  steps.push_back(write_step(object_index::target_torque, 0, permille));
-  auto since = std::make_shared<moment>();
-  steps.push_back(call_step([this, permille, since] {
-    *since = now_moment();
-    need(object_index::torque_actual_value);
-    op_->res.torque = permille;
-    progress(progress_kind::target_torque);
-  }));
-  steps.push_back(wait_step([this, permille, since] {
-    const auto t = fresh(object_index::torque_actual_value, *since);
-    if (!t) return false;
-    op_->res.torque = *t;
-    return std::abs(*t - permille) <= window_of(permille);
-  }, 0, [] { return std::string(); }));
-  return begin("torque", std::move(steps), std::move(done), true);
+  return reach("torque", mode::profile_torque, object_index::target_torque, object_index::torque_actual_value, permille,
+               progress_kind::target_torque, &result::torque, std::move(done));
 }
 
 std::uint64_t session::home(const home_request& r, completion done) {

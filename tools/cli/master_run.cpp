@@ -2,7 +2,6 @@
 // the next when all are through), the bus's clock, SIGINT and SIGTERM, and the end: each session
 // closed so its link puts back what it changed (on a signal the drives are first stopped as their
 // 0x6007 says, as a lapsed lease would).
-#include <csignal>
 #include <cstdlib>
 #include <memory>
 #include <ostream>
@@ -22,8 +21,7 @@ constexpr int failed = 1;
 // How long closing may take: a stop to standstill and the writes that put the node back.
 constexpr std::uint64_t close_limit_us = 10'000'000;
 
-volatile std::sig_atomic_t stop_signal = 0;
-extern "C" void on_master_signal(int) { stop_signal = 1; }
+bool stop_signal() { return stop_signals::flag() != 0; }
 
 class runner {
  public:
@@ -44,9 +42,9 @@ class runner {
       if (!run_step(s)) break;
     }
     if (status_ == 0 && a_.hold) {
-      while (stop_signal == 0) (void)pump();
+      while (!stop_signal()) (void)pump();
     }
-    close_all(stop_signal != 0);
+    close_all(stop_signal());
     bus_.finish(out_);
     return status_;
   }
@@ -130,7 +128,7 @@ class runner {
   bool pass_time(const master_step& s, std::uint64_t us, bool until_signal) {
     std::uint64_t passed = 0;
     while (us == 0 ? until_signal : passed < us) {
-      if (stop_signal != 0) {
+      if (stop_signal()) {
         if (until_signal) break;
         return interrupted(s);
       }
@@ -193,7 +191,7 @@ class runner {
       return false;
     };
     while (busy()) {
-      if (stop_signal != 0) return interrupted(s);
+      if (stop_signal()) return interrupted(s);
       if (limit != 0 && passed >= limit && s.verb != "watch") {
         for (auto& r : drives_) {
           if (!r->pending) continue;
@@ -279,18 +277,9 @@ int run_master(const master_args& a, std::ostream& out, std::ostream& err) {
       a.ecat.empty() ? open_can_bus(a, choice.get(), *steps, output, status) : open_ecat_bus(a, choice.get(), output, status);
   if (!bus) return status;
 
-  stop_signal = 0;
-  struct sigaction action {};
-  action.sa_handler = on_master_signal;
-  sigemptyset(&action.sa_mask);
-  struct sigaction old_int {}, old_term {};
-  sigaction(SIGINT, &action, &old_int);
-  sigaction(SIGTERM, &action, &old_term);
+  const stop_signals stop;
   runner r(a, choice.get(), *bus, output);
-  status = r.run(*steps);
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
-  return status;
+  return r.run(*steps);
 }
 
 }  // namespace cia402::cli

@@ -33,7 +33,6 @@ enum class link_phase : std::uint8_t {
   running,     ///< transfers work; status and control go cyclically once cyclic() is true
   failed,      ///< the drive or the bus is gone; phase_text() says why
 };
-const char* link_phase_name(link_phase p) noexcept;
 
 /// How one acyclic transfer (an SDO) ended.
 struct transfer_result {

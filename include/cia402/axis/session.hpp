@@ -61,7 +61,6 @@ enum class outcome : std::uint8_t {
   failed,      ///< `error` says why
   superseded,  ///< a newer operation took over (or the lease lapsed, or the session closed)
 };
-const char* outcome_name(outcome o) noexcept;
 
 /// How a request ended, with what it found.
 struct result {
@@ -285,6 +284,9 @@ class session {
   void write_integer(std::uint16_t index, std::uint8_t sub, std::int64_t value, std::function<void(std::string)> done);
   // session_ops.cpp
   std::vector<step> motion_start(std::int8_t mode);
+  std::uint64_t reach(const char* name, std::int8_t mode, std::uint16_t set_point, std::uint16_t actual_index,
+                      std::int64_t target, progress_kind kind, std::optional<std::int64_t> result::*field,
+                      completion done);
   step progress_step(progress_kind kind);
   step read_position_step();
   // session_stream.cpp

@@ -123,30 +123,27 @@ void drive_master::drop_requests() {
   for (auto& done : cancelled) done(r);
 }
 
+bool drive_master::queue_request(sdo_job j) {
+  if (phase_ != master_phase::running) return false;
+  requests_.push_back(std::move(j));
+  return true;
+}
+
 bool drive_master::read(std::uint16_t index, std::uint8_t sub, bool is_signed,
                         std::function<void(const sdo_result&)> done) {
-  if (phase_ != master_phase::running) return false;
   sdo_job j;
   j.index = index;
   j.sub = sub;
   j.is_signed = is_signed;
   j.done = std::move(done);
-  requests_.push_back(std::move(j));
-  return true;
+  return queue_request(std::move(j));
 }
 
 bool drive_master::write(std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes,
                          std::function<void(const sdo_result&)> done) {
-  if (phase_ != master_phase::running) return false;
-  sdo_job j;
-  j.write = true;
-  j.index = index;
-  j.sub = sub;
-  j.value = [value] { return value; };
-  j.bytes = bytes;
-  j.done = std::move(done);
-  requests_.push_back(std::move(j));
-  return true;
+  std::vector<std::uint8_t> data(bytes);
+  put_le(data.data(), static_cast<std::uint64_t>(value), bytes);
+  return download(index, sub, std::move(data), std::move(done));
 }
 
 bool drive_master::upload(std::uint16_t index, std::uint8_t sub, std::function<void(const sdo_result&)> done) {
@@ -155,15 +152,13 @@ bool drive_master::upload(std::uint16_t index, std::uint8_t sub, std::function<v
 
 bool drive_master::download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes,
                             std::function<void(const sdo_result&)> done) {
-  if (phase_ != master_phase::running) return false;
   sdo_job j;
   j.write = true;
   j.index = index;
   j.sub = sub;
   j.raw = std::move(bytes);
   j.done = std::move(done);
-  requests_.push_back(std::move(j));
-  return true;
+  return queue_request(std::move(j));
 }
 
 std::vector<std::pair<std::uint16_t, std::uint8_t>> drive_master::objects_written() const {

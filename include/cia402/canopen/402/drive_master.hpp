@@ -243,6 +243,7 @@ class drive_master {
   void go_running();
   void fail(master_failure f, sdo_abort a, std::uint16_t index, std::uint8_t sub, std::string text);
   void drop_requests();
+  bool queue_request(sdo_job j);
   void start_transfer(const sdo_job& j);
   bool start_next_job();
   void complete_current();
