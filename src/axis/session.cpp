@@ -145,8 +145,8 @@ void session::run_operation() {
     }
     if (!op.fault_ok && status_known() &&
         (observed_ == state::fault || observed_ == state::fault_reaction_active)) {
-      // Before its first step a request is refused; later the fault ended it.
-      return finish(outcome::failed, fault_text() + (op.at == 0 ? "; reset it first" : ""));
+      // Before it commanded anything a request is refused; later the fault ended it.
+      return finish(outcome::failed, fault_text() + (op.commanded ? "" : "; reset it first"));
     }
     if (op.at >= op.steps.size()) return finish(outcome::done, {});
     step& s = op.steps[op.at];
@@ -227,6 +227,7 @@ void session::drive_control_word() {
 }
 
 void session::set_target(state target) {
+  if (op_) op_->commanded = true;
   control_ = control::target;
   words_.clear();
   policy_ = master_policy::make(*profile_, options_, target);
@@ -236,6 +237,7 @@ void session::set_target(state target) {
 }
 
 void session::set_command(command c) {
+  if (op_) op_->commanded = true;
   control_ = control::command;
   words_.clear();
   command_ = c;

@@ -19,6 +19,7 @@ struct session::operation {
   bool fault_ok = false;    // a drive in FAULT is what it works on (reset, state)
   bool streaming = false;   // source_ is its set-point source
   bool jogging = false;     // turning at a jog velocity until released
+  bool commanded = false;   // it has given the drive a word (a target, a command, an edge)
   completion done;
   result res;
   std::string error;        // set by the step that failed

@@ -151,6 +151,7 @@ std::uint64_t session::reset(completion done) {
                             config_.transition_timeout_us,
                             [this] { return "the fault reaction did not end (" + state_text() + ")"; }));
   steps.push_back(call_step([this] {
+    op_->commanded = true;
     control_ = control::words;
     words_.clear();
     std::uint16_t off = 0;
