@@ -107,6 +107,12 @@ TEST(cli_master_steps, a_fault_whose_cause_persists_fails_the_reset_at_once_with
                              "first"),
             std::string::npos)
       << refused.err;
+  // Faulted before the node was set up: the refusal still says what to do.
+  const result first = run_tool({"master", "--can", "virtual", "sdo", "write", "0x2001", "0x2310", "wait", "50", "enable"});
+  EXPECT_EQ(first.status, 1);
+  EXPECT_NE(first.err.find("enable: the drive is in FAULT: error code 0x2310 (continuous over-current); reset it first"),
+            std::string::npos)
+      << first.err;
 }
 
 TEST(cli_master_steps, texts_and_bytes_go_with_their_type) {
