@@ -128,7 +128,7 @@ void master_output::progress(const drive_tag& who, axes::progress_kind kind, con
   }
 }
 
-void master_output::result(const drive_tag& who, const master_step& step, const axes::result& r, const axes::session& s) {
+void master_output::result(const drive_tag& who, const master_step& step, const axes::result& r) {
   const std::string& v = step.verb;
   if (v == "state") {
     json j = merged(json{{"event", "status"}}, state_json(r));
@@ -190,7 +190,6 @@ void master_output::result(const drive_tag& who, const master_step& step, const 
     }
     return drive(who, j, words);
   }
-  (void)s;
 }
 
 }  // namespace cia402::cli

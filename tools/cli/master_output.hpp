@@ -35,7 +35,7 @@ class master_output {
   bool json_lines() const noexcept { return json_; }
 
   /// The step's result, as its verb prints it.
-  void result(const drive_tag& who, const master_step& step, const axes::result& r, const axes::session& s);
+  void result(const drive_tag& who, const master_step& step, const axes::result& r);
   /// What an operation reports on its way; `stream_words` says how a stream goes on this bus.
   void progress(const drive_tag& who, axes::progress_kind kind, const axes::result& r, const std::string& stream_words,
                 std::uint32_t cycle_us);

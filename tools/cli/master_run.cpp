@@ -146,7 +146,7 @@ class runner {
     r.pending = true;
     auto done = [this, &r, s](const axes::result& res) {
       r.pending = false;
-      if (res.ok()) return out_.result(r.d.tag, s, res, *r.session);
+      if (res.ok()) return out_.result(r.d.tag, s, res);
       fail(r.d.tag, s, res.error, res.bad_input ? usage_error : failed);
     };
     const std::string& v = s.verb;
