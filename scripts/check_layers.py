@@ -17,6 +17,12 @@ import sys
 # (layer, path prefix) in the order they are matched: the first prefix that fits wins.
 LAYERS = [
     ("core", "include/cia402/detail/"),
+    ("axis", "include/cia402/axis/"),
+    ("axis", "src/axis/"),
+    ("canopen/axis", "include/cia402/canopen/axis/"),
+    ("canopen/axis", "src/canopen/axis/"),
+    ("ethercat/axis", "include/cia402/ethercat/axis/"),
+    ("ethercat/axis", "src/ethercat/axis/"),
     ("motion", "include/cia402/motion/"),
     ("motion", "src/motion/"),
     ("sim", "include/cia402/sim/"),
@@ -75,15 +81,19 @@ ALLOWED = {
     "ethercat/402": {"core", "support", "sim", "motion", "canopen/can", "canopen/301", "canopen/306",
                      "canopen/402", "ethercat/esc", "ethercat/sii", "ethercat/coe"},
     "ethercat/master": {"core", "ethercat/esc", "ethercat/sii"},
+    # The axis session and its links: the session sees the core only; each link its own fieldbus.
+    "axis": {"core"},
+    "canopen/axis": {"core", "axis", "support", "canopen/can", "canopen/301", "canopen/306", "canopen/402"},
+    "ethercat/axis": {"core", "axis", "ethercat/esc", "ethercat/sii", "ethercat/master"},
     "apps": {"ethercat/master", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/402", "sim", "motion", "support",
              "core", "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
              "canopen/monitor"},
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
              "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "ethercat/esc",
-             "ethercat/sii", "ethercat/master"},
+             "ethercat/sii", "ethercat/master", "axis", "canopen/axis", "ethercat/axis"},
     "tools": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
               "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "canopen/monitor",
-              "apps", "page",
+              "apps", "page", "axis", "canopen/axis", "ethercat/axis",
               "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/402", "ethercat/master"},
 }
 

@@ -111,6 +111,7 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   bus_args bus_options;
   auto* bus = add_bus_subcommand(app, bus_options);
   master_args master_options;
+  master_options.raw = args;  // its steps and their options are read in order from here
   auto* master = add_master_subcommand(app, master_options);
   monitor_args monitor_options;
   auto* monitor = add_monitor_subcommand(app, monitor_options);

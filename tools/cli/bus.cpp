@@ -2,7 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
-#include <csignal>
+#include <optional>
 #include <memory>
 #include <ostream>
 
@@ -16,9 +16,7 @@ namespace cia402::cli {
 namespace {
 
 constexpr int usage_error = 2;
-volatile std::sig_atomic_t stop_requested = 0;
 
-extern "C" void request_stop(int) { stop_requested = 1; }
 
 bool split_host_port(const std::string& text, std::string& host, std::uint16_t& port,
                      std::string& why) {
@@ -135,21 +133,14 @@ int run_bus(const bus_args& args, std::ostream& out, std::ostream& err) {
     return usage_error;
   }
   // Handlers before the line that tells a parent the bus is up, so a stop right after it counts.
-  stop_requested = 0;
-  struct sigaction action {};
-  action.sa_handler = request_stop;
-  sigemptyset(&action.sa_mask);
-  struct sigaction old_int {}, old_term {};
-  sigaction(SIGINT, &action, &old_int);
-  sigaction(SIGTERM, &action, &old_term);
+  std::optional<stop_signals> stop(std::in_place);
 
   out << "cia402 bus: socketcand on " << config.host << ":" << host.server().port() << " bus "
       << config.bus_name << ", " << host.drives().size() << " drive(s) (profile " << choice.get().name
       << "), nodes " << args.nodes << (args.log.empty() ? "" : ", log " + args.log) << std::endl;
 
-  host.run(stop_requested);
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
+  host.run(stop_signals::flag());
+  stop.reset();
   if (const auto ec = host.log_failure()) {
     err << "cia402 bus: --log " << args.log << ": writing failed after " << host.frames_logged()
         << " frames: " << ec.message() << "\n";

@@ -8,6 +8,28 @@
 #include "cia402/profile_file.hpp"
 
 namespace cia402::cli {
+namespace {
+
+volatile std::sig_atomic_t stop_flag = 0;
+extern "C" void on_stop_signal(int) { stop_flag = 1; }
+
+}  // namespace
+
+stop_signals::stop_signals() {
+  stop_flag = 0;
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, &old_int_);
+  sigaction(SIGTERM, &action, &old_term_);
+}
+
+stop_signals::~stop_signals() {
+  sigaction(SIGINT, &old_int_, nullptr);
+  sigaction(SIGTERM, &old_term_, nullptr);
+}
+
+const volatile std::sig_atomic_t& stop_signals::flag() noexcept { return stop_flag; }
 
 std::optional<std::int64_t> parse_number(std::string_view text) {
   return support::parse_integer(text, std::numeric_limits<std::int32_t>::min(),

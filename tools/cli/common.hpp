@@ -2,6 +2,7 @@
 // and choosing a profile by name or file.
 #pragma once
 
+#include <csignal>
 #include <cstdint>
 #include <iosfwd>
 #include <optional>
@@ -37,6 +38,24 @@ class profile_choice {
  private:
   custom_profile loaded_;
   const profile* profile_ = &standard_profile();
+};
+
+/// While it lives, SIGINT and SIGTERM set a flag instead of ending the process (and the handlers
+/// before it come back after): how the tool's loops (bus, ecat-slave, monitor, master) learn that
+/// they are to stop and end cleanly. One at a time.
+class stop_signals {
+ public:
+  stop_signals();
+  ~stop_signals();
+  stop_signals(const stop_signals&) = delete;
+  stop_signals& operator=(const stop_signals&) = delete;
+  bool requested() const noexcept { return flag() != 0; }
+  /// The flag itself, for a loop that takes one (apps::bus_host::run).
+  static const volatile std::sig_atomic_t& flag() noexcept;
+
+ private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
 };
 
 /// "cia402, no-quick-stop, ..." for messages.

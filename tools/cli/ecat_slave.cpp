@@ -1,7 +1,7 @@
 #include "cli/ecat_slave.hpp"
 
 #include <CLI/CLI.hpp>
-#include <csignal>
+#include <optional>
 #include <ostream>
 
 #include "cia402/apps/ethercat_host.hpp"
@@ -10,8 +10,6 @@
 namespace cia402::cli {
 namespace {
 
-volatile std::sig_atomic_t stop_requested = 0;
-extern "C" void request_ecat_stop(int) { stop_requested = 1; }
 
 }  // namespace
 
@@ -36,18 +34,11 @@ int run_ecat_slave(const ecat_slave_args& args, std::ostream& out, std::ostream&
         << (ec.value() == EPERM ? " (a raw socket needs root or CAP_NET_RAW)" : "") << "\n";
     return 1;
   }
-  stop_requested = 0;
-  struct sigaction action {};
-  action.sa_handler = request_ecat_stop;
-  sigemptyset(&action.sa_mask);
-  struct sigaction old_int {}, old_term {};
-  sigaction(SIGINT, &action, &old_int);
-  sigaction(SIGTERM, &action, &old_term);
+  std::optional<stop_signals> stop(std::in_place);
   out << "cia402 ecat-slave: " << args.nodes << " drive(s) on " << args.iface << " (profile " << choice.get().name
       << ", cycle " << args.cycle_us << " us)" << std::endl;
-  host.run(stop_requested);
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
+  host.run(stop_signals::flag());
+  stop.reset();
   out << "cia402 ecat-slave: stopped after " << host.frames_answered() << " frame(s), " << host.frames_refused()
       << " refused" << std::endl;
   return 0;

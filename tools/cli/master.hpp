@@ -1,13 +1,15 @@
-// `cia402 master --can URL --node N COMMAND`: a CANopen master for one CiA 402 drive on a real or
-// virtual bus: NMT start, PDO set-up over SDO, then the core's master step over PDOs with SYNC
-// (canopen/drive_master.hpp). COMMAND: state (read 0x6041 over SDO and print), enable, disable,
-// quick-stop, reset (fault reset), watch (print state changes, velocity and EMCYs), velocity RPM
-// (enable, write 0x60FF, wait until the shaft turns at it), mode MODE (0x6060, confirmed by 0x6061),
-// move POSITION (profile position: enable, 0x607A, the set-point handshake, wait for target
-// reached), home (homing with --method / --offset, wait for homing attained), csp-stream --to POSITION
-// --velocity RPM (cyclic synchronous position: a ramp of 0x607A in RPDO3 before every SYNC, 0x6064
-// from TPDO3, the largest following error reported); for test benches, without
-// any set-up: sdo read INDEX[:SUB], sdo write INDEX[:SUB] VALUE, nmt start|stop|preop|reset.
+// `cia402 master`: one command set for a CiA 402 drive over CANopen (`--can URL --node N`) or the
+// drives of an EtherCAT line (`--ecat IF [--position N]`). The words after the options are steps
+// run in order in one session per drive (the axis layer, include/cia402/axis/session.hpp): state,
+// enable, disable, quick-stop, reset, halt on|off, mode MODE, move POS [--relative] [--velocity RPM],
+// velocity RPM, torque PERMILLE, home [METHOD] [--offset INC], jog RPM MS, csp-stream --to POS
+// --velocity RPM, wait MS, watch, sdo read INDEX[:SUB], sdo write INDEX[:SUB] VALUE, and on CANopen
+// nmt start|stop|preop|reset|reset-communication. docs/master.md has every step, option, JSON shape
+// and exit status.
+//
+// The files: master_options.cpp (the options), master_steps.cpp (the step parser), master_buses.cpp
+// (the buses: a CAN channel or the virtual bus, an EtherCAT line), master_run.cpp (the runner),
+// master_output.cpp (prose and JSON lines).
 #pragma once
 
 #include <cstdint>
@@ -27,30 +29,30 @@ struct master_args {
   std::string ecat;             ///< a network interface: our EtherCAT master there instead of CANopen
   std::optional<int> position;  ///< --ecat: the slave's position on the line (all when not given)
   int node = 1;
-  std::string command;
-  std::vector<std::string> operands;  ///< after sdo / nmt: what to read, write or send
-  bool json = false;                  ///< one JSON object a line (state, sdo: one; others: per event)
+  std::vector<std::string> words;  ///< the steps as CLI11 collected them (checked, not used)
+  /// The whole command line from "master" on: the steps and their options are read from it in
+  /// order (CLI11 keeps positionals and options apart).
+  std::vector<std::string> raw;
+  bool json = false;  ///< one JSON object a line
   std::string profile = "cia402";
   std::string profile_file;
-  std::uint32_t cycle_ms = 10;       ///< SYNC period
-  std::uint32_t timeout_ms = 10000;  ///< the whole command; watch: how long to watch (0 = until a signal)
-  std::uint16_t heartbeat_ms = 100;  ///< the drive's heartbeat, watched by the master
-  std::uint16_t guard_ms = 0;        ///< the master's heartbeat, watched by the drive (0x6007)
-  bool hold = false;                 ///< after reaching the target, keep cycling until a signal
-  bool relative = false;             ///< move: the position adds to the last target
-  std::optional<std::int64_t> profile_velocity;  ///< move: 0x6081; csp-stream: the ramp's speed
-  std::optional<std::int64_t> stream_to;         ///< csp-stream: where the ramp ends
-  std::uint32_t sync_us = 1000;                  ///< csp-stream: SYNC period
-  std::optional<std::int64_t> homing_method;     ///< home: 0x6098
-  std::optional<std::int64_t> home_offset;       ///< home: 0x607C
+  std::string eds;                   ///< CANopen: the node's EDS or DCF, for the types of its objects
+  std::uint32_t cycle_ms = 10;       ///< CANopen: the SYNC period
+  std::uint32_t timeout_ms = 10000;  ///< each step; watch: how long (0 = until a signal)
+  std::uint16_t heartbeat_ms = 100;  ///< CANopen: the drive's heartbeat, watched by the master
+  std::uint16_t guard_ms = 0;        ///< CANopen: the master's heartbeat, watched by the drive (0x6007)
+  bool hold = false;                 ///< after the steps, keep the drives as they are until a signal
+  std::uint32_t sync_us = 1000;      ///< csp-stream's SYNC period on CANopen; the LRW cycle on EtherCAT
+  bool sync_us_given = false;
+  // Step options: CLI11 takes them anywhere; the step parser gives each to the step before it.
+  std::vector<std::string> step_values;
+  int relative_flags = 0;
 };
 
 CLI::App* add_master_subcommand(CLI::App& app, master_args& args);
 
-/// Exit status: 0 done; 1 the drive or the bus failed (missing node, SDO abort, lost heartbeat,
-/// fault, timeout); 2 a refused option.
+/// Exit status: 0 every step done; 1 a step failed (the drive, the bus, a time-out); 2 refused
+/// input (an option, a step, a value outside its object's type).
 int run_master(const master_args& args, std::ostream& out, std::ostream& err);
-/// `--ecat IF`: the EtherCAT master (master_ecat.cpp); COMMAND and OPERANDS are steps run in order.
-int run_ecat_master(const master_args& args, std::ostream& out, std::ostream& err);
 
 }  // namespace cia402::cli

@@ -3,7 +3,6 @@
 #include <poll.h>
 
 #include <CLI/CLI.hpp>
-#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
@@ -19,14 +18,13 @@
 #include "cia402/canopen/monitor/decoder.hpp"
 #include "cia402/canopen/transport/candump_log.hpp"
 #include "cia402/canopen/transport/channel_url.hpp"
+#include "cli/common.hpp"
 
 namespace cia402::cli {
 namespace {
 
 constexpr int usage_error = 2;
 constexpr int failed = 1;
-volatile std::sig_atomic_t stop_requested = 0;
-extern "C" void request_monitor_stop(int) { stop_requested = 1; }
 
 using canopen::monitor::decoded_frame;
 
@@ -193,17 +191,11 @@ int watch_bus(const monitor_args& a, canopen::monitor::decoder& dec, printer& p,
     return failed;
   }
   err << "cia402 monitor: watching " << a.url << std::endl;
-  stop_requested = 0;
-  struct sigaction action {};
-  action.sa_handler = request_monitor_stop;
-  sigemptyset(&action.sa_mask);
-  struct sigaction old_int {}, old_term {};
-  sigaction(SIGINT, &action, &old_int);
-  sigaction(SIGTERM, &action, &old_term);
+  const stop_signals stop;
   apps::elapsed_clock clock;
   std::uint64_t waited_us = 0, frames = 0;
   int status = 0;
-  while (stop_requested == 0 && (a.duration_ms == 0 || waited_us < a.duration_ms * 1000) &&
+  while (!stop.requested() && (a.duration_ms == 0 || waited_us < a.duration_ms * 1000) &&
          (a.count == 0 || frames < a.count)) {
     pollfd fd{channel->native_handle(), POLLIN, 0};
     const std::uint64_t left_ms = a.duration_ms == 0 ? 100 : a.duration_ms - waited_us / 1000;
@@ -220,8 +212,6 @@ int watch_bus(const monitor_args& a, canopen::monitor::decoder& dec, printer& p,
       break;
     }
   }
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
   return status;
 }
 

@@ -123,30 +123,52 @@ void drive_master::drop_requests() {
   for (auto& done : cancelled) done(r);
 }
 
+bool drive_master::queue_request(sdo_job j) {
+  if (phase_ != master_phase::running) return false;
+  requests_.push_back(std::move(j));
+  return true;
+}
+
 bool drive_master::read(std::uint16_t index, std::uint8_t sub, bool is_signed,
                         std::function<void(const sdo_result&)> done) {
-  if (phase_ != master_phase::running) return false;
   sdo_job j;
   j.index = index;
   j.sub = sub;
   j.is_signed = is_signed;
   j.done = std::move(done);
-  requests_.push_back(std::move(j));
-  return true;
+  return queue_request(std::move(j));
 }
 
 bool drive_master::write(std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes,
                          std::function<void(const sdo_result&)> done) {
-  if (phase_ != master_phase::running) return false;
+  std::vector<std::uint8_t> data(bytes);
+  put_le(data.data(), static_cast<std::uint64_t>(value), bytes);
+  return download(index, sub, std::move(data), std::move(done));
+}
+
+bool drive_master::upload(std::uint16_t index, std::uint8_t sub, std::function<void(const sdo_result&)> done) {
+  return read(index, sub, false, std::move(done));
+}
+
+bool drive_master::download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes,
+                            std::function<void(const sdo_result&)> done) {
   sdo_job j;
   j.write = true;
   j.index = index;
   j.sub = sub;
-  j.value = [value] { return value; };
-  j.bytes = bytes;
+  j.raw = std::move(bytes);
   j.done = std::move(done);
-  requests_.push_back(std::move(j));
-  return true;
+  return queue_request(std::move(j));
+}
+
+std::vector<std::pair<std::uint16_t, std::uint8_t>> drive_master::objects_written() const {
+  std::vector<std::pair<std::uint16_t, std::uint8_t>> out;
+  for (const sdo_job& j : script_) {
+    if (!j.write) continue;
+    const std::pair<std::uint16_t, std::uint8_t> at{j.index, j.sub};
+    if (std::find(out.begin(), out.end(), at) == out.end()) out.push_back(at);
+  }
+  return out;
 }
 
 bool drive_master::request_pending() const noexcept {
@@ -155,7 +177,9 @@ bool drive_master::request_pending() const noexcept {
 
 void drive_master::start_transfer(const sdo_job& j) {
   sdo_.clear();
-  if (j.write) {
+  if (j.write && j.raw) {
+    (void)sdo_.start_download(j.index, j.sub, *j.raw);
+  } else if (j.write) {
     (void)sdo_.start_download(j.index, j.sub, j.value(), j.bytes);
   } else {
     (void)sdo_.start_upload(j.index, j.sub);
@@ -239,6 +263,7 @@ void drive_master::complete_current() {
     sdo_result r;
     r.abort = abort;
     if (ok) r.value = sdo_.value(job.is_signed);
+    if (ok && !job.write) r.data = sdo_.data();
     job.done(r);
     // A node that lets an SDO request time out is silent, whatever its heartbeat did last.
     if (timed_out) lose();

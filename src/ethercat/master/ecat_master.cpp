@@ -483,12 +483,29 @@ ecat_sdo_result ecat_master::sdo_read(std::size_t i, std::uint16_t index, std::u
 
 ecat_sdo_result ecat_master::sdo_write(std::size_t i, std::uint16_t index, std::uint8_t sub, std::int64_t value,
                                        unsigned bytes) {
-  bytes = std::clamp(bytes, 1u, 4u);
-  std::vector<std::uint8_t> r{static_cast<std::uint8_t>(0x23 | ((4 - bytes) << 2))};  // expedited, size given
+  return sdo_download(i, index, sub, le_bytes(static_cast<std::uint64_t>(value), std::clamp(bytes, 1u, 4u)));
+}
+
+ecat_sdo_result ecat_master::sdo_download(std::size_t i, std::uint16_t index, std::uint8_t sub,
+                                          const std::vector<std::uint8_t>& data) {
+  const bool expedited = !data.empty() && data.size() <= 4;
+  // Expedited with the size given (n = 4 - size in bits 2..3), else normal with the complete size.
+  std::vector<std::uint8_t> r{static_cast<std::uint8_t>(expedited ? 0x23 | ((4 - data.size()) << 2) : 0x21)};
   put_le(r, index, 2);
   r.push_back(sub);
-  put_le(r, static_cast<std::uint64_t>(value), bytes);
-  r.resize(8, 0);
+  if (expedited) {
+    r.insert(r.end(), data.begin(), data.end());
+    r.resize(8, 0);
+  } else {
+    put_le(r, data.size(), 4);
+    r.insert(r.end(), data.begin(), data.end());
+  }
+  if (i < slaves_.size() && mailbox_header_size + 2 + r.size() > slaves_[i].sii.mailbox_out_size) {
+    ecat_sdo_result result;
+    result.error = slave_text(slaves_[i]) + ": " + std::to_string(data.size()) + " bytes for " + hex(index, 4) +
+                   " need a segmented download, which this master does not do";
+    return result;
+  }
   return sdo(i, r, index, sub);
 }
 
@@ -693,6 +710,12 @@ bool ecat_master::bring_to_operational() {
   // Outputs are valid before SAFE-OP -> OP: the drives get them from the first cycle on.
   if (!request_state(line_state::safe_operational, true)) return false;
   return request_state(line_state::operational, true);
+}
+
+bool ecat_master::leave_operational() {
+  stop_cycling();
+  pre_operational_ = request_state(line_state::pre_operational, false);
+  return pre_operational_;
 }
 
 void ecat_master::set_target(std::size_t i, state target) {

@@ -52,10 +52,12 @@ def session(port):
         time.sleep(0.15)
     finally:
         bus.shutdown()
+    # `wait 300`: node 2 sends its heartbeat (0x1017 = 100 ms) as OPERATIONAL while the master runs;
+    # when it ends, the master puts 0x1017 back to 0 and the heartbeats stop.
     master = subprocess.run([BIN, "master", "--can", "socketcand://127.0.0.1:%d/can0" % port, "--node", "2",
-                             "enable"], capture_output=True, text=True, timeout=30)
+                             "enable", "wait", "300"], capture_output=True, text=True, timeout=30)
     assert master.returncode == 0, master.stdout + master.stderr
-    time.sleep(0.25)  # node 2 goes on sending its heartbeat (0x1017 = 100 ms) as OPERATIONAL
+    time.sleep(0.05)
 
 
 def check_decoded(records):

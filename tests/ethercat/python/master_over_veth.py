@@ -68,7 +68,7 @@ def check_session(events, drives):
     slaves = of(events, "slave")
     assert [e["serial"] for e in slaves] == list(range(1, drives + 1)), slaves
     assert all(e["product_code"] == "0x00000402" for e in slaves), slaves
-    assert all(e["station"] == "0x%04X" % (0x1001 + e["position"]) for e in slaves), slaves
+    assert all(e["station"] == "0x%04X" % (0x1001 + e["slave"]) for e in slaves), slaves
     op = of(events, "operational")
     assert len(op) == 1 and op[0]["working_counter"] == 3 * drives, op
     assert all(e["source"] == "CoE 0x1C12/0x1C13" for e in of(events, "mapping"))
@@ -77,9 +77,9 @@ def check_session(events, drives):
     assert len(enabled) == 2 * drives, reached  # enable, and enable again after the quick stop
     assert len(of(events, "quick_stop_done")) == drives
     faults = [e for e in of(events, "state") if e["state"] == "FAULT"]
-    assert sorted(e["position"] for e in faults) == list(range(drives)), faults
+    assert sorted(e["slave"] for e in faults) == list(range(drives)), faults
     assert all(e["error_code"] == "0x2310" for e in faults), faults
-    emcy = [e["position"] for e in of(events, "emcy") if e["error_code"] == "0x2310"]
+    emcy = [e["slave"] for e in of(events, "emcy") if e["error_code"] == "0x2310"]
     assert sorted(emcy) == list(range(drives)), of(events, "emcy")
     reset = [e for e in reached if e["state"] == "SWITCH_ON_DISABLED"]
     assert len(reset) == drives, reached

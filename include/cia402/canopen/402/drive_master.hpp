@@ -102,6 +102,7 @@ struct sdo_result {
   bool cancelled = false;
   sdo_abort abort = sdo_abort::none;
   std::int64_t value = 0;  ///< after a done read: the value, sign-extended when asked
+  std::vector<std::uint8_t> data;  ///< after a done read: its bytes
   bool ok() const noexcept { return !cancelled && abort == sdo_abort::none; }
 };
 
@@ -145,8 +146,16 @@ class drive_master {
             std::function<void(const sdo_result&)> done);
   bool write(std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes,
              std::function<void(const sdo_result&)> done);
+  /// The same with the object's bytes as they travel (a text, a domain, a number of any size):
+  /// expedited up to 4 bytes, segmented beyond.
+  bool upload(std::uint16_t index, std::uint8_t sub, std::function<void(const sdo_result&)> done);
+  bool download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes,
+                std::function<void(const sdo_result&)> done);
   /// A request queued or in flight.
   bool request_pending() const noexcept;
+  /// Every object the set-up may write, in the order it writes them first (each once): what a
+  /// caller reads beforehand to put the node back as it was.
+  std::vector<std::pair<std::uint16_t, std::uint8_t>> objects_written() const;
 
   master_phase phase() const noexcept { return phase_; }
   master_failure failure() const noexcept { return failure_; }
@@ -218,6 +227,7 @@ class drive_master {
     std::uint8_t sub = 0;
     std::function<std::int64_t()> value;
     unsigned bytes = 0;
+    std::optional<std::vector<std::uint8_t>> raw;  // a download of these bytes as they are
     bool is_signed = false;
     bool optional = false;  // set-up: a refusal does not end it (a timeout does)
     int group = 0;          // set-up: a refusal skips the rest of the group
@@ -233,6 +243,7 @@ class drive_master {
   void go_running();
   void fail(master_failure f, sdo_abort a, std::uint16_t index, std::uint8_t sub, std::string text);
   void drop_requests();
+  bool queue_request(sdo_job j);
   void start_transfer(const sdo_job& j);
   bool start_next_job();
   void complete_current();

@@ -112,6 +112,9 @@ class ecat_master {
   /// sync managers and FMMUs, SAFE-OP, then OP with the cyclic exchange running. False with error()
   /// (including the slave's AL status code) when a slave refuses or does not get there in time.
   bool bring_to_operational();
+  /// Every slave from OP back to PRE-OP (the cycle stops first): how a master leaves the line when
+  /// it is done. False with error() when a slave does not get there.
+  bool leave_operational();
   /// One cycle: the LRW of every slave's process data and each AL status; each drive's master step
   /// runs on what came back. False when the frame did not come back or the working counter was
   /// short (the cycle still counts; error() says which), and, sending nothing, when no bring-up to
@@ -137,6 +140,10 @@ class ecat_master {
   /// SDO transfers with slave `i` (an error result, not an exception, for one the line does not have).
   ecat_sdo_result sdo_read(std::size_t i, std::uint16_t index, std::uint8_t sub);
   ecat_sdo_result sdo_write(std::size_t i, std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes);
+  /// A download of the object's bytes as they travel: expedited up to 4 bytes, else a normal
+  /// transfer within one mailbox (a text, a domain); longer needs a segmented one, which this master
+  /// does not do (an error says so).
+  ecat_sdo_result sdo_download(std::size_t i, std::uint16_t index, std::uint8_t sub, const std::vector<std::uint8_t>& data);
 
   std::vector<ecat_slave>& slaves() noexcept { return slaves_; }
   const std::vector<ecat_slave>& slaves() const noexcept { return slaves_; }

@@ -1,0 +1,134 @@
+// The axis session's link to a CiA 402 drive on an EtherCAT line (axis/drive_link.hpp), over our
+// EtherCAT master (ethercat/master/ecat_master.hpp).
+//
+// One `ecat_line` per line: the master, brought to OP once, cycled at its period by whichever drive
+// link polls first when a cycle is due (each drive's `before_cycle` first, so a stream's set-point
+// goes in the cycle it was made for). One `ecat_link` per drive on it:
+// - the cyclic data is the mapping the master learnt (0x1C12/0x1C13 over CoE, else the SII's
+//   defaults): the control word and every other output object it maps (0x6060, 0x607A, 0x60FF,
+//   0x6071, ...) go in the LRW, so a write to one is not undone by the next cycle; the inputs
+//   (0x6041, 0x6064, 0x606C, 0x6077, 0x6061, 0x603F, ...) come from it;
+// - an object transfer (CoE SDO) runs between two cycles, one at a time, the process data flowing
+//   while it waits;
+// - describe(): the types of ETG.1000.6's CoE objects (0x1000, 0x1001, 0x1008..0x100A, 0x1018, the
+//   PDO mapping and assignment objects, 0x1C00), and for the project's virtual drive (its SII
+//   name) its manufacturer objects;
+// - close(): nothing in a drive's dictionary was changed (the mapping is read, not written); once
+//   every drive's link is closed the line leaves OP for PRE-OP at once, rather than by the sync
+//   managers' watchdog, and each drive reacts as its 0x6007 says to its master going.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "cia402/axis/drive_link.hpp"
+#include "cia402/ethercat/master/ecat_master.hpp"
+#include "cia402/profile.hpp"
+
+namespace cia402::ethercat {
+
+class ecat_link;
+
+class ecat_line {
+ public:
+  /// `link` and `p` must outlive the line; `name` is how what() names it ("ecm").
+  ecat_line(master_link& link, const profile& p, std::uint32_t cycle_us, std::string name);
+
+  /// Scan, SII, mailbox, the mapping, SAFE-OP and OP (blocking, as the master's bring-up is):
+  /// false with error().
+  bool scan();
+  bool bring_to_operational();
+  const std::string& error() const noexcept { return master_.error(); }
+  ecat_master& master() noexcept { return master_; }
+  const ecat_master& master() const noexcept { return master_; }
+  const std::string& name() const noexcept { return name_; }
+  bool operational() const noexcept { return up_; }
+
+  /// A cycle when one is due by the line's clock (each drive's before_cycle first); the
+  /// microseconds until the next.
+  std::uint32_t service();
+  /// Cycles run since OP, and whether the line answers.
+  std::uint64_t cycles() const noexcept { return master_.cycles(); }
+  bool failed() const noexcept { return !failure_.empty(); }
+  const std::string& failure() const noexcept { return failure_; }
+
+ private:
+  friend class ecat_link;
+  void attach(ecat_link* l);
+  void detach_closed();
+
+  master_link* link_;
+  ecat_master master_;
+  std::string name_;
+  bool up_ = false;
+  bool left_op_ = false;
+  std::uint64_t next_cycle_us_ = 0;
+  int lost_in_a_row_ = 0;
+  std::string failure_;
+  std::vector<ecat_link*> drives_;
+};
+
+class ecat_link final : public axes::drive_link {
+ public:
+  /// Drive `position` on `line` (which must outlive the link and be in OP for it to run).
+  ecat_link(ecat_line& line, std::size_t position);
+  ~ecat_link() override;
+
+  std::uint32_t poll(std::uint32_t elapsed_us) override;
+  axes::link_phase phase() const override;
+  std::string phase_text() const override;
+  std::string what() const override;
+  std::string short_name() const override;
+
+  bool cyclic() const override { return phase() == axes::link_phase::running; }
+  void start_cyclic() override {}
+  std::uint32_t cycle_us() const override { return line_->master().cycle_us(); }
+  bool status_known() const override { return cyclic() && status_count_ > 0; }
+  std::uint16_t status_word() const override;
+  std::uint64_t status_count() const override { return status_count_; }
+  std::optional<std::uint16_t> error_code() const override;
+  void set_control_word(std::uint16_t word) override;
+
+  const std::vector<axes::cyclic_object>& cyclic_inputs() const override { return inputs_; }
+  const std::vector<axes::cyclic_object>& cyclic_outputs() const override { return outputs_; }
+  std::optional<std::int64_t> cyclic_input(std::uint16_t index, std::uint8_t sub) const override;
+  bool set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) override;
+
+  bool upload(std::uint16_t index, std::uint8_t sub, axes::transfer_done done) override;
+  bool download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes, axes::transfer_done done) override;
+  std::optional<axes::value_format> describe(std::uint16_t index, std::uint8_t sub) const override;
+
+  void close() override;
+  const axes::close_report& closing() const override { return report_; }
+
+  std::size_t position() const noexcept { return position_; }
+
+ private:
+  friend class ecat_line;
+  struct transfer {
+    std::uint16_t index = 0;
+    std::uint8_t sub = 0;
+    bool download = false;
+    std::vector<std::uint8_t> bytes;
+    axes::transfer_done done;
+  };
+  const ecat_slave& slave() const { return line_->master().slaves()[position_]; }
+  void after_cycle(bool ok);
+  void fail(std::string why);
+  void run_one_transfer();
+
+  ecat_line* line_;
+  std::size_t position_;
+  bool started_ = false;
+  std::string failure_;
+  std::vector<axes::cyclic_object> inputs_, outputs_;
+  std::uint64_t status_count_ = 0;
+  std::size_t emergencies_seen_ = 0;
+  std::deque<transfer> transfers_;
+  bool closed_ = false;
+  axes::close_report report_;
+};
+
+}  // namespace cia402::ethercat

@@ -1,0 +1,250 @@
+#include "cia402/ethercat/axis/ecat_link.hpp"
+
+#include <algorithm>
+
+#include "cia402/objects.hpp"
+
+namespace cia402::ethercat {
+namespace {
+
+// Frames lost (or short of their working counter) in a row before the line counts as gone: with a
+// 1 ms cycle, 25 ms, well inside a drive's 100 ms sync-manager watchdog.
+constexpr int lost_cycles_limit = 25;
+// The SII name of the project's virtual drive: its manufacturer objects are known by it.
+constexpr const char* virtual_drive_name = "cia402 virtual drive";
+
+std::string hex4(std::uint32_t v) {
+  static const char* d = "0123456789ABCDEF";
+  std::string s = "0x";
+  for (int i = 3; i >= 0; --i) s += d[(v >> (4 * i)) & 0xF];
+  return s;
+}
+
+// The types of ETG.1000.6's CoE communication objects (table 59 ff.), by index and sub-index.
+std::optional<axes::value_format> coe_object_format(std::uint16_t index, std::uint8_t sub) {
+  using axes::value_format;
+  const auto u = [](unsigned bytes) { return value_format::integer(bytes, false); };
+  switch (index) {
+    case 0x1000: return sub == 0 ? std::optional(u(4)) : std::nullopt;  // device type
+    case 0x1001: return sub == 0 ? std::optional(u(1)) : std::nullopt;  // error register
+    case 0x1008:                                                         // device name,
+    case 0x1009:                                                         // hardware and
+    case 0x100A: return sub == 0 ? std::optional(value_format::text()) : std::nullopt;  // software version
+    case 0x1018: return sub == 0 ? u(1) : sub <= 4 ? u(4) : std::optional<value_format>();  // identity
+    case 0x1C00: return u(1);  // sync manager communication types
+    default: break;
+  }
+  // PDO mapping (entries of 32 bits: index, sub-index, length) and PDO assignment (16-bit indices).
+  if ((index >= 0x1600 && index <= 0x17FF) || (index >= 0x1A00 && index <= 0x1BFF)) return sub == 0 ? u(1) : u(4);
+  if (index >= 0x1C10 && index <= 0x1C2F) return sub == 0 ? u(1) : u(2);
+  return std::nullopt;
+}
+
+}  // namespace
+
+// --- the line -----------------------------------------------------------------------------------
+
+ecat_line::ecat_line(master_link& link, const profile& p, std::uint32_t cycle_us, std::string name)
+    : link_(&link), master_(link, p, cycle_us), name_(std::move(name)) {}
+
+bool ecat_line::scan() { return master_.scan(); }
+
+bool ecat_line::bring_to_operational() {
+  up_ = master_.bring_to_operational();
+  next_cycle_us_ = link_->now_us();
+  return up_;
+}
+
+void ecat_line::attach(ecat_link* l) { drives_.push_back(l); }
+
+std::uint32_t ecat_line::service() {
+  if (!up_ || left_op_ || !failure_.empty()) return 0xFFFFFFFFu;
+  const std::uint64_t now = link_->now_us();
+  if (now < next_cycle_us_) return static_cast<std::uint32_t>(next_cycle_us_ - now);
+  for (ecat_link* d : drives_) {
+    if (!d->closed_ && d->before_cycle) d->before_cycle();
+  }
+  const bool ok = master_.cycle();
+  lost_in_a_row_ = ok ? 0 : lost_in_a_row_ + 1;
+  if (lost_in_a_row_ > lost_cycles_limit) failure_ = "the line does not answer (" + master_.error() + ")";
+  for (ecat_link* d : drives_) d->after_cycle(ok);
+  // Late: go on from now rather than rush to catch up.
+  next_cycle_us_ = std::max(next_cycle_us_ + master_.cycle_us(), now);
+  const std::uint64_t after = link_->now_us();
+  return next_cycle_us_ > after ? static_cast<std::uint32_t>(next_cycle_us_ - after) : 0;
+}
+
+void ecat_line::detach_closed() {
+  if (left_op_ || !std::all_of(drives_.begin(), drives_.end(), [](const ecat_link* d) { return d->closed_; })) return;
+  left_op_ = true;
+  // Every drive's session is done: out of OP at once, not by the watchdog 100 ms later.
+  const bool ok = up_ && failure_.empty() && master_.leave_operational();
+  for (ecat_link* d : drives_) {
+    if (ok) {
+      d->report_.left.push_back(name_ + " left in PRE-OP: the drive applies 0x6007 to its master going");
+    } else {
+      d->report_.left.push_back(name_ + " left as it was: " + (failure_.empty() ? master_.error() : failure_));
+    }
+    d->report_.done = true;
+  }
+}
+
+// --- a drive ------------------------------------------------------------------------------------
+
+ecat_link::ecat_link(ecat_line& line, std::size_t position) : line_(&line), position_(position) {
+  line.attach(this);
+}
+
+ecat_link::~ecat_link() {
+  auto& list = line_->drives_;
+  list.erase(std::remove(list.begin(), list.end(), this), list.end());
+}
+
+std::string ecat_link::short_name() const { return "slave " + std::to_string(position_); }
+
+std::string ecat_link::what() const {
+  const auto& slaves = line_->master().slaves();
+  const std::string station = position_ < slaves.size() ? " (station " + hex4(slaves[position_].station) + ")" : "";
+  return short_name() + station + " on " + line_->name();
+}
+
+axes::link_phase ecat_link::phase() const {
+  if (!failure_.empty() || line_->failed() || closed_) return axes::link_phase::failed;
+  if (!line_->operational() || position_ >= line_->master().slaves().size()) return axes::link_phase::connecting;
+  return axes::link_phase::running;
+}
+
+std::string ecat_link::phase_text() const {
+  if (!failure_.empty()) return failure_;
+  if (line_->failed()) return line_->failure();
+  if (closed_) return "closed";
+  if (!line_->operational()) return line_->name() + " is not in OP yet";
+  return {};
+}
+
+std::uint32_t ecat_link::poll(std::uint32_t) {
+  if (phase() == axes::link_phase::connecting) return 1000;
+  if (!started_ && phase() == axes::link_phase::running) {
+    started_ = true;
+    for (const auto& o : slave().inputs) {
+      if (o.index != 0) inputs_.push_back({o.index, o.sub, o.bits});
+    }
+    for (const auto& o : slave().outputs) {
+      if (o.index != 0) outputs_.push_back({o.index, o.sub, o.bits});
+    }
+    if (on_event) {
+      on_event(axes::link_event::running, {});
+      on_event(axes::link_event::cyclic, {});
+    }
+  }
+  std::uint32_t next = line_->service();
+  if (line_->failed() && failure_.empty()) fail(line_->failure());
+  if (phase() == axes::link_phase::running && !transfers_.empty()) {
+    run_one_transfer();
+    next = 0;  // the process data is due again (and the next transfer may run)
+  }
+  return next;
+}
+
+void ecat_link::after_cycle(bool ok) {
+  if (closed_ || !failure_.empty()) return;
+  const ecat_slave& s = slave();
+  if (ok) ++status_count_;
+  if (ok && (s.al_state & 0x0F) != static_cast<std::uint8_t>(line_state::operational)) {
+    std::string why = what() + " left OP: AL state " + line_state_name(s.al_state);
+    if (s.al_code != 0) why += ", AL status code " + hex4(s.al_code) + " (" + al_status_code_text(s.al_code) + ")";
+    return fail(why);
+  }
+  for (; emergencies_seen_ < s.emergencies.size(); ++emergencies_seen_) {
+    if (on_emergency) on_emergency(s.emergencies[emergencies_seen_], 0, {});
+  }
+}
+
+void ecat_link::fail(std::string why) {
+  if (!failure_.empty()) return;
+  failure_ = std::move(why);
+  axes::transfer_result r;
+  r.cancelled = true;
+  r.error = failure_;
+  std::deque<transfer> gone;
+  gone.swap(transfers_);
+  for (transfer& t : gone) {
+    if (t.done) t.done(r);
+  }
+  if (on_event) on_event(axes::link_event::failed, failure_);
+}
+
+std::uint16_t ecat_link::status_word() const { return status_count_ > 0 ? slave().last_status : 0; }
+
+std::optional<std::uint16_t> ecat_link::error_code() const {
+  if (status_count_ == 0 || !slave().error_code) return std::nullopt;
+  return slave().last_error_code;
+}
+
+void ecat_link::set_control_word(std::uint16_t word) {
+  if (phase() == axes::link_phase::running) line_->master().send_control_word(position_, word);
+}
+
+std::optional<std::int64_t> ecat_link::cyclic_input(std::uint16_t index, std::uint8_t sub) const {
+  if (status_count_ == 0) return std::nullopt;
+  return line_->master().input(position_, index, sub);
+}
+
+bool ecat_link::set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) {
+  if (phase() != axes::link_phase::running) return false;
+  return line_->master().set_output(position_, index, value, sub);
+}
+
+// --- transfers ----------------------------------------------------------------------------------
+
+bool ecat_link::upload(std::uint16_t index, std::uint8_t sub, axes::transfer_done done) {
+  if (phase() != axes::link_phase::running) return false;
+  transfers_.push_back({index, sub, false, {}, std::move(done)});
+  return true;
+}
+
+bool ecat_link::download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes, axes::transfer_done done) {
+  if (phase() != axes::link_phase::running || bytes.empty()) return false;
+  transfers_.push_back({index, sub, true, std::move(bytes), std::move(done)});
+  return true;
+}
+
+void ecat_link::run_one_transfer() {
+  transfer t = std::move(transfers_.front());
+  transfers_.pop_front();
+  // The master keeps the process data flowing while it waits for the mailbox.
+  const ecat_sdo_result r = t.download ? line_->master().sdo_download(position_, t.index, t.sub, t.bytes)
+                                       : line_->master().sdo_read(position_, t.index, t.sub);
+  axes::transfer_result out;
+  out.ok = r.ok;
+  if (r.aborted) out.abort = r.abort;
+  if (!r.ok && !r.aborted) out.error = r.error;
+  if (r.ok && !t.download) out.data = r.data;
+  if (t.done) t.done(out);
+}
+
+std::optional<axes::value_format> ecat_link::describe(std::uint16_t index, std::uint8_t sub) const {
+  if (const auto f = coe_object_format(index, sub)) return f;
+  if (position_ < line_->master().slaves().size() && slave().sii.device_name == virtual_drive_name && sub == 0) {
+    if (index == 0x2000) return axes::value_format::text();                // device label
+    if (index == 0x2001) return axes::value_format::integer(2, false);     // fault injection
+  }
+  return std::nullopt;
+}
+
+void ecat_link::close() {
+  if (closed_) return;
+  closed_ = true;
+  axes::transfer_result r;
+  r.cancelled = true;
+  r.error = "closed";
+  std::deque<transfer> gone;
+  gone.swap(transfers_);
+  for (transfer& t : gone) {
+    if (t.done) t.done(r);
+  }
+  line_->detach_closed();
+  if (!line_->left_op_) report_.done = true;  // the line leaves OP with its last drive
+}
+
+}  // namespace cia402::ethercat

@@ -1,0 +1,123 @@
+"""The issue's done-when command, run by `cia402 master` over both buses, its JSON lines checked:
+
+    cia402 master <bus options> --json enable mode pp move 20000 mode pv velocity 300 wait 500 \\
+        home 37 sdo write 0x1017 100 sdo read 0x1017 sdo read 0x1008 quick-stop reset disable
+
+can:  `cia402 bus` on a free loopback port, `--can socketcand://127.0.0.1:PORT/can0 --node 1`.
+ecat: `cia402 ecat-slave` on one end of a veth pair, `--ecat IF --position 0` on the other (root;
+      exit 77 otherwise). EtherCAT has no heartbeat, and a CoE slave may have no 0x1017 (ETG.1000.6
+      defines none): the command is run as it is and, where the slave refuses 0x1017 with 0x06020000,
+      the failure must name the step and the abort, and the run is repeated with 0x6065 (a CiA 402
+      UNSIGNED32 every drive has) in its place.
+Usage: master_done_when.py CIA402_BINARY can|ecat"""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+
+SKIP = 77
+STEPS = ["enable", "mode", "pp", "move", "20000", "mode", "pv", "velocity", "300", "wait", "500", "home", "37",
+         "sdo", "write", "0x1017", "100", "sdo", "read", "0x1017", "sdo", "read", "0x1008", "quick-stop", "reset",
+         "disable"]
+
+
+def run_master(cia402, bus_options, steps):
+    done = subprocess.run([cia402, "master"] + bus_options + ["--json"] + steps, capture_output=True, text=True,
+                          timeout=120)
+    lines = [json.loads(line) for line in done.stdout.splitlines()]
+    return done, lines
+
+
+def check(done, lines, key, register):
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert lines and all(isinstance(e, dict) and "event" in e for e in lines), done.stdout
+    mine = [e for e in lines if e.get(key) == 0 or (key == "node" and e.get("node") == 1)]
+    assert any(e["event"] == "reached" and e.get("position") == 20000 for e in mine), mine
+    assert any(e["event"] == "reached" and e.get("velocity_rpm", 0) >= 297 for e in mine), mine
+    assert any(e["event"] == "homed" for e in mine), mine
+    assert {"event": "sdo", "object": register + ":0", "value": 100}.items() <= \
+        next(e for e in mine if e["event"] == "sdo" and e["object"] == register + ":0").items(), mine
+    name = next(e for e in mine if e["event"] == "sdo" and e["object"] == "0x1008:0")
+    assert name["value"] == "cia402 virtual drive" and name["type"] == "visible_string", name
+    results = [e for e in mine if e["event"] in ("reached", "quick_stop_done", "nothing_to_reset") and "state" in e]
+    assert results[-1]["event"] == "reached" and results[-1]["state"] == "SWITCH_ON_DISABLED", results[-1]
+    assert not [e for e in lines if e["event"] == "failed"], lines
+
+
+def over_can(cia402):
+    bus = subprocess.Popen([cia402, "bus", "--listen", "127.0.0.1:0", "--nodes", "1"], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
+    try:
+        first = bus.stdout.readline()
+        assert "socketcand on 127.0.0.1:" in first, first + bus.stderr.read()
+        port = int(first.split("127.0.0.1:")[1].split()[0])
+        done, lines = run_master(cia402, ["--can", "socketcand://127.0.0.1:%d/can0" % port, "--node", "1"], STEPS)
+        check(done, lines, "node", "0x1017")
+        closed = [e for e in lines if e["event"] == "closed"]
+        assert closed and "0x1017 (Producer heartbeat time)" in closed[0]["restored"], closed
+    finally:
+        bus.send_signal(signal.SIGTERM)
+        bus.wait(timeout=10)
+    print("CANopen: the done-when command exits 0, %d JSON lines" % len(lines))
+    return 0
+
+
+def start_slave(cia402, interface):
+    slave = subprocess.Popen([cia402, "ecat-slave", "--iface", interface, "--nodes", "1"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+    first = slave.stdout.readline()
+    assert "1 drive(s) on %s" % interface in first, first + slave.stderr.read()
+    return slave
+
+
+def over_ecat(cia402):
+    if os.geteuid() != 0:
+        print("SKIPPED: a raw socket and a veth pair need root")
+        return SKIP
+    if shutil.which("ip") is None:
+        print("FAILED: ip (iproute2) is missing (scripts/install-deps.sh installs it)")
+        return 1
+    tag = "%d" % (os.getpid() % 10000)
+    m, s = "c4dm" + tag, "c4ds" + tag
+    subprocess.run(["ip", "link", "add", m, "type", "veth", "peer", "name", s], check=True)
+    slave = None
+    try:
+        for name in (m, s):
+            subprocess.run(["ip", "link", "set", name, "up"], check=True)
+        slave = start_slave(cia402, s)
+        options = ["--ecat", m, "--position", "0"]
+        done, lines = run_master(cia402, options, STEPS)
+        register = "0x1017"
+        if done.returncode != 0:
+            failed = [e for e in lines if e["event"] == "failed"]
+            assert failed and failed[0]["step"] == "sdo write 0x1017 100", done.stdout + done.stderr
+            assert "SDO abort 0x06020000" in failed[0]["error"], failed
+            assert done.returncode == 1
+            print("EtherCAT: the slave has no 0x1017 (%s); 0x6065 in its place" % failed[0]["error"])
+            register = "0x6065"
+            steps = [register if w == "0x1017" else w for w in STEPS]
+            # A fresh drive: the one before saw its master go and applied 0x6007 (a fault, 0x8130).
+            slave.send_signal(signal.SIGTERM)
+            slave.wait(timeout=10)
+            slave = start_slave(cia402, s)
+            done, lines = run_master(cia402, options, steps)
+        check(done, lines, "slave", register)
+        assert [e for e in lines if e["event"] == "done"][0]["lost_frames"] == 0, lines
+    finally:
+        if slave is not None:
+            slave.send_signal(signal.SIGTERM)
+            slave.wait(timeout=10)
+        subprocess.run(["ip", "link", "del", m], capture_output=True)
+    print("EtherCAT: the done-when command exits 0, %d JSON lines" % len(lines))
+    return 0
+
+
+def main():
+    cia402, bus = sys.argv[1], sys.argv[2]
+    return over_can(cia402) if bus == "can" else over_ecat(cia402)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

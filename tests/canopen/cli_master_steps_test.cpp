@@ -1,0 +1,155 @@
+// `cia402 master` as one command set: several steps in one run on the virtual bus, the steps the
+// old command lacked, objects with their types, and every failure exiting non-zero at once.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli/app.hpp"
+
+namespace cia402::cli {
+namespace {
+
+struct result {
+  int status;
+  std::string out;
+  std::string err;
+};
+
+result run_tool(std::vector<std::string> args) {
+  std::istringstream in;
+  std::ostringstream out, err;
+  const int status = run(args, in, out, err);
+  return {status, out.str(), err.str()};
+}
+
+std::vector<nlohmann::json> lines_of(const std::string& out) {
+  std::vector<nlohmann::json> v;
+  std::istringstream in(out);
+  for (std::string line; std::getline(in, line);) v.push_back(nlohmann::json::parse(line));
+  return v;
+}
+
+TEST(cli_master_steps, the_done_when_command_runs_every_step_in_one_session) {
+  const result r = run_tool({"master", "--can", "virtual", "--json", "enable", "mode", "pp", "move", "20000", "mode", "pv",
+                             "velocity", "300", "wait", "500", "home", "37", "sdo", "write", "0x1017", "100", "sdo",
+                             "read", "0x1017", "sdo", "read", "0x1008", "quick-stop", "reset", "disable"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto lines = lines_of(r.out);
+  bool moved = false, read_back = false, named = false;
+  std::string last_state;
+  for (const auto& l : lines) {
+    ASSERT_EQ(l["node"], 1) << l;
+    moved = moved || (l["event"] == "reached" && l.value("position", 0) == 20000);
+    read_back = read_back || (l["event"] == "sdo" && l["object"] == "0x1017:0" && l["value"] == 100);
+    named = named || (l["event"] == "sdo" && l["object"] == "0x1008:0" && l["value"] == "cia402 virtual drive");
+    if (l["event"] == "reached" && l.contains("state")) last_state = l["state"];
+  }
+  EXPECT_TRUE(moved) << r.out;
+  EXPECT_TRUE(read_back) << "0x1017 written as UNSIGNED16, as CiA 301 types it" << r.out;
+  EXPECT_TRUE(named) << "0x1008 as text" << r.out;
+  EXPECT_EQ(last_state, "SWITCH_ON_DISABLED");
+}
+
+TEST(cli_master_steps, velocity_outside_pv_switches_the_mode_itself) {
+  const result r = run_tool({"master", "--can", "virtual", "mode", "pp", "velocity", "500"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("node 1: mode 3 (pv)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("node 1: running at "), std::string::npos) << r.out;
+}
+
+TEST(cli_master_steps, hold_with_a_timeout_that_is_not_met_exits_1) {
+  const result r = run_tool({"master", "--can", "virtual", "--hold", "--timeout", "300", "move", "2000000", "--velocity", "10"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("move 2000000 --velocity 10: did not finish within 300 ms (the drive shows OPERATION_ENABLED"),
+            std::string::npos)
+      << r.err;
+}
+
+TEST(cli_master_steps, torque_jog_and_halt_run_on_the_virtual_bus) {
+  const result r = run_tool({"master", "--can", "virtual", "torque", "150", "jog", "200", "300", "halt", "on", "halt", "off",
+                             "disable"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("node 1: mode 4 (tq)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("permille reached"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("node 1: jogging at 200 rpm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("node 1: jog released"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("node 1: halt on (control bit 8)"), std::string::npos) << r.out;
+}
+
+TEST(cli_master_steps, a_fault_injected_and_cleared_is_reset_in_the_same_run) {
+  const result r = run_tool({"master", "--can", "virtual", "--json", "enable", "sdo", "write", "0x2001", "0x2310", "wait",
+                             "50", "sdo", "write", "0x2001", "0", "reset", "state"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find(R"("event":"state","state":"FAULT","statusword":"0x1218","error_code":"0x2310")"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find(R"("event":"emcy","error_code":"0x2310")"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(R"("event":"sdo_written","object":"0x2001:0","value":8976,"type":"unsigned16")"), std::string::npos)
+      << "0x2001 typed as the virtual drive's dictionary says" << r.out;
+  EXPECT_NE(r.out.find(R"({"node":1,"event":"status","state":"SWITCH_ON_DISABLED")"), std::string::npos) << r.out;
+}
+
+TEST(cli_master_steps, a_fault_whose_cause_persists_fails_the_reset_at_once_with_its_text) {
+  const result r = run_tool({"master", "--can", "virtual", "enable", "sdo", "write", "0x2001", "0x2310", "wait", "50",
+                             "reset"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("still in FAULT after the fault-reset edge: error code 0x2310 (continuous over-current); is the "
+                       "fault cause still present?"),
+            std::string::npos)
+      << r.err;
+  const result refused = run_tool({"master", "--can", "virtual", "enable", "sdo", "write", "0x2001", "0x2310", "wait", "50",
+                                   "velocity", "100"});
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("velocity 100: the drive is in FAULT: error code 0x2310 (continuous over-current); reset it "
+                             "first"),
+            std::string::npos)
+      << refused.err;
+  // Faulted before the node was set up: the refusal still says what to do.
+  const result first = run_tool({"master", "--can", "virtual", "sdo", "write", "0x2001", "0x2310", "wait", "50", "enable"});
+  EXPECT_EQ(first.status, 1);
+  EXPECT_NE(first.err.find("enable: the drive is in FAULT: error code 0x2310 (continuous over-current); reset it first"),
+            std::string::npos)
+      << first.err;
+}
+
+TEST(cli_master_steps, texts_and_bytes_go_with_their_type) {
+  const result r = run_tool({"master", "--can", "virtual", "--json", "sdo", "write", "0x2000", "\"axis 1\"", "sdo", "read",
+                             "0x2000", "sdo", "read", "0x1018:2"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find(R"("object":"0x2000:0","value":"axis 1","type":"visible_string")"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(R"("object":"0x1018:2","value":1026,"type":"unsigned32")"), std::string::npos) << r.out;
+  const result bad = run_tool({"master", "--can", "virtual", "sdo", "write", "0x1017", "\"text\""});
+  EXPECT_EQ(bad.status, 2) << "a text for an UNSIGNED16";
+  EXPECT_NE(bad.err.find("a text for an object of type unsigned16"), std::string::npos) << bad.err;
+}
+
+TEST(cli_master_steps, options_belong_to_the_step_before_them) {
+  EXPECT_EQ(run_tool({"master", "--can", "virtual", "--velocity", "5", "move", "10"}).status, 2);
+  const result wrong = run_tool({"master", "--can", "virtual", "enable", "--relative"});
+  EXPECT_EQ(wrong.status, 2);
+  EXPECT_NE(wrong.err.find("--relative belongs to move, not enable"), std::string::npos) << wrong.err;
+  const result two = run_tool({"master", "--can", "virtual", "--json", "move", "1000", "--velocity", "600", "move", "500",
+                               "--relative", "--velocity", "300"});
+  ASSERT_EQ(two.status, 0) << two.err;
+  EXPECT_NE(two.out.find(R"({"node":1,"event":"reached","position":1500})"), std::string::npos) << two.out;
+}
+
+TEST(cli_master_steps, nmt_on_ethercat_is_refused_before_the_line_is_opened) {
+  const result r = run_tool({"master", "--ecat", "no-such-interface", "nmt", "start"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("nmt is CANopen's"), std::string::npos) << r.err;
+}
+
+TEST(cli_master_steps, an_eds_that_does_not_parse_is_refused_with_its_line) {
+  const std::string path = ::testing::TempDir() + "bad.eds";
+  std::ofstream(path) << "[1000]\nDataType=banana\n";
+  const result r = run_tool({"master", "--can", "virtual", "--eds", path, "state"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--eds " + path + ":"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace cia402::cli
