@@ -48,7 +48,7 @@ CLI::App* add_master_subcommand(CLI::App& app, master_args& args) {
         ->description(std::string(name) == "--velocity" ? "move: 0x6081 in rpm; csp-stream: the ramp's speed in rpm"
                       : std::string(name) == "--to"     ? "csp-stream: where the ramp of 0x607A ends, in increments"
                       : std::string(name) == "--offset" ? "home: the home offset 0x607C, in increments"
-                                                        : "home: the homing method 0x6098")
+                                                        : "home: the homing method 0x6098 (one of 0x60E3: 1..14, 17..30, 33, 34, 35, 37)")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   }
