@@ -114,8 +114,8 @@ TEST(session, home_sets_the_position_to_the_home_offset) {
 
 TEST(session, a_homing_method_the_drive_refuses_names_0x6098_and_its_abort) {
   bench b;
-  // Method 1 needs a limit switch the virtual drive lacks: the drive refuses 0x6098 = 1.
-  const result r = b.finish([&](completion d) { return b.s->home({std::int8_t{1}, std::nullopt}, std::move(d)); });
+  // Method 15 is reserved (CiA 402-2): 0x60E3 does not list it, and the drive refuses 0x6098 = 15.
+  const result r = b.finish([&](completion d) { return b.s->home({std::int8_t{15}, std::nullopt}, std::move(d)); });
   EXPECT_FALSE(r.ok());
   EXPECT_NE(r.error.find("0x6098"), std::string::npos) << r.error;
   EXPECT_NE(r.error.find("SDO abort 0x06090030"), std::string::npos) << r.error;
