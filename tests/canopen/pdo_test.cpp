@@ -359,9 +359,7 @@ class array_device final : public device {
 class pdo_sub_index_test : public ::testing::Test {
  protected:
   void SetUp() override {
-    slave_config c;
-    c.node_id = id;
-    c.objects = drive_objects();
+    slave_config c = apps::drive_node_config(id);
     object_entry pair;
     pair.index = array_device::index;
     pair.name = "Pair";

@@ -17,11 +17,10 @@
 
 #include "cia402/apps/elapsed_clock.hpp"
 #include "cia402/objects.hpp"
-#include "cia402/canopen/402/drive_objects.hpp"
 #include "cia402/canopen/transport/channel_url.hpp"
 #include "cia402/canopen/402/drive_master.hpp"
 #include "cia402/canopen/301/sdo_client.hpp"
-#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cli/common.hpp"
 
@@ -46,8 +45,8 @@ class bus_session {
     }
     if (url.type == canopen::channel_url::kind::virtual_bus) {
       virtual_ = true;
-      drive_ = std::make_unique<canopen::virtual_drive_node>(
-          p, bus_.attach(), canopen::drive_node_config(static_cast<std::uint8_t>(a.node)));
+      drive_ = std::make_unique<apps::virtual_drive_node>(
+          p, bus_.attach(), apps::drive_node_config(static_cast<std::uint8_t>(a.node)));
       master_ch_ = bus_.attach();
       channel_ = master_ch_.get();
       for (int i = 0; i < 10; ++i) drive_->poll(1000);  // past power-up (T0, T1)
@@ -131,7 +130,7 @@ class bus_session {
   std::uint32_t virtual_step_us_ = 1000;
   bool precise_ = false;
   canopen::virtual_bus bus_;
-  std::unique_ptr<canopen::virtual_drive_node> drive_;
+  std::unique_ptr<apps::virtual_drive_node> drive_;
   std::unique_ptr<canopen::virtual_channel> master_ch_;
   std::unique_ptr<canopen::channel> real_;
   canopen::channel* channel_ = nullptr;

@@ -1,48 +1,44 @@
-// The object dictionary of a CiA 402 drive node: the communication objects of CiA 301 and the drive
-// objects of CiA 402 that the virtual drive has. The slave serves this table and `cia402 eds` prints
-// it; nothing else lists objects.
+// The virtual CiA 402 drive's part of a dictionary, the same on every fieldbus: what it says it is
+// (0x1000 device type, 0x1008..0x100A names, 0x1018 identity), its error register 0x1001, its
+// manufacturer objects (0x2000 device label, 0x2001 fault injection: cia402/manufacturer_objects.hpp)
+// and the drive objects of CiA 402 it has, from the core's one object table (cia402/objects.hpp).
+// A fieldbus adds the communication objects it serves itself: the CANopen node 0x1005..0x1BFF
+// (canopen/301/slave.hpp), the CoE slave 0x1600.., 0x1A00.., 0x1C00, 0x1C12, 0x1C13
+// (ethercat/slave/coe_slave.hpp).
 //
 // Choices, with the reason:
 // - 0x1000 device type = 0x00020192: the low word is the device profile number, 402 = 0x0192; bits
 //   16..23 are CiA 402's "type" field, 0x02 = servo drive; bits 24..31 are 0.
 // - 0x1018 identity: vendor-ID 0 (no CiA-assigned ID), product code 0x00000402, revision 0x00010000,
-//   serial number = node-ID, so each virtual drive on a bus differs.
+//   serial number = the given serial + node-ID, so each virtual drive on a CAN bus differs (a CoE
+//   dictionary has no node-ID: the serial alone, the slave's position + 1).
 // - 0x1008 device name "cia402 virtual drive" and 0x2000 (device label, rw, up to 64 characters) are
 //   VISIBLE_STRINGs longer than 4 bytes: they travel by segmented SDO transfer.
 // - 0x2001 "fault injection" (wo, UNSIGNED16): writing an error code raises a fault cause in the
 //   virtual drive, 0 clears every cause. Write-only because it is a command, not a state.
-// - PDO defaults are the CiA 402 predefined set (as drive manuals restate it, e.g. Kollmorgen S300
-//   CANopen manual §5.3.1.3): RPDO1 = 0x6040; RPDO2 = 0x6040 + 0x6060; RPDO3 = 0x6040 + 0x607A
-//   (target position); RPDO4 = 0x6040 + 0x60FF. TPDO1 = 0x6041; TPDO2 = 0x6041 + 0x6061; TPDO3 =
-//   0x6041 + 0x6064 (position actual value); TPDO4 = 0x6041 + 0x606C. PDO 3 is what a cyclic
-//   synchronous position master needs, so it is synchronous (transmission type 1: RPDO3 takes effect
-//   at the next SYNC, TPDO3 goes out on every SYNC); the others are event-driven (255). Every
-//   event-driven TPDO has an event timer of 1000 ms (a master can rely on hearing each one every
-//   second) and TPDO4, which carries the velocity, an inhibit time of 10 ms (at most 100 frames/s
-//   while the drive ramps, where it sent about 850).
-// - 0x1016 has 4 consumer entries; 0x1017 defaults to 0 (no heartbeat) as CiA 301 does.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
 #include "cia402/canopen/301/object_dictionary.hpp"
-#include "cia402/canopen/301/slave.hpp"
+#include "cia402/manufacturer_objects.hpp"
 
-namespace cia402::canopen {
+namespace cia402::drive402 {
 
-inline constexpr std::uint32_t device_type_cia402_servo = 0x00020192;
-/// 0x1008 of every virtual drive: how a master tells a `cia402 bus` node (and its 0x2001) apart.
-inline constexpr const char* virtual_drive_device_name = "cia402 virtual drive";
-inline constexpr std::uint16_t fault_injection_index = 0x2001;
-inline constexpr std::uint16_t device_label_index = 0x2000;
-inline constexpr std::size_t device_label_capacity = 64;
+/// 0x1000: CiA 402 (0x0192), servo drive (0x02).
+inline constexpr std::uint32_t device_type = 0x00020192;
+/// 0x1018 sub 1..3.
+inline constexpr std::uint32_t vendor_id = 0;
+inline constexpr std::uint32_t product_code = 0x402;
+inline constexpr std::uint32_t revision_number = 0x00010000;
+/// 0x1009, 0x100A.
+inline constexpr const char* hardware_version = "virtual";
+inline constexpr const char* software_version = "0.1.0";
 
-/// The table; 0x6xxx objects and 0x2001 are backed by the device.
-std::vector<object_entry> drive_objects();
+/// The drive's objects: 0x1000, 0x1001, 0x1008..0x100A, 0x1018 (sub 4 = `serial` + node-ID), 0x2000,
+/// 0x2001 and the 0x6xxx objects; 0x1001, 0x2001 and the 0x6xxx objects are backed by the device
+/// (sim_device), the rest stored.
+std::vector<canopen::object_entry> drive_objects(std::uint32_t serial = 0);
 
-/// A node configuration that serves the drive's table: what a CiA 402 node is built with.
-slave_config drive_node_config(std::uint8_t node_id, std::uint32_t sdo_timeout_us = 1000000,
-                               std::uint16_t heartbeat_ms = 0);
-
-}  // namespace cia402::canopen
+}  // namespace cia402::drive402

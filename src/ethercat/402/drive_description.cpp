@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <string>
 
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/drive402/drive_objects.hpp"
+#include "cia402/pdo_maps.hpp"
 
 namespace cia402::ethercat {
 namespace {
@@ -30,10 +31,6 @@ sub_entry limited(sub_entry e, std::int64_t low, std::int64_t high) {
   e.low = low;
   e.high = high;
   return e;
-}
-
-std::uint32_t map_entry(std::uint16_t index, std::uint8_t sub, std::uint8_t bits) {
-  return (static_cast<std::uint32_t>(index) << 16) | (static_cast<std::uint32_t>(sub) << 8) | bits;
 }
 
 object_entry group(std::uint16_t index, std::string name, object_code code, std::vector<sub_entry> subs) {
@@ -64,12 +61,6 @@ object_entry pdo_assignment(std::uint16_t index, std::string name, std::uint16_t
                {limited(var(0, "Number of assigned PDOs", data_type::unsigned8, access::rw, assigned ? 1 : 0), 0, 2),
                 var(1, "PDO 1", data_type::unsigned16, access::rw, assigned ? first_pdo : 0),
                 var(2, "PDO 2", data_type::unsigned16, access::rw, 0)});
-}
-
-// The communication objects of CiA 301 that only CAN has.
-bool can_only(std::uint16_t index) {
-  return index == 0x1005 || index == 0x1014 || index == 0x1016 || index == 0x1017 || index == 0x1200 ||
-         (index >= 0x1400 && index <= 0x1BFF);
 }
 
 const object_entry* find(const std::vector<object_entry>& t, std::uint16_t index) {
@@ -117,23 +108,20 @@ pdo_description pdo_of(const std::vector<object_entry>& t, std::uint16_t index, 
 }  // namespace
 
 std::vector<object_entry> coe_drive_objects() {
-  std::vector<object_entry> t;
-  for (object_entry& o : canopen::drive_objects()) {
-    if (!can_only(o.index)) t.push_back(std::move(o));
-  }
+  std::vector<object_entry> t = drive402::drive_objects();
   // Sub 4 of the identity is the serial number; on CAN it adds the node-ID, here the slave's
   // position (set per slave by drive_slave_description's caller through its serial).
   for (object_entry& o : t) {
     for (sub_entry& e : o.subs) e.plus_node_id = false;
   }
-  t.push_back(pdo_mapping(0x1600, "RxPDO 1 mapping",
-                          {map_entry(0x6040, 0, 16), map_entry(0x607A, 0, 32), map_entry(0x60FF, 0, 32),
-                           map_entry(0x6071, 0, 16), map_entry(0x6060, 0, 8)}));
+  const auto words = [](const pdo_map& m) {
+    std::vector<std::uint32_t> w;
+    for (std::size_t i = 0; i < m.count; ++i) w.push_back(m.entries[i].word());
+    return w;
+  };
+  t.push_back(pdo_mapping(0x1600, "RxPDO 1 mapping", words(pdo_maps::ecat_rxpdo)));
   t.push_back(pdo_mapping(0x1601, "RxPDO 2 mapping", {}));
-  t.push_back(pdo_mapping(0x1A00, "TxPDO 1 mapping",
-                          {map_entry(0x6041, 0, 16), map_entry(0x6064, 0, 32), map_entry(0x606C, 0, 32),
-                           map_entry(0x6077, 0, 16), map_entry(0x6061, 0, 8), map_entry(0x603F, 0, 16),
-                           map_entry(0x60F4, 0, 32)}));
+  t.push_back(pdo_mapping(0x1A00, "TxPDO 1 mapping", words(pdo_maps::ecat_txpdo)));
   t.push_back(pdo_mapping(0x1A01, "TxPDO 2 mapping", {}));
   t.push_back(group(0x1C00, "Sync manager communication type", object_code::array,
                     {var(0, "Number of used sync managers", data_type::unsigned8, access::ro, 4),
@@ -154,7 +142,7 @@ slave_description drive_slave_description(const std::vector<object_entry>& t, st
   d.revision = static_cast<std::uint32_t>(default_of(t, 0x1018, 3));
   d.serial = serial;
   d.vendor_name = "cia402 project";
-  d.device_name = canopen::virtual_drive_device_name;
+  d.device_name = virtual_drive_device_name;
   d.group_name = "Drives";
   d.mailbox_out_start = mailbox_out_start;
   d.mailbox_out_size = mailbox_size;

@@ -28,7 +28,7 @@
 #include "cia402/canopen/301/device.hpp"
 #include "cia402/canopen/301/dictionary_access.hpp"
 #include "cia402/canopen/301/object_dictionary.hpp"
-#include "cia402/canopen/402/sim_device.hpp"
+#include "cia402/drive402/sim_device.hpp"
 #include "cia402/ethercat/coe/mailbox.hpp"
 #include "cia402/ethercat/esc/esc.hpp"
 #include "cia402/ethercat/sii/slave_information.hpp"
@@ -61,7 +61,7 @@ class drive_slave final : private canopen::dictionary_access, private canopen::d
   /// and of the watchdog.
   void step(std::uint32_t elapsed_us);
   al_state state() const noexcept { return state_; }
-  canopen::sim_device& device() noexcept { return device_; }
+  drive402::sim_device& device() noexcept { return device_; }
   const slave_description& description() const noexcept { return description_; }
   /// Bytes of the assigned RxPDOs (outputs) and TxPDOs (inputs) as the dictionary has them now.
   std::uint16_t output_bytes() const noexcept;
@@ -93,7 +93,7 @@ class drive_slave final : private canopen::dictionary_access, private canopen::d
   void error_changed(std::uint16_t code) noexcept override;
 
   canopen::object_dictionary od_;
-  canopen::sim_device device_;
+  drive402::sim_device device_;
   slave_description description_;
   esc esc_;
   coe_server coe_;
