@@ -153,7 +153,7 @@ class slave final : private dictionary_access, private device_events {
   sdo_abort read_value(const object_dictionary::slot& s, std::int64_t& v) override;
   sdo_abort check_mapping_entry(bool receive, std::uint32_t entry) const;
   void resolve_pdos();
-  pdo_config resolve(std::uint16_t comm, std::uint16_t mapping) const;
+  pdo_config resolve(std::uint16_t comm, std::uint16_t mapping);
   void configure_consumer();
 
   void boot();
