@@ -13,7 +13,7 @@
 #include <memory>
 #include <vector>
 
-#include "cia402/ethercat/402/drive_slave.hpp"
+#include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/esc/esc.hpp"
 #include "cia402/ethercat/master/ecat_master.hpp"
 #include "cia402/profile.hpp"
@@ -75,7 +75,7 @@ class wire_link final : public master_link {
  public:
   explicit wire_link(std::size_t drives) {
     for (std::size_t i = 0; i < drives; ++i) {
-      slaves.push_back(std::make_unique<drive_slave>(cia402::standard_profile(), static_cast<std::uint32_t>(i + 1)));
+      slaves.push_back(std::make_unique<cia402::apps::virtual_drive_slave>(cia402::standard_profile(), static_cast<std::uint32_t>(i + 1)));
       wire.add(slaves.back()->controller());
     }
   }
@@ -85,7 +85,7 @@ class wire_link final : public master_link {
     now += us;
     for (auto& s : slaves) s->step(us);
   }
-  std::vector<std::unique_ptr<drive_slave>> slaves;
+  std::vector<std::unique_ptr<cia402::apps::virtual_drive_slave>> slaves;
   chain wire;
   std::uint64_t now = 0;
 };

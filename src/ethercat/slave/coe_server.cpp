@@ -1,47 +1,13 @@
-#include "cia402/ethercat/coe/mailbox.hpp"
+#include "cia402/ethercat/slave/coe_server.hpp"
 
 #include <algorithm>
-#include <cstring>
 
 namespace cia402::ethercat {
 namespace {
 
-using canopen::access;
-using canopen::data_type;
 using canopen::object_code;
 using canopen::object_entry;
 using canopen::sub_entry;
-
-std::uint16_t le16(const std::uint8_t* p) noexcept { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
-std::uint32_t le32(const std::uint8_t* p) noexcept {
-  return le16(p) | (static_cast<std::uint32_t>(le16(p + 2)) << 16);
-}
-void put16(std::vector<std::uint8_t>& b, std::uint16_t v) {
-  b.push_back(static_cast<std::uint8_t>(v));
-  b.push_back(static_cast<std::uint8_t>(v >> 8));
-}
-void put32(std::vector<std::uint8_t>& b, std::uint32_t v) {
-  put16(b, static_cast<std::uint16_t>(v));
-  put16(b, static_cast<std::uint16_t>(v >> 16));
-}
-
-// SDO command specifiers, as on CAN (CiA 301 §7.2.4.3); bit 4 of an initiate request is CoE's
-// complete access.
-constexpr std::uint8_t ccs_download_segment = 0;
-constexpr std::uint8_t ccs_initiate_download = 1;
-constexpr std::uint8_t ccs_initiate_upload = 2;
-constexpr std::uint8_t ccs_upload_segment = 3;
-constexpr std::uint8_t ccs_abort = 4;
-constexpr std::uint8_t complete_access_bit = 0x10;
-
-// SDO information opcodes (ETG.1000.6 §5.6.3).
-constexpr std::uint8_t info_od_list_request = 1;
-constexpr std::uint8_t info_od_list_response = 2;
-constexpr std::uint8_t info_object_request = 3;
-constexpr std::uint8_t info_object_response = 4;
-constexpr std::uint8_t info_entry_request = 5;
-constexpr std::uint8_t info_entry_response = 6;
-constexpr std::uint8_t info_error = 7;
 
 // Objects whose writes configure the process data: writable in PRE-OP only (ETG.1000.6).
 bool pdo_configuration(std::uint16_t index) noexcept {
@@ -68,27 +34,24 @@ std::uint16_t bit_length(const sub_entry& e) noexcept {
   return static_cast<std::uint16_t>(std::min<std::size_t>(text, 8191) * 8);
 }
 
+// Which objects an OD list names (ETG.1000.6 table 42): all, RxPDO-mappable, TxPDO-mappable; none is
+// stored to backup memory or taken as a setting.
+bool in_list(const object_entry& o, std::uint16_t list) noexcept {
+  const auto any = [&](auto pred) { return std::any_of(o.subs.begin(), o.subs.end(), pred); };
+  switch (list) {
+    case 1: return true;
+    case 2: return any([](const sub_entry& e) { return e.pdo_mappable && canopen::writable(e.acc); });
+    case 3: return any([](const sub_entry& e) { return e.pdo_mappable && !canopen::writable(e.acc); });
+    default: return false;
+  }
+}
+
+std::vector<std::uint8_t> le32_bytes(std::uint32_t v) {
+  return {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8), static_cast<std::uint8_t>(v >> 16),
+          static_cast<std::uint8_t>(v >> 24)};
+}
+
 }  // namespace
-
-bool read_mailbox_header(std::span<const std::uint8_t> mailbox, mailbox_header& out) noexcept {
-  if (mailbox.size() < mailbox_header_size) return false;
-  out.length = le16(mailbox.data());
-  out.address = le16(mailbox.data() + 2);
-  out.channel = mailbox[4] & 0x3F;
-  out.priority = static_cast<std::uint8_t>(mailbox[4] >> 6);
-  out.type = static_cast<mailbox_type>(mailbox[5] & 0x0F);
-  out.counter = static_cast<std::uint8_t>((mailbox[5] >> 4) & 0x07);
-  return true;
-}
-
-void write_mailbox_header(const mailbox_header& h, std::uint8_t* p) noexcept {
-  p[0] = static_cast<std::uint8_t>(h.length);
-  p[1] = static_cast<std::uint8_t>(h.length >> 8);
-  p[2] = static_cast<std::uint8_t>(h.address);
-  p[3] = static_cast<std::uint8_t>(h.address >> 8);
-  p[4] = static_cast<std::uint8_t>((h.channel & 0x3F) | (h.priority << 6));
-  p[5] = static_cast<std::uint8_t>((static_cast<std::uint8_t>(h.type) & 0x0F) | ((h.counter & 0x07) << 4));
-}
 
 coe_server::coe_server(canopen::object_access& access, const canopen::object_dictionary& dictionary,
                        std::uint16_t mailbox_size, std::uint16_t station_address)
@@ -110,95 +73,66 @@ std::vector<std::uint8_t> coe_server::take_reply() {
   return r;
 }
 
-void coe_server::reply(mailbox_type type, std::span<const std::uint8_t> body) {
-  std::vector<std::uint8_t> m(mailbox_size_, 0);
-  const std::size_t n = std::min<std::size_t>(body.size(), mailbox_size_ - mailbox_header_size);
-  counter_ = static_cast<std::uint8_t>(counter_ % 7 + 1);  // 1..7; 0 is reserved
+void coe_server::reply(mailbox_type type, std::span<const std::uint8_t> data) {
+  counter_ = next_mailbox_counter(counter_);
   mailbox_header h;
-  h.length = static_cast<std::uint16_t>(n);
   h.address = station_address_;
   h.type = type;
   h.counter = counter_;
-  write_mailbox_header(h, m.data());
-  std::copy_n(body.begin(), n, m.begin() + mailbox_header_size);
+  const std::size_t n = std::min<std::size_t>(data.size(), mailbox_size_ - mailbox_header_size);
   if (replies_.size() >= max_queued) {
     replies_.pop_front();
     ++dropped_;
   }
-  replies_.push_back(std::move(m));
+  replies_.push_back(make_mailbox(h, data.first(n), mailbox_size_));
 }
 
 void coe_server::mailbox_error_reply(mailbox_error e) {
   ++errors_;
-  std::vector<std::uint8_t> body;
-  put16(body, 0x0001);  // service: mailbox error
-  put16(body, static_cast<std::uint16_t>(e));
-  reply(mailbox_type::error, body);
-}
-
-void coe_server::sdo_reply(std::span<const std::uint8_t> sdo) {
-  std::vector<std::uint8_t> body;
-  put16(body, static_cast<std::uint16_t>(static_cast<unsigned>(coe_service::sdo_response) << 12));
-  body.insert(body.end(), sdo.begin(), sdo.end());
-  reply(mailbox_type::coe, body);
+  reply(mailbox_type::error, mailbox_error_data(e));
 }
 
 void coe_server::abort(std::uint16_t index, std::uint8_t sub, sdo_abort code) {
   ++errors_;
   transfer_ = transfer::none;
-  std::vector<std::uint8_t> sdo{static_cast<std::uint8_t>(ccs_abort << 5)};
-  put16(sdo, index);
-  sdo.push_back(sub);
-  put32(sdo, static_cast<std::uint32_t>(code));
-  sdo_reply(sdo);
+  reply(mailbox_type::coe, sdo_abort_request(index, sub, static_cast<std::uint32_t>(code)));
 }
 
 void coe_server::emergency(std::uint16_t code, std::uint8_t error_register,
                            const std::array<std::uint8_t, 5>& data) {
-  std::vector<std::uint8_t> body;
-  put16(body, static_cast<std::uint16_t>(static_cast<unsigned>(coe_service::emergency) << 12));
-  put16(body, code);
-  body.push_back(error_register);
-  body.insert(body.end(), data.begin(), data.end());
-  reply(mailbox_type::coe, body);
+  reply(mailbox_type::coe, emergency_request({code, error_register, data}));
 }
 
 void coe_server::on_mailbox(std::span<const std::uint8_t> mailbox) {
   mailbox_header h;
   if (!read_mailbox_header(mailbox, h)) return mailbox_error_reply(mailbox_error::size_too_short);
-  if (h.length > mailbox.size() - mailbox_header_size) return mailbox_error_reply(mailbox_error::invalid_size);
+  const std::optional<mailbox_view> m = parse_mailbox(mailbox);
+  if (!m) return mailbox_error_reply(mailbox_error::invalid_size);
   if (h.type != mailbox_type::coe) return mailbox_error_reply(mailbox_error::unsupported_protocol);
-  if (h.length < coe_header_size) return mailbox_error_reply(mailbox_error::size_too_short);
-  const std::span<const std::uint8_t> coe = mailbox.subspan(mailbox_header_size, h.length);
-  const auto service = static_cast<coe_service>(coe[1] >> 4);
-  const std::span<const std::uint8_t> rest = coe.subspan(coe_header_size);
-  switch (service) {
-    case coe_service::sdo_request: return on_sdo(rest);
-    case coe_service::sdo_information: return on_sdo_information(rest);
-    case coe_service::emergency:
-    case coe_service::sdo_response: break;
+  const std::optional<coe_view> c = parse_coe(m->data);
+  if (!c) return mailbox_error_reply(mailbox_error::size_too_short);
+  switch (c->service) {
+    case coe_service::sdo_request: return on_sdo(c->body);
+    case coe_service::sdo_information: return on_sdo_information(c->body);
+    default: break;
   }
   mailbox_error_reply(mailbox_error::service_not_supported);
 }
 
-void coe_server::on_sdo(std::span<const std::uint8_t> sdo) {
-  if (sdo.empty()) return mailbox_error_reply(mailbox_error::size_too_short);
-  const std::uint8_t command = sdo[0];
-  const std::uint8_t ccs = static_cast<std::uint8_t>(command >> 5);
-  if (ccs == ccs_download_segment) return download_segment(sdo);
-  if (ccs == ccs_upload_segment) return upload_segment(command);
-  if (ccs == ccs_abort) {
-    transfer_ = transfer::none;  // the master gave up: no answer (CiA 301)
-    return;
+void coe_server::on_sdo(std::span<const std::uint8_t> body) {
+  const std::optional<sdo_frame> f = parse_sdo_request(body);
+  if (!f) return mailbox_error_reply(mailbox_error::size_too_short);
+  switch (f->command) {
+    case sdo_command::download_segment: return download_segment(*f);
+    case sdo_command::upload_segment: return upload_segment(*f);
+    case sdo_command::abort: transfer_ = transfer::none; return;  // the master gave up: no answer (CiA 301)
+    case sdo_command::other: return abort(f->index, f->sub, sdo_abort::command_specifier_invalid);
+    case sdo_command::initiate_upload:
+    case sdo_command::initiate_download: break;
   }
-  if (sdo.size() < 8) return mailbox_error_reply(mailbox_error::size_too_short);
-  const std::uint16_t index = le16(sdo.data() + 1);
-  const std::uint8_t sub = sdo[3];
-  const bool complete = (command & complete_access_bit) != 0;
-  if (complete && sub > 1) return abort(index, sub, sdo_abort::unsupported_access);
-  if (ccs == ccs_initiate_upload) return upload(index, sub, complete);
-  if (ccs == ccs_initiate_download) return download(sdo);
-  abort(index, sub, sdo_abort::command_specifier_invalid);
+  if (f->complete_access && f->sub > 1) return abort(f->index, f->sub, sdo_abort::unsupported_access);
+  if (f->command == sdo_command::initiate_upload) return upload(*f);
+  download(*f);
 }
 
 sdo_abort coe_server::upload_complete(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t>& out) {
@@ -217,59 +151,42 @@ sdo_abort coe_server::upload_complete(std::uint16_t index, std::uint8_t sub, std
   return sdo_abort::none;
 }
 
-void coe_server::upload(std::uint16_t index, std::uint8_t sub, bool complete) {
+void coe_server::upload(const sdo_frame& f) {
   std::vector<std::uint8_t> value;
-  const sdo_abort r = complete ? upload_complete(index, sub, value) : access_->upload(index, sub, value);
-  if (r != sdo_abort::none) return abort(index, sub, r);
-  std::vector<std::uint8_t> sdo;
-  const std::uint8_t ca = complete ? complete_access_bit : 0;
-  if (value.size() <= 4 && !complete) {
-    // Expedited: the value in the four data bytes, n = 4 - size.
-    sdo.push_back(static_cast<std::uint8_t>((ccs_initiate_upload << 5) | ((4 - value.size()) << 2) | 0x03));
-    put16(sdo, index);
-    sdo.push_back(sub);
-    sdo.insert(sdo.end(), value.begin(), value.end());
-    sdo.resize(8, 0);
-    return sdo_reply(sdo);
+  const sdo_abort r = f.complete_access ? upload_complete(f.index, f.sub, value) : access_->upload(f.index, f.sub, value);
+  if (r != sdo_abort::none) return abort(f.index, f.sub, r);
+  if (!value.empty() && value.size() <= 4 && !f.complete_access) {
+    return reply(mailbox_type::coe, sdo_upload_expedited_response(f.index, f.sub, value));
   }
-  // Normal: the size, then as much of the value as the mailbox holds; segments carry the rest.
-  sdo.push_back(static_cast<std::uint8_t>((ccs_initiate_upload << 5) | ca | 0x01));
-  put16(sdo, index);
-  sdo.push_back(sub);
-  put32(sdo, static_cast<std::uint32_t>(value.size()));
-  const std::size_t first = std::min(value.size(), sdo_room() - sdo.size());
-  sdo.insert(sdo.end(), value.begin(), value.begin() + static_cast<std::ptrdiff_t>(first));
+  // Normal: the size, then as much of the value as the mailbox holds; segments carry the rest. An
+  // empty value (a string) is a normal upload of size 0: expedited frames carry 1 to 4 bytes.
+  const std::size_t first = std::min(value.size(), sdo_initiate_room(mailbox_size_));
+  const std::vector<std::uint8_t> response = sdo_upload_normal_response(
+      f.index, f.sub, f.complete_access, static_cast<std::uint32_t>(value.size()), std::span(value).first(first));
   if (first < value.size()) {
     transfer_ = transfer::uploading;
-    index_ = index;
-    sub_ = sub;
-    toggle_ = 0;
+    index_ = f.index;
+    sub_ = f.sub;
+    toggle_ = false;
     buffer_ = std::move(value);
     offset_ = first;
   } else {
     transfer_ = transfer::none;
   }
-  sdo_reply(sdo);
+  reply(mailbox_type::coe, response);
 }
 
-void coe_server::upload_segment(std::uint8_t command) {
+void coe_server::upload_segment(const sdo_frame& f) {
   if (transfer_ != transfer::uploading) return abort(index_, sub_, sdo_abort::command_specifier_invalid);
-  const std::uint8_t toggle = (command >> 4) & 1u;
-  if (toggle != toggle_) return abort(index_, sub_, sdo_abort::toggle_bit_not_alternated);
-  const std::size_t room = sdo_room() - 1;
-  const std::size_t n = std::min(room, buffer_.size() - offset_);
+  if (f.toggle != toggle_) return abort(index_, sub_, sdo_abort::toggle_bit_not_alternated);
+  const std::size_t n = std::min(sdo_segment_room(mailbox_size_), buffer_.size() - offset_);
   const bool last = offset_ + n == buffer_.size();
-  std::vector<std::uint8_t> sdo;
-  // n (bits 1..3) says how many of 7 bytes carry no data when fewer than 7 are sent.
-  const unsigned unused = n < 7 ? static_cast<unsigned>(7 - n) : 0u;
-  sdo.push_back(static_cast<std::uint8_t>((toggle << 4) | (unused << 1) | (last ? 1u : 0u)));
-  sdo.insert(sdo.end(), buffer_.begin() + static_cast<std::ptrdiff_t>(offset_),
-             buffer_.begin() + static_cast<std::ptrdiff_t>(offset_ + n));
-  if (sdo.size() < 8) sdo.resize(8, 0);
+  const std::vector<std::uint8_t> response =
+      sdo_upload_segment_response(f.toggle, last, std::span(buffer_).subspan(offset_, n));
   offset_ += n;
-  toggle_ ^= 1u;
+  toggle_ = !toggle_;
   if (last) transfer_ = transfer::none;
-  sdo_reply(sdo);
+  reply(mailbox_type::coe, response);
 }
 
 sdo_abort coe_server::download_complete(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data) {
@@ -328,168 +245,123 @@ sdo_abort coe_server::download_complete(std::uint16_t index, std::uint8_t sub, s
   return sdo_abort::none;
 }
 
-void coe_server::download(std::span<const std::uint8_t> sdo) {
-  const std::uint8_t command = sdo[0];
-  const std::uint16_t index = le16(sdo.data() + 1);
-  const std::uint8_t sub = sdo[3];
-  const bool complete = (command & complete_access_bit) != 0;
-  const bool expedited = (command & 0x02) != 0;
-  const bool size_indicated = (command & 0x01) != 0;
+void coe_server::download(const sdo_frame& f) {
   transfer_ = transfer::none;
-  if (expedited) {
-    if (complete) return abort(index, sub, sdo_abort::unsupported_access);
-    const std::size_t n = size_indicated ? 4 - ((command >> 2) & 3u) : 4;
-    const std::span<const std::uint8_t> data = sdo.subspan(4, n);
-    if (const sdo_abort r = access_->check_download(index, sub, n, size_indicated); r != sdo_abort::none) {
-      return abort(index, sub, r);
+  if (f.expedited) {
+    if (f.complete_access) return abort(f.index, f.sub, sdo_abort::unsupported_access);
+    if (const sdo_abort r = access_->check_download(f.index, f.sub, f.data.size(), f.size_indicated); r != sdo_abort::none) {
+      return abort(f.index, f.sub, r);
     }
-    if (const sdo_abort r = access_->download(index, sub, data, size_indicated); r != sdo_abort::none) {
-      return abort(index, sub, r);
+    if (const sdo_abort r = access_->download(f.index, f.sub, f.data, f.size_indicated); r != sdo_abort::none) {
+      return abort(f.index, f.sub, r);
     }
   } else {
-    if (!size_indicated) return abort(index, sub, sdo_abort::command_specifier_invalid);
-    const std::size_t size = le32(sdo.data() + 4);
-    if (size > max_download) return abort(index, sub, sdo_abort::out_of_memory);
-    if (!complete) {
-      if (const sdo_abort r = access_->check_download(index, sub, size, true); r != sdo_abort::none) {
-        return abort(index, sub, r);
+    if (!f.size_indicated) return abort(f.index, f.sub, sdo_abort::command_specifier_invalid);
+    if (f.size > max_download) return abort(f.index, f.sub, sdo_abort::out_of_memory);
+    if (!f.complete_access) {
+      if (const sdo_abort r = access_->check_download(f.index, f.sub, f.size, true); r != sdo_abort::none) {
+        return abort(f.index, f.sub, r);
       }
     }
-    const std::span<const std::uint8_t> first = sdo.subspan(8, std::min(size, sdo.size() - 8));
-    if (first.size() < size) {
+    if (f.data.size() < f.size) {
       // The rest follows in download segments.
       transfer_ = transfer::downloading;
-      index_ = index;
-      sub_ = sub;
-      complete_access_ = complete;
-      toggle_ = 0;
-      size_ = size;
-      buffer_.assign(first.begin(), first.end());
+      index_ = f.index;
+      sub_ = f.sub;
+      complete_access_ = f.complete_access;
+      toggle_ = false;
+      size_ = f.size;
+      buffer_.assign(f.data.begin(), f.data.end());
     } else {
-      const sdo_abort r = complete ? download_complete(index, sub, first) : access_->download(index, sub, first, true);
-      if (r != sdo_abort::none) return abort(index, sub, r);
+      const sdo_abort r = f.complete_access ? download_complete(f.index, f.sub, f.data)
+                                            : access_->download(f.index, f.sub, f.data, true);
+      if (r != sdo_abort::none) return abort(f.index, f.sub, r);
     }
   }
-  std::vector<std::uint8_t> reply{static_cast<std::uint8_t>(0x60 | (complete ? complete_access_bit : 0))};
-  put16(reply, index);
-  reply.push_back(sub);
-  reply.resize(8, 0);
-  sdo_reply(reply);
+  reply(mailbox_type::coe, sdo_download_response(f.index, f.sub, f.complete_access));
 }
 
-void coe_server::download_segment(std::span<const std::uint8_t> sdo) {
+void coe_server::download_segment(const sdo_frame& f) {
   if (transfer_ != transfer::downloading) return abort(index_, sub_, sdo_abort::command_specifier_invalid);
-  const std::uint8_t command = sdo[0];
-  const std::uint8_t toggle = (command >> 4) & 1u;
-  if (toggle != toggle_) return abort(index_, sub_, sdo_abort::toggle_bit_not_alternated);
-  const bool last = (command & 1u) != 0;
-  std::size_t n = sdo.size() - 1;
-  if (n <= 7) n = 7 - ((command >> 1) & 7u);
-  n = std::min(n, sdo.size() - 1);
-  if (buffer_.size() + n > size_) return abort(index_, sub_, sdo_abort::data_type_length_too_high);
-  buffer_.insert(buffer_.end(), sdo.begin() + 1, sdo.begin() + 1 + static_cast<std::ptrdiff_t>(n));
-  toggle_ ^= 1u;
-  if (last) {
+  if (f.toggle != toggle_) return abort(index_, sub_, sdo_abort::toggle_bit_not_alternated);
+  if (buffer_.size() + f.data.size() > size_) return abort(index_, sub_, sdo_abort::data_type_length_too_high);
+  buffer_.insert(buffer_.end(), f.data.begin(), f.data.end());
+  toggle_ = !toggle_;
+  if (f.last) {
     transfer_ = transfer::none;
     if (buffer_.size() != size_) return abort(index_, sub_, sdo_abort::data_type_length_too_low);
     const sdo_abort r = complete_access_ ? download_complete(index_, sub_, buffer_)
                                          : access_->download(index_, sub_, buffer_, true);
     if (r != sdo_abort::none) return abort(index_, sub_, r);
   }
-  std::vector<std::uint8_t> reply{static_cast<std::uint8_t>((1u << 5) | (toggle << 4))};
-  reply.resize(8, 0);
-  sdo_reply(reply);
+  reply(mailbox_type::coe, sdo_download_segment_response(f.toggle));
 }
 
-void coe_server::on_sdo_information(std::span<const std::uint8_t> info) {
-  if (info.size() < 4) return mailbox_error_reply(mailbox_error::size_too_short);
-  const std::uint8_t opcode = info[0] & 0x7F;
-  const std::span<const std::uint8_t> request = info.subspan(4);
-  // Each response: the information header (opcode, incomplete bit, fragments left), then data that
-  // is cut into as many mailboxes as it needs.
-  const auto respond = [&](std::uint8_t op, const std::vector<std::uint8_t>& data) {
-    const std::size_t room = sdo_room() - 4;
-    const std::size_t fragments = data.empty() ? 1 : (data.size() + room - 1) / room;
-    for (std::size_t f = 0; f < fragments; ++f) {
-      std::vector<std::uint8_t> body;
-      put16(body, static_cast<std::uint16_t>(static_cast<unsigned>(coe_service::sdo_information) << 12));
-      const std::size_t left = fragments - 1 - f;
-      body.push_back(static_cast<std::uint8_t>(op | (left > 0 ? 0x80 : 0)));
-      body.push_back(0);
-      put16(body, static_cast<std::uint16_t>(left));
-      const std::size_t from = f * room;
-      const std::size_t to = std::min(data.size(), from + room);
-      body.insert(body.end(), data.begin() + static_cast<std::ptrdiff_t>(from),
-                  data.begin() + static_cast<std::ptrdiff_t>(to));
-      reply(mailbox_type::coe, body);
-    }
+// ---- SDO information --------------------------------------------------------------------------
+
+void coe_server::information_reply(sdo_info_opcode op, std::span<const std::uint8_t> data) {
+  // The data cut into as many mailboxes as it needs, each saying how many fragments are left.
+  const std::size_t room = sdo_info_room(mailbox_size_);
+  const std::size_t fragments = data.empty() ? 1 : (data.size() + room - 1) / room;
+  for (std::size_t f = 0; f < fragments; ++f) {
+    const std::size_t from = f * room;
+    const std::size_t to = std::min(data.size(), from + room);
+    reply(mailbox_type::coe, sdo_info_fragment(op, static_cast<std::uint16_t>(fragments - 1 - f), data.subspan(from, to - from)));
+  }
+}
+
+std::vector<std::uint8_t> coe_server::od_list(std::uint16_t list) const {
+  const std::vector<object_entry>& table = dictionary_->table();
+  std::vector<std::uint8_t> data{static_cast<std::uint8_t>(list), static_cast<std::uint8_t>(list >> 8)};
+  const auto put16 = [&](std::size_t v) {
+    data.push_back(static_cast<std::uint8_t>(v));
+    data.push_back(static_cast<std::uint8_t>(v >> 8));
   };
+  if (list == 0) {
+    for (std::uint16_t which = 1; which <= 5; ++which) {
+      put16(static_cast<std::size_t>(
+          std::count_if(table.begin(), table.end(), [&](const object_entry& o) { return in_list(o, which); })));
+    }
+    return data;
+  }
+  for (const object_entry& o : table) {
+    if (in_list(o, list)) put16(o.index);
+  }
+  return data;
+}
+
+void coe_server::on_sdo_information(std::span<const std::uint8_t> body) {
+  const std::optional<sdo_info_view> v = parse_sdo_information(body);
+  if (!v) return mailbox_error_reply(mailbox_error::size_too_short);
   const auto error = [&](sdo_abort code) {
     ++errors_;
-    std::vector<std::uint8_t> data;
-    put32(data, static_cast<std::uint32_t>(code));
-    respond(info_error, data);
+    information_reply(sdo_info_opcode::error, le32_bytes(static_cast<std::uint32_t>(code)));
   };
-  const std::vector<object_entry>& table = dictionary_->table();
-  switch (opcode) {
-    case info_od_list_request: {
-      if (request.size() < 2) return error(sdo_abort::general_error);
-      const std::uint16_t list = le16(request.data());
-      const auto in_list = [&](const object_entry& o, std::uint16_t which) {
-        const auto any = [&](auto pred) { return std::any_of(o.subs.begin(), o.subs.end(), pred); };
-        switch (which) {
-          case 1: return true;
-          case 2: return any([](const sub_entry& e) { return e.pdo_mappable && canopen::writable(e.acc); });
-          case 3: return any([](const sub_entry& e) { return e.pdo_mappable && !canopen::writable(e.acc); });
-          default: return false;  // nothing is stored to backup memory or settings
-        }
-      };
-      std::vector<std::uint8_t> data;
-      put16(data, list);
-      if (list == 0) {
-        for (std::uint16_t which = 1; which <= 5; ++which) {
-          put16(data, static_cast<std::uint16_t>(
-                          std::count_if(table.begin(), table.end(), [&](const auto& o) { return in_list(o, which); })));
-        }
-      } else if (list <= 5) {
-        for (const object_entry& o : table) {
-          if (in_list(o, list)) put16(data, o.index);
-        }
-      } else {
-        return error(sdo_abort::general_error);
-      }
-      return respond(info_od_list_response, data);
-    }
-    case info_object_request: {
-      if (request.size() < 2) return error(sdo_abort::general_error);
-      const object_entry* o = dictionary_->object(le16(request.data()));
+  const std::optional<sdo_info_request> request = parse_sdo_info_request(*v);
+  switch (v->opcode) {
+    case sdo_info_opcode::od_list_request:
+      if (!request || request->list_or_index > 5) return error(sdo_abort::general_error);
+      return information_reply(sdo_info_opcode::od_list_response, od_list(request->list_or_index));
+    case sdo_info_opcode::object_description_request: {
+      if (!request) return error(sdo_abort::general_error);
+      const object_entry* o = dictionary_->object(request->list_or_index);
       if (o == nullptr || o->subs.empty()) return error(sdo_abort::object_does_not_exist);
-      std::vector<std::uint8_t> data;
-      put16(data, o->index);
       const sub_entry& typed = o->subs.size() > 1 ? o->subs[1] : o->subs[0];
-      put16(data, o->code == object_code::record ? 0 : static_cast<std::uint16_t>(typed.type));
-      data.push_back(o->subs.back().sub);
-      data.push_back(static_cast<std::uint8_t>(o->code));
-      data.insert(data.end(), o->name.begin(), o->name.end());
-      return respond(info_object_response, data);
+      const auto type = static_cast<std::uint16_t>(o->code == object_code::record ? 0 : static_cast<unsigned>(typed.type));
+      return information_reply(sdo_info_opcode::object_description_response,
+                               object_description_data(o->index, type, o->subs.back().sub,
+                                                       static_cast<std::uint8_t>(o->code), o->name));
     }
-    case info_entry_request: {
-      if (request.size() < 4) return error(sdo_abort::general_error);
-      const std::uint16_t index = le16(request.data());
-      const std::uint8_t sub = request[2];
-      const object_entry* o = dictionary_->object(index);
+    case sdo_info_opcode::entry_description_request: {
+      if (!request) return error(sdo_abort::general_error);
+      const object_entry* o = dictionary_->object(request->list_or_index);
       if (o == nullptr) return error(sdo_abort::object_does_not_exist);
-      const auto e = std::find_if(o->subs.begin(), o->subs.end(), [&](const sub_entry& s) { return s.sub == sub; });
+      const auto e = std::find_if(o->subs.begin(), o->subs.end(), [&](const sub_entry& s) { return s.sub == request->sub; });
       if (e == o->subs.end()) return error(sdo_abort::sub_index_does_not_exist);
-      std::vector<std::uint8_t> data;
-      put16(data, index);
-      data.push_back(sub);
-      data.push_back(0);  // value info: name only (no unit, default, minimum or maximum)
-      put16(data, static_cast<std::uint16_t>(e->type));
-      put16(data, bit_length(*e));
-      put16(data, access_bits(index, *e));
-      data.insert(data.end(), e->name.begin(), e->name.end());
-      return respond(info_entry_response, data);
+      // Value info: the name only (no unit, default, minimum or maximum).
+      return information_reply(sdo_info_opcode::entry_description_response,
+                               entry_description_data(o->index, e->sub, 0, static_cast<std::uint16_t>(e->type),
+                                                      bit_length(*e), access_bits(o->index, *e), e->name));
     }
     default: break;
   }

@@ -1,11 +1,11 @@
-// The EtherCAT mailbox (ETG.1000.4 §5.6) and CANopen over EtherCAT (ETG.1000.6 §5.6): the slave side
-// of SDO upload and download (expedited, normal and segmented, with complete access), SDO
-// information (object list, object and entry descriptions, fragmented across mailboxes) and
-// emergency messages. The values are the object dictionary's, through the same object_access the
-// CANopen SDO server uses, so a value refused on CAN is refused here with the same abort code.
+// The slave side of CANopen over EtherCAT (ETG.1000.6 §5.6): SDO upload and download (expedited,
+// normal and segmented, with complete access), SDO information (object list, object and entry
+// descriptions, fragmented across mailboxes) and emergency messages, over a CANopen object
+// dictionary. The values go through the same object_access the CANopen SDO server uses
+// (canopen/301/dictionary_access.hpp), so a value refused on CAN is refused here with the same abort
+// code. Every frame is read and written by the CoE codec (ethercat/coe).
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <deque>
 #include <span>
@@ -13,48 +13,11 @@
 
 #include "cia402/canopen/301/object_dictionary.hpp"
 #include "cia402/canopen/301/sdo_server.hpp"
+#include "cia402/ethercat/coe/mailbox.hpp"
+#include "cia402/ethercat/coe/sdo.hpp"
+#include "cia402/ethercat/coe/sdo_information.hpp"
 
 namespace cia402::ethercat {
-
-/// Mailbox types (the low nibble of header byte 5).
-enum class mailbox_type : std::uint8_t { error = 0, aoe = 1, eoe = 2, coe = 3, foe = 4, soe = 5, voe = 15 };
-
-/// Mailbox error reply codes (ETG.1000.4 table 30).
-enum class mailbox_error : std::uint16_t {
-  syntax = 0x0001,
-  unsupported_protocol = 0x0002,
-  invalid_channel = 0x0003,
-  service_not_supported = 0x0004,
-  invalid_header = 0x0005,
-  size_too_short = 0x0006,
-  no_more_memory = 0x0007,
-  invalid_size = 0x0008,
-};
-
-/// CoE services (the high nibble of the CoE header).
-enum class coe_service : std::uint8_t {
-  emergency = 1,
-  sdo_request = 2,
-  sdo_response = 3,
-  sdo_information = 8,
-};
-
-inline constexpr std::size_t mailbox_header_size = 6;
-inline constexpr std::size_t coe_header_size = 2;
-
-/// A mailbox header as it travels: data length after the header, station address, channel and
-/// priority, type and the 1..7 counter.
-struct mailbox_header {
-  std::uint16_t length = 0;
-  std::uint16_t address = 0;
-  std::uint8_t channel = 0;
-  std::uint8_t priority = 0;
-  mailbox_type type = mailbox_type::error;
-  std::uint8_t counter = 0;
-};
-
-bool read_mailbox_header(std::span<const std::uint8_t> mailbox, mailbox_header& out) noexcept;
-void write_mailbox_header(const mailbox_header& h, std::uint8_t* six_bytes) noexcept;
 
 /// What a slave's CoE does with the mailboxes the master writes. Replies queue up; the slave hands
 /// the next one to the master whenever its send mailbox (SM1) is free.
@@ -85,19 +48,19 @@ class coe_server {
   void reset() noexcept;
 
  private:
-  void on_sdo(std::span<const std::uint8_t> sdo);
-  void on_sdo_information(std::span<const std::uint8_t> info);
-  void upload(std::uint16_t index, std::uint8_t sub, bool complete);
-  void download(std::span<const std::uint8_t> sdo);
-  void download_segment(std::span<const std::uint8_t> sdo);
-  void upload_segment(std::uint8_t command);
-  void sdo_reply(std::span<const std::uint8_t> body);
+  void on_sdo(std::span<const std::uint8_t> body);
+  void on_sdo_information(std::span<const std::uint8_t> body);
+  void upload(const sdo_frame& f);
+  void download(const sdo_frame& f);
+  void download_segment(const sdo_frame& f);
+  void upload_segment(const sdo_frame& f);
   void abort(std::uint16_t index, std::uint8_t sub, sdo_abort code);
-  void reply(mailbox_type type, std::span<const std::uint8_t> body);
+  void reply(mailbox_type type, std::span<const std::uint8_t> data);
   void mailbox_error_reply(mailbox_error e);
+  void information_reply(sdo_info_opcode op, std::span<const std::uint8_t> data);
+  std::vector<std::uint8_t> od_list(std::uint16_t list) const;
   sdo_abort upload_complete(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t>& out);
   sdo_abort download_complete(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data);
-  std::size_t sdo_room() const noexcept { return mailbox_size_ - mailbox_header_size - coe_header_size; }
 
   canopen::object_access* access_;
   const canopen::object_dictionary* dictionary_;
@@ -114,7 +77,7 @@ class coe_server {
   std::uint16_t index_ = 0;
   std::uint8_t sub_ = 0;
   bool complete_access_ = false;
-  std::uint8_t toggle_ = 0;
+  bool toggle_ = false;
   std::size_t size_ = 0;
   std::size_t offset_ = 0;
   std::vector<std::uint8_t> buffer_;
