@@ -1,11 +1,11 @@
 // An EtherCAT CoE slave around a device (canopen/301/device.hpp): an emulated controller (esc), the
 // application behind it (the AL state machine, CoE mailboxes, process data) and the device's part of
-// the dictionary, to which it adds the communication objects of CoE's communication area (ETG.1000.6): 0x1600 /
+// the dictionary, to which it adds the objects of CoE's communication area (ETG.1000.6): 0x1600 /
 // 0x1601 RxPDO and 0x1A00 / 0x1A01 TxPDO mappings, 0x1C00 sync manager types, 0x1C12 / 0x1C13 PDO
 // assignment, and 0x1017 (producer heartbeat time: stored and acting on nothing, EtherCAT has no
-// heartbeat, so a master that writes it on every bus is not refused). It knows no device profile: the
-// SII and ESI (description()) say what the device's 0x1000, 0x1008 and 0x1018 say. A master reaches it
-// only through frames on a wire (the in-process `chain`, or a network interface).
+// heartbeat, so a master that writes it on every bus is not refused). It knows no device profile:
+// the SII and ESI (description()) say what the device's 0x1000, 0x1008 and 0x1018 say. A master
+// reaches it only through frames on a wire (the in-process `chain`, or a network interface).
 //
 // AL state machine (ETG.1000.6 §6.4): INIT -> PRE-OP needs SM0/SM1 as the SII describes them (else
 // 0x0016 invalid mailbox configuration); PRE-OP -> SAFE-OP needs every assigned PDO entry to name an
@@ -18,13 +18,14 @@
 // CiA 402 drive applies 0x6007 (S10).
 //
 // Process data: each assigned PDO entry is bound once, on the way to SAFE-OP (as SOES fills its sync
-// manager maps then), to its dictionary slot, bit offset, length and sign. Each cycle then copies bits
-// between those slots and the sync managers' buffers, with no lookup and no allocation: in SAFE-OP and
-// OP the inputs (SM3) every cycle, in OP the outputs (SM2) when a whole buffer arrived. A value the
-// outputs carry goes through the dictionary's rules as an SDO write does (dictionary_access). PDO
-// mappings and assignments are written in PRE-OP only (0x08000022 otherwise), and only with objects
-// that are PDO mappable the right way, of their own length and within the process data room; an entry
-// of 0 bits, or a count that takes in an entry left empty, is refused (0x06040041).
+// manager maps then), to its dictionary slot, bit offset, length and sign. Each cycle then copies
+// bytes between those slots and the sync managers' buffers, with no lookup and no allocation: in
+// SAFE-OP and OP the inputs (SM3) every cycle, in OP the outputs (SM2) when a whole buffer arrived. A
+// value the outputs carry goes through the dictionary's rules as an SDO write does
+// (dictionary_access). PDO mappings and assignments are written in PRE-OP only (0x08000022
+// otherwise), and only with objects that are PDO mappable the right way, of their own length and
+// within the process data room; an entry of 0 bits, or a count that takes in an entry left empty, is
+// refused (0x06040041).
 //
 // Sync managers changed under a state that checked them take the slave back (with the error flag):
 // SM0/SM1 in PRE-OP or above to INIT (0x0016), SM2/SM3 in SAFE-OP or OP to PRE-OP (0x001D / 0x001E).
