@@ -9,9 +9,8 @@
 #include <memory>
 #include <vector>
 
-#include "cia402/canopen/402/drive_objects.hpp"
 #include "cia402/canopen/301/nmt.hpp"
-#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cia402/master.hpp"
 
@@ -21,7 +20,7 @@ using namespace cia402;
 using namespace cia402::canopen;
 
 struct node {
-  std::unique_ptr<virtual_drive_node> drive;
+  std::unique_ptr<cia402::apps::virtual_drive_node> drive;
   cia402::master m;
 };
 
@@ -35,7 +34,7 @@ void bm_bus_64_drives_1ms_sync(benchmark::State& state) {
   std::vector<node> nodes(drives);
   for (std::size_t i = 0; i < drives; ++i) {
     node& n = nodes[i];
-    const slave_config c = drive_node_config(static_cast<std::uint8_t>(i + 1));
+    const slave_config c = cia402::apps::drive_node_config(static_cast<std::uint8_t>(i + 1));
     std::unique_ptr<virtual_channel> ch = bus.attach();
     // With `filtered`, the node's CAN controller takes only what concerns it (NMT, SYNC, its SDO
     // and RPDO1), as hardware acceptance filters do; without, every node sees every frame.
@@ -45,7 +44,7 @@ void bm_bus_64_drives_1ms_sync(benchmark::State& state) {
         ch->accept(id);
       }
     }
-    n.drive = std::make_unique<virtual_drive_node>(p, std::move(ch), c);
+    n.drive = std::make_unique<cia402::apps::virtual_drive_node>(p, std::move(ch), c);
     n.drive->node().write(0x1800, 2, 1);  // TPDO1 on every SYNC
     n.m.set_target(policy, 0, 0);
   }

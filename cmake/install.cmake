@@ -25,7 +25,8 @@ install(TARGETS ${cia402_exported_targets}
 # Only the headers of the exported libraries: the tools-side layers (diagram, sim, canopen,
 # ethercat, page, motion) are built for the cia402 tool and are not part of the package.
 set(cia402_header_excludes PATTERN "diagram.hpp" EXCLUDE PATTERN "sim" EXCLUDE
-    PATTERN "canopen" EXCLUDE PATTERN "ethercat" EXCLUDE PATTERN "page" EXCLUDE PATTERN "motion" EXCLUDE)
+    PATTERN "canopen" EXCLUDE PATTERN "ethercat" EXCLUDE PATTERN "page" EXCLUDE PATTERN "motion" EXCLUDE
+    PATTERN "drive402" EXCLUDE PATTERN "apps" EXCLUDE)
 if(NOT TARGET cia402_profile_file)
   list(APPEND cia402_header_excludes PATTERN "profile_file.hpp" EXCLUDE)  # no library for it
 endif()

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""The layer check fails on an upward include, on a private include and on a stale exception, and
-passes a tree that keeps the rules."""
+"""The layer check fails on an upward include, on a private include, on a fieldbus that includes the
+simulator, on a CoE codec that includes canopen, on a rule table that would allow either, and on a stale
+exception, and passes a tree that keeps the rules."""
 import os
 import subprocess
 import sys
@@ -45,6 +46,27 @@ def main():
     checks.append(("a listed breach passes", code == 0))
     code, out = run(sound, "src/sim/scenario_file.cpp -> src/core/profiles/rows.hpp  # why\n")
     checks.append(("a listed breach that is gone fails", code == 1 and "remove it" in out))
+    fieldbus = dict(sound)
+    fieldbus["include/cia402/sim/virtual_drive.hpp"] = "#pragma once\n"
+    fieldbus["src/canopen/402/drive_master.cpp"] = '#include "cia402/sim/virtual_drive.hpp"\n'
+    fieldbus["src/ethercat/slave/coe_slave.cpp"] = '#include "cia402/sim/virtual_drive.hpp"\n'
+    code, out = run(fieldbus)
+    checks.append(("canopen or ethercat including sim fails",
+                   code == 1 and "canopen/402 may not include sim" in out and "ethercat/slave may not include sim" in out))
+    codec = dict(sound)
+    codec["include/cia402/canopen/301/device.hpp"] = "#pragma once\n"
+    codec["src/ethercat/coe/sdo.cpp"] = '#include "cia402/canopen/301/device.hpp"\n'
+    code, out = run(codec)
+    checks.append(("the CoE codec including canopen/301 fails", code == 1 and "ethercat/coe may not include canopen/301" in out))
+    sys.path.insert(0, HERE)
+    import check_layers
+    widened = {layer: set(seen) for layer, seen in check_layers.ALLOWED.items()}
+    widened["canopen/402"].add("sim")
+    widened["ethercat/master"].add("ethercat/slave")
+    checks.append(("the rule table itself may not let a fieldbus see the simulator",
+                   check_layers.check_rules(check_layers.ALLOWED) == [] and
+                   ("canopen/402", "sim") in check_layers.check_rules(widened) and
+                   ("ethercat/master", "ethercat/slave") in check_layers.check_rules(widened)))
     failed = [name for name, ok in checks if not ok]
     for name, ok in checks:
         print(("ok   " if ok else "FAIL ") + name)

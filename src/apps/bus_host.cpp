@@ -53,9 +53,9 @@ void bus_host::flush_log() noexcept {
   }
 }
 
-canopen::virtual_drive_node& bus_host::add_drive(const profile& p,
+virtual_drive_node& bus_host::add_drive(const profile& p,
                                                  const canopen::slave_config& config) {
-  drives_.push_back(std::make_unique<canopen::virtual_drive_node>(p, bus_.attach(), config));
+  drives_.push_back(std::make_unique<virtual_drive_node>(p, bus_.attach(), config));
   return *drives_.back();
 }
 

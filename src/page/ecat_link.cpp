@@ -1,6 +1,7 @@
 #include <deque>
 #include <optional>
 
+#include "cia402/manufacturer_objects.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/page/ecat_drive.hpp"
 #include "cia402/words.hpp"
@@ -14,7 +15,6 @@ namespace {
 using json = nlohmann::ordered_json;
 using detail::hex;
 
-constexpr std::uint16_t fault_injection_index = 0x2001;
 // Frames lost in a row before the line counts as gone (each waits for its answer: with the 20 ms
 // of `cia402 serve` about half a second).
 constexpr int lost_cycles_limit = 25;

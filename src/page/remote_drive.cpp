@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "cia402/canopen/402/drive_master.hpp"
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/manufacturer_objects.hpp"
 #include "cia402/canopen/301/nmt.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/page/transition_inference.hpp"
@@ -789,7 +789,7 @@ reply remote_drive::change_plant(const plant_change& change) {
   // 0x2001 takes an error code only; the drive raises it with its default class.
   if (*change.fault && m.table.error_classes) action += " (class not sent: 0x2001 takes a code)";
   const auto w = m.download(
-      lock, co::fault_injection_index, code, 2, [&m, code] { m.injected_fault = code; }, action);
+      lock, fault_injection_index, code, 2, [&m, code] { m.injected_fault = code; }, action);
   return m.download_reply(w, action);
 }
 

@@ -10,7 +10,7 @@
 
 #include "cia402/apps/bus_host.hpp"
 #include "cia402/apps/elapsed_clock.hpp"
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/candump_log.hpp"
 
 namespace cia402::canopen {
@@ -125,7 +125,7 @@ TEST_F(bus_log_test, the_log_holds_every_frame_the_bus_carried_in_order_with_the
   auto client = host.bus().attach();
   ASSERT_FALSE(host.log_frames(path, "can0"));
   const std::uint64_t before = apps::unix_time_us();
-  host.add_drive(standard_profile(), drive_node_config(3));
+  host.add_drive(standard_profile(), apps::drive_node_config(3));
   (void)host.cycle(1000);  // boot-up
   ASSERT_FALSE(client->send(make_frame(0x603, {0x40, 0x41, 0x60, 0, 0, 0, 0, 0})));
   ASSERT_FALSE(client->send(make_frame(0x000, {0x01, 0x03})));

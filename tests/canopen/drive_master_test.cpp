@@ -7,9 +7,9 @@
 #include <memory>
 #include <vector>
 
-#include "cia402/canopen/402/drive_objects.hpp"
 #include "cia402/canopen/402/drive_master.hpp"
-#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
+#include "cia402/manufacturer_objects.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cia402/words.hpp"
 
@@ -29,7 +29,7 @@ class bench {
   }
   void add_drive(std::uint8_t id) {
     drives_.push_back(
-        std::make_unique<virtual_drive_node>(standard_profile(), bus_.attach(), drive_node_config(id)));
+        std::make_unique<apps::virtual_drive_node>(standard_profile(), bus_.attach(), apps::drive_node_config(id)));
   }
   /// `ms` milliseconds in steps of 1 ms; the master stays silent with `master_alive` false.
   void run_ms(int ms, bool master_alive = true) {
@@ -77,7 +77,7 @@ class bench {
 
  private:
   virtual_bus bus_;
-  std::vector<std::unique_ptr<virtual_drive_node>> drives_;
+  std::vector<std::unique_ptr<apps::virtual_drive_node>> drives_;
   std::unique_ptr<virtual_channel> master_ch_;
   std::unique_ptr<virtual_channel> sniffer_;
   std::unique_ptr<drive_master> master_;
@@ -140,12 +140,12 @@ TEST(drive_master, disable_from_operation_enabled_reaches_switch_on_disabled) {
 
 TEST(drive_master, two_drives_on_one_bus_each_follow_their_own_master) {
   virtual_bus bus;
-  std::vector<std::unique_ptr<virtual_drive_node>> nodes;
+  std::vector<std::unique_ptr<apps::virtual_drive_node>> nodes;
   std::vector<std::unique_ptr<virtual_channel>> chs;
   std::vector<std::unique_ptr<drive_master>> masters;
   for (std::uint8_t id : {1, 2}) {
     nodes.push_back(
-        std::make_unique<virtual_drive_node>(standard_profile(), bus.attach(), drive_node_config(id)));
+        std::make_unique<apps::virtual_drive_node>(standard_profile(), bus.attach(), apps::drive_node_config(id)));
     chs.push_back(bus.attach());
     drive_master_config c;
     c.node_id = id;

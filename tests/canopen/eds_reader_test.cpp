@@ -9,8 +9,8 @@
 
 #include "cia402/canopen/306/eds.hpp"
 #include "cia402/canopen/306/eds_reader.hpp"
-#include "cia402/canopen/402/drive_objects.hpp"
-#include "cia402/canopen/402/sim_device.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
+#include "cia402/drive402/sim_device.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 
 namespace cia402::canopen {
@@ -19,8 +19,8 @@ namespace {
 std::string drive_eds(std::uint8_t node_id = 0) {
   virtual_bus bus;
   auto ch = bus.attach();
-  sim_device dev(standard_profile());
-  slave node(dev, *ch, drive_node_config(1));
+  drive402::sim_device dev(standard_profile());
+  slave node(dev, *ch, apps::drive_node_config(1));
   eds_info info;
   info.node_id = node_id;
   std::ostringstream out;
@@ -48,7 +48,7 @@ TEST(eds_reader, the_drives_eds_reads_back_as_the_table_it_was_written_from) {
   const eds_contents eds = read_ok(drive_eds());
   EXPECT_EQ(eds.node_id, 0);
   std::size_t compared = 0;
-  for (const object_entry& o : drive_objects()) {
+  for (const object_entry& o : node_objects(apps::drive_node_config(1))) {
     const object_entry* r = find(eds.objects, o.index);
     if (r == nullptr) continue;  // an object the device lacks is not in the EDS
     ++compared;

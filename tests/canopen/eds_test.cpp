@@ -9,10 +9,11 @@
 
 #include <algorithm>
 
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/306/eds.hpp"
 #include "cia402/objects.hpp"
-#include "cia402/canopen/402/sim_device.hpp"
+#include "cia402/drive402/drive_objects.hpp"
+#include "cia402/drive402/sim_device.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 
 namespace cia402::canopen {
@@ -43,8 +44,8 @@ ini parse_ini(const std::string& text) {
 std::string eds_of(const profile& p) {
   virtual_bus bus;
   auto ch = bus.attach();
-  sim_device dev(p);
-  slave node(dev, *ch, drive_node_config(1));
+  drive402::sim_device dev(p);
+  slave node(dev, *ch, apps::drive_node_config(1));
   std::ostringstream out;
   write_eds(node, eds_info{}, out);
   return out.str();
@@ -151,7 +152,7 @@ namespace {
 // The CANopen dictionary takes the drive profile's objects from the one table: same type, access,
 // PDO mapping and limits, and their values are the device's.
 TEST(eds, the_dictionary_holds_every_object_of_the_one_table_as_it_describes_it) {
-  const std::vector<cia402::canopen::object_entry> od = cia402::canopen::drive_objects();
+  const std::vector<cia402::canopen::object_entry> od = cia402::drive402::drive_objects();
   for (std::size_t i = 0; i < cia402::drive_object_count(); ++i) {
     const cia402::object_description& d = cia402::drive_object(i);
     SCOPED_TRACE(d.name);

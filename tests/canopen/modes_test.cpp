@@ -12,8 +12,7 @@
 #include <vector>
 
 #include "cia402/canopen/402/drive_master.hpp"
-#include "cia402/canopen/402/drive_objects.hpp"
-#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 #include "network.hpp"
 
@@ -31,7 +30,7 @@ constexpr std::uint16_t bit10 = 1u << 10, bit12 = 1u << 12, bit13 = 1u << 13;
 class modes_test : public ::testing::Test {
  protected:
   void SetUp() override {
-    node_ = std::make_unique<virtual_drive_node>(standard_profile(), bus_.attach(), drive_node_config(id));
+    node_ = std::make_unique<apps::virtual_drive_node>(standard_profile(), bus_.attach(), apps::drive_node_config(id));
     tester_ = bus_.attach();
     run_ms(10);  // power-up
     send(nmt_frame(nmt_command::start, id));
@@ -121,7 +120,7 @@ class modes_test : public ::testing::Test {
   }
 
   virtual_bus bus_;
-  std::unique_ptr<virtual_drive_node> node_;
+  std::unique_ptr<apps::virtual_drive_node> node_;
   std::unique_ptr<virtual_channel> tester_;
   std::vector<frame> received;
   std::vector<std::uint16_t> status_words;
@@ -241,7 +240,7 @@ TEST_F(modes_test, objects_with_sub_indices_go_through_sdo_to_the_drive) {
 // from TPDO3.
 TEST(modes_master, map_position_streams_rpdo3_and_reads_tpdo3) {
   virtual_bus bus;
-  virtual_drive_node drive(standard_profile(), bus.attach(), drive_node_config(id));
+  apps::virtual_drive_node drive(standard_profile(), bus.attach(), apps::drive_node_config(id));
   auto ch = bus.attach();
   drive_master_config mc;
   mc.cycle_us = 1000;

@@ -127,7 +127,7 @@ TEST(monitor, aborts_from_either_side_carry_their_code_and_text) {
 class monitor_on_a_node : public ::testing::Test {
  protected:
   void SetUp() override {
-    dec.describe_other_nodes(drive_objects());  // names; its PDO maps are replaced where a test says
+    dec.describe_other_nodes(node_objects(apps::drive_node_config(0)));  // names; its PDO maps are replaced where a test says
     witness = net.bus().attach();
     net.add(id);
     net.settle();
@@ -261,7 +261,7 @@ TEST_F(monitor_on_a_node, a_tpdo_decodes_by_the_mapping_learnt_from_the_sdo_traf
 }
 
 TEST_F(monitor_on_a_node, a_described_node_decodes_its_predefined_pdos_and_a_reset_restores_them) {
-  dec.describe_other_nodes(drive_objects());
+  dec.describe_other_nodes(node_objects(apps::drive_node_config(0)));
   const decoded_frame d = dec.decode(make_frame(0x480 + id, {0x37, 0x06, 0x88, 0xFF, 0xFF, 0xFF}), 0);
   EXPECT_EQ(d.kind, frame_kind::pdo);
   EXPECT_EQ(d.text, "TPDO4 0x6041:0 = 0x0637 (Statusword: OPERATION_ENABLED), "
@@ -301,7 +301,7 @@ TEST(monitor, a_node_described_by_its_eds_decodes_by_the_files_mapping) {
 
 TEST(monitor, frames_that_are_not_what_their_cob_id_says_decode_as_unknown_with_the_reason) {
   decoder dec;
-  dec.describe_other_nodes(drive_objects());
+  dec.describe_other_nodes(node_objects(apps::drive_node_config(0)));
   frame rtr_sdo = make_frame(0x601, {});
   rtr_sdo.rtr = true;
   frame extended = make_frame(0x181, {1, 2});
@@ -350,7 +350,7 @@ TEST(monitor, segments_with_no_transfer_open_and_toggle_errors_are_named_not_tru
 
 TEST(monitor, random_frames_never_crash_the_decoder_and_always_say_something) {
   decoder dec;
-  dec.describe_other_nodes(drive_objects());
+  dec.describe_other_nodes(node_objects(apps::drive_node_config(0)));
   std::mt19937 random(402);
   // Most frames where the services are (SDO, PDO, EMCY, heartbeat), some anywhere, a few malformed.
   const std::uint32_t bases[] = {0x000, 0x080, 0x100, 0x180, 0x200, 0x280, 0x300, 0x380, 0x400,

@@ -9,7 +9,7 @@
 #include <memory>
 #include <vector>
 
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/301/nmt.hpp"
 #include "cia402/canopen/301/slave.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
@@ -33,11 +33,7 @@ class network {
     node n;
     n.dev = dev ? std::move(dev) : std::make_unique<test_device>();
     n.ch = bus_.attach();
-    slave_config c;
-    c.objects = drive_objects();
-    c.node_id = id;
-    c.heartbeat_ms = heartbeat_ms;
-    c.sdo_timeout_us = sdo_timeout_us;
+    const slave_config c = apps::drive_node_config(id, sdo_timeout_us, heartbeat_ms);
     n.sl = std::make_unique<slave>(*n.dev, *n.ch, c);
     nodes_.push_back(std::move(n));
     return *nodes_.back().sl;

@@ -359,9 +359,7 @@ class array_device final : public device {
 class pdo_sub_index_test : public ::testing::Test {
  protected:
   void SetUp() override {
-    slave_config c;
-    c.node_id = id;
-    c.objects = drive_objects();
+    slave_config c = apps::drive_node_config(id);
     object_entry pair;
     pair.index = array_device::index;
     pair.name = "Pair";
@@ -378,6 +376,11 @@ class pdo_sub_index_test : public ::testing::Test {
       e.acc = access::rw;
       e.pdo_mappable = true;
       e.where = backing::device;
+      if (sub == 1) {  // a limit of the dictionary's own: the device takes any value
+        e.has_limits = true;
+        e.low = -20000;
+        e.high = 20000;
+      }
       pair.subs.push_back(e);
     }
     c.objects.push_back(pair);
@@ -449,6 +452,25 @@ TEST_F(pdo_sub_index_test, a_mapped_sub_index_is_sampled_and_written_with_its_su
   settle();
   EXPECT_EQ(dev.values[0], 12345);
   EXPECT_EQ(dev.values[1], -123456) << "sub 2 untouched";
+}
+
+// A PDO writes through the slot its mapping was bound to with the rules of an SDO write: a value
+// beyond the entry's limits is dropped (a PDO has no answer to carry the abort code).
+TEST_F(pdo_sub_index_test, an_rpdo_value_beyond_the_dictionarys_limit_is_dropped_as_an_sdo_write_is_refused) {
+  ASSERT_EQ(write(0x1403, 1, 0x80000503, 4), 0u);
+  ASSERT_EQ(write(0x1603, 0, 0, 1), 0u);
+  ASSERT_EQ(write(0x1603, 1, 0x21000120, 4), 0u);
+  ASSERT_EQ(write(0x1603, 0, 1, 1), 0u);
+  ASSERT_EQ(write(0x1403, 1, 0x503, 4), 0u);
+  EXPECT_FALSE(tester->send(nmt_frame(nmt_command::start, id)));
+  settle();
+  EXPECT_FALSE(tester->send(make_frame(0x503, {0x10, 0x27, 0x00, 0x00})));  // 10000
+  settle();
+  EXPECT_EQ(dev.values[0], 10000);
+  EXPECT_FALSE(tester->send(make_frame(0x503, {0x30, 0x75, 0x00, 0x00})));  // 30000
+  settle();
+  EXPECT_EQ(dev.values[0], 10000) << "above the entry's limit";
+  EXPECT_EQ(write(0x2100, 1, 30000, 4), 0x06090031u) << "as an SDO write is refused";
 }
 
 }  // namespace

@@ -13,9 +13,8 @@
 #include <vector>
 
 #include "cia402/apps/bus_host.hpp"
-#include "cia402/canopen/402/drive_objects.hpp"
 #include "cia402/canopen/402/drive_master.hpp"
-#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/socketcand.hpp"
 
 namespace cia402::canopen {
@@ -131,7 +130,7 @@ class socketcand_server_test : public ::testing::Test {
     ASSERT_NE(srv->port(), 0);
   }
   void add_drive(std::uint8_t id) {
-    host.add_drive(standard_profile(), drive_node_config(id));
+    host.add_drive(standard_profile(), apps::drive_node_config(id));
   }
   /// One cycle of the server loop: sockets, time, nodes, output.
   void spin(int cycles = 1, std::uint32_t us = 1000) {
@@ -157,7 +156,7 @@ class socketcand_server_test : public ::testing::Test {
   }
 
   apps::bus_host host{socketcand::server_config{}};
-  std::vector<std::unique_ptr<virtual_drive_node>>& drives = host.drives();
+  std::vector<std::unique_ptr<apps::virtual_drive_node>>& drives = host.drives();
   socketcand::server* srv = nullptr;
 };
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "cia402/canopen/301/dictionary_access.hpp"
-#include "cia402/ethercat/coe/mailbox.hpp"
+#include "cia402/ethercat/slave/coe_server.hpp"
 
 namespace cia402::ethercat {
 namespace {
@@ -158,6 +158,21 @@ TEST_F(fixture, refusals_answer_with_the_dictionary_abort_codes_and_change_nothi
   EXPECT_FALSE(coe.has_reply()) << "an abort from the master is not answered";
   coe.on_mailbox(sdo(0xE0, 0x6040, 0));
   EXPECT_EQ(abort_code(next()), 0x05040001u) << "no such command specifier";
+}
+
+// ETG.1000.6 §5.6.2.7 codes "Abort SDO Transfer" as an SDO *request* (CoE service 2) in either
+// direction; SOEM and IgH look for an abort under service 2 and misread one sent as a response (3).
+TEST_F(fixture, a_refused_sdo_is_an_abort_transfer_request_of_coe_service_2) {
+  coe.on_mailbox(sdo(0x40, 0x6042, 0));
+  ASSERT_TRUE(coe.has_reply());
+  const std::vector<std::uint8_t> m = coe.take_reply();
+  EXPECT_EQ(m[7] >> 4, 2) << "CoE service: SDO request";
+  EXPECT_EQ(m[8], 0x80) << "abort transfer";
+  EXPECT_EQ(m[9] | (m[10] << 8), 0x6042);
+  EXPECT_EQ(m[12] | (m[13] << 8) | (m[14] << 16) | (m[15] << 24), 0x06020000);
+  // A segment out of turn too.
+  coe.on_mailbox(sdo(0x60, 0, 0));
+  EXPECT_EQ(coe.take_reply()[7] >> 4, 2);
 }
 
 TEST_F(fixture, a_long_value_uploads_in_segments) {

@@ -1,11 +1,12 @@
 // The virtual drive's CoE dictionary and what its SII says: the CiA 402 objects of the one table,
-// the CANopen identity, no CAN-only communication object, and default PDOs a csp master can run.
+// the CANopen identity, CoE's own communication objects and none of CAN's, and default PDOs a csp
+// master can run.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <string>
 
-#include "cia402/ethercat/402/drive_description.hpp"
+#include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/objects.hpp"
 
 namespace cia402::ethercat {
@@ -17,21 +18,22 @@ const canopen::object_entry* find(const std::vector<canopen::object_entry>& t, s
 }
 
 TEST(coe_dictionary, holds_every_drive_object_and_no_can_only_object) {
-  const auto t = coe_drive_objects();
+  const auto t = coe_objects(apps::drive_slave_config());
   for (std::size_t i = 0; i < drive_object_count(); ++i) {
     EXPECT_NE(find(t, drive_object(i).index), nullptr) << std::hex << drive_object(i).index;
   }
-  for (std::uint16_t can_only : {0x1005, 0x1014, 0x1016, 0x1017, 0x1200, 0x1400, 0x1800}) {
+  for (std::uint16_t can_only : {0x1005, 0x1014, 0x1016, 0x1200, 0x1400, 0x1800}) {
     EXPECT_EQ(find(t, can_only), nullptr) << std::hex << can_only;
   }
-  for (std::uint16_t coe : {0x1000, 0x1018, 0x1600, 0x1A00, 0x1C00, 0x1C12, 0x1C13}) {
+  // 0x1017 is CoE's too: stored, acting on nothing (a master sets it on every bus).
+  for (std::uint16_t coe : {0x1000, 0x1017, 0x1018, 0x1600, 0x1A00, 0x1C00, 0x1C12, 0x1C13}) {
     EXPECT_NE(find(t, coe), nullptr) << std::hex << coe;
   }
   EXPECT_TRUE(std::is_sorted(t.begin(), t.end(), [](const auto& a, const auto& b) { return a.index < b.index; }));
 }
 
 TEST(coe_dictionary, default_pdos_carry_a_csp_masters_objects) {
-  const slave_description d = drive_slave_description(coe_drive_objects(), 3);
+  const slave_description d = coe_slave_description(apps::drive_slave_config(3));
   ASSERT_EQ(d.rx_pdos.size(), 1u);
   ASSERT_EQ(d.tx_pdos.size(), 1u);
   const auto has = [](const pdo_description& p, std::uint16_t index) {

@@ -6,11 +6,13 @@
 #include <cstdint>
 #include <vector>
 
-#include "cia402/ethercat/402/drive_description.hpp"
-#include "cia402/ethercat/402/drive_slave.hpp"
+#include "cia402/apps/virtual_drive_slave.hpp"
+#include "cia402/ethercat/coe/mailbox.hpp"
 
 namespace cia402::ethercat {
 namespace {
+
+using drive_slave = apps::virtual_drive_slave;
 
 constexpr std::array<std::uint8_t, 6> broadcast{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
 constexpr std::array<std::uint8_t, 6> master_mac{0x02, 0, 0, 0, 0, 1};

@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "cia402/ethercat/402/drive_slave.hpp"
+#include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/esc/esc.hpp"
 #include "cia402/ethercat/esc/frame.hpp"
 #include "cia402/ethercat/master/ecat_master.hpp"
@@ -21,6 +21,8 @@
 #include "cia402/profile.hpp"
 
 namespace cia402::ethercat::testing {
+
+using drive_slave = apps::virtual_drive_slave;
 
 class hostile_line final : public master_link {
  public:

@@ -9,14 +9,15 @@
 #include <tuple>
 #include <vector>
 
-#include "cia402/ethercat/402/drive_description.hpp"
-#include "cia402/ethercat/402/drive_slave.hpp"
+#include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/master/ecat_master.hpp"
 #include "cia402/master.hpp"
 #include "cia402/profile.hpp"
 
 namespace cia402::ethercat {
 namespace {
+
+using drive_slave = apps::virtual_drive_slave;
 
 // The line: frames pass every controller in order at once; waiting runs the drives' applications.
 class wire_link final : public master_link {

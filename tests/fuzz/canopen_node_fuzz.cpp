@@ -5,8 +5,7 @@
 #include <cstdlib>
 #include <memory>
 
-#include "cia402/canopen/402/drive_objects.hpp"
-#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/301/nmt.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cia402/profile.hpp"
@@ -15,7 +14,7 @@ using namespace cia402::canopen;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   virtual_bus bus;
-  virtual_drive_node node(cia402::standard_profile(), bus.attach(), drive_node_config(5));
+  cia402::apps::virtual_drive_node node(cia402::standard_profile(), bus.attach(), cia402::apps::drive_node_config(5));
   auto master = bus.attach();
   node.poll(1000);
   // Each frame: 2 bytes id (11 bits), 1 byte length (0..8), the data, 1 byte of time to pass.

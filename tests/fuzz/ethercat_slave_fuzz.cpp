@@ -1,5 +1,6 @@
 // EtherCAT frames, CoE mailboxes, sync manager settings, mapping objects and state requests into a
-// virtual drive slave (ethercat/402) on the in-process wire. The input is a sequence of chunks, each
+// virtual drive slave (apps/virtual_drive_slave.hpp: the CoE slave of ethercat/slave around the drive)
+// on the in-process wire. The input is a sequence of chunks, each
 // a length byte, a kind byte and that many bytes: a raw frame; a mailbox the fuzzer's bytes fill
 // (written into SM0 with a sound frame, so the CoE server sees them); a sync manager's 8 bytes; an
 // SDO download of any value into a PDO mapping or assignment object; a sound bring-up to INIT,
@@ -14,12 +15,13 @@
 #include <cstdlib>
 #include <vector>
 
-#include "cia402/ethercat/402/drive_description.hpp"
-#include "cia402/ethercat/402/drive_slave.hpp"
+#include "cia402/apps/virtual_drive_slave.hpp"
+#include "cia402/ethercat/coe/mailbox.hpp"
 
 namespace {
 
 using namespace cia402::ethercat;
+using drive_slave = cia402::apps::virtual_drive_slave;
 
 constexpr std::array<std::uint8_t, 6> broadcast{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
 constexpr std::array<std::uint8_t, 6> master_mac{2, 0, 0, 0, 0, 1};

@@ -12,7 +12,7 @@
 #include <memory>
 #include <vector>
 
-#include "cia402/ethercat/402/drive_slave.hpp"
+#include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/page/ecat_drive.hpp"
 #include "cia402/profile.hpp"
 
@@ -30,7 +30,7 @@ class wire final : public ethercat::master_link {
  public:
   wire() {
     for (std::uint32_t i = 0; i < 2; ++i) {
-      slaves.push_back(std::make_unique<ethercat::drive_slave>(standard_profile(), i + 1));
+      slaves.push_back(std::make_unique<apps::virtual_drive_slave>(standard_profile(), i + 1));
       line.add(slaves.back()->controller());
     }
   }
@@ -43,7 +43,7 @@ class wire final : public ethercat::master_link {
     now += us;
     for (auto& s : slaves) s->step(us);
   }
-  std::vector<std::unique_ptr<ethercat::drive_slave>> slaves;
+  std::vector<std::unique_ptr<apps::virtual_drive_slave>> slaves;
   ethercat::chain line;
   std::uint64_t now = 0;
   bool cut = false;

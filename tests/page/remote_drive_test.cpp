@@ -13,8 +13,7 @@
 #include <memory>
 #include <thread>
 
-#include "cia402/canopen/402/drive_objects.hpp"
-#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cia402/page/remote_drive.hpp"
 #include "cia402/profile.hpp"
@@ -22,6 +21,7 @@
 namespace {
 
 namespace co = cia402::canopen;
+namespace apps = cia402::apps;
 using cia402::page::accepted;
 using cia402::page::page_command;
 using cia402::page::plant_change;
@@ -47,7 +47,7 @@ class remote_bench {
  public:
   explicit remote_bench(remote_config config = test_config(),
                         const cia402::profile& p = cia402::standard_profile())
-      : node_(std::make_unique<co::virtual_drive_node>(p, bus_.attach(), co::drive_node_config(1))) {
+      : node_(std::make_unique<apps::virtual_drive_node>(p, bus_.attach(), apps::drive_node_config(1))) {
     for (int i = 0; i < 10; ++i) node_->poll(1000);  // power-up: T0, T1
     page_ch_ = bus_.attach();
     remote_ = std::make_unique<remote_drive>(p, *page_ch_, config);
@@ -100,7 +100,7 @@ class remote_bench {
       while (page_ch_->receive(f)) {}
     }
   }
-  co::virtual_drive_node& drive_node() { return *node_; }
+  apps::virtual_drive_node& drive_node() { return *node_; }
   co::virtual_bus& bus() { return bus_; }
   void revive() { alive_ = true; }
 
@@ -114,7 +114,7 @@ class remote_bench {
 
  private:
   co::virtual_bus bus_;
-  std::unique_ptr<co::virtual_drive_node> node_;
+  std::unique_ptr<apps::virtual_drive_node> node_;
   std::unique_ptr<co::virtual_channel> page_ch_;
   std::unique_ptr<remote_drive> remote_;
   bool alive_ = true;

@@ -7,7 +7,7 @@
 #include <ostream>
 
 #include "cia402/apps/bus_host.hpp"
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/socketcand.hpp"
 #include "cia402/page/server.hpp"
 #include "cli/common.hpp"
@@ -124,7 +124,7 @@ int run_bus(const bus_args& args, std::ostream& out, std::ostream& err) {
     }
   }
   for (std::uint8_t id : ids) {
-    canopen::slave_config sc = canopen::drive_node_config(id);
+    canopen::slave_config sc = apps::drive_node_config(id);
     sc.heartbeat_ms = args.heartbeat_ms;
     host.add_drive(choice.get(), sc);
   }

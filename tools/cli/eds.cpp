@@ -6,9 +6,9 @@
 #include <fstream>
 #include <ostream>
 
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/306/eds.hpp"
-#include "cia402/canopen/402/sim_device.hpp"
+#include "cia402/drive402/sim_device.hpp"
 #include "cia402/canopen/301/slave.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cli/common.hpp"
@@ -32,8 +32,8 @@ int run_eds(const eds_args& args, std::ostream& out, std::ostream& err) {
   if (!choice.resolve(args.profile, args.profile_file, err)) return 2;
   canopen::virtual_bus bus;
   auto ch = bus.attach();
-  canopen::sim_device dev(choice.get());
-  canopen::slave node(dev, *ch, canopen::drive_node_config(static_cast<std::uint8_t>(args.node)));
+  drive402::sim_device dev(choice.get());
+  canopen::slave node(dev, *ch, apps::drive_node_config(static_cast<std::uint8_t>(args.node)));
 
   canopen::eds_info info;
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());

@@ -4,7 +4,7 @@
 #include <fstream>
 #include <ostream>
 
-#include "cia402/ethercat/402/drive_description.hpp"
+#include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/sii/slave_information.hpp"
 
 namespace cia402::cli {
@@ -18,7 +18,7 @@ CLI::App* add_esi_subcommand(CLI::App& app, esi_args& args) {
 
 int run_esi(const esi_args& args, std::ostream& out, std::ostream& err) {
   const std::string xml =
-      ethercat::esi_xml(ethercat::drive_slave_description(ethercat::coe_drive_objects()));
+      ethercat::esi_xml(ethercat::coe_slave_description(apps::drive_slave_config()));
   if (args.output.empty()) {
     out << xml;
     return 0;

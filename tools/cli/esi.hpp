@@ -1,5 +1,5 @@
 // `cia402 esi`: the ETG.2000 ESI file of the virtual drive as an EtherCAT CoE slave, from the same
-// description its SII EEPROM image is built from (ethercat/402), like `cia402 eds` for CANopen.
+// description its SII EEPROM image is built from (apps/virtual_drive_slave.hpp), like `cia402 eds` for CANopen.
 #pragma once
 
 #include <iosfwd>

@@ -12,7 +12,7 @@
 #include "cia402/apps/elapsed_clock.hpp"
 #include "cia402/apps/ethercat_link.hpp"
 #include "cia402/canopen/306/eds_reader.hpp"
-#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/axis/can_link.hpp"
 #include "cia402/canopen/transport/channel_url.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
@@ -45,6 +45,7 @@ class can_bus final : public master_bus {
     c.master_heartbeat_ms = a.guard_ms;
     c.drive_profile = &p;
     c.map_position = streaming;
+    c.known_objects = canopen::node_objects(apps::drive_node_config(static_cast<std::uint8_t>(a.node)));
     if (!a.eds.empty() && !read_eds_file(a.eds, c, out)) {
       status = usage_error;
       return false;
@@ -54,8 +55,8 @@ class can_bus final : public master_bus {
     virtual_step_us_ = std::clamp<std::uint32_t>(c.cycle_us, 1, 1000);
     if (url.type == canopen::channel_url::kind::virtual_bus) {
       virtual_ = true;
-      drive_ = std::make_unique<canopen::virtual_drive_node>(p, bus_.attach(),
-                                                            canopen::drive_node_config(static_cast<std::uint8_t>(a.node)));
+      drive_ = std::make_unique<apps::virtual_drive_node>(p, bus_.attach(),
+                                                         apps::drive_node_config(static_cast<std::uint8_t>(a.node)));
       master_ch_ = bus_.attach();
       channel_ = master_ch_.get();
       for (int i = 0; i < 10; ++i) drive_->poll(1000);  // past power-up (T0, T1)
@@ -143,7 +144,7 @@ class can_bus final : public master_bus {
   bool precise_ = false;
   std::uint32_t virtual_step_us_ = 1000;
   canopen::virtual_bus bus_;
-  std::unique_ptr<canopen::virtual_drive_node> drive_;
+  std::unique_ptr<apps::virtual_drive_node> drive_;
   std::unique_ptr<canopen::virtual_channel> master_ch_;
   std::unique_ptr<canopen::channel> real_;
   canopen::channel* channel_ = nullptr;

@@ -14,7 +14,7 @@
 
 #include "cia402/apps/elapsed_clock.hpp"
 #include "cia402/canopen/306/eds_reader.hpp"
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/monitor/decoder.hpp"
 #include "cia402/canopen/transport/candump_log.hpp"
 #include "cia402/canopen/transport/channel_url.hpp"
@@ -247,7 +247,7 @@ int run_monitor(const monitor_args& args, std::istream& in, std::ostream& out, s
     return usage_error;
   }
   canopen::monitor::decoder dec;
-  if (!args.no_drive_defaults) dec.describe_other_nodes(canopen::drive_objects());
+  if (!args.no_drive_defaults) dec.describe_other_nodes(canopen::node_objects(apps::drive_node_config(0)));
   if (!describe_nodes(args, dec, err)) return usage_error;
   printer p(args, out);
   const int status = args.log.empty() ? watch_bus(args, dec, p, err) : decode_log(args, in, dec, p, err);

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "cia402/canopen/301/slave.hpp"
-#include "cia402/canopen/402/virtual_drive_node.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/socketcand.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cia402/profile.hpp"
@@ -31,7 +31,7 @@ class bus_host {
   bus_host& operator=(const bus_host&) = delete;
 
   /// A virtual drive as a node of the bus. The profile must outlive the host.
-  canopen::virtual_drive_node& add_drive(const profile& p, const canopen::slave_config& config);
+  virtual_drive_node& add_drive(const profile& p, const canopen::slave_config& config);
   /// Binds and listens: the socket error (e.g. address in use) if that fails.
   std::error_code open() { return server_->open(); }
   /// From now on writes every frame the bus carries to `path` (created, or emptied) in candump's log
@@ -55,7 +55,7 @@ class bus_host {
 
   canopen::socketcand::server& server() noexcept { return *server_; }
   canopen::virtual_bus& bus() noexcept { return bus_; }
-  std::vector<std::unique_ptr<canopen::virtual_drive_node>>& drives() noexcept { return drives_; }
+  std::vector<std::unique_ptr<virtual_drive_node>>& drives() noexcept { return drives_; }
 
  private:
   std::uint32_t advance(std::uint32_t elapsed_us);
@@ -67,7 +67,7 @@ class bus_host {
   };
 
   canopen::virtual_bus bus_;
-  std::vector<std::unique_ptr<canopen::virtual_drive_node>> drives_;
+  std::vector<std::unique_ptr<virtual_drive_node>> drives_;
   std::unique_ptr<canopen::socketcand::server> server_;
   std::unique_ptr<std::FILE, file_closer> log_;
   std::string log_interface_;

@@ -12,7 +12,7 @@
 #include <system_error>
 #include <vector>
 
-#include "cia402/ethercat/402/drive_slave.hpp"
+#include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/esc/esc.hpp"
 #include "cia402/profile.hpp"
 
@@ -38,12 +38,12 @@ class ethercat_host {
   /// One application cycle of every drive.
   void cycle(std::uint32_t elapsed_us);
 
-  std::vector<std::unique_ptr<ethercat::drive_slave>>& drives() noexcept { return drives_; }
+  std::vector<std::unique_ptr<virtual_drive_slave>>& drives() noexcept { return drives_; }
   std::uint64_t frames_answered() const noexcept { return wire_.frames(); }
   std::uint64_t frames_refused() const noexcept { return wire_.refused_frames(); }
 
  private:
-  std::vector<std::unique_ptr<ethercat::drive_slave>> drives_;
+  std::vector<std::unique_ptr<virtual_drive_slave>> drives_;
   ethercat::chain wire_;
   std::uint32_t cycle_us_;
   int fd_ = -1;

@@ -8,23 +8,31 @@ sdo_abort dictionary_access::read(std::uint16_t index, std::uint8_t sub, std::in
   sdo_abort a = sdo_abort::none;
   const object_dictionary::slot* s = od_->find(index, sub, a);
   if (s == nullptr) return a;
-  if (!readable(s->entry->acc)) return sdo_abort::write_only_object;
-  if (s->entry->type == data_type::visible_string) return sdo_abort::unsupported_access;
-  return read_value(*s, value);
+  return read(*s, value);
 }
 
 sdo_abort dictionary_access::write(std::uint16_t index, std::uint8_t sub, std::int64_t value) {
   sdo_abort a = sdo_abort::none;
   object_dictionary::slot* s = od_->find(index, sub, a);
   if (s == nullptr) return a;
-  const sub_entry& e = *s->entry;
+  return write(*s, value);
+}
+
+sdo_abort dictionary_access::read(const object_dictionary::slot& s, std::int64_t& value) {
+  if (!readable(s.entry->acc)) return sdo_abort::write_only_object;
+  if (s.entry->type == data_type::visible_string) return sdo_abort::unsupported_access;
+  return read_value(s, value);
+}
+
+sdo_abort dictionary_access::write(object_dictionary::slot& s, std::int64_t value) {
+  const sub_entry& e = *s.entry;
   if (!writable(e.acc)) return sdo_abort::read_only_object;
   if (e.type == data_type::visible_string) return sdo_abort::unsupported_access;
   if (value < type_min(e.type)) return sdo_abort::value_too_low;
   if (value > type_max(e.type)) return sdo_abort::value_too_high;
   if (e.has_limits && value < e.low) return sdo_abort::value_too_low;
   if (e.has_limits && value > e.high) return sdo_abort::value_too_high;
-  return write_value(*s, value);
+  return write_value(s, value);
 }
 
 sdo_abort dictionary_access::check_download(std::uint16_t index, std::uint8_t sub, std::size_t size,

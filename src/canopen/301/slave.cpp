@@ -6,14 +6,6 @@
 namespace cia402::canopen {
 namespace {
 
-std::vector<object_entry> table_for(const slave_config& c) {
-  std::vector<object_entry> t = c.objects;
-  for (object_entry& o : t) {
-    if (o.index == 0x1017) o.subs[0].default_value = c.heartbeat_ms;
-  }
-  return t;
-}
-
 bool is_pdo_parameter(std::uint16_t index) noexcept {
   const std::uint16_t base = index & 0xFFFC;
   return base == 0x1400 || base == 0x1600 || base == 0x1800 || base == 0x1A00;
@@ -26,7 +18,7 @@ slave::slave(device& d, channel& out, const slave_config& config)
       device_(&d),
       out_(&out),
       config_(config),
-      od_(table_for(config), config.node_id),
+      od_(node_objects(config), config.node_id),
       sdo_(*this, out, config.node_id, config.sdo_timeout_us) {
   device_->attach(this);
   consumer_.on_change = [this](std::uint8_t, bool) {

@@ -40,8 +40,9 @@ void slave::apply_rpdo(rpdo_state& r, const std::uint8_t* data) {
     const mapped_object& m = r.cfg.map[i];
     const std::int64_t v = decode_value(m.type, std::span<const std::uint8_t>(data + offset, m.bytes));
     offset += m.bytes;
-    // A value the object refuses is dropped: a PDO has no answer to carry an abort code.
-    (void)write(m.index, m.sub, v);
+    // The slot bound when the mapping was configured, with the rules of an SDO write. A value the
+    // object refuses is dropped: a PDO has no answer to carry an abort code.
+    (void)write(*m.slot, v);
   }
 }
 
@@ -51,7 +52,7 @@ bool slave::sample(const tpdo_state& t, std::array<std::uint8_t, 8>& out) {
   for (std::uint8_t i = 0; i < t.cfg.count; ++i) {
     const mapped_object& m = t.cfg.map[i];
     std::int64_t v = 0;
-    if (read(m.index, m.sub, v) != sdo_abort::none) return false;
+    if (read(*m.slot, v) != sdo_abort::none) return false;
     put_le(out.data() + offset, static_cast<std::uint64_t>(v), m.bytes);
     offset += m.bytes;
   }
@@ -100,7 +101,7 @@ std::uint32_t slave::process_tpdo_events(std::uint32_t elapsed_us) {
 
 // ---- PDO parameters and their rules -------------------------------------------------------------
 
-pdo_config slave::resolve(std::uint16_t comm, std::uint16_t mapping) const {
+pdo_config slave::resolve(std::uint16_t comm, std::uint16_t mapping) {
   pdo_config c;
   const auto cob_id = static_cast<std::uint32_t>(od_.number(comm, 1));
   c.valid = (cob_id & pdo_cob_invalid) == 0;
@@ -111,14 +112,15 @@ pdo_config slave::resolve(std::uint16_t comm, std::uint16_t mapping) const {
   c.count = static_cast<std::uint8_t>(od_.number(mapping, 0));
   for (std::uint8_t i = 0; i < c.count && i < c.map.size(); ++i) {
     const auto entry = static_cast<std::uint32_t>(od_.number(mapping, static_cast<std::uint8_t>(i + 1)));
-    const object_dictionary::slot* s = od_.find(map_index(entry), map_sub(entry));
+    sdo_abort ignored = sdo_abort::none;
+    object_dictionary::slot* s = od_.find(map_index(entry), map_sub(entry), ignored);
     if (s == nullptr) {  // cannot happen: entries are checked when written
       c.valid = false;
       c.count = i;
       break;
     }
     c.map[i] = mapped_object{map_index(entry), map_sub(entry), s->entry->type,
-                             static_cast<std::uint8_t>(map_bits(entry) / 8)};
+                             static_cast<std::uint8_t>(map_bits(entry) / 8), s};
     c.length = static_cast<std::uint8_t>(c.length + c.map[i].bytes);
   }
   return c;

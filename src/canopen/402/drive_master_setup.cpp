@@ -4,9 +4,10 @@
 #include <iterator>
 
 #include "cia402/canopen/402/drive_master.hpp"
-#include "cia402/canopen/402/drive_objects.hpp"
 #include "cia402/canopen/301/pdo.hpp"
+#include "cia402/manufacturer_objects.hpp"
 #include "cia402/objects.hpp"
+#include "cia402/pdo_maps.hpp"
 #include "cia402/support/text.hpp"
 
 namespace cia402::canopen {
@@ -164,9 +165,12 @@ void drive_master::build_script() {
   // RPDO1: the control word, acting on receipt.
   const std::int64_t rpdo1 = cob::rpdo1 + node;
   script_.push_back(write(0x1400, 1, pdo_cob_invalid | rpdo1, 4));
+  const pdo_map& control = pdo_maps::can_rpdo[0];  // the control word alone: CiA 402's RPDO1
   script_.push_back(write(0x1600, 0, 0, 1));
-  script_.push_back(write(0x1600, 1, 0x60400010, 4));
-  script_.push_back(write(0x1600, 0, 1, 1));
+  for (std::uint8_t e = 0; e < control.count; ++e) {
+    script_.push_back(write(0x1600, static_cast<std::uint8_t>(e + 1), control.entries[e].word(), 4));
+  }
+  script_.push_back(write(0x1600, 0, control.count, 1));
   script_.push_back(write(0x1400, 2, 255, 1));
   script_.push_back(write(0x1400, 1, rpdo1, 4));
 
@@ -175,22 +179,26 @@ void drive_master::build_script() {
   // drive set up otherwise before (or by another master) gets them back. Required: a csp master has
   // nothing without them.
   if (config_.map_position) {
-    const std::int64_t rpdo3 = cob::rpdo1 + 0x200 + node;
-    script_.push_back(write(0x1402, 1, pdo_cob_invalid | rpdo3, 4));
+    const std::int64_t rpdo3_id = cob::rpdo1 + 0x200 + node;
+    script_.push_back(write(0x1402, 1, pdo_cob_invalid | rpdo3_id, 4));
+    const pdo_map& rpdo3 = pdo_maps::can_rpdo[2];
     script_.push_back(write(0x1602, 0, 0, 1));
-    script_.push_back(write(0x1602, 1, 0x60400010, 4));
-    script_.push_back(write(0x1602, 2, 0x607A0020, 4));
-    script_.push_back(write(0x1602, 0, 2, 1));
-    script_.push_back(write(0x1402, 2, 1, 1));
-    script_.push_back(write(0x1402, 1, rpdo3, 4));
-    const std::int64_t tpdo3 = cob::tpdo1 + 0x200 + node;
-    script_.push_back(write(0x1802, 1, pdo_cob_invalid | tpdo3, 4));
+    for (std::uint8_t e = 0; e < rpdo3.count; ++e) {
+      script_.push_back(write(0x1602, static_cast<std::uint8_t>(e + 1), rpdo3.entries[e].word(), 4));
+    }
+    script_.push_back(write(0x1602, 0, rpdo3.count, 1));
+    script_.push_back(write(0x1402, 2, rpdo3.transmission_type, 1));
+    script_.push_back(write(0x1402, 1, rpdo3_id, 4));
+    const std::int64_t tpdo3_id = cob::tpdo1 + 0x200 + node;
+    script_.push_back(write(0x1802, 1, pdo_cob_invalid | tpdo3_id, 4));
+    const pdo_map& tpdo3 = pdo_maps::can_tpdo[2];
     script_.push_back(write(0x1A02, 0, 0, 1));
-    script_.push_back(write(0x1A02, 1, 0x60410010, 4));
-    script_.push_back(write(0x1A02, 2, 0x60640020, 4));
-    script_.push_back(write(0x1A02, 0, 2, 1));
-    script_.push_back(write(0x1802, 2, 1, 1));
-    sdo_job enable3 = write(0x1802, 1, tpdo3, 4);
+    for (std::uint8_t e = 0; e < tpdo3.count; ++e) {
+      script_.push_back(write(0x1A02, static_cast<std::uint8_t>(e + 1), tpdo3.entries[e].word(), 4));
+    }
+    script_.push_back(write(0x1A02, 0, tpdo3.count, 1));
+    script_.push_back(write(0x1802, 2, tpdo3.transmission_type, 1));
+    sdo_job enable3 = write(0x1802, 1, tpdo3_id, 4);
     enable3.then = note_done(position_mapped_);
     script_.push_back(enable3);
   }

@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "cia402/canopen/301/pdo.hpp"
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/manufacturer_objects.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/support/text.hpp"
 
@@ -231,10 +231,9 @@ std::optional<axes::value_format> can_link::describe(std::uint16_t index, std::u
   if (const auto f = find_format(config_.eds, index, sub)) return f;
   // CiA 301's communication objects are the same on every node; the manufacturer's are known only
   // on a node that says it is the project's virtual drive.
-  static const std::vector<object_entry> table = drive_objects();
   const bool ours = device_name_ == virtual_drive_device_name;
   if ((index >= 0x1000 && index <= 0x1FFF) || (ours && index >= 0x2000 && index <= 0x5FFF)) {
-    return find_format(table, index, sub);
+    return find_format(config_.known_objects, index, sub);
   }
   return std::nullopt;
 }

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <map>
 
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/canopen/301/slave.hpp"
 #include "cia402/canopen/axis/can_link.hpp"
 #include "cia402/support/text.hpp"
 
@@ -23,8 +23,9 @@ bool pdo_mapping(std::uint16_t index) {
 // The communication index a PDO is known by.
 std::uint16_t pdo_of(std::uint16_t index) { return pdo_mapping(index) ? static_cast<std::uint16_t>(index - 0x200) : index; }
 
+// What the master restores is CiA 301's communication objects: their names are any node's.
 std::string name_of(std::uint16_t index) {
-  static const std::vector<object_entry> table = drive_objects();
+  static const std::vector<object_entry> table = communication_objects(slave_config{});
   for (const object_entry& o : table) {
     if (o.index == index) return hex(index, 4) + " (" + o.name + ")";
   }

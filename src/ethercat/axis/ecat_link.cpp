@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "cia402/manufacturer_objects.hpp"
 #include "cia402/objects.hpp"
 
 namespace cia402::ethercat {
@@ -10,8 +11,6 @@ namespace {
 // Frames lost (or short of their working counter) in a row before the line counts as gone: with a
 // 1 ms cycle, 25 ms, well inside a drive's 100 ms sync-manager watchdog.
 constexpr int lost_cycles_limit = 25;
-// The SII name of the project's virtual drive: its manufacturer objects are known by it.
-constexpr const char* virtual_drive_name = "cia402 virtual drive";
 
 std::string hex4(std::uint32_t v) {
   static const char* d = "0123456789ABCDEF";
@@ -30,6 +29,8 @@ std::optional<axes::value_format> coe_object_format(std::uint16_t index, std::ui
     case 0x1008:                                                         // device name,
     case 0x1009:                                                         // hardware and
     case 0x100A: return sub == 0 ? std::optional(value_format::text()) : std::nullopt;  // software version
+    case 0x1017: return sub == 0 ? std::optional(u(2)) : std::nullopt;  // CiA 301's producer heartbeat time,
+                                                                         // kept by CoE slaves of CANopen descent
     case 0x1018: return sub == 0 ? u(1) : sub <= 4 ? u(4) : std::optional<value_format>();  // identity
     case 0x1C00: return u(1);  // sync manager communication types
     default: break;
@@ -213,7 +214,7 @@ void ecat_link::run_one_transfer() {
   transfer t = std::move(transfers_.front());
   transfers_.pop_front();
   // The master keeps the process data flowing while it waits for the mailbox.
-  const ecat_sdo_result r = t.download ? line_->master().sdo_download(position_, t.index, t.sub, t.bytes)
+  const ecat_sdo_result r = t.download ? line_->master().sdo_write_bytes(position_, t.index, t.sub, t.bytes)
                                        : line_->master().sdo_read(position_, t.index, t.sub);
   axes::transfer_result out;
   out.ok = r.ok;
@@ -225,9 +226,9 @@ void ecat_link::run_one_transfer() {
 
 std::optional<axes::value_format> ecat_link::describe(std::uint16_t index, std::uint8_t sub) const {
   if (const auto f = coe_object_format(index, sub)) return f;
-  if (position_ < line_->master().slaves().size() && slave().sii.device_name == virtual_drive_name && sub == 0) {
-    if (index == 0x2000) return axes::value_format::text();                // device label
-    if (index == 0x2001) return axes::value_format::integer(2, false);     // fault injection
+  if (position_ < line_->master().slaves().size() && slave().sii.device_name == virtual_drive_device_name && sub == 0) {
+    if (index == device_label_index) return axes::value_format::text();
+    if (index == fault_injection_index) return axes::value_format::integer(2, false);
   }
   return std::nullopt;
 }

@@ -3,11 +3,18 @@
 #include <algorithm>
 #include <cstring>
 
+#include "cia402/ethercat/coe/mailbox.hpp"
+#include "cia402/ethercat/coe/sdo.hpp"
 #include "cia402/objects.hpp"
-
+#include "master_text.hpp"
 
 namespace cia402::ethercat {
 namespace {
+
+using detail::hex;
+using detail::mailbox_us;
+using detail::poll_us;
+using detail::slave_text;
 
 // Registers (ETG.1000.4 table 29 ff.), written out here rather than taken from the emulated ESC:
 // the master is for any slave controller.
@@ -29,12 +36,9 @@ constexpr std::uint32_t logical_base = 0x00010000;
 // Limits in link time: a slave that has not done it by then will not.
 constexpr std::uint64_t state_change_us = 5'000'000;  // PRE-OP -> SAFE-OP may load a drive's parameters
 constexpr std::uint64_t eeprom_us = 100'000;
-constexpr std::uint64_t mailbox_us = 1'000'000;
-constexpr std::uint32_t poll_us = 200;
 constexpr std::size_t sii_max_bytes = 8192;
 // A mailbox: 6 bytes of header, then CoE's 2 and an SDO's 8 at least, so an expedited SDO fits.
-constexpr std::size_t mailbox_header_size = 6;
-constexpr std::size_t smallest_coe_mailbox = mailbox_header_size + 2 + 8;
+constexpr std::size_t smallest_coe_mailbox = mailbox_header_size + coe_header_size + sdo_header_size;
 // A mailbox is read or written in one datagram of one frame.
 constexpr std::size_t largest_mailbox = maximum_frame_size - ethernet_header_size - ethercat_header_size -
                                         datagram_header_size - working_counter_size;
@@ -45,9 +49,6 @@ const std::array<std::uint8_t, 6> broadcast{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
 const std::array<std::uint8_t, 6> master_mac{0x02, 0x00, 0x00, 0x00, 0x00, 0x01};
 
 std::uint16_t le16(const std::uint8_t* p) noexcept { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
-std::uint32_t le32(const std::uint8_t* p) noexcept {
-  return static_cast<std::uint32_t>(p[0] | (p[1] << 8) | (p[2] << 16)) | (static_cast<std::uint32_t>(p[3]) << 24);
-}
 void put_le(std::vector<std::uint8_t>& v, std::uint64_t value, unsigned bytes) {
   for (unsigned i = 0; i < bytes; ++i) v.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
 }
@@ -55,13 +56,6 @@ std::vector<std::uint8_t> le_bytes(std::uint64_t value, unsigned bytes) {
   std::vector<std::uint8_t> v;
   put_le(v, value, bytes);
   return v;
-}
-
-std::string hex(std::uint32_t v, int digits) {
-  static const char* d = "0123456789ABCDEF";
-  std::string s = "0x";
-  for (int i = digits - 1; i >= 0; --i) s += d[(v >> (4 * i)) & 0xF];
-  return s;
 }
 
 // Bits of the process image, little-endian as EtherCAT carries them. A place outside the image
@@ -86,10 +80,6 @@ void put_bits(std::vector<std::uint8_t>& image, std::size_t bit, unsigned bits, 
     const auto mask = static_cast<std::uint8_t>(1u << (b % 8));
     image[b / 8] = static_cast<std::uint8_t>(((v >> i) & 1u) ? (image[b / 8] | mask) : (image[b / 8] & ~mask));
   }
-}
-
-std::string slave_text(const ecat_slave& s) {
-  return "slave " + std::to_string(s.position) + " (station " + hex(s.station, 4) + ")";
 }
 
 }  // namespace
@@ -350,163 +340,6 @@ bool ecat_master::configure_mailbox(ecat_slave& s) {
   if (!write_register(s, reg_sm0, sm)) return fail(slave_text(s) + " did not take its mailbox sync managers");
   s.mailbox = true;
   return true;
-}
-
-// --- mailbox and SDO ---------------------------------------------------------------------------------
-
-bool ecat_master::mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe) {
-  s.mailbox_counter = static_cast<std::uint8_t>(s.mailbox_counter % 7 + 1);  // 1..7, 0 is reserved
-  std::vector<std::uint8_t> m;
-  put_le(m, coe.size(), 2);
-  put_le(m, 0, 2);  // address
-  m.push_back(0);   // channel, priority
-  m.push_back(static_cast<std::uint8_t>(0x03 | (s.mailbox_counter << 4)));  // CoE
-  m.insert(m.end(), coe.begin(), coe.end());
-  if (m.size() > s.sii.mailbox_out_size) return false;
-  m.resize(s.sii.mailbox_out_size, 0);  // the whole mailbox: the last byte hands it over
-  for (const std::uint64_t start = link_->now_us();;) {
-    const single r = one(command::fpwr, s.station | (static_cast<std::uint32_t>(s.sii.mailbox_out_start) << 16), m);
-    if (r.ok && r.wkc == 1) return true;  // 0: the slave has not read the one before yet
-    if (link_->now_us() - start > mailbox_us) return false;
-    pause(poll_us);
-  }
-}
-
-std::optional<std::vector<std::uint8_t>> ecat_master::mailbox_receive(ecat_slave& s) {
-  for (const std::uint64_t start = link_->now_us();;) {
-    const single r = one(command::fprd, s.station | (static_cast<std::uint32_t>(s.sii.mailbox_in_start) << 16),
-                         std::vector<std::uint8_t>(s.sii.mailbox_in_size, 0));
-    if (r.ok && r.wkc == 1) return r.data;  // 0: nothing in the mailbox yet
-    if (link_->now_us() - start > mailbox_us) return std::nullopt;
-    pause(poll_us);
-  }
-}
-
-ecat_sdo_result ecat_master::sdo(std::size_t i, const std::vector<std::uint8_t>& request, std::uint16_t index,
-                                 std::uint8_t sub) {
-  ecat_sdo_result result;
-  if (i >= slaves_.size()) {
-    result.error = "no slave " + std::to_string(i) + ": the line has " + std::to_string(slaves_.size());
-    return result;
-  }
-  ecat_slave& s = slaves_[i];
-  if (!s.mailbox) {
-    result.error = slave_text(s) + " has no CoE mailbox";
-    return result;
-  }
-  std::vector<std::uint8_t> coe{0x00, 0x20};  // CoE header: SDO request
-  coe.insert(coe.end(), request.begin(), request.end());
-  // While the transfer runs the cycles go on (outputs stay valid, no watchdog expires), but leave
-  // the send mailbox to this transfer: its answer is there.
-  const bool was_in_mailbox = in_mailbox_;
-  in_mailbox_ = true;
-  struct restore {
-    bool& flag;
-    bool value;
-    ~restore() { flag = value; }
-  } restore_flag{in_mailbox_, was_in_mailbox};
-  if (!mailbox_send(s, coe)) {
-    result.error = slave_text(s) + ": its receive mailbox stays full";
-    return result;
-  }
-  // A slave that keeps sending what is not the answer (emergencies, stale replies) is given a
-  // bounded number of mailboxes, not the master's whole life.
-  for (int looked = 0; looked < 64; ++looked) {
-    pause(0);
-    const auto reply = mailbox_receive(s);
-    if (!reply) {
-      result.error = slave_text(s) + ": no SDO answer for " + hex(index, 4) + ":" + std::to_string(sub);
-      return result;
-    }
-    const std::vector<std::uint8_t>& m = *reply;
-    // Every length is the slave's word: the reply must hold its own header and what it claims.
-    if (m.size() < mailbox_header_size + 2) continue;
-    const std::size_t length = le16(m.data());
-    if (length < 2 || mailbox_header_size + length > m.size()) continue;
-    const std::uint8_t type = m[5] & 0x0F;
-    const unsigned service = m[7] >> 4;
-    if (type == 0x03 && service == 1 && length >= 2 + 8) {  // an emergency on the way: note it, go on
-      s.emergencies.push_back(le16(m.data() + 8));
-      continue;
-    }
-    if (type == 0x00) {
-      // A mailbox error: type 1 and a 2-byte code after the header (ETG.1000.6 table 29).
-      const std::string code = length >= 4 ? hex(le16(m.data() + 8), 4) : std::string("without a code");
-      result.error = slave_text(s) + " answered with a mailbox error " + code;
-      return result;
-    }
-    if (type != 0x03 || service != 3 || length < 2 + 8) continue;  // not ours
-    const std::uint8_t* sdo = m.data() + 8;
-    if (le16(sdo + 1) != index || sdo[3] != sub) continue;
-    const std::uint8_t cmd = sdo[0];
-    if (cmd == 0x80) {
-      result.aborted = true;
-      result.abort = static_cast<sdo_abort>(le32(sdo + 4));
-      result.error = slave_text(s) + " aborted " + hex(index, 4) + ":" + std::to_string(sub) + ": " +
-                     hex(le32(sdo + 4), 8) + " (" + sdo_abort_text(result.abort) + ")";
-      return result;
-    }
-    if ((cmd & 0xE0) == 0x60) {  // download response
-      result.ok = true;
-      return result;
-    }
-    if ((cmd & 0xE0) == 0x40) {  // upload response
-      if (cmd & 0x02) {          // expedited: 4 - n bytes of data, n in bits 2..3 when bit 0 says so
-        const std::size_t n = (cmd & 0x01) ? 4u - ((cmd >> 2) & 3u) : 4u;
-        result.data.assign(sdo + 4, sdo + 4 + n);
-      } else {
-        const std::size_t size = le32(sdo + 4);
-        const std::size_t have = length - 2 - 8;
-        if (size > have) {
-          result.error = slave_text(s) + ": " + hex(index, 4) + " needs a segmented upload (" + std::to_string(size) +
-                         " bytes), which this master does not do";
-          return result;
-        }
-        result.data.assign(sdo + 8, sdo + 8 + size);
-      }
-      result.ok = true;
-      return result;
-    }
-  }
-  result.error = slave_text(s) + ": no answer to the SDO for " + hex(index, 4) + ":" + std::to_string(sub) +
-                 " among 64 mailboxes it sent";
-  return result;
-}
-
-ecat_sdo_result ecat_master::sdo_read(std::size_t i, std::uint16_t index, std::uint8_t sub) {
-  std::vector<std::uint8_t> r{0x40};
-  put_le(r, index, 2);
-  r.push_back(sub);
-  put_le(r, 0, 4);
-  return sdo(i, r, index, sub);
-}
-
-ecat_sdo_result ecat_master::sdo_write(std::size_t i, std::uint16_t index, std::uint8_t sub, std::int64_t value,
-                                       unsigned bytes) {
-  return sdo_download(i, index, sub, le_bytes(static_cast<std::uint64_t>(value), std::clamp(bytes, 1u, 4u)));
-}
-
-ecat_sdo_result ecat_master::sdo_download(std::size_t i, std::uint16_t index, std::uint8_t sub,
-                                          const std::vector<std::uint8_t>& data) {
-  const bool expedited = !data.empty() && data.size() <= 4;
-  // Expedited with the size given (n = 4 - size in bits 2..3), else normal with the complete size.
-  std::vector<std::uint8_t> r{static_cast<std::uint8_t>(expedited ? 0x23 | ((4 - data.size()) << 2) : 0x21)};
-  put_le(r, index, 2);
-  r.push_back(sub);
-  if (expedited) {
-    r.insert(r.end(), data.begin(), data.end());
-    r.resize(8, 0);
-  } else {
-    put_le(r, data.size(), 4);
-    r.insert(r.end(), data.begin(), data.end());
-  }
-  if (i < slaves_.size() && mailbox_header_size + 2 + r.size() > slaves_[i].sii.mailbox_out_size) {
-    ecat_sdo_result result;
-    result.error = slave_text(slaves_[i]) + ": " + std::to_string(data.size()) + " bytes for " + hex(index, 4) +
-                   " need a segmented download, which this master does not do";
-    return result;
-  }
-  return sdo(i, r, index, sub);
 }
 
 // --- process data ------------------------------------------------------------------------------------
@@ -838,9 +671,7 @@ bool ecat_master::cycle() {
       (f[static_cast<std::size_t>(sm1)] & 0x08)) {
     const single m = one(command::fprd, asked->station | (static_cast<std::uint32_t>(asked->sii.mailbox_in_start) << 16),
                          std::vector<std::uint8_t>(asked->sii.mailbox_in_size, 0));
-    if (m.ok && m.wkc == 1 && m.data.size() >= 16 && (m.data[5] & 0x0F) == 0x03 && (m.data[7] >> 4) == 1) {
-      asked->emergencies.push_back(le16(m.data.data() + 8));
-    }
+    if (m.ok && m.wkc == 1) note_emergency(*asked, m.data);
   }
   if (last_wkc_ != expected_wkc_) {
     error_ = "working counter " + std::to_string(last_wkc_) + ", expected " + std::to_string(expected_wkc_);

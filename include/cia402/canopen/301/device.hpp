@@ -9,7 +9,9 @@
 // samples an event-driven TPDO only when an object it maps was reported (or written by the node),
 // and sends EMCY on the reported error.
 //
-// Implementations: sim_device (sim_device.hpp) over the simulator's virtual drive, and test doubles.
+// Implementations: drive402::sim_device (cia402/drive402/sim_device.hpp) over the simulator's virtual
+// drive, and test doubles. A device is fieldbus-neutral: the CANopen node (slave.hpp) and the CoE slave
+// (ethercat/slave) mount the same one.
 #pragma once
 
 #include <array>

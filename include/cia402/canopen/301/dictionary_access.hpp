@@ -21,6 +21,10 @@ class dictionary_access : public object_access {
   /// Local access with every rule the SDO server applies; values as int64 (strings refused).
   sdo_abort read(std::uint16_t index, std::uint8_t sub, std::int64_t& value);
   sdo_abort write(std::uint16_t index, std::uint8_t sub, std::int64_t value);
+  /// The same rules on an entry found before: a PDO entry is bound to its slot once, when its mapping
+  /// is configured, so a cycle reads and writes through these without looking the object up.
+  sdo_abort read(const object_dictionary::slot& s, std::int64_t& value);
+  sdo_abort write(object_dictionary::slot& s, std::int64_t value);
 
   sdo_abort check_download(std::uint16_t index, std::uint8_t sub, std::size_t size,
                            bool size_known) noexcept override;

@@ -24,12 +24,15 @@ constexpr bool restricted_can_id(std::uint32_t id) noexcept {
          (id >= 0x601 && id <= 0x67F) || (id >= 0x6E0 && id <= 0x6FF) || id >= 0x701;
 }
 
-/// One mapped object, resolved.
+/// One mapped object, resolved when the mapping is configured (the node starts, or a PDO parameter
+/// is written) and bound to its dictionary slot, as CANopenNode binds an OD_IO_t per mapped entry: a
+/// PDO then reads and writes the slot with the dictionary's rules and looks nothing up.
 struct mapped_object {
   std::uint16_t index = 0;
   std::uint8_t sub = 0;
   data_type type = data_type::unsigned8;
   std::uint8_t bytes = 0;
+  object_dictionary::slot* slot = nullptr;
 };
 
 /// One PDO as configured by its two parameter objects.

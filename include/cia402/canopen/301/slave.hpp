@@ -1,5 +1,4 @@
-// A CiA 301 slave node around a device (device.hpp) with the CiA 402 drive dictionary
-// (drive_objects.hpp): NMT slave with boot-up, heartbeat producer (0x1017) and consumer (0x1016),
+// A CiA 301 slave node around a device (device.hpp) and the device's objects: NMT slave with boot-up, heartbeat producer (0x1017) and consumer (0x1016),
 // SDO server, EMCY producer, SYNC consumer and 4 RPDOs / 4 TPDOs whose parameters and mappings are
 // changed over SDO with the CiA 301 rules.
 //
@@ -49,6 +48,7 @@
 #include "cia402/canopen/301/pdo.hpp"
 #include "cia402/canopen/301/sdo_server.hpp"
 #include "cia402/canopen/301/timing.hpp"
+#include "cia402/pdo_maps.hpp"
 
 namespace cia402::canopen {
 
@@ -62,10 +62,26 @@ struct slave_config {
   std::uint32_t sdo_timeout_us = 1000000;
   /// Default of 0x1017 (also after a reset); 0 = no heartbeat until a master asks for one.
   std::uint16_t heartbeat_ms = 0;
-  /// The dictionary the node serves, given by the layer above (a CiA 402 drive: drive_objects(),
-  /// or drive_node_config() in canopen/402), so this CiA 301 node knows no device profile.
+  /// The device's objects, given by the layer above (a CiA 402 drive's: drive402::drive_objects()):
+  /// its identity, its profile's objects, its own. The node adds the communication objects it serves
+  /// itself (communication_objects()), so this CiA 301 node knows no device profile.
   std::vector<object_entry> objects;
+  /// RPDO1..4 / TPDO1..4 as they start and after a reset: mapping, transmission type, inhibit time,
+  /// event timer (a CiA 402 drive's: cia402::pdo_maps). A PDO with no entries starts invalid.
+  std::array<pdo_map, pdo_count> rpdo{};
+  std::array<pdo_map, pdo_count> tpdo{};
 };
+
+/// The communication objects the node serves itself, beside the services that use them (CiA 301
+/// §7.5.2): 0x1005 COB-ID SYNC, 0x1014 COB-ID EMCY, 0x1016 consumer heartbeat times, 0x1017
+/// producer heartbeat time, 0x1200 SDO server, 0x1400..0x1403 / 0x1600..0x1603 RPDO communication
+/// and mapping, 0x1800..0x1803 / 0x1A00..0x1A03 TPDO communication and mapping; defaults from the
+/// predefined connection set (CiA 301 §7.3.5) and `c`.
+std::vector<object_entry> communication_objects(const slave_config& c);
+/// The whole table a node of configuration `c` serves (and its EDS lists): the device's objects and
+/// the communication objects, by index. Throws std::invalid_argument when the device's objects hold
+/// one of the node's own.
+std::vector<object_entry> node_objects(const slave_config& c);
 
 /// Error codes the node raises itself (not the drive).
 namespace node_error {
@@ -76,7 +92,8 @@ inline constexpr std::uint16_t pdo_length = 0x8210;       ///< PDO not processed
 class slave final : private dictionary_access, private device_events {
  public:
   /// Sends the boot-up message and enters PRE-OPERATIONAL. Device and channel must outlive it; the
-  /// node attaches itself to the device's reports until it is destroyed.
+  /// node attaches itself to the device's reports until it is destroyed. Throws
+  /// std::invalid_argument as node_objects() does.
   slave(device& d, channel& out, const slave_config& config);
   ~slave();
   slave(const slave&) = delete;
@@ -136,7 +153,7 @@ class slave final : private dictionary_access, private device_events {
   sdo_abort read_value(const object_dictionary::slot& s, std::int64_t& v) override;
   sdo_abort check_mapping_entry(bool receive, std::uint32_t entry) const;
   void resolve_pdos();
-  pdo_config resolve(std::uint16_t comm, std::uint16_t mapping) const;
+  pdo_config resolve(std::uint16_t comm, std::uint16_t mapping);
   void configure_consumer();
 
   void boot();

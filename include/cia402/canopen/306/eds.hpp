@@ -1,5 +1,6 @@
 // CiA 306 electronic data sheet (EDS) of a node, printed from the node's own object dictionary table
-// (drive_objects.hpp), so the EDS and the node never disagree. Default values are the node's values
+// (its device's objects and its communication objects, slave.hpp), so the EDS and the node never
+// disagree. Default values are the node's values
 // at power-up, read from the live node: device-backed objects show the drive's defaults (e.g. 0x605A
 // of the chosen profile), and objects the device does not have (0x06020000) are left out.
 // Node-dependent defaults are written "$NODEID+0x180" as CiA 306 allows.

@@ -84,8 +84,9 @@ class decoder {
   /// read_eds (306/eds_reader.hpp), or the dictionary the node serves. Its PDO maps start from the
   /// description's values.
   void describe_node(std::uint8_t node_id, std::vector<object_entry> objects);
-  /// Describes every node that describe_node did not, e.g. by the project's drive (canopen/402's
-  /// drive_objects()), so the predefined PDOs of a `cia402 bus` decode with no EDS.
+  /// Describes every node that describe_node did not, e.g. by the whole table of the project's drive
+  /// as a node (canopen::node_objects(apps::drive_node_config(0))), so the predefined PDOs of a
+  /// `cia402 bus` decode with no EDS.
   void describe_other_nodes(std::vector<object_entry> objects);
 
   decoded_frame decode(const frame& f, std::uint64_t time_us);

@@ -1,18 +1,14 @@
-// The EtherCAT mailbox (ETG.1000.4 §5.6) and CANopen over EtherCAT (ETG.1000.6 §5.6): the slave side
-// of SDO upload and download (expedited, normal and segmented, with complete access), SDO
-// information (object list, object and entry descriptions, fragmented across mailboxes) and
-// emergency messages. The values are the object dictionary's, through the same object_access the
-// CANopen SDO server uses, so a value refused on CAN is refused here with the same abort code.
+// The EtherCAT mailbox (ETG.1000.4 §5.6, ETG.1000.6 §5.6.1): the 6-byte header every mailbox starts
+// with, the mailbox types, and the mailbox error reply. Part of the CoE codec, which both the master
+// (ethercat/master) and the slave (ethercat/slave) use: no other file reads or writes a mailbox byte
+// by byte. Links only the core; nothing here allocates but the builders that return a vector.
 #pragma once
 
-#include <array>
+#include <cstddef>
 #include <cstdint>
-#include <deque>
+#include <optional>
 #include <span>
 #include <vector>
-
-#include "cia402/canopen/301/object_dictionary.hpp"
-#include "cia402/canopen/301/sdo_server.hpp"
 
 namespace cia402::ethercat {
 
@@ -31,16 +27,7 @@ enum class mailbox_error : std::uint16_t {
   invalid_size = 0x0008,
 };
 
-/// CoE services (the high nibble of the CoE header).
-enum class coe_service : std::uint8_t {
-  emergency = 1,
-  sdo_request = 2,
-  sdo_response = 3,
-  sdo_information = 8,
-};
-
 inline constexpr std::size_t mailbox_header_size = 6;
-inline constexpr std::size_t coe_header_size = 2;
 
 /// A mailbox header as it travels: data length after the header, station address, channel and
 /// priority, type and the 1..7 counter.
@@ -56,68 +43,28 @@ struct mailbox_header {
 bool read_mailbox_header(std::span<const std::uint8_t> mailbox, mailbox_header& out) noexcept;
 void write_mailbox_header(const mailbox_header& h, std::uint8_t* six_bytes) noexcept;
 
-/// What a slave's CoE does with the mailboxes the master writes. Replies queue up; the slave hands
-/// the next one to the master whenever its send mailbox (SM1) is free.
-class coe_server {
- public:
-  /// Most replies that wait for the master; beyond it the oldest (emergencies first) are dropped
-  /// and counted, so a master that never reads cannot grow the queue.
-  static constexpr std::size_t max_queued = 16;
-  /// Longest value a download may carry (as the CANopen server's).
-  static constexpr std::size_t max_download = canopen::sdo_server::max_download;
+/// The next mailbox counter after `c` (1..7; 0 is reserved, ETG.1000.4 §5.6).
+constexpr std::uint8_t next_mailbox_counter(std::uint8_t c) noexcept {
+  return static_cast<std::uint8_t>(c % 7 + 1);
+}
 
-  /// `mailbox_size` is the size of the send and receive mailboxes (SM0/SM1 length).
-  coe_server(canopen::object_access& access, const canopen::object_dictionary& dictionary,
-             std::uint16_t mailbox_size, std::uint16_t station_address = 0);
-
-  /// One mailbox the master wrote. Anything that is not a sound CoE request gets a mailbox error
-  /// reply (or an SDO abort), changes nothing and is counted in errors().
-  void on_mailbox(std::span<const std::uint8_t> mailbox);
-  /// Queues an emergency (error code, error register, five manufacturer bytes).
-  void emergency(std::uint16_t code, std::uint8_t error_register, const std::array<std::uint8_t, 5>& data);
-
-  bool has_reply() const noexcept { return !replies_.empty(); }
-  /// The next reply, exactly mailbox_size bytes (zero padded); empty when none waits.
-  std::vector<std::uint8_t> take_reply();
-  std::size_t errors() const noexcept { return errors_; }
-  std::size_t dropped() const noexcept { return dropped_; }
-  /// Forgets transfers in progress and queued replies (a state change to INIT).
-  void reset() noexcept;
-
- private:
-  void on_sdo(std::span<const std::uint8_t> sdo);
-  void on_sdo_information(std::span<const std::uint8_t> info);
-  void upload(std::uint16_t index, std::uint8_t sub, bool complete);
-  void download(std::span<const std::uint8_t> sdo);
-  void download_segment(std::span<const std::uint8_t> sdo);
-  void upload_segment(std::uint8_t command);
-  void sdo_reply(std::span<const std::uint8_t> body);
-  void abort(std::uint16_t index, std::uint8_t sub, sdo_abort code);
-  void reply(mailbox_type type, std::span<const std::uint8_t> body);
-  void mailbox_error_reply(mailbox_error e);
-  sdo_abort upload_complete(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t>& out);
-  sdo_abort download_complete(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data);
-  std::size_t sdo_room() const noexcept { return mailbox_size_ - mailbox_header_size - coe_header_size; }
-
-  canopen::object_access* access_;
-  const canopen::object_dictionary* dictionary_;
-  std::uint16_t mailbox_size_;
-  std::uint16_t station_address_;
-  std::uint8_t counter_ = 0;
-  std::deque<std::vector<std::uint8_t>> replies_;
-  std::size_t errors_ = 0;
-  std::size_t dropped_ = 0;
-
-  // A segmented transfer in progress.
-  enum class transfer : std::uint8_t { none, downloading, uploading };
-  transfer transfer_ = transfer::none;
-  std::uint16_t index_ = 0;
-  std::uint8_t sub_ = 0;
-  bool complete_access_ = false;
-  std::uint8_t toggle_ = 0;
-  std::size_t size_ = 0;
-  std::size_t offset_ = 0;
-  std::vector<std::uint8_t> buffer_;
+/// A mailbox as read: its header and the `header.length` bytes of data after it.
+struct mailbox_view {
+  mailbox_header header;
+  std::span<const std::uint8_t> data;
 };
+
+/// A mailbox a peer wrote, checked before any field after the header is read: nothing when it is
+/// shorter than a header or than the length its header claims. Bytes after the length are padding.
+std::optional<mailbox_view> parse_mailbox(std::span<const std::uint8_t> mailbox) noexcept;
+
+/// A whole mailbox of `size` bytes: `h` with its length set to data's, then `data`, zero padded (the
+/// last byte hands a mailbox over). Empty when the header and data do not fit `size`.
+std::vector<std::uint8_t> make_mailbox(mailbox_header h, std::span<const std::uint8_t> data, std::size_t size);
+
+/// The data of a mailbox error reply (type error, ETG.1000.4 table 29): service 1, then the code.
+std::vector<std::uint8_t> mailbox_error_data(mailbox_error e);
+/// The code of a mailbox error reply's data; nothing when the data does not hold one.
+std::optional<std::uint16_t> parse_mailbox_error(std::span<const std::uint8_t> data) noexcept;
 
 }  // namespace cia402::ethercat

@@ -17,9 +17,11 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "cia402/ethercat/coe/sdo.hpp"
 #include "cia402/ethercat/esc/frame.hpp"
 #include "cia402/ethercat/sii/slave_information.hpp"
 #include "cia402/master.hpp"
@@ -137,13 +139,17 @@ class ecat_master {
   /// Whether every slave shows OP (as the last cycle or status read saw it).
   bool all_operational() const noexcept;
 
-  /// SDO transfers with slave `i` (an error result, not an exception, for one the line does not have).
+  /// SDO transfers with slave `i` (an error result, not an exception, for one the line does not have),
+  /// through the CoE codec (ethercat/coe): expedited, normal or segmented as the value's length needs,
+  /// so an object longer than a mailbox (a string, a DCF's value) goes in segments. An upload longer
+  /// than max_sdo_upload bytes is refused with the size the slave announced.
+  static constexpr std::size_t max_sdo_upload = 65536;
   ecat_sdo_result sdo_read(std::size_t i, std::uint16_t index, std::uint8_t sub);
+  /// `bytes` (1..4) of `value`, expedited.
   ecat_sdo_result sdo_write(std::size_t i, std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes);
-  /// A download of the object's bytes as they travel: expedited up to 4 bytes, else a normal
-  /// transfer within one mailbox (a text, a domain); longer needs a segmented one, which this master
-  /// does not do (an error says so).
-  ecat_sdo_result sdo_download(std::size_t i, std::uint16_t index, std::uint8_t sub, const std::vector<std::uint8_t>& data);
+  /// Any number of bytes: expedited up to 4, else a normal download with segments for what the first
+  /// mailbox does not hold.
+  ecat_sdo_result sdo_write_bytes(std::size_t i, std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data);
 
   std::vector<ecat_slave>& slaves() noexcept { return slaves_; }
   const std::vector<ecat_slave>& slaves() const noexcept { return slaves_; }
@@ -173,7 +179,21 @@ class ecat_master {
   bool configure_process_data(ecat_slave& s, std::uint32_t& logical);
   bool mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe);
   std::optional<std::vector<std::uint8_t>> mailbox_receive(ecat_slave& s);
-  ecat_sdo_result sdo(std::size_t i, const std::vector<std::uint8_t>& request, std::uint16_t index, std::uint8_t sub);
+  // The slave `i` names, with its CoE mailbox, or an error in `result`.
+  ecat_slave* sdo_slave(std::size_t i, ecat_sdo_result& result);
+  // Sends one SDO request (a mailbox's CoE data) and waits for the answer of kind `expected` (for an
+  // initiate, of index:sub), noting emergencies on the way. The answer's data points into `reply`.
+  std::optional<sdo_frame> sdo_exchange(ecat_slave& s, const std::vector<std::uint8_t>& request, std::uint16_t index,
+                                        std::uint8_t sub, sdo_command expected, std::vector<std::uint8_t>& reply,
+                                        ecat_sdo_result& result);
+  // The upload segments after a normal upload response, until the value is whole.
+  bool upload_segments(ecat_slave& s, std::uint16_t index, std::uint8_t sub, const sdo_frame& first,
+                       ecat_sdo_result& result);
+  // Ends a transfer the slave got wrong: the abort to the slave, the reason in `result`.
+  void give_up(ecat_slave& s, std::uint16_t index, std::uint8_t sub, sdo_abort code, std::string why,
+               ecat_sdo_result& result);
+  // An emergency a mailbox the master read brought, kept with the slave.
+  static void note_emergency(ecat_slave& s, std::span<const std::uint8_t> mailbox);
   bool fail(std::string text);
   // Forgets the process image: no cycle runs until bring_to_operational() builds the next.
   void stop_cycling();

@@ -1,5 +1,7 @@
-// The node's device (device.hpp) implemented by the simulator's virtual drive (sim/virtual_drive.hpp):
-// the core state machine and a plant, stepped once per plant cycle of the time the node passes in.
+// The virtual CiA 402 drive as a fieldbus device (canopen/301/device.hpp): the simulator's virtual
+// drive (sim/virtual_drive.hpp), the core state machine and a plant, stepped once per plant cycle of
+// the time the fieldbus passes in. It answers the drive's objects (drive_objects.hpp) and takes fault
+// injection (0x2001); the CANopen node and the CoE slave mount it unchanged.
 #pragma once
 
 #include <array>
@@ -10,9 +12,9 @@
 #include "cia402/profile.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 
-namespace cia402::canopen {
+namespace cia402::drive402 {
 
-class sim_device final : public device {
+class sim_device final : public canopen::device {
  public:
   /// Most cycles one step() runs; a longer gap (a stalled host) is dropped, not replayed.
   static constexpr std::uint32_t max_catch_up_cycles = 1000;
@@ -53,4 +55,4 @@ class sim_device final : public device {
   std::int8_t mode_ = 0;
 };
 
-}  // namespace cia402::canopen
+}  // namespace cia402::drive402

@@ -1,10 +1,10 @@
-#include "cia402/canopen/402/sim_device.hpp"
+#include "cia402/drive402/sim_device.hpp"
 
 #include <algorithm>
 
-#include "cia402/canopen/402/drive_objects.hpp"
+#include "cia402/manufacturer_objects.hpp"
 
-namespace cia402::canopen {
+namespace cia402::drive402 {
 
 sim_device::sim_device(const profile& p, const sim::plant_config& config)
     : profile_(&p), config_(config), drive_(std::make_unique<sim::virtual_drive>(p, config)) {}
@@ -90,4 +90,4 @@ void sim_device::reset() noexcept {
   report_changes();
 }
 
-}  // namespace cia402::canopen
+}  // namespace cia402::drive402

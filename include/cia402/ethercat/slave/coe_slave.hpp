@@ -1,0 +1,166 @@
+// An EtherCAT CoE slave around a device (canopen/301/device.hpp): an emulated controller (esc), the
+// application behind it (the AL state machine, CoE mailboxes, process data) and the device's part of
+// the dictionary, to which it adds the objects of CoE's communication area (ETG.1000.6): 0x1600 /
+// 0x1601 RxPDO and 0x1A00 / 0x1A01 TxPDO mappings, 0x1C00 sync manager types, 0x1C12 / 0x1C13 PDO
+// assignment, and 0x1017 (producer heartbeat time: stored and acting on nothing, EtherCAT has no
+// heartbeat, so a master that writes it on every bus is not refused). It knows no device profile:
+// the SII and ESI (description()) say what the device's 0x1000, 0x1008 and 0x1018 say. A master
+// reaches it only through frames on a wire (the in-process `chain`, or a network interface).
+//
+// AL state machine (ETG.1000.6 §6.4): INIT -> PRE-OP needs SM0/SM1 as the SII describes them (else
+// 0x0016 invalid mailbox configuration); PRE-OP -> SAFE-OP needs every assigned PDO entry to name an
+// object (else 0x0025 invalid output mapping / 0x0024 invalid input mapping) and SM2/SM3 as long as
+// the assigned PDOs and configured as outputs / inputs (0x001D / 0x001E); SAFE-OP -> OP; any state
+// back down; BOOT is refused (0x0013); an unknown or skipped state is refused (0x0011 / 0x0012). A
+// refusal keeps the state, sets the error flag (0x0130 bit 4) and the code, until the master
+// acknowledges it (0x0120 bit 4). In OP the process data watchdog guards the outputs: when it
+// expires the slave falls to SAFE-OP with 0x001B and tells the device its connection is lost, so a
+// CiA 402 drive applies 0x6007 (S10).
+//
+// Process data: each assigned PDO entry is bound once, on the way to SAFE-OP (as SOES fills its sync
+// manager maps then), to its dictionary slot, bit offset, length and sign. Each cycle then copies
+// bytes between those slots and the sync managers' buffers, with no lookup and no allocation: in
+// SAFE-OP and OP the inputs (SM3) every cycle, in OP the outputs (SM2) when a whole buffer arrived. A
+// value the outputs carry goes through the dictionary's rules as an SDO write does
+// (dictionary_access). PDO mappings and assignments are written in PRE-OP only (0x08000022
+// otherwise), and only with objects that are PDO mappable the right way, of their own length and
+// within the process data room; an entry of 0 bits, or a count that takes in an entry left empty, is
+// refused (0x06040041).
+//
+// Sync managers changed under a state that checked them take the slave back (with the error flag):
+// SM0/SM1 in PRE-OP or above to INIT (0x0016), SM2/SM3 in SAFE-OP or OP to PRE-OP (0x001D / 0x001E).
+// The application moves process data through the controller's buffers only, never into registers.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cia402/canopen/301/device.hpp"
+#include "cia402/canopen/301/dictionary_access.hpp"
+#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/ethercat/esc/esc.hpp"
+#include "cia402/ethercat/sii/slave_information.hpp"
+#include "cia402/ethercat/slave/coe_server.hpp"
+#include "cia402/pdo_maps.hpp"
+
+namespace cia402::ethercat {
+
+/// AL status codes (ETG.1000.6 table 11) this slave gives.
+namespace al_code {
+inline constexpr std::uint16_t none = 0x0000;
+inline constexpr std::uint16_t invalid_state_change = 0x0011;
+inline constexpr std::uint16_t unknown_state = 0x0012;
+inline constexpr std::uint16_t bootstrap_not_supported = 0x0013;
+inline constexpr std::uint16_t invalid_mailbox_configuration = 0x0016;
+inline constexpr std::uint16_t sync_manager_watchdog = 0x001B;
+inline constexpr std::uint16_t invalid_output_configuration = 0x001D;
+inline constexpr std::uint16_t invalid_input_configuration = 0x001E;
+inline constexpr std::uint16_t invalid_input_mapping = 0x0024;
+inline constexpr std::uint16_t invalid_output_mapping = 0x0025;
+}  // namespace al_code
+
+/// Memory: SM0 (mailbox out) 0x1000, 128 bytes; SM1 (mailbox in) 0x1080, 128 bytes; SM2 (outputs)
+/// 0x1100; SM3 (inputs) 0x1180; each process data SM as long as its assigned PDOs.
+inline constexpr std::uint16_t mailbox_out_start = 0x1000;
+inline constexpr std::uint16_t mailbox_in_start = 0x1080;
+inline constexpr std::uint16_t mailbox_size = 128;
+inline constexpr std::uint16_t outputs_start = 0x1100;
+inline constexpr std::uint16_t inputs_start = 0x1180;
+/// Most bytes a process data SM may take (the room between SM2 and SM3, and after SM3).
+inline constexpr std::uint16_t max_process_data = 0x80;
+/// Entries a PDO mapping object holds.
+inline constexpr int max_pdo_entries = 12;
+
+struct coe_slave_config {
+  /// The device's objects: its identity (0x1000, 0x1008, 0x1018 ...), its profile's objects, its own.
+  /// The slave adds its communication objects (coe_communication_objects()).
+  std::vector<canopen::object_entry> objects;
+  /// RxPDO 0x1600 and TxPDO 0x1A00 as they start, assigned by 0x1C12 / 0x1C13; 0x1601 and 0x1A01
+  /// start empty and unassigned.
+  pdo_map rx_pdo{};
+  pdo_map tx_pdo{};
+  /// What the SII and ESI name besides the dictionary's identity.
+  std::string vendor_name;
+  std::string group_name;
+};
+
+/// The objects the slave serves itself: 0x1017, 0x1600, 0x1601, 0x1A00, 0x1A01, 0x1C00, 0x1C12, 0x1C13.
+std::vector<canopen::object_entry> coe_communication_objects(const coe_slave_config& c);
+/// The whole table of a slave of configuration `c`, by index. Throws std::invalid_argument when the
+/// device's objects hold one of the slave's own.
+std::vector<canopen::object_entry> coe_objects(const coe_slave_config& c);
+/// The SII / ESI description of a slave of configuration `c`: identity and names from its 0x1018,
+/// 0x1008 and 0x1000 (the device profile number), the PDOs 0x1C12 / 0x1C13 assign by default with their
+/// entries' names and types, mailbox and sync manager layout.
+slave_description coe_slave_description(const coe_slave_config& c);
+
+class coe_slave final : private canopen::dictionary_access, private canopen::device_events {
+ public:
+  /// The device must outlive the slave; the slave attaches itself to its reports until destroyed.
+  /// Throws std::invalid_argument as coe_objects() does.
+  coe_slave(canopen::device& d, const coe_slave_config& c);
+  ~coe_slave();
+  coe_slave(const coe_slave&) = delete;
+  coe_slave& operator=(const coe_slave&) = delete;
+
+  esc& controller() noexcept { return esc_; }
+  /// The application's cycle: AL requests, mailboxes, process data, then `elapsed_us` of the device
+  /// and of the watchdog.
+  void step(std::uint32_t elapsed_us);
+  al_state state() const noexcept { return state_; }
+  const slave_description& description() const noexcept { return description_; }
+  const canopen::object_dictionary& dictionary() const noexcept { return od_; }
+  /// Bytes of the assigned RxPDOs (outputs) and TxPDOs (inputs) as the dictionary has them now.
+  std::uint16_t output_bytes() const noexcept;
+  std::uint16_t input_bytes() const noexcept;
+
+ private:
+  /// One PDO entry bound on the way to SAFE-OP.
+  struct bound_entry {
+    canopen::object_dictionary::slot* slot = nullptr;
+    std::uint16_t bit_offset = 0;
+    std::uint8_t bits = 0;
+    bool is_signed = false;
+  };
+  unsigned assigned_bits(std::uint16_t assignment) const noexcept;
+  bool bind(std::uint16_t assignment, std::vector<bound_entry>& out, unsigned& bits);
+  void handle_al_control();
+  bool to_safe_operational();
+  void refuse(std::uint16_t code);
+  void enter(al_state s);
+  bool mailbox_sync_managers_sound() const;
+  bool process_data_sync_manager_sound(int n, std::uint16_t bytes, bool outputs) const;
+  bool entry_mappable(std::uint16_t mapping, std::uint32_t entry) const;
+  sdo_abort write_pdo_configuration(canopen::object_dictionary::slot& s, std::int64_t v);
+  void watch_sync_managers();
+  void exchange_process_data();
+  void serve_mailbox();
+
+  // dictionary_access
+  sdo_abort read_value(const canopen::object_dictionary::slot& s, std::int64_t& v) override;
+  sdo_abort write_value(canopen::object_dictionary::slot& s, std::int64_t v) override;
+  // device_events
+  void object_changed(std::uint16_t, std::uint8_t) noexcept override {}
+  void error_changed(std::uint16_t code) noexcept override;
+
+  canopen::device* device_;
+  canopen::object_dictionary od_;
+  slave_description description_;
+  esc esc_;
+  coe_server coe_;
+  al_state state_ = al_state::init;
+  bool error_ = false;
+  std::uint16_t code_ = al_code::none;
+  // SM2 and SM3 as the way to SAFE-OP found them sound: the only layout process data moves through.
+  esc::sync_manager outputs_checked_{};
+  esc::sync_manager inputs_checked_{};
+  // The assigned PDOs' entries as SAFE-OP bound them, and their lengths in bits.
+  std::vector<bound_entry> outputs_;
+  std::vector<bound_entry> inputs_;
+  unsigned output_bits_ = 0;
+  unsigned input_bits_ = 0;
+  std::vector<std::uint8_t> mailbox_;  // the last request SM0 brought (its room kept across cycles)
+};
+
+}  // namespace cia402::ethercat

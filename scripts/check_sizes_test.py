@@ -1,0 +1,60 @@
+#!/usr/bin/env python3
+"""The size check fails on a file over 600 lines, on a function over 150 lines (not on a namespace or
+a class that long), and on a stale exception, and passes a listed breach and a tree that keeps the
+rules."""
+import os
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def run(files, exceptions=""):
+    with tempfile.TemporaryDirectory() as root:
+        for path, text in files.items():
+            os.makedirs(os.path.dirname(os.path.join(root, path)), exist_ok=True)
+            with open(os.path.join(root, path), "w", encoding="utf-8") as f:
+                f.write(text)
+        os.makedirs(os.path.join(root, "scripts"), exist_ok=True)
+        with open(os.path.join(root, "scripts", "size_exceptions.txt"), "w", encoding="utf-8") as f:
+            f.write(exceptions)
+        r = subprocess.run([sys.executable, os.path.join(HERE, "check_sizes.py"), root], capture_output=True, text=True)
+        return r.returncode, r.stdout
+
+
+def function(name, body_lines):
+    return f"int {name}(int a) {{\n" + "  a += 1;  // '{{' in a comment\n" * (body_lines - 2) + "}\n"
+
+
+def main():
+    long_namespace = "namespace x {\nstruct big {\n" + function("inside", 150) + "};\n" + function("free", 150) * 2 + "}\n"
+    sound = {"src/core/a.cpp": long_namespace, "include/cia402/a.hpp": "#pragma once\n" * 600}
+    checks = []
+    code, out = run(sound)
+    checks.append(("functions of 150 lines in a namespace and a class pass", code == 0))
+    big_file = dict(sound)
+    big_file["tools/cli/b.cpp"] = "\n" * 601
+    code, out = run(big_file)
+    checks.append(("a file of 601 lines fails", code == 1 and "tools/cli/b.cpp: 601 lines" in out))
+    big_function = dict(sound)
+    big_function["src/sim/c.cpp"] = "namespace y {\n" + function("cut_me", 151) + "}\n"
+    code, out = run(big_function)
+    checks.append(("a function of 151 lines fails, named", code == 1 and "src/sim/c.cpp:cut_me: 151 lines" in out))
+    method = dict(sound)
+    method["src/sim/d.cpp"] = "int thing::method(int a) const {\n" + "  a += 1;\n" * 150 + "}\n"
+    code, out = run(method)
+    checks.append(("a member function is named with its class", code == 1 and "src/sim/d.cpp:thing::method" in out))
+    code, out = run(big_function, "src/sim/c.cpp:cut_me  # why\n")
+    checks.append(("a listed breach passes", code == 0))
+    code, out = run(sound, "src/sim/c.cpp:cut_me  # why\n")
+    checks.append(("a listed breach that is gone fails", code == 1 and "remove it" in out))
+    failed = [name for name, ok in checks if not ok]
+    for name, ok in checks:
+        print(("ok   " if ok else "FAIL ") + name)
+    print(f"{len(checks) - len(failed)} passed, {len(failed)} failed")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,90 @@
+// The communication objects of CiA 301 that the node serves itself, beside the services that use
+// them (SYNC 0x1005, EMCY 0x1014, heartbeat 0x1016 / 0x1017, SDO server 0x1200, PDOs 0x1400..0x1BFF),
+// with the defaults of the predefined connection set (CiA 301 §7.3.5) and the PDO defaults the
+// layer above gives (slave_config::rpdo / tpdo).
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "cia402/canopen/301/object_builders.hpp"
+#include "cia402/canopen/301/slave.hpp"
+#include "cia402/canopen/can/frame.hpp"
+
+namespace cia402::canopen {
+namespace {
+
+std::string hex4(std::uint16_t v) {
+  static const char* digits = "0123456789ABCDEF";
+  std::string s = "0x";
+  for (int shift = 12; shift >= 0; shift -= 4) s += digits[(v >> shift) & 0xF];
+  return s;
+}
+
+void add_pdos(std::vector<object_entry>& t, const slave_config& c) {
+  for (int n = 0; n < pdo_count; ++n) {
+    const pdo_map& m = c.rpdo[static_cast<std::size_t>(n)];
+    const auto num = std::to_string(n + 1);
+    const std::uint32_t cob_id = (m.count == 0 ? pdo_cob_invalid : 0u) + cob::rpdo1 + 0x100u * static_cast<std::uint32_t>(n);
+    t.push_back(group(static_cast<std::uint16_t>(0x1400 + n), "RPDO" + num + " communication parameter",
+                      object_code::record, object_category::optional,
+                      {variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 2),
+                       plus_node_id(variable(1, "COB-ID used by RPDO", data_type::unsigned32, access::rw, cob_id)),
+                       variable(2, "Transmission type", data_type::unsigned8, access::rw, m.transmission_type)}));
+    t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1600 + n), "RPDO" + num + " mapping parameter", m,
+                            max_mapped_objects));
+  }
+  for (int n = 0; n < pdo_count; ++n) {
+    const pdo_map& m = c.tpdo[static_cast<std::size_t>(n)];
+    const auto num = std::to_string(n + 1);
+    const std::uint32_t cob_id = (m.count == 0 ? pdo_cob_invalid : 0u) + cob::tpdo1 + 0x100u * static_cast<std::uint32_t>(n);
+    t.push_back(group(static_cast<std::uint16_t>(0x1800 + n), "TPDO" + num + " communication parameter",
+                      object_code::record, object_category::optional,
+                      {variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 5),
+                       plus_node_id(variable(1, "COB-ID used by TPDO", data_type::unsigned32, access::rw, cob_id)),
+                       variable(2, "Transmission type", data_type::unsigned8, access::rw, m.transmission_type),
+                       variable(3, "Inhibit time", data_type::unsigned16, access::rw, m.inhibit_100us),
+                       variable(5, "Event timer", data_type::unsigned16, access::rw, m.event_timer_ms)}));
+    t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1A00 + n), "TPDO" + num + " mapping parameter", m,
+                            max_mapped_objects));
+  }
+}
+
+}  // namespace
+
+std::vector<object_entry> communication_objects(const slave_config& c) {
+  using enum object_category;
+  std::vector<object_entry> t;
+  t.push_back(single(0x1005, optional, variable(0, "COB-ID SYNC message", data_type::unsigned32, access::rw, cob::sync)));
+  t.push_back(single(0x1014, optional,
+                     plus_node_id(variable(0, "COB-ID EMCY", data_type::unsigned32, access::ro, cob::emcy))));
+  std::vector<sub_entry> consumers;
+  consumers.push_back(variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, heartbeat_consumers));
+  for (int i = 1; i <= heartbeat_consumers; ++i) {
+    consumers.push_back(variable(static_cast<std::uint8_t>(i), "Consumer heartbeat time " + std::to_string(i),
+                                 data_type::unsigned32, access::rw));
+  }
+  t.push_back(group(0x1016, "Consumer heartbeat time", object_code::array, optional, std::move(consumers)));
+  t.push_back(single(0x1017, optional,
+                     variable(0, "Producer heartbeat time", data_type::unsigned16, access::rw, c.heartbeat_ms)));
+  t.push_back(group(0x1200, "SDO server parameter", object_code::record, optional,
+                    {variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 2),
+                     plus_node_id(variable(1, "COB-ID client to server", data_type::unsigned32, access::ro, cob::sdo_rx)),
+                     plus_node_id(variable(2, "COB-ID server to client", data_type::unsigned32, access::ro, cob::sdo_tx))}));
+  add_pdos(t, c);
+  return t;
+}
+
+std::vector<object_entry> node_objects(const slave_config& c) {
+  std::vector<object_entry> t = communication_objects(c);
+  for (const object_entry& o : c.objects) {
+    if (std::any_of(t.begin(), t.end(), [&](const object_entry& mine) { return mine.index == o.index; })) {
+      throw std::invalid_argument("the device's table has " + hex4(o.index) +
+                                  ", a communication object the CiA 301 node serves itself");
+    }
+  }
+  t.insert(t.end(), c.objects.begin(), c.objects.end());
+  std::sort(t.begin(), t.end(), [](const object_entry& a, const object_entry& b) { return a.index < b.index; });
+  return t;
+}
+
+}  // namespace cia402::canopen

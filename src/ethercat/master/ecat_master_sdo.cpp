@@ -1,0 +1,256 @@
+// Our master's mailbox and SDO transfers: every mailbox it writes is built, and every one it reads is
+// parsed, by the CoE codec (ethercat/coe), which checks each length the slave gives before it reads
+// what the length covers. Expedited, normal and segmented upload and download; aborts both ways;
+// emergencies met on the way are kept with the slave.
+#include <algorithm>
+#include <utility>
+
+#include "cia402/ethercat/coe/mailbox.hpp"
+#include "cia402/ethercat/coe/sdo.hpp"
+#include "cia402/ethercat/master/ecat_master.hpp"
+#include "master_text.hpp"
+
+namespace cia402::ethercat {
+namespace {
+
+using detail::hex;
+using detail::mailbox_us;
+using detail::poll_us;
+using detail::slave_text;
+
+// A slave that keeps sending what is not the answer (emergencies, stale replies) is given a bounded
+// number of mailboxes, not the master's whole life.
+constexpr int max_unrelated_replies = 64;
+
+std::string object_text(std::uint16_t index, std::uint8_t sub) { return hex(index, 4) + ":" + std::to_string(sub); }
+
+// While a transfer runs the cycles go on (outputs stay valid, no watchdog expires), but they leave the
+// send mailbox to the transfer: its answer is there.
+class mailbox_owner {
+ public:
+  explicit mailbox_owner(bool& flag) : flag_(flag), before_(flag) { flag_ = true; }
+  ~mailbox_owner() { flag_ = before_; }
+  mailbox_owner(const mailbox_owner&) = delete;
+  mailbox_owner& operator=(const mailbox_owner&) = delete;
+
+ private:
+  bool& flag_;
+  bool before_;
+};
+
+}  // namespace
+
+bool ecat_master::mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe) {
+  s.mailbox_counter = next_mailbox_counter(s.mailbox_counter);
+  mailbox_header h;
+  h.type = mailbox_type::coe;
+  h.counter = s.mailbox_counter;
+  // The whole mailbox: its last byte hands it over.
+  const std::vector<std::uint8_t> m = make_mailbox(h, coe, s.sii.mailbox_out_size);
+  if (m.empty()) return false;
+  for (const std::uint64_t start = link_->now_us();;) {
+    const single r = one(command::fpwr, s.station | (static_cast<std::uint32_t>(s.sii.mailbox_out_start) << 16), m);
+    if (r.ok && r.wkc == 1) return true;  // 0: the slave has not read the one before yet
+    if (link_->now_us() - start > mailbox_us) return false;
+    pause(poll_us);
+  }
+}
+
+std::optional<std::vector<std::uint8_t>> ecat_master::mailbox_receive(ecat_slave& s) {
+  for (const std::uint64_t start = link_->now_us();;) {
+    const single r = one(command::fprd, s.station | (static_cast<std::uint32_t>(s.sii.mailbox_in_start) << 16),
+                         std::vector<std::uint8_t>(s.sii.mailbox_in_size, 0));
+    if (r.ok && r.wkc == 1) return r.data;  // 0: nothing in the mailbox yet
+    if (link_->now_us() - start > mailbox_us) return std::nullopt;
+    pause(poll_us);
+  }
+}
+
+void ecat_master::note_emergency(ecat_slave& s, std::span<const std::uint8_t> mailbox) {
+  const std::optional<mailbox_view> m = parse_mailbox(mailbox);
+  if (!m || m->header.type != mailbox_type::coe) return;
+  const std::optional<coe_view> c = parse_coe(m->data);
+  if (!c || c->service != coe_service::emergency) return;
+  if (const std::optional<emergency_message> e = parse_emergency(c->body)) s.emergencies.push_back(e->code);
+}
+
+ecat_slave* ecat_master::sdo_slave(std::size_t i, ecat_sdo_result& result) {
+  if (i >= slaves_.size()) {
+    result.error = "no slave " + std::to_string(i) + ": the line has " + std::to_string(slaves_.size());
+    return nullptr;
+  }
+  ecat_slave& s = slaves_[i];
+  if (!s.mailbox) {
+    result.error = slave_text(s) + " has no CoE mailbox";
+    return nullptr;
+  }
+  return &s;
+}
+
+std::optional<sdo_frame> ecat_master::sdo_exchange(ecat_slave& s, const std::vector<std::uint8_t>& request,
+                                                   std::uint16_t index, std::uint8_t sub, sdo_command expected,
+                                                   std::vector<std::uint8_t>& reply, ecat_sdo_result& result) {
+  if (!mailbox_send(s, request)) {
+    result.error = slave_text(s) + ": its receive mailbox stays full";
+    return std::nullopt;
+  }
+  const bool initiate = expected == sdo_command::initiate_upload || expected == sdo_command::initiate_download;
+  for (int looked = 0; looked < max_unrelated_replies; ++looked) {
+    pause(0);
+    std::optional<std::vector<std::uint8_t>> got = mailbox_receive(s);
+    if (!got) {
+      result.error = slave_text(s) + ": no SDO answer for " + object_text(index, sub);
+      return std::nullopt;
+    }
+    reply = std::move(*got);
+    // Every length is the slave's word: the reply must hold its own header and what it claims.
+    const std::optional<mailbox_view> m = parse_mailbox(reply);
+    if (!m || m->data.size() < coe_header_size) continue;
+    if (m->header.type == mailbox_type::error) {
+      const std::optional<std::uint16_t> code = parse_mailbox_error(m->data);
+      result.error = slave_text(s) + " answered with a mailbox error " + (code ? hex(*code, 4) : std::string("without a code"));
+      return std::nullopt;
+    }
+    if (m->header.type != mailbox_type::coe) continue;
+    const std::optional<coe_view> c = parse_coe(m->data);
+    if (!c) continue;
+    if (c->service == coe_service::emergency) {  // an emergency on the way: note it, go on
+      if (const std::optional<emergency_message> e = parse_emergency(c->body)) s.emergencies.push_back(e->code);
+      continue;
+    }
+    const std::optional<sdo_frame> f = parse_sdo_response(c->service, c->body);
+    if (!f) continue;
+    if (f->command == sdo_command::abort) {
+      if (f->index != index || f->sub != sub) continue;  // another transfer's
+      result.aborted = true;
+      result.abort = static_cast<sdo_abort>(f->abort_code);
+      result.error = slave_text(s) + " aborted " + object_text(index, sub) + ": " + hex(f->abort_code, 8) + " (" +
+                     sdo_abort_text(result.abort) + ")";
+      return std::nullopt;
+    }
+    if (f->command != expected || (initiate && (f->index != index || f->sub != sub))) continue;  // not ours
+    return f;
+  }
+  result.error = slave_text(s) + ": no answer to the SDO for " + object_text(index, sub) + " among " +
+                 std::to_string(max_unrelated_replies) + " mailboxes it sent";
+  return std::nullopt;
+}
+
+void ecat_master::give_up(ecat_slave& s, std::uint16_t index, std::uint8_t sub, sdo_abort code, std::string why,
+                          ecat_sdo_result& result) {
+  (void)mailbox_send(s, sdo_abort_request(index, sub, static_cast<std::uint32_t>(code)));  // no answer comes
+  result.error = slave_text(s) + ": " + object_text(index, sub) + ": " + std::move(why);
+}
+
+bool ecat_master::upload_segments(ecat_slave& s, std::uint16_t index, std::uint8_t sub, const sdo_frame& first,
+                                  ecat_sdo_result& result) {
+  const std::size_t limit = first.size_indicated ? first.size : max_sdo_upload;
+  std::vector<std::uint8_t> reply;
+  // Every segment but the last brings a byte at least, so the size bounds the exchanges.
+  for (bool toggle = false;; toggle = !toggle) {
+    const std::optional<sdo_frame> seg =
+        sdo_exchange(s, sdo_upload_segment_request(toggle), index, sub, sdo_command::upload_segment, reply, result);
+    if (!seg) return false;
+    if (seg->toggle != toggle) {
+      give_up(s, index, sub, sdo_abort::toggle_bit_not_alternated, "an upload segment did not alternate its toggle bit",
+              result);
+      return false;
+    }
+    if (result.data.size() + seg->data.size() > limit) {
+      give_up(s, index, sub, sdo_abort::data_type_length_mismatch,
+              "its segments bring more than the " + std::to_string(limit) + " bytes " +
+                  (first.size_indicated ? "it announced" : "this master reads"),
+              result);
+      return false;
+    }
+    result.data.insert(result.data.end(), seg->data.begin(), seg->data.end());
+    if (seg->last) break;
+    if (seg->data.empty()) {
+      give_up(s, index, sub, sdo_abort::general_error, "an empty upload segment that is not the last", result);
+      return false;
+    }
+  }
+  if (first.size_indicated && result.data.size() != first.size) {
+    result.error = slave_text(s) + ": " + object_text(index, sub) + ": its last segment came after " +
+                   std::to_string(result.data.size()) + " of the " + std::to_string(first.size) + " bytes it announced";
+    return false;
+  }
+  return true;
+}
+
+ecat_sdo_result ecat_master::sdo_read(std::size_t i, std::uint16_t index, std::uint8_t sub) {
+  ecat_sdo_result result;
+  ecat_slave* s = sdo_slave(i, result);
+  if (s == nullptr) return result;
+  const mailbox_owner owner(in_mailbox_);
+  std::vector<std::uint8_t> reply;
+  const std::optional<sdo_frame> f =
+      sdo_exchange(*s, sdo_upload_request(index, sub), index, sub, sdo_command::initiate_upload, reply, result);
+  if (!f) return result;
+  if (!f->expedited && f->size_indicated && f->size > max_sdo_upload) {
+    give_up(*s, index, sub, sdo_abort::out_of_memory,
+            "it announces " + std::to_string(f->size) + " bytes; this master reads at most " +
+                std::to_string(max_sdo_upload),
+            result);
+    return result;
+  }
+  result.data.assign(f->data.begin(), f->data.end());
+  // A normal upload whose first mailbox does not hold the value goes on in segments.
+  if (!f->expedited && !(f->size_indicated && result.data.size() == f->size) &&
+      !upload_segments(*s, index, sub, *f, result)) {
+    result.data.clear();
+    return result;
+  }
+  result.ok = true;
+  return result;
+}
+
+ecat_sdo_result ecat_master::sdo_write(std::size_t i, std::uint16_t index, std::uint8_t sub, std::int64_t value,
+                                       unsigned bytes) {
+  bytes = std::clamp(bytes, 1u, 4u);
+  std::vector<std::uint8_t> data(bytes);
+  for (unsigned b = 0; b < bytes; ++b) data[b] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(value) >> (8 * b));
+  return sdo_write_bytes(i, index, sub, data);
+}
+
+ecat_sdo_result ecat_master::sdo_write_bytes(std::size_t i, std::uint16_t index, std::uint8_t sub,
+                                             std::span<const std::uint8_t> data) {
+  ecat_sdo_result result;
+  ecat_slave* s = sdo_slave(i, result);
+  if (s == nullptr) return result;
+  const mailbox_owner owner(in_mailbox_);
+  std::vector<std::uint8_t> reply;
+  if (!data.empty() && data.size() <= 4) {
+    result.ok = sdo_exchange(*s, sdo_download_expedited(index, sub, data), index, sub, sdo_command::initiate_download,
+                             reply, result)
+                    .has_value();
+    return result;
+  }
+  // Normal: the size and what the first mailbox holds, then segments with the rest.
+  const std::size_t first = std::min(data.size(), sdo_initiate_room(s->sii.mailbox_out_size));
+  const std::vector<std::uint8_t> initiate =
+      sdo_download_normal(index, sub, false, static_cast<std::uint32_t>(data.size()), data.first(first));
+  if (!sdo_exchange(*s, initiate, index, sub, sdo_command::initiate_download, reply, result)) return result;
+  bool toggle = false;
+  for (std::size_t at = first; at < data.size(); toggle = !toggle) {
+    const std::size_t n = std::min(sdo_segment_room(s->sii.mailbox_out_size), data.size() - at);
+    if (n == 0) {  // a mailbox smaller than configure_mailbox lets through: never a segment of nothing
+      result.error = slave_text(*s) + ": its receive mailbox holds no segment";
+      return result;
+    }
+    const bool last = at + n == data.size();
+    const std::optional<sdo_frame> seg = sdo_exchange(*s, sdo_download_segment(toggle, last, data.subspan(at, n)), index,
+                                                      sub, sdo_command::download_segment, reply, result);
+    if (!seg) return result;
+    if (seg->toggle != toggle) {
+      give_up(*s, index, sub, sdo_abort::toggle_bit_not_alternated,
+              "a download segment's answer did not alternate its toggle bit", result);
+      return result;
+    }
+    at += n;
+  }
+  result.ok = true;
+  return result;
+}
+
+}  // namespace cia402::ethercat

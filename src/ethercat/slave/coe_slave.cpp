@@ -1,0 +1,235 @@
+// The CoE slave's application: the AL state machine, the mailboxes, the dictionary's rules for the
+// process data configuration, and the cycle. The process data itself: process_data.cpp.
+#include "cia402/ethercat/slave/coe_slave.hpp"
+
+#include <algorithm>
+
+namespace cia402::ethercat {
+namespace {
+
+bool mapping_object(std::uint16_t index) noexcept {
+  return (index >= 0x1600 && index <= 0x17FF) || (index >= 0x1A00 && index <= 0x1BFF);
+}
+bool assignment_object(std::uint16_t index) noexcept { return index == 0x1C12 || index == 0x1C13; }
+
+constexpr std::uint8_t al_error_flag = 0x10;
+constexpr std::uint8_t al_acknowledge = 0x10;
+constexpr int sm_outputs = 2;
+constexpr int sm_inputs = 3;
+
+}  // namespace
+
+coe_slave::coe_slave(canopen::device& d, const coe_slave_config& c)
+    : dictionary_access(od_),
+      device_(&d),
+      od_(coe_objects(c), 0),
+      description_(coe_slave_description(c)),
+      esc_(sii_image(description_)),
+      coe_(*this, od_, mailbox_size) {
+  device_->attach(this);
+  esc_.set_al_status(static_cast<std::uint8_t>(al_state::init), al_code::none);
+  // The most entries two assigned PDOs can hold: bound on the way to SAFE-OP without allocating.
+  outputs_.reserve(2 * max_pdo_entries);
+  inputs_.reserve(2 * max_pdo_entries);
+  mailbox_.reserve(mailbox_size);
+}
+
+coe_slave::~coe_slave() { device_->attach(nullptr); }
+
+// ---- the dictionary's rules -------------------------------------------------------------------
+
+sdo_abort coe_slave::read_value(const canopen::object_dictionary::slot& s, std::int64_t& v) {
+  if (s.entry->where == canopen::backing::device) return device_->read(s.object->index, s.entry->sub, v);
+  v = s.number;
+  return sdo_abort::none;
+}
+
+bool coe_slave::entry_mappable(std::uint16_t mapping, std::uint32_t m) const {
+  // An entry names an object of the dictionary, mappable in this direction, of its own size.
+  const canopen::object_dictionary::slot* target = od_.find(static_cast<std::uint16_t>(m >> 16),
+                                                              static_cast<std::uint8_t>(m >> 8));
+  const bool rx = mapping < 0x1A00;
+  return target != nullptr && target->entry->pdo_mappable &&
+         (rx ? canopen::writable(target->entry->acc) : !canopen::writable(target->entry->acc)) &&
+         canopen::type_size(target->entry->type) * 8 == (m & 0xFFu) && (m & 0xFFu) != 0;
+}
+
+sdo_abort coe_slave::write_pdo_configuration(canopen::object_dictionary::slot& s, std::int64_t v) {
+  const std::uint16_t index = s.object->index;
+  const std::uint8_t sub = s.entry->sub;
+  // The process data are configured in PRE-OP only.
+  if (state_ != al_state::pre_operational) return sdo_abort::cannot_store_in_present_state;
+  if (mapping_object(index) && sub != 0 && v != 0 && !entry_mappable(index, static_cast<std::uint32_t>(v))) {
+    return sdo_abort::cannot_map_to_pdo;
+  }
+  if (mapping_object(index) && sub == 0) {
+    // The entries it counts in are checked again: one left 0 (or never written) maps nothing of no
+    // length, which the process data cannot carry.
+    unsigned bits = 0;
+    for (std::int64_t k = 1; k <= v; ++k) {
+      const auto m = static_cast<std::uint32_t>(od_.number(index, static_cast<std::uint8_t>(k)));
+      if (!entry_mappable(index, m)) return sdo_abort::cannot_map_to_pdo;
+      bits += m & 0xFFu;
+    }
+    if ((bits + 7) / 8 > max_process_data) return sdo_abort::pdo_length_exceeded;
+  }
+  if (assignment_object(index) && sub != 0 && v != 0) {
+    // A PDO this slave has, of the assignment's direction.
+    const std::uint16_t first = index == 0x1C12 ? 0x1600 : 0x1A00;
+    if (v != first && v != first + 1) return sdo_abort::invalid_value;
+  }
+  s.number = v;
+  return sdo_abort::none;
+}
+
+sdo_abort coe_slave::write_value(canopen::object_dictionary::slot& s, std::int64_t v) {
+  const std::uint16_t index = s.object->index;
+  if (s.entry->where == canopen::backing::device) return device_->write(index, s.entry->sub, v);
+  if (mapping_object(index) || assignment_object(index)) return write_pdo_configuration(s, v);
+  s.number = v;
+  return sdo_abort::none;
+}
+
+void coe_slave::error_changed(std::uint16_t code) noexcept {
+  std::int64_t reg = 0;
+  (void)read(0x1001, 0, reg);
+  coe_.emergency(code, static_cast<std::uint8_t>(reg), device_->manufacturer_error_field());
+}
+
+// ---- the AL state machine ---------------------------------------------------------------------
+
+void coe_slave::refuse(std::uint16_t code) {
+  error_ = true;
+  code_ = code;
+  esc_.set_al_status(static_cast<std::uint8_t>(static_cast<std::uint8_t>(state_) | al_error_flag), code_);
+}
+
+void coe_slave::enter(al_state s) {
+  const al_state before = state_;
+  state_ = s;
+  if (s == al_state::init) coe_.reset();
+  // Leaving OP the master no longer commands the device; entering it, it does again (a CiA 402
+  // drive's 0x6007, S10).
+  if (before == al_state::operational && s != al_state::operational) device_->set_connection_lost(true);
+  if (s == al_state::operational) device_->set_connection_lost(false);
+  esc_.set_al_status(static_cast<std::uint8_t>(static_cast<std::uint8_t>(state_) | (error_ ? al_error_flag : 0)),
+                     error_ ? code_ : al_code::none);
+}
+
+bool coe_slave::mailbox_sync_managers_sound() const {
+  for (int n = 0; n < 2; ++n) {
+    const esc::sync_manager sm = esc_.sm(n);
+    const sync_manager_description& want = description_.sync_managers[static_cast<std::size_t>(n)];
+    if (!sm.enabled || sm.start != want.start || sm.length != want.length || !sm.mailbox() ||
+        sm.ecat_writes() != (n == 0)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool coe_slave::process_data_sync_manager_sound(int n, std::uint16_t bytes, bool outputs) const {
+  const esc::sync_manager sm = esc_.sm(n);
+  if (bytes == 0) return !sm.enabled || sm.length == 0;
+  return sm.enabled && !sm.mailbox() && sm.ecat_writes() == outputs && sm.length == bytes &&
+         std::uint32_t{sm.start} + sm.length <= esc::memory_size && sm.start >= reg::process_ram;
+}
+
+bool coe_slave::to_safe_operational() {
+  // Every assigned entry bound to its object, then the sync managers as long as the PDOs they carry.
+  if (!bind(0x1C12, outputs_, output_bits_)) {
+    refuse(al_code::invalid_output_mapping);
+    return false;
+  }
+  if (!bind(0x1C13, inputs_, input_bits_)) {
+    refuse(al_code::invalid_input_mapping);
+    return false;
+  }
+  if (!process_data_sync_manager_sound(sm_outputs, static_cast<std::uint16_t>((output_bits_ + 7) / 8), true)) {
+    refuse(al_code::invalid_output_configuration);
+    return false;
+  }
+  if (!process_data_sync_manager_sound(sm_inputs, static_cast<std::uint16_t>((input_bits_ + 7) / 8), false)) {
+    refuse(al_code::invalid_input_configuration);
+    return false;
+  }
+  outputs_checked_ = esc_.sm(sm_outputs);
+  inputs_checked_ = esc_.sm(sm_inputs);
+  return true;
+}
+
+void coe_slave::handle_al_control() {
+  const std::uint16_t control = esc_.read16(reg::al_control);
+  if ((control & al_acknowledge) && error_) {
+    error_ = false;
+    code_ = al_code::none;
+  }
+  const unsigned wanted = control & 0x0Fu;
+  const auto current = static_cast<unsigned>(state_);
+  switch (wanted) {
+    case 1: enter(al_state::init); return;
+    case 3: refuse(al_code::bootstrap_not_supported); return;
+    case 2:
+      if (state_ == al_state::init && !mailbox_sync_managers_sound()) return refuse(al_code::invalid_mailbox_configuration);
+      enter(al_state::pre_operational);
+      return;
+    case 4:
+      if (state_ == al_state::init) return refuse(al_code::invalid_state_change);
+      if (state_ == al_state::pre_operational && !to_safe_operational()) return;
+      enter(al_state::safe_operational);
+      return;
+    case 8:
+      if (current < static_cast<unsigned>(al_state::safe_operational)) return refuse(al_code::invalid_state_change);
+      enter(al_state::operational);
+      return;
+    default: refuse(al_code::unknown_state); return;
+  }
+}
+
+void coe_slave::watch_sync_managers() {
+  // A sync manager the master changes after the state that checked it takes the slave back to where
+  // it is checked again, with the code that says which (as the ETG's slave code does): the mailbox
+  // to INIT, the process data to PRE-OP. Until then nothing is read from it or written to it.
+  const auto same = [](const esc::sync_manager& a, const esc::sync_manager& b) {
+    return a.start == b.start && a.length == b.length && a.control == b.control && a.enabled == b.enabled;
+  };
+  if (state_ == al_state::init) return;
+  if (!mailbox_sync_managers_sound()) {
+    refuse(al_code::invalid_mailbox_configuration);
+    return enter(al_state::init);
+  }
+  if (state_ != al_state::safe_operational && state_ != al_state::operational) return;
+  if (!same(esc_.sm(sm_outputs), outputs_checked_)) {
+    refuse(al_code::invalid_output_configuration);
+    return enter(al_state::pre_operational);
+  }
+  if (!same(esc_.sm(sm_inputs), inputs_checked_)) {
+    refuse(al_code::invalid_input_configuration);
+    return enter(al_state::pre_operational);
+  }
+}
+
+void coe_slave::serve_mailbox() {
+  if (state_ == al_state::init) return;
+  if (esc_.read_mailbox(0, mailbox_)) coe_.on_mailbox(mailbox_);
+  if (coe_.has_reply() && !esc_.mailbox_full(1)) (void)esc_.write_mailbox(1, coe_.take_reply());
+}
+
+void coe_slave::step(std::uint32_t elapsed_us) {
+  if (esc_.take_al_control_event()) handle_al_control();
+  watch_sync_managers();
+  serve_mailbox();
+  exchange_process_data();
+  device_->step(elapsed_us);
+  esc_.advance(std::uint64_t{elapsed_us} * 1000);
+  if (esc_.take_watchdog_event() && state_ == al_state::operational) {
+    // The master stopped sending outputs: SAFE-OP with the watchdog's code, and the device's
+    // fieldbus connection is lost.
+    error_ = true;
+    code_ = al_code::sync_manager_watchdog;
+    enter(al_state::safe_operational);
+  }
+  serve_mailbox();  // a reply (or an emergency) the step produced goes out now
+}
+
+}  // namespace cia402::ethercat

@@ -1,0 +1,98 @@
+// The CoE slave's process data: each assigned PDO entry bound to its dictionary slot on the way to
+// SAFE-OP, then every cycle a copy of bytes between those slots and the sync managers' buffers, with
+// no lookup and no allocation (SOES fills its sync manager maps the same way).
+#include <array>
+#include <span>
+
+#include "cia402/ethercat/slave/coe_slave.hpp"
+
+namespace cia402::ethercat {
+namespace {
+
+constexpr int sm_outputs = 2;
+constexpr int sm_inputs = 3;
+
+// An entry's bytes in a little-endian buffer (EtherCAT's byte order). Entries map whole objects
+// (entry_mappable), so each starts and ends on a byte.
+std::uint64_t get_bytes(std::span<const std::uint8_t> b, unsigned bit_offset, unsigned bits) noexcept {
+  std::uint64_t v = 0;
+  for (unsigned i = 0; i < bits / 8; ++i) v |= std::uint64_t{b[bit_offset / 8 + i]} << (8 * i);
+  return v;
+}
+
+void put_bytes(std::span<std::uint8_t> b, unsigned bit_offset, unsigned bits, std::uint64_t v) noexcept {
+  for (unsigned i = 0; i < bits / 8; ++i) b[bit_offset / 8 + i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
+}  // namespace
+
+unsigned coe_slave::assigned_bits(std::uint16_t assignment) const noexcept {
+  unsigned bits = 0;
+  const std::int64_t pdos = od_.number(assignment, 0);
+  for (std::int64_t i = 1; i <= pdos; ++i) {
+    const auto pdo = static_cast<std::uint16_t>(od_.number(assignment, static_cast<std::uint8_t>(i)));
+    const std::int64_t entries = od_.number(pdo, 0);
+    for (std::int64_t k = 1; k <= entries; ++k) bits += static_cast<std::uint8_t>(od_.number(pdo, static_cast<std::uint8_t>(k)));
+  }
+  return bits;
+}
+
+std::uint16_t coe_slave::output_bytes() const noexcept {
+  return static_cast<std::uint16_t>((assigned_bits(0x1C12) + 7) / 8);
+}
+
+std::uint16_t coe_slave::input_bytes() const noexcept {
+  return static_cast<std::uint16_t>((assigned_bits(0x1C13) + 7) / 8);
+}
+
+bool coe_slave::bind(std::uint16_t assignment, std::vector<bound_entry>& out, unsigned& bits) {
+  out.clear();
+  bits = 0;
+  const std::int64_t pdos = od_.number(assignment, 0);
+  for (std::int64_t i = 1; i <= pdos; ++i) {
+    const auto pdo = static_cast<std::uint16_t>(od_.number(assignment, static_cast<std::uint8_t>(i)));
+    const std::int64_t entries = od_.number(pdo, 0);
+    for (std::int64_t k = 1; k <= entries; ++k) {
+      const auto m = static_cast<std::uint32_t>(od_.number(pdo, static_cast<std::uint8_t>(k)));
+      sdo_abort ignored = sdo_abort::none;
+      canopen::object_dictionary::slot* s = od_.find(static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8), ignored);
+      const auto length = static_cast<std::uint8_t>(m);
+      // An entry cleared after its count was written names nothing: the mapping cannot run.
+      if (s == nullptr || length == 0 || length > 64 || length % 8 != 0) return false;
+      out.push_back({s, static_cast<std::uint16_t>(bits), length, canopen::type_is_signed(s->entry->type)});
+      bits += length;
+    }
+  }
+  return bits <= 8u * max_process_data;
+}
+
+void coe_slave::exchange_process_data() {
+  if (state_ != al_state::safe_operational && state_ != al_state::operational) return;
+  // Whole buffers through the sync managers checked on the way to SAFE-OP, whose lengths hold the
+  // bound entries: the application reaches process RAM only, in the buffer the controller gives it.
+  std::array<std::uint8_t, max_process_data> buffer{};
+  const bool outputs_arrived = esc_.take_sync_manager_event(sm_outputs);
+  const std::size_t out_bytes = outputs_checked_.enabled ? outputs_checked_.length : 0;
+  if (state_ == al_state::operational && outputs_arrived && out_bytes <= buffer.size() &&
+      output_bits_ <= 8 * out_bytes && esc_.read_buffer(sm_outputs, std::span(buffer.data(), out_bytes))) {
+    for (const bound_entry& e : outputs_) {
+      const std::uint64_t raw = get_bytes(buffer, e.bit_offset, e.bits);
+      auto value = static_cast<std::int64_t>(raw);
+      // Signed objects come sign-extended, as the dictionary takes them.
+      if (e.is_signed && e.bits < 64 && ((raw >> (e.bits - 1)) & 1u)) value -= std::int64_t{1} << e.bits;
+      (void)write(*e.slot, value);
+    }
+  }
+  // Inputs: every cycle, so the master always reads the present values.
+  const std::size_t in_bytes = inputs_checked_.enabled ? inputs_checked_.length : 0;
+  if (in_bytes == 0 || in_bytes > buffer.size() || input_bits_ > 8 * in_bytes) return;
+  buffer.fill(0);
+  for (const bound_entry& e : inputs_) {
+    std::int64_t value = 0;
+    (void)read(*e.slot, value);
+    put_bytes(buffer, e.bit_offset, e.bits, static_cast<std::uint64_t>(value));
+  }
+  (void)esc_.write_buffer(sm_inputs, std::span<const std::uint8_t>(buffer.data(), in_bytes));
+}
+
+}  // namespace cia402::ethercat
