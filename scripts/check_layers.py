@@ -45,6 +45,7 @@ LAYERS = [
     ("apps", "include/cia402/apps/"),
     ("apps", "src/apps/"),
     ("page", "src/page/"),
+    ("python", "src/python/"),
     ("support", "src/support/"),
     ("profile_file", "include/cia402/profile_file.hpp"),
     ("profile_file", "src/profile_file/"),
@@ -84,6 +85,9 @@ ALLOWED = {
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
              "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "ethercat/esc",
              "ethercat/sii", "ethercat/master"},
+    # The Python binding: the core, profile files, the replay and the simulator now; the fieldbus
+    # layers and the axis session join when their bindings do.
+    "python": {"core", "motion", "support", "profile_file", "replay", "sim"},
     "tools": {"core", "motion", "support", "profile_file", "diagram", "replay", "sim", "canopen/can",
               "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "canopen/monitor",
               "apps", "page",
