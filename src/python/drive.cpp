@@ -4,8 +4,10 @@
 #include <pybind11/stl.h>
 
 #include <cstdio>
+#include <iterator>
 #include <optional>
 #include <string>
+#include <variant>
 
 #include "binding.hpp"
 #include "cia402/master.hpp"
@@ -33,6 +35,79 @@ struct input_args {
   std::optional<std::int64_t> status_bits;
   std::optional<std::int64_t> actual_speed_rpm;
 };
+
+// The keyword inputs by name. A call site's keyword is the interned string of its name, so a
+// lookup is mostly a pointer comparison: a step with a keyword costs little more than one without
+// (pybind11's own keyword matching looks every declared name up in the call's dict).
+struct input_keyword {
+  const char* name;
+  std::variant<std::optional<std::int64_t> input_args::*, std::optional<bool> input_args::*> member;
+};
+const input_keyword input_keywords[] = {
+    {"control_word", &input_args::control_word},
+    {"dc_link", &input_args::dc_link},
+    {"sto", &input_args::sto},
+    {"fault", &input_args::fault},
+    {"fault_class", &input_args::fault_class},
+    {"standstill", &input_args::standstill},
+    {"brake_engaged", &input_args::brake_engaged},
+    {"remote", &input_args::remote},
+    {"connection_lost", &input_args::connection_lost},
+    {"local_enable", &input_args::local_enable},
+    {"local_disable", &input_args::local_disable},
+    {"status_bits", &input_args::status_bits},
+    {"actual_speed_rpm", &input_args::actual_speed_rpm},
+};
+constexpr std::size_t input_keyword_count = std::size(input_keywords);
+
+[[noreturn]] void raise_type_error(const std::string& message) {
+  PyErr_SetString(PyExc_TypeError, message.c_str());
+  throw py::error_already_set();
+}
+
+std::size_t keyword_of(PyObject* key, const char* function) {
+  static PyObject* interned[input_keyword_count] = {};
+  if (interned[0] == nullptr) {
+    for (std::size_t i = 0; i < input_keyword_count; ++i) interned[i] = PyUnicode_InternFromString(input_keywords[i].name);
+  }
+  for (std::size_t i = 0; i < input_keyword_count; ++i) {
+    if (key == interned[i]) return i;
+  }
+  for (std::size_t i = 0; i < input_keyword_count; ++i) {
+    if (PyUnicode_Check(key) && PyUnicode_CompareWithASCIIString(key, input_keywords[i].name) == 0) return i;
+  }
+  raise_type_error(std::string(function) + "() got an unexpected keyword argument '" + py::str(key).cast<std::string>() + "'");
+}
+
+input_args parse_inputs(const py::kwargs& kwargs, const char* function) {
+  input_args a;
+  PyObject* key = nullptr;
+  PyObject* value = nullptr;
+  Py_ssize_t at = 0;
+  while (PyDict_Next(kwargs.ptr(), &at, &key, &value)) {
+    const input_keyword& k = input_keywords[keyword_of(key, function)];
+    if (value == Py_None) continue;
+    std::visit(
+        [&](auto member) {
+          using type = typename std::remove_reference_t<decltype(a.*member)>::value_type;
+          if constexpr (std::is_same_v<type, bool>) {
+            if (!PyBool_Check(value)) raise_type_error(std::string(function) + "(): " + k.name + " takes True or False");
+            a.*member = value == Py_True;
+          } else {
+            if (PyFloat_Check(value) || !PyIndex_Check(value)) {
+              raise_type_error(std::string(function) + "(): " + k.name + " takes an int");
+            }
+            const auto number = py::reinterpret_steal<py::object>(PyNumber_Index(value));
+            int overflow = 0;
+            const long long v = PyLong_AsLongLongAndOverflow(number.ptr(), &overflow);
+            if (overflow != 0) raise_argument_error(std::string(k.name) + " is beyond 64 bits");
+            a.*member = v;
+          }
+        },
+        k.member);
+  }
+  return a;
+}
 
 // The objects an ideal drive answers besides its option codes: its control-word input and what
 // its last step decided.
@@ -259,7 +334,10 @@ running ("none", "slow_down", "quick_stop", "current_limit", "voltage_limit", "c
       }, "state, status_word, transitions, torque, brake, ramp and error_code as a dict.")
       .def("__repr__", [](const step_outputs& o) {
         std::string t;
-        for (const auto n : o.transitions) t += (t.empty() ? "" : ", ") + std::to_string(n);
+        for (const auto n : o.transitions) {
+          if (!t.empty()) t += ", ";
+          t += std::to_string(n);
+        }
         char word[8];
         std::snprintf(word, sizeof word, "0x%04X", o.out.status_word);
         return std::string("Outputs(state='") + state_name(o.out.current) + "', status_word=" + word +
@@ -293,41 +371,15 @@ access raises SdoError with its abort code.)doc")
                   },
                   py::arg("path"), py::arg("plant") = py::none(),
                   "A drive on a TOML profile file; ProfileError with the line and reason.")
-      .def("step",
-           [](drive_core& d, std::optional<std::int64_t> control_word, std::optional<bool> dc_link,
-              std::optional<bool> sto, std::optional<std::int64_t> fault, std::optional<std::int64_t> fault_class,
-              std::optional<bool> standstill, std::optional<bool> brake_engaged, std::optional<bool> remote,
-              std::optional<bool> connection_lost, std::optional<bool> local_enable,
-              std::optional<bool> local_disable, std::optional<std::int64_t> status_bits,
-              std::optional<std::int64_t> actual_speed_rpm) {
-             return d.step({control_word, dc_link, sto, fault, fault_class, standstill, brake_engaged, remote,
-                            connection_lost, local_enable, local_disable, status_bits, actual_speed_rpm});
-           },
-           py::kw_only(), py::arg("control_word") = py::none(), py::arg("dc_link") = py::none(),
-           py::arg("sto") = py::none(), py::arg("fault") = py::none(), py::arg("fault_class") = py::none(),
-           py::arg("standstill") = py::none(), py::arg("brake_engaged") = py::none(),
-           py::arg("remote") = py::none(), py::arg("connection_lost") = py::none(),
-           py::arg("local_enable") = py::none(), py::arg("local_disable") = py::none(),
-           py::arg("status_bits") = py::none(), py::arg("actual_speed_rpm") = py::none(),
-           (std::string("Runs one cycle and returns its Outputs.\n") + inputs_doc).c_str())
-      .def("settle",
-           [](drive_core& d, std::optional<std::int64_t> control_word, std::optional<bool> dc_link,
-              std::optional<bool> sto, std::optional<std::int64_t> fault, std::optional<std::int64_t> fault_class,
-              std::optional<bool> standstill, std::optional<bool> brake_engaged, std::optional<bool> remote,
-              std::optional<bool> connection_lost, std::optional<bool> local_enable,
-              std::optional<bool> local_disable, std::optional<std::int64_t> status_bits,
-              std::optional<std::int64_t> actual_speed_rpm) {
-             return d.settle({control_word, dc_link, sto, fault, fault_class, standstill, brake_engaged, remote,
-                              connection_lost, local_enable, local_disable, status_bits, actual_speed_rpm});
-           },
-           py::kw_only(), py::arg("control_word") = py::none(), py::arg("dc_link") = py::none(),
-           py::arg("sto") = py::none(), py::arg("fault") = py::none(), py::arg("fault_class") = py::none(),
-           py::arg("standstill") = py::none(), py::arg("brake_engaged") = py::none(),
-           py::arg("remote") = py::none(), py::arg("connection_lost") = py::none(),
-           py::arg("local_enable") = py::none(), py::arg("local_disable") = py::none(),
-           py::arg("status_bits") = py::none(), py::arg("actual_speed_rpm") = py::none(),
-           (std::string("Steps with these inputs until the drive is at rest (at most 64 steps), as a "
-                        "replay line does; the Outputs list every transition taken.\n") + inputs_doc).c_str())
+      .def("step", [](drive_core& d, const py::kwargs& inputs) { return d.step(parse_inputs(inputs, "step")); },
+           (std::string("step(*, control_word=None, dc_link=None, sto=None, fault=None, fault_class=None, "
+                        "standstill=None, brake_engaged=None, remote=None, connection_lost=None, "
+                        "local_enable=None, local_disable=None, status_bits=None, actual_speed_rpm=None)\n\n"
+                        "Runs one cycle and returns its Outputs.\n") + inputs_doc).c_str())
+      .def("settle", [](drive_core& d, const py::kwargs& inputs) { return d.settle(parse_inputs(inputs, "settle")); },
+           (std::string("settle(*, control_word=None, ...): the inputs of step()\n\n"
+                        "Steps with these inputs until the drive is at rest (at most 64 steps), as a replay "
+                        "line does; the Outputs list every transition taken.\n") + inputs_doc).c_str())
       .def("read", [](const drive_core& d, std::int64_t index, std::int64_t sub) {
              return d.read(object_key_of(py::make_tuple(index, sub)));
            }, py::arg("index"), py::arg("sub") = 0, "Reads an object; SdoError when refused.")

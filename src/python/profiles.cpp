@@ -21,7 +21,8 @@ namespace {
 std::string builtin_names() {
   std::string list;
   for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
-    list += (i ? ", " : "") + std::string(builtin_profile(i).name);
+    if (i != 0) list += ", ";
+    list += builtin_profile(i).name;
   }
   return list;
 }

@@ -4,7 +4,8 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
-#include <cstring>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -29,19 +30,20 @@ std::int64_t integer_of(const py::handle& h, const char* what) {
   return v;
 }
 
-/// The int64 values of a C-contiguous buffer (a NumPy int64 array) of 1 or 2 dimensions, copied
-/// at once; false for any other object.
-bool int64_buffer(const py::handle& values, std::vector<std::int64_t>& out, std::vector<py::ssize_t>& shape) {
-  if (py::isinstance<py::sequence>(values) == false || !PyObject_CheckBuffer(values.ptr())) return false;
-  const py::buffer_info b = py::reinterpret_borrow<py::buffer>(values).request();
-  if (b.itemsize != 8 || (b.format != "q" && b.format != "l") || b.ndim < 1 || b.ndim > 2) return false;
+/// A C-contiguous int64 buffer (a NumPy int64 array) of 1 or 2 dimensions, viewed in place (the
+/// view keeps it alive); nothing for any other object.
+std::optional<py::buffer_info> int64_buffer(const py::handle& values) {
+  if (!py::isinstance<py::sequence>(values) || !PyObject_CheckBuffer(values.ptr())) return std::nullopt;
+  py::buffer_info b = py::reinterpret_borrow<py::buffer>(values).request();
+  if (b.itemsize != 8 || (b.format != "q" && b.format != "l") || b.ndim < 1 || b.ndim > 2) return std::nullopt;
   for (py::ssize_t d = b.ndim - 1, stride = 8; d >= 0; stride *= b.shape[static_cast<std::size_t>(d)], --d) {
-    if (b.strides[static_cast<std::size_t>(d)] != stride) return false;
+    if (b.strides[static_cast<std::size_t>(d)] != stride) return std::nullopt;
   }
-  out.resize(static_cast<std::size_t>(b.size));
-  if (!out.empty()) std::memcpy(out.data(), b.ptr, out.size() * 8);
-  shape = b.shape;
-  return true;
+  return b;
+}
+
+std::span<const std::int64_t> values_of(const py::buffer_info& b) {
+  return {static_cast<const std::int64_t*>(b.ptr), static_cast<std::size_t>(b.size)};
 }
 
 /// Values from a scalar (one value) or a flat sequence of scalars.
@@ -49,13 +51,14 @@ std::vector<std::int64_t> values_for(const py::handle& values, const char* what)
   if (!py::isinstance<py::sequence>(values) && PyIndex_Check(values.ptr())) {
     return std::vector<std::int64_t>(1, integer_of(values, what));
   }
-  std::vector<std::int64_t> out;
-  std::vector<py::ssize_t> shape;
-  if (int64_buffer(values, out, shape) && shape.size() == 1) return out;
-  out.clear();
+  if (const auto b = int64_buffer(values); b && b->ndim == 1) {
+    const auto v = values_of(*b);
+    return {v.begin(), v.end()};
+  }
   if (py::isinstance<py::str>(values) || !py::hasattr(values, "__iter__")) {
     raise_argument_error(std::string(what) + " takes an int or a sequence of ints");
   }
+  std::vector<std::int64_t> out;
   for (const py::handle v : py::iter(values)) out.push_back(integer_of(v, what));
   return out;
 }
@@ -88,13 +91,15 @@ py::object int_column(const std::vector<std::int64_t>& v) {
 
 void stream(machine_core& m, std::int64_t index, const py::object& values, std::int64_t sub) {
   const object_key k = object_key_of(py::make_tuple(index, sub));
-  std::vector<std::int64_t> flat;
-  std::vector<py::ssize_t> shape;
+  // A NumPy table is read where it is; anything else is gathered into `gathered` first.
+  const std::optional<py::buffer_info> table = int64_buffer(values);
+  std::vector<std::int64_t> gathered;
+  std::span<const std::int64_t> flat;
   std::size_t width = 0;
-  if (int64_buffer(values, flat, shape)) {
-    width = shape.size() == 1 ? 1 : static_cast<std::size_t>(shape[1]);
+  if (table) {
+    flat = values_of(*table);
+    width = table->ndim == 1 ? 1 : static_cast<std::size_t>(table->shape[1]);
   } else {
-    flat.clear();
     if (py::isinstance<py::str>(values) || !py::hasattr(values, "__iter__")) {
       raise_argument_error("stream takes a sequence of rows");
     }
@@ -102,14 +107,15 @@ void stream(machine_core& m, std::int64_t index, const py::object& values, std::
       const std::vector<std::int64_t> v = values_for(row, "stream");
       if (width == 0) width = v.size();
       if (v.size() != width) raise_argument_error("stream: every row has the same number of values");
-      flat.insert(flat.end(), v.begin(), v.end());
+      gathered.insert(gathered.end(), v.begin(), v.end());
     }
+    flat = gathered;
   }
+  if (flat.empty()) return;
   if (width != 1 && width != m.size()) {
     raise_argument_error("stream: every row is one value for all axes or one per axis (" +
                          std::to_string(m.size()) + ")");
   }
-  if (flat.empty()) return;
   m.check_writes(k.index, k.sub, flat);
   machine_core::use busy(m);
   py::gil_scoped_release nogil;

@@ -86,7 +86,10 @@ plant_config plant_config_from(const py::handle& plant) {
                                  [&](const plant_field& each) { return name == each.name; });
     if (f == std::end(plant_fields)) {
       std::string known;
-      for (const plant_field& each : plant_fields) known += (known.empty() ? "" : ", ") + std::string(each.name);
+      for (const plant_field& each : plant_fields) {
+        if (!known.empty()) known += ", ";
+        known += each.name;
+      }
       raise_argument_error("unknown plant key '" + name + "' (the keys: " + known + ")");
     }
     set_field(c, *f, value);
@@ -143,7 +146,7 @@ void machine_core::step_cycles(std::uint64_t cycles) noexcept {
 }
 
 void machine_core::check_writes(std::uint16_t index, std::uint8_t sub,
-                                const std::vector<std::int64_t>& values) const {
+                                std::span<const std::int64_t> values) const {
   // A scratch axis: whether a write is refused depends on the profile, the object and the value,
   // never on the axis's state (sim/virtual_drive.hpp), so one scratch axis answers for all.
   sim::axis_state scratch = sim::make_axis_state(profile_->get(), machine_.constants());
@@ -155,7 +158,7 @@ void machine_core::check_writes(std::uint16_t index, std::uint8_t sub,
   }
 }
 
-void machine_core::stream(std::uint16_t index, std::uint8_t sub, const std::vector<std::int64_t>& values,
+void machine_core::stream(std::uint16_t index, std::uint8_t sub, std::span<const std::int64_t> values,
                           std::size_t width) noexcept {
   const std::size_t n = size();
   for (std::size_t row = 0; row * width < values.size(); ++row) {

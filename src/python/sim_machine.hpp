@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -60,11 +61,11 @@ class machine_core {
   /// Steps one cycle per row of `values` (cycles x width, width 1 or size()), writing row k to
   /// index:sub of every axis before cycle k. The values are checked beforehand. Call with the GIL
   /// released and a `use` held.
-  void stream(std::uint16_t index, std::uint8_t sub, const std::vector<std::int64_t>& values,
+  void stream(std::uint16_t index, std::uint8_t sub, std::span<const std::int64_t> values,
               std::size_t width) noexcept;
   /// Refuses (SdoError) a write of any of `values` to index:sub before anything is written: the
   /// result of a write depends only on the profile, the object and the value.
-  void check_writes(std::uint16_t index, std::uint8_t sub, const std::vector<std::int64_t>& values) const;
+  void check_writes(std::uint16_t index, std::uint8_t sub, std::span<const std::int64_t> values) const;
 
   /// Starts (on) or stops recording an axis's cycles; a stopped trace keeps its rows until
   /// clear_trace().

@@ -82,7 +82,10 @@ const trace_column& find_column(const std::string& name) {
     if (name == c.name) return c;
   }
   std::string known;
-  for (const trace_column& c : trace_columns) known += (known.empty() ? "" : ", ") + std::string(c.name);
+  for (const trace_column& c : trace_columns) {
+    if (!known.empty()) known += ", ";
+    known += c.name;
+  }
   raise_argument_error("no trace column '" + name + "' (the columns: " + known + ")");
 }
 
