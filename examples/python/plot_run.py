@@ -39,17 +39,19 @@ def main(argv):
     trace = run()
     seconds = [t / 1e6 for t in trace["time_us"]]
     states = list(trace["state"])
-    figure, (speed, lanes) = plt.subplots(2, 1, sharex=True, figsize=(9, 5),
-                                          gridspec_kw={"height_ratios": [3, 1]})
+    figure, (speed, state, torque) = plt.subplots(3, 1, sharex=True, figsize=(9, 6),
+                                                  gridspec_kw={"height_ratios": [4, 2, 1]})
     speed.plot(seconds, list(trace["velocity_rpm"]), label="velocity (0x606C)")
     speed.plot(seconds, list(trace["target_rpm"]), "--", label="target (0x60FF)")
     speed.set_ylabel("rpm")
-    speed.legend(loc="upper right")
-    names = sorted(set(states), key=states.index)
-    lanes.step(seconds, [names.index(s) for s in states], where="post", label="state")
-    lanes.step(seconds, [-1 + int(t) for t in trace["torque"]], where="post", label="torque on")
-    lanes.set_yticks(range(-1, len(names)), ["torque"] + names, fontsize=7)
-    lanes.set_xlabel("s")
+    speed.legend(loc="upper left")
+    names = sorted(set(states), key=states.index)  # in the order the run visits them
+    state.step(seconds, [names.index(s) for s in states], where="post")
+    state.set_yticks(range(len(names)), names, fontsize=7)
+    torque.step(seconds, [int(t) for t in trace["torque"]], where="post", color="tab:red")
+    torque.set_yticks([0, 1], ["off", "on"], fontsize=7)
+    torque.set_ylabel("torque", fontsize=8)
+    torque.set_xlabel("s")
     figure.tight_layout()
     figure.savefig(out, dpi=100)
     print(f"plot_run: wrote {out}")
