@@ -153,6 +153,7 @@ class drive_core {
 
   std::int64_t read(const object_key& k) const {
     if (plant_) {
+      machine_core::use busy(*plant_);
       std::int64_t value = 0;
       check_access(plant_->get().drive(0).read(k.index, k.sub, value), k.index, k.sub, "reading");
       return value;
@@ -195,6 +196,8 @@ class drive_core {
   }
 
   py::dict inputs() const {
+    std::optional<machine_core::use> busy;
+    if (plant_) busy.emplace(*plant_);
     const drive_inputs in = plant_ ? plant_->get().drive(0).inputs() : inputs_;
     py::dict d;
     d["control_word"] = plant_ ? plant_->get().drive(0).control_word() : in.control_word;
@@ -214,7 +217,10 @@ class drive_core {
   }
 
   step_outputs last() const {
-    if (plant_) return outputs_of(plant_->get().drive(0));
+    if (plant_) {
+      machine_core::use busy(*plant_);
+      return outputs_of(plant_->get().drive(0));
+    }
     step_outputs o;
     o.out = last_;
     if (last_.transition != no_transition) o.transitions.push_back(last_.transition);

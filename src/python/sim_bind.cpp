@@ -308,6 +308,11 @@ before any cycle runs.)doc")
       .def("axis", [](const machine_ptr& m, std::int64_t i) { return axis_handle{m, m->checked_axis(i)}; },
            py::arg("i"))
       .def("__len__", &machine_core::size)
+      .def("__iter__", [](const machine_ptr& m) {
+        py::list axes;
+        for (std::size_t i = 0; i < m->size(); ++i) axes.append(axis_handle{m, i});
+        return py::iter(axes);
+      }, "The axes, in order.")
       .def("__getitem__", [](const machine_ptr& m, std::int64_t i) { return axis_handle{m, m->checked_axis(i)}; })
       .def("record", [](machine_core& m, std::int64_t axis, bool on) {
              machine_core::use busy(m);

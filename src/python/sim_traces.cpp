@@ -168,6 +168,11 @@ position_demand, torque_permille, mode, digital_inputs (0x60FD).)doc")
         return py::tuple(py::cast(names));
       })
       .def("__len__", [](const trace_data& t) { return t.rows.size(); })
+      .def("__iter__", [](const trace_data&) {
+        py::list names;
+        for (const trace_column& c : trace_columns) names.append(c.name);
+        return py::iter(names);
+      }, "The column names, as a mapping's keys.")
       .def("__getitem__", [](const trace_data& t, const std::string& name) { return column_of(t, find_column(name)); })
       .def("__contains__", [](const trace_data&, const std::string& name) {
         for (const trace_column& c : trace_columns) {

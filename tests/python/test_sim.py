@@ -191,4 +191,13 @@ def test_homing_phase_and_the_digital_inputs():
     a = m.axis(0)
     assert a.homing_phase == "not started" and a.digital_inputs & 0x10000  # an index pulse at 0
     assert a.brake_engaged and a.following_error == 0 and a.torque_permille == 0
-    assert repr(a) == "cia402.sim.Axis(0, state='START')" or "Axis(0" in repr(a)
+    assert repr(a) == "cia402.sim.Axis(0, state='START')"  # not stepped yet: T0 comes first
+    assert repr(m) == "cia402.sim.Machine(axes=1, profile='cia402', time_us=0)"
+
+
+def test_a_machine_iterates_its_axes_and_a_trace_its_columns():
+    m = sim.Machine(axes=3, trace=[0])
+    assert [a.index for a in m] == [0, 1, 2]
+    m.advance(2)
+    t = m.trace(0)
+    assert list(t) == list(t.columns) and dict(zip(t, (t[c] for c in t)))["time_us"][1] == 1000

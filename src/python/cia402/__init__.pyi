@@ -1,6 +1,6 @@
 # Type stubs of the public cia402 package (the classes and functions come from the extension
 # module _cia402). tests/python/test_stubs.py checks they name exactly what the package has.
-from typing import Any, Dict, Iterable, List, Literal, Mapping, Optional, Tuple, Union, overload
+from typing import Any, Dict, Iterable, List, Literal, Mapping, Optional, Tuple, Union
 
 from . import sim as sim
 from ._errors import (
