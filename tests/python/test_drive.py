@@ -113,6 +113,18 @@ def test_an_input_out_of_range_is_refused_and_changes_nothing():
         d.step(6)  # keywords only
 
 
+def test_inputs_take_their_own_types_and_none_leaves_an_input_as_it_is():
+    d = cia402.Drive()
+    d.settle(control_word=0x06)
+    with pytest.raises(TypeError, match="sto takes True or False"):
+        d.step(sto=1)
+    with pytest.raises(TypeError, match="control_word takes an int"):
+        d.step(control_word=6.0)
+    assert d.step(control_word=None, sto=None).state == RTSO and d.inputs["control_word"] == 0x06
+    numpy = pytest.importorskip("numpy")
+    assert d.settle(control_word=numpy.int64(0x0F)).transitions == [3, 4]  # anything with __index__
+
+
 def test_option_codes_are_written_and_read_by_index():
     d = cia402.Drive()
     assert d[0x605A] == 2 and d.read(0x605E) == 2
