@@ -22,11 +22,11 @@ install(TARGETS ${cia402_exported_targets}
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})  # include dirs: each target's INSTALL_INTERFACE
-# Only the headers of the exported libraries: the tools-side layers (diagram, sim, canopen,
+# Only the headers of the exported libraries: the tools-side layers (diagram, replay, sim, canopen,
 # ethercat, page, motion) are built for the cia402 tool and are not part of the package.
-set(cia402_header_excludes PATTERN "diagram.hpp" EXCLUDE PATTERN "sim" EXCLUDE
+set(cia402_header_excludes PATTERN "diagram.hpp" EXCLUDE PATTERN "replay.hpp" EXCLUDE PATTERN "sim" EXCLUDE
     PATTERN "canopen" EXCLUDE PATTERN "ethercat" EXCLUDE PATTERN "page" EXCLUDE PATTERN "motion" EXCLUDE
-    PATTERN "drive402" EXCLUDE PATTERN "apps" EXCLUDE)
+    PATTERN "drive402" EXCLUDE PATTERN "apps" EXCLUDE PATTERN "axis" EXCLUDE)
 if(NOT TARGET cia402_profile_file)
   list(APPEND cia402_header_excludes PATTERN "profile_file.hpp" EXCLUDE)  # no library for it
 endif()

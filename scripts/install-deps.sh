@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 (bookworm) package needed to build, test and run cia402. Idempotent: on a
 # machine that already has them all it only asks dpkg and returns, without touching apt.
+# The Python package needs pybind11 and Python's headers to build; NumPy is optional at run time
+# (its tests take both paths) and matplotlib is not installed: examples/python/plot_run.py skips
+# itself without it.
 set -euo pipefail
 
 packages=(
@@ -11,6 +14,7 @@ packages=(
   clang libclang-rt-14-dev
   gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib
   chromium python3-can python3-pytest
+  pybind11-dev python3-pybind11 python3-dev python3-numpy
   iproute2 tshark
 )
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds cia402 (release preset) and runs the main job: `cia402 serve`, the virtual drive and its
-# instrument control page. As root on a fresh Debian 12 it installs what
+# instrument control page. It builds the Python package too (build/release/python: `PYTHONPATH=
+# build/release/python python3 -c 'import cia402'`), when pybind11 is there (install-deps.sh). As root on a fresh Debian 12 it installs what
 # it needs first. Arguments are passed to the job.
 set -euo pipefail
 
@@ -12,5 +13,9 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 bash scripts/install-deps.sh
 cmake --preset release
-cmake --build --preset release --target cia402
+python_target=()
+if grep -q '^cia402_python:' <(cmake --build --preset release --target help 2>/dev/null); then
+  python_target=(cia402_python)
+fi
+cmake --build --preset release --target cia402 "${python_target[@]}"
 exec "$root/build/release/tools/cia402" "${main_job[@]}" "$@"

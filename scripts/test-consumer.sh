@@ -5,7 +5,8 @@
 #      has it, cia402::profile_file through profile_file_consumer.cpp);
 #   2. pkg-config against the same install, compiled with -fno-exceptions -fno-rtti;
 #   3. add_subdirectory() of the source tree.
-# Also checks that README.md's usage example is tests/consumer/main.cpp, word for word.
+# Also checks that README.md's usage example is tests/consumer/main.cpp, word for word, and that the
+# Python package, when built, imports from the prefix it was installed into.
 # Extra cmake arguments for the library build: CIA402_CONSUMER_CMAKE_ARGS (e.g. -DCIA402_BUILD_TOOLS=OFF).
 set -euo pipefail
 
@@ -36,6 +37,13 @@ cmake --install "$work/lib" --prefix "$prefix"
 (cd "$prefix" && find . -type f | sort)
 if [ -e "$prefix/bin/cia402" ]; then
   "$prefix/bin/cia402" --help > /dev/null
+fi
+# The Python package, when it was built (pybind11 found): it imports from where it was installed.
+python_init=$(find "$prefix" -path '*/dist-packages/cia402/__init__.py' -print -quit)
+if [ -n "$python_init" ]; then
+  say "the Python package imports from the prefix"
+  PYTHONPATH=$(dirname "$(dirname "$python_init")") /usr/bin/python3 -c \
+    'import cia402; print(cia402.__version__, cia402.__file__); assert cia402.Drive().settle().transitions == [0, 1]'
 fi
 
 say "1/3 find_package(cia402 CONFIG)"

@@ -6,7 +6,7 @@
 #   no-exceptions preset: build the core
 #   alone as C++17 without exceptions or RTTI; release preset: benchmarks (a short run, ratios to the
 #   baseline), instructions per step (callgrind), whether g++ inlines the compiled step at -O2 and
-#   -O3, the Cortex-M4 flash and RAM, the state diagrams
+#   -O3, the Cortex-M4 flash and RAM, the Python binding's overhead (bench/python), the state diagrams
 #   against docs/diagrams; the libFuzzer targets for 30 s each (tests/fuzz/run.sh); then
 #   scripts/test-consumer.sh.
 set -euo pipefail
@@ -83,8 +83,12 @@ bash bench/cortex_m4/size.sh build/cortex-m4
 # and the instructions per axis-step, which are not.
 build/release/bench/cia402_sim_bench --benchmark_filter=sim_1000_axes_csp
 bash bench/instructions/sim_instructions.sh build/release/bench/cia402_sim_bench
+# The Python binding's overhead: steps/s from Python beside the same in C++ (printed, not judged).
+if [ -d build/release/python/cia402 ]; then
+  /usr/bin/python3 bench/python/bench.py build/release
+fi
 bash scripts/diagrams.sh build/release/tools/cia402 --check
-done_steps+=("release: bench, inlining, sim bench, cortex-m4 size, diagrams")
+done_steps+=("release: bench, inlining, sim bench, Python bench, cortex-m4 size, diagrams")
 
 banner fuzz
 bash tests/fuzz/run.sh 30
