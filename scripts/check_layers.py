@@ -83,7 +83,7 @@ ALLOWED = {
     "canopen/402": {"core", "support", "canopen/can", "canopen/301", "canopen/306"},
     "drive402": {"core", "motion", "sim", "canopen/301"},
     "ethercat/esc": set(),
-    "ethercat/sii": set(),
+    "ethercat/sii": {"support"},
     "ethercat/coe": {"core"},
     "ethercat/slave": {"core", "canopen/301", "ethercat/esc", "ethercat/sii", "ethercat/coe"},
     "ethercat/master": {"core", "ethercat/esc", "ethercat/sii", "ethercat/coe"},

@@ -1,6 +1,6 @@
 // Text helpers the layers above the core share: one way to write a number in hexadecimal and one
-// way to read an integer a person typed (decimal or 0x-hexadecimal), so every file format, message
-// and command line agrees.
+// way to read an integer a person typed (decimal or 0x-hexadecimal), and one way to put text into XML
+// (the ESI file, the SVG plot), so every file format, message and command line agrees.
 #pragma once
 
 #include <cstdint>
@@ -17,5 +17,9 @@ std::string hex(std::uint64_t value, int digits);
 /// A decimal or 0x-hexadecimal integer with an optional sign, the whole text and nothing else,
 /// within [min, max]; nothing otherwise.
 std::optional<std::int64_t> parse_integer(std::string_view text, std::int64_t min, std::int64_t max);
+
+/// `text` with XML's five special characters written as entities, for element content and quoted
+/// attribute values alike.
+std::string xml_escaped(std::string_view text);
 
 }  // namespace cia402::support
