@@ -78,7 +78,7 @@ ALLOWED = {
     "canopen/can": {"core"},
     "canopen/301": {"core", "canopen/can"},
     "canopen/306": {"core", "support", "canopen/can", "canopen/301"},
-    "canopen/transport": {"core", "canopen/can"},
+    "canopen/transport": {"core", "support", "canopen/can"},
     "canopen/monitor": {"core", "canopen/can", "canopen/301"},
     "canopen/402": {"core", "support", "canopen/can", "canopen/301", "canopen/306"},
     "drive402": {"core", "motion", "sim", "canopen/301"},
