@@ -20,16 +20,11 @@ ethercat_host::ethercat_host(const profile& p, int nodes, std::uint32_t cycle_us
 }
 
 ethercat_host::~ethercat_host() {
-  if (fd_ >= 0) ::close(fd_);
+  if (socket_.fd >= 0) ::close(socket_.fd);
 }
 
 std::error_code ethercat_host::open(const std::string& interface) {
-  detail::raw_socket opened;
-  if (const std::error_code ec = detail::open_raw_ethercat_socket(interface, opened)) return ec;
-  if (fd_ >= 0) ::close(fd_);
-  fd_ = opened.fd;
-  ifindex_ = opened.ifindex;
-  return {};
+  return detail::open_raw_ethercat_socket(interface, socket_);
 }
 
 bool ethercat_host::pass(std::vector<std::uint8_t>& frame) {
@@ -50,22 +45,22 @@ void ethercat_host::run(const volatile std::sig_atomic_t& stop) {
   std::vector<std::uint8_t> frame(ethercat::maximum_frame_size + 4);
   while (stop == 0) {
     // Sleep until a frame comes or the next cycle is due, to the microsecond: no busy loop.
-    pollfd p{fd_, POLLIN, 0};
+    pollfd p{socket_.fd, POLLIN, 0};
     const std::uint32_t wait_us = cycle_us_ > pending_us ? cycle_us_ - pending_us : 0;
     const timespec wait{0, static_cast<long>(wait_us) * 1000};
     (void)::ppoll(&p, 1, &wait, nullptr);
     // Every frame waiting, answered at once: a master's cycle is a frame and its answer.
-    for (int burst = 0; burst < 64 && fd_ >= 0; ++burst) {
+    for (int burst = 0; burst < 64 && socket_.fd >= 0; ++burst) {
       sockaddr_ll from{};
       socklen_t from_len = sizeof from;
       frame.resize(ethercat::maximum_frame_size + 4);
-      const ssize_t n = ::recvfrom(fd_, frame.data(), frame.size(), MSG_DONTWAIT,
+      const ssize_t n = ::recvfrom(socket_.fd, frame.data(), frame.size(), MSG_DONTWAIT,
                                    reinterpret_cast<sockaddr*>(&from), &from_len);
       if (n <= 0) break;
       if (from.sll_pkttype == PACKET_OUTGOING) continue;  // our own answer, seen going out
       frame.resize(static_cast<std::size_t>(n));
       if (!pass(frame)) continue;
-      (void)detail::send_raw_frame({fd_, ifindex_}, frame);
+      (void)detail::send_raw_frame(socket_, frame);
     }
     pending_us += clock.take();
     // Catch up at most a few cycles: a stalled host does not replay a second of drive time at once.

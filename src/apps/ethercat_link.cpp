@@ -21,33 +21,28 @@ ethercat_link::ethercat_link(std::uint32_t answer_timeout_us)
     : answer_timeout_us_(answer_timeout_us), buffer_(ethercat::maximum_frame_size + 4) {}
 
 ethercat_link::~ethercat_link() {
-  if (fd_ >= 0) ::close(fd_);
+  if (socket_.fd >= 0) ::close(socket_.fd);
 }
 
 std::error_code ethercat_link::open(const std::string& interface) {
-  detail::raw_socket opened;
-  if (const std::error_code ec = detail::open_raw_ethercat_socket(interface, opened)) return ec;
-  if (fd_ >= 0) ::close(fd_);
-  fd_ = opened.fd;
-  ifindex_ = opened.ifindex;
-  return {};
+  return detail::open_raw_ethercat_socket(interface, socket_);
 }
 
 bool ethercat_link::exchange(std::vector<std::uint8_t>& frame) {
-  if (fd_ < 0 || frame.size() <= first_index_at) return false;
-  if (!detail::send_raw_frame({fd_, ifindex_}, frame)) return false;
+  if (socket_.fd < 0 || frame.size() <= first_index_at) return false;
+  if (!detail::send_raw_frame(socket_, frame)) return false;
   const std::uint8_t index = frame[first_index_at];
   const std::uint64_t until = now_us() + answer_timeout_us_;
   for (;;) {
     const std::uint64_t now = now_us();
     if (now >= until) return false;
-    pollfd p{fd_, POLLIN, 0};
+    pollfd p{socket_.fd, POLLIN, 0};
     const std::uint64_t left = until - now;
     const timespec wait{static_cast<time_t>(left / 1000000), static_cast<long>(left % 1000000) * 1000};
     if (::ppoll(&p, 1, &wait, nullptr) <= 0) continue;
     sockaddr_ll from{};
     socklen_t from_len = sizeof from;
-    const ssize_t n = ::recvfrom(fd_, buffer_.data(), buffer_.size(), MSG_DONTWAIT,
+    const ssize_t n = ::recvfrom(socket_.fd, buffer_.data(), buffer_.size(), MSG_DONTWAIT,
                                  reinterpret_cast<sockaddr*>(&from), &from_len);
     if (n <= 0) continue;
     if (from.sll_pkttype == PACKET_OUTGOING) continue;  // our own frame, seen going out

@@ -13,7 +13,7 @@
 
 namespace cia402::apps::detail {
 
-std::error_code open_raw_ethercat_socket(const std::string& interface, raw_socket& out) {
+std::error_code open_raw_ethercat_socket(const std::string& interface, raw_socket& held) {
   const unsigned index = ::if_nametoindex(interface.c_str());
   if (index == 0) return {errno != 0 ? errno : ENODEV, std::generic_category()};
   const int fd = ::socket(AF_PACKET, SOCK_RAW | SOCK_CLOEXEC, htons(ethercat::ethertype));
@@ -27,8 +27,9 @@ std::error_code open_raw_ethercat_socket(const std::string& interface, raw_socke
     ::close(fd);
     return {e, std::generic_category()};
   }
-  out.fd = fd;
-  out.ifindex = static_cast<int>(index);
+  if (held.fd >= 0) ::close(held.fd);
+  held.fd = fd;
+  held.ifindex = static_cast<int>(index);
   return {};
 }
 

@@ -7,15 +7,13 @@
 #include <system_error>
 #include <vector>
 
+#include "cia402/apps/raw_socket.hpp"
+
 namespace cia402::apps::detail {
 
-struct raw_socket {
-  int fd = -1;
-  int ifindex = 0;
-};
-
-/// Opens and binds the socket on `interface`; on success `out` holds it (the caller closes it).
-std::error_code open_raw_ethercat_socket(const std::string& interface, raw_socket& out);
+/// Opens and binds the socket on `interface`; on success `held` is closed and then holds the new one
+/// (the caller closes it), on failure `held` is as it was.
+std::error_code open_raw_ethercat_socket(const std::string& interface, raw_socket& held);
 /// Sends a whole frame out of the interface, to the destination its first six bytes name.
 bool send_raw_frame(const raw_socket& s, const std::vector<std::uint8_t>& frame);
 

@@ -493,12 +493,7 @@ std::string state_list(std::uint16_t states) {
 }  // namespace
 
 std::string profile_file_error::message() const {
-  std::string out = source_name.empty() ? std::string("<profile>") : source_name;
-  if (line > 0) {
-    out += ":" + std::to_string(line);
-    if (column > 0) out += ":" + std::to_string(column);
-  }
-  return out + ": " + reason;
+  return support::located_message(source_name, "<profile>", line, column, reason);
 }
 
 const char* row_stop_name(row_stop s) noexcept {

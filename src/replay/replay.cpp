@@ -11,18 +11,7 @@ namespace cia402 {
 namespace {
 
 using support::hex;
-
-std::vector<std::string_view> split_words(std::string_view line) {
-  std::vector<std::string_view> words;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
-    if (i > start) words.push_back(line.substr(start, i - start));
-  }
-  return words;
-}
+using support::split_words;
 
 // A number as `cia402 replay` reads one: decimal or 0x-hexadecimal, within 32 bits signed or
 // unsigned; each event checks its own range after.

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cia402/sim/trace.hpp"
+#include "cia402/support/text.hpp"
 
 namespace cia402::sim {
 namespace {
@@ -61,20 +62,6 @@ std::string num(double v) {
   return s;
 }
 
-std::string escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 // A "nice" tick step (1, 2 or 5 x 10^k) giving about `target` intervals over span.
 double nice_step(double span, int target) {
   if (span <= 0) return 1;
@@ -111,6 +98,27 @@ struct scale {
   }
 };
 
+// Per pixel column, the first, lowest, highest and last sample in time order, each once: a line
+// drawn through them keeps every peak of a trace far longer than the plot is wide.
+template <typename Value, typename Point>
+void each_column_extremes(const std::vector<trace_row>& rows, const scale& s, Value value, Point point) {
+  auto column_of = [&](const trace_row& r) { return std::lround(std::floor(s.x(static_cast<double>(r.time_us)))); };
+  for (std::size_t i = 0; i < rows.size();) {
+    const long column = column_of(rows[i]);
+    std::size_t j = i, lo = i, hi = i;
+    while (j < rows.size() && column_of(rows[j]) == column) {
+      if (value(rows[j]) < value(rows[lo])) lo = j;
+      if (value(rows[j]) > value(rows[hi])) hi = j;
+      ++j;
+    }
+    std::vector<std::size_t> picks = {i, lo, hi, j - 1};
+    std::sort(picks.begin(), picks.end());
+    picks.erase(std::unique(picks.begin(), picks.end()), picks.end());
+    for (std::size_t k : picks) point(rows[k]);
+    i = j;
+  }
+}
+
 double rpm(std::int64_t micro) { return static_cast<double>(micro) / 1e6; }
 
 
@@ -133,8 +141,8 @@ void write_header(std::ostream& out, const trace_info& info, const layout& at, b
       << "\" font-family=\"DejaVu Sans, Arial, sans-serif\" font-size=\"11\">\n"
       << "<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n";
   out << "<text x=\"" << num(left) << "\" y=\"24\" font-size=\"15\" font-weight=\"bold\">"
-      << escape(info.title) << "</text>\n";
-  out << "<text x=\"" << num(left) << "\" y=\"42\" fill=\"#444\">profile " << escape(info.profile_name)
+      << support::xml_escaped(info.title) << "</text>\n";
+  out << "<text x=\"" << num(left) << "\" y=\"42\" fill=\"#444\">profile " << support::xml_escaped(info.profile_name)
       << ", cycle " << info.cycle_us << " us; velocity 0x606C (solid), target 0x60FF (dashed); "
       << (positions ? "position 0x6064 (magenta, right scale); torque 0x6077 below; " : "")
       << "bands: state; marks: transitions</text>\n";
@@ -271,24 +279,7 @@ void write_velocities(std::ostream& out, const std::vector<trace_row>& rows, con
     if (static_cast<double>(rows.size()) <= columns * 2) {
       for (const trace_row& r : rows) point(r);
     } else {
-      std::size_t i = 0;
-      while (i < rows.size()) {
-        const long column = std::lround(std::floor(s.x(static_cast<double>(rows[i].time_us))));
-        std::size_t j = i;
-        std::size_t lo = i;
-        std::size_t hi = i;
-        while (j < rows.size() &&
-               std::lround(std::floor(s.x(static_cast<double>(rows[j].time_us)))) == column) {
-          if (rows[j].velocity < rows[lo].velocity) lo = j;
-          if (rows[j].velocity > rows[hi].velocity) hi = j;
-          ++j;
-        }
-        std::vector<std::size_t> picks = {i, lo, hi, j - 1};
-        std::sort(picks.begin(), picks.end());
-        picks.erase(std::unique(picks.begin(), picks.end()), picks.end());
-        for (std::size_t k : picks) point(rows[k]);
-        i = j;
-      }
+      each_column_extremes(rows, s, [](const trace_row& r) { return r.velocity; }, point);
     }
   }
   out << "\"/>\n";
@@ -406,20 +397,7 @@ void write_torque_lane(std::ostream& out, const std::vector<trace_row>& rows, co
         << num(yt(static_cast<double>(r.torque_permille)));
     first = false;
   };
-  for (std::size_t i = 0; i < rows.size();) {
-    const long column = std::lround(std::floor(s.x(static_cast<double>(rows[i].time_us))));
-    std::size_t j = i, lo = i, hi = i;
-    while (j < rows.size() && std::lround(std::floor(s.x(static_cast<double>(rows[j].time_us)))) == column) {
-      if (rows[j].torque_permille < rows[lo].torque_permille) lo = j;
-      if (rows[j].torque_permille > rows[hi].torque_permille) hi = j;
-      ++j;
-    }
-    std::vector<std::size_t> picks = {i, lo, hi, j - 1};
-    std::sort(picks.begin(), picks.end());
-    picks.erase(std::unique(picks.begin(), picks.end()), picks.end());
-    for (std::size_t k : picks) point(rows[k]);
-    i = j;
-  }
+  each_column_extremes(rows, s, [](const trace_row& r) { return r.torque_permille; }, point);
   out << "\"/>\n</g>\n";
 }
 

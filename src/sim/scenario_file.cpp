@@ -474,12 +474,7 @@ std::string stem_of(std::string_view source_name) {
 }  // namespace
 
 std::string scenario_error::message() const {
-  std::string out = source_name.empty() ? std::string("<scenario>") : source_name;
-  if (line > 0) {
-    out += ":" + std::to_string(line);
-    if (column > 0) out += ":" + std::to_string(column);
-  }
-  return out + ": " + reason;
+  return support::located_message(source_name, "<scenario>", line, column, reason);
 }
 
 const char* invariant_name(invariant i) noexcept {

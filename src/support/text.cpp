@@ -8,7 +8,8 @@ namespace cia402::support {
 
 std::string hex(std::uint64_t value, int digits) { return fmt::format("0x{:0{}X}", value, digits); }
 
-std::optional<std::int64_t> parse_integer(std::string_view text, std::int64_t min, std::int64_t max) {
+std::optional<std::int64_t> parse_integer(std::string_view text, std::int64_t min, std::int64_t max,
+                                          leading_zero zero) {
   bool negative = false;
   if (!text.empty() && (text[0] == '-' || text[0] == '+')) {
     negative = text[0] == '-';
@@ -18,6 +19,8 @@ std::optional<std::int64_t> parse_integer(std::string_view text, std::int64_t mi
   if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
     base = 16;
     text.remove_prefix(2);
+  } else if (zero == leading_zero::octal && text.size() > 1 && text[0] == '0') {
+    base = 8;
   }
   // from_chars takes no sign of its own here: "--5" and "0x-5" are not numbers.
   if (text.empty() || text[0] == '-' || text[0] == '+') return std::nullopt;
@@ -31,6 +34,44 @@ std::optional<std::int64_t> parse_integer(std::string_view text, std::int64_t mi
                                       : static_cast<std::int64_t>(magnitude);
   if (value < min || value > max) return std::nullopt;
   return value;
+}
+
+std::string xml_escaped(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::vector<std::string_view> split_words(std::string_view line) {
+  std::vector<std::string_view> words;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+    if (i > start) words.push_back(line.substr(start, i - start));
+  }
+  return words;
+}
+
+std::string located_message(const std::string& source, const char* unnamed, int line, int column,
+                            const std::string& reason) {
+  std::string out = source.empty() ? std::string(unnamed) : source;
+  if (line > 0) {
+    out += ":" + std::to_string(line);
+    if (column > 0) out += ":" + std::to_string(column);
+  }
+  return out + ": " + reason;
 }
 
 }  // namespace cia402::support

@@ -12,6 +12,7 @@
 #include <system_error>
 #include <vector>
 
+#include "cia402/apps/raw_socket.hpp"
 #include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/esc/esc.hpp"
 #include "cia402/profile.hpp"
@@ -46,8 +47,7 @@ class ethercat_host {
   std::vector<std::unique_ptr<virtual_drive_slave>> drives_;
   ethercat::chain wire_;
   std::uint32_t cycle_us_;
-  int fd_ = -1;
-  int ifindex_ = 0;
+  detail::raw_socket socket_;
 };
 
 }  // namespace cia402::apps

@@ -9,6 +9,7 @@
 #include <system_error>
 #include <vector>
 
+#include "cia402/apps/raw_socket.hpp"
 #include "cia402/ethercat/master/ecat_master.hpp"
 
 namespace cia402::apps {
@@ -29,8 +30,7 @@ class ethercat_link final : public ethercat::master_link {
   void wait_us(std::uint32_t us) override;
 
  private:
-  int fd_ = -1;
-  int ifindex_ = 0;
+  detail::raw_socket socket_;
   std::uint32_t answer_timeout_us_;
   std::vector<std::uint8_t> buffer_;
 };

@@ -1,8 +1,11 @@
 #include "cia402/canopen/306/eds_reader.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <optional>
+
+#include "cia402/support/text.hpp"
 
 namespace cia402::canopen {
 namespace {
@@ -46,31 +49,8 @@ std::optional<std::uint32_t> hex_number(std::string_view s, std::size_t max_digi
 
 // CiA 306 §4.6.3: decimal, 0x-hexadecimal, or octal with a leading 0; an optional sign.
 std::optional<std::int64_t> integer(std::string_view s) {
-  s = trim(s);
-  bool negative = false;
-  if (!s.empty() && (s[0] == '-' || s[0] == '+')) {
-    negative = s[0] == '-';
-    s.remove_prefix(1);
-  }
-  unsigned base = 10;
-  if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
-    base = 16;
-    s.remove_prefix(2);
-  } else if (s.size() > 1 && s[0] == '0') {
-    base = 8;
-  }
-  if (s.empty() || s.size() > 20) return std::nullopt;
-  std::uint64_t v = 0;
-  for (char c : s) {
-    unsigned d = 99;
-    if (c >= '0' && c <= '9') d = static_cast<unsigned>(c - '0');
-    else if (c >= 'a' && c <= 'f') d = static_cast<unsigned>(c - 'a' + 10);
-    else if (c >= 'A' && c <= 'F') d = static_cast<unsigned>(c - 'A' + 10);
-    if (d >= base) return std::nullopt;
-    if (v > (0x7FFFFFFFFFFFFFFFull - d) / base) return std::nullopt;  // beyond INT64
-    v = v * base + d;
-  }
-  return negative ? -static_cast<std::int64_t>(v) : static_cast<std::int64_t>(v);
+  return support::parse_integer(trim(s), std::numeric_limits<std::int64_t>::min(),
+                                std::numeric_limits<std::int64_t>::max(), support::leading_zero::octal);
 }
 
 bool known_type(std::int64_t t) {

@@ -1,4 +1,5 @@
 #include "cia402/canopen/transport/candump_log.hpp"
+#include "cia402/support/text.hpp"
 
 #include <charconv>
 #include <cstdio>
@@ -9,18 +10,6 @@ namespace {
 
 // can-utils' error-frame flag (CAN_ERR_FLAG) in a logged identifier.
 constexpr std::uint32_t error_frame_flag = 0x20000000u;
-
-std::vector<std::string_view> tokens(std::string_view line) {
-  std::vector<std::string_view> out;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
-    if (i > start) out.push_back(line.substr(start, i - start));
-  }
-  return out;
-}
 
 bool digits_only(std::string_view text) {
   if (text.empty()) return false;
@@ -145,7 +134,7 @@ std::string format_line(const frame& f, std::uint64_t time_us, std::string_view 
 
 bool parse_line(std::string_view line, log_entry& out, std::string& why) {
   while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
-  const auto t = tokens(line);
+  const auto t = support::split_words(line);
   // python-can's writer adds the direction: " R" received, " T" transmitted.
   const bool direction = t.size() == 4 && (t[3] == "R" || t[3] == "T" || t[3] == "r" || t[3] == "t");
   if (t.size() != 3 && !direction) {

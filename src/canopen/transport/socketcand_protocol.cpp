@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "cia402/canopen/transport/socketcand.hpp"
+#include "cia402/support/text.hpp"
 
 namespace cia402::canopen::socketcand {
 namespace {
@@ -71,15 +72,7 @@ std::vector<std::string_view> words(std::string_view element) {
   if (element.size() >= 2 && element.front() == '<' && element.back() == '>') {
     element = element.substr(1, element.size() - 2);
   }
-  std::vector<std::string_view> out;
-  std::size_t i = 0;
-  while (i < element.size()) {
-    while (i < element.size() && (element[i] == ' ' || element[i] == '\t')) ++i;
-    const std::size_t start = i;
-    while (i < element.size() && element[i] != ' ' && element[i] != '\t') ++i;
-    if (i > start) out.push_back(element.substr(start, i - start));
-  }
-  return out;
+  return support::split_words(element);
 }
 
 std::string format_frame(const frame& f, std::uint64_t time_us) {

@@ -1,5 +1,7 @@
 #include "cia402/ethercat/sii/slave_information.hpp"
 
+#include "cia402/support/text.hpp"
+
 #include <cstdio>
 
 namespace cia402::ethercat {
@@ -114,20 +116,6 @@ std::string hex(std::uint32_t v, int digits) {
   return buf;
 }
 
-std::string escaped(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 // ESI data type names (ETG.2000) of the CiA 301 data type indices.
 const char* esi_type(std::uint16_t t) {
   switch (t) {
@@ -170,14 +158,14 @@ void pdos_xml(std::string& x, const std::vector<pdo_description>& pdos, const ch
     x += "        <" + std::string(tag) + " Sm=\"" + std::to_string(p.sync_manager) + "\" Fixed=\"" +
          (p.fixed ? "1" : "0") + "\" Mandatory=\"" + (p.mandatory ? "1" : "0") + "\">\n";
     x += "          <Index>" + hex(p.index, 4) + "</Index>\n";
-    x += "          <Name>" + escaped(p.name) + "</Name>\n";
+    x += "          <Name>" + support::xml_escaped(p.name) + "</Name>\n";
     for (const pdo_entry& e : p.entries) {
       x += "          <Entry>\n";
       x += "            <Index>" + hex(e.index, 4) + "</Index>\n";
       if (e.index != 0) x += "            <SubIndex>" + std::to_string(e.sub) + "</SubIndex>\n";
       x += "            <BitLen>" + std::to_string(e.bits) + "</BitLen>\n";
       if (e.index != 0) {
-        x += "            <Name>" + escaped(e.name) + "</Name>\n";
+        x += "            <Name>" + support::xml_escaped(e.name) + "</Name>\n";
         x += "            <DataType>" + std::string(esi_type(e.data_type)) + "</DataType>\n";
       }
       x += "          </Entry>\n";
@@ -384,15 +372,15 @@ std::string esi_xml(const slave_description& d) {
   std::string x;
   x += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   x += "<EtherCATInfo xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" Version=\"1.6\">\n";
-  x += "  <Vendor>\n    <Id>" + hex(d.vendor_id, 8) + "</Id>\n    <Name>" + escaped(d.vendor_name) +
+  x += "  <Vendor>\n    <Id>" + hex(d.vendor_id, 8) + "</Id>\n    <Name>" + support::xml_escaped(d.vendor_name) +
        "</Name>\n  </Vendor>\n";
-  x += "  <Descriptions>\n    <Groups>\n      <Group>\n        <Type>" + escaped(d.group_name) +
-       "</Type>\n        <Name>" + escaped(d.group_name) + "</Name>\n      </Group>\n    </Groups>\n";
+  x += "  <Descriptions>\n    <Groups>\n      <Group>\n        <Type>" + support::xml_escaped(d.group_name) +
+       "</Type>\n        <Name>" + support::xml_escaped(d.group_name) + "</Name>\n      </Group>\n    </Groups>\n";
   x += "    <Devices>\n      <Device Physics=\"YY\">\n";
   x += "        <Type ProductCode=\"" + hex(d.product_code, 8) + "\" RevisionNo=\"" + hex(d.revision, 8) +
-       "\">" + escaped(d.device_name) + "</Type>\n";
-  x += "        <Name>" + escaped(d.device_name) + "</Name>\n";
-  x += "        <GroupType>" + escaped(d.group_name) + "</GroupType>\n";
+       "\">" + support::xml_escaped(d.device_name) + "</Type>\n";
+  x += "        <Name>" + support::xml_escaped(d.device_name) + "</Name>\n";
+  x += "        <GroupType>" + support::xml_escaped(d.group_name) + "</GroupType>\n";
   x += "        <Profile>\n          <ProfileNo>" + std::to_string(d.profile_number) +
        "</ProfileNo>\n          <AddInfo>0</AddInfo>\n        </Profile>\n";
   for (fmmu_use u : d.fmmus) x += "        <Fmmu>" + std::string(fmmu_name(u)) + "</Fmmu>\n";

@@ -1,12 +1,13 @@
 // Text helpers the layers above the core share: one way to write a number in hexadecimal and one
-// way to read an integer a person typed (decimal or 0x-hexadecimal), so every file format, message
-// and command line agrees.
+// way to read an integer a person typed (decimal or 0x-hexadecimal), and one way to put text into XML
+// (the ESI file, the SVG plot), so every file format, message and command line agrees.
 #pragma once
 
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace cia402::support {
 
@@ -14,8 +15,24 @@ namespace cia402::support {
 /// is "0x6041".
 std::string hex(std::uint64_t value, int digits);
 
+/// How a leading 0 reads: as decimal (a person typing "010"), or as octal (CiA 306 §4.6.3, EDS files).
+enum class leading_zero { decimal, octal };
+
 /// A decimal or 0x-hexadecimal integer with an optional sign, the whole text and nothing else,
 /// within [min, max]; nothing otherwise.
-std::optional<std::int64_t> parse_integer(std::string_view text, std::int64_t min, std::int64_t max);
+std::optional<std::int64_t> parse_integer(std::string_view text, std::int64_t min, std::int64_t max,
+                                          leading_zero zero = leading_zero::decimal);
+
+/// `text` with XML's five special characters written as entities, for element content and quoted
+/// attribute values alike.
+std::string xml_escaped(std::string_view text);
+
+/// The words of `line`: runs of anything but spaces and tabs, in order, viewing `line`.
+std::vector<std::string_view> split_words(std::string_view line);
+
+/// "SOURCE:LINE:COLUMN: REASON" as compilers write it; `unnamed` stands for an empty source, a line
+/// or column of 0 is left out. Every file format's error reads this way.
+std::string located_message(const std::string& source, const char* unnamed, int line, int column,
+                            const std::string& reason);
 
 }  // namespace cia402::support
