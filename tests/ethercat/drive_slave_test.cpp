@@ -84,6 +84,13 @@ struct bench {
     EXPECT_EQ(a.wkc, 1) << "a reply is waiting";
     return a.data;
   }
+  // Reads every mailbox the slave has queued (emergencies), so the next SDO's answer comes first.
+  void drain_mailbox() {
+    for (int i = 0; i < 32; ++i) {
+      run(1);
+      if (send(command::fprd, fp(mailbox_in_start), std::vector<std::uint8_t>(mailbox_size, 0)).wkc == 0) return;
+    }
+  }
   std::int64_t upload(std::uint16_t index, std::uint8_t sub) {
     const std::vector<std::uint8_t> r = sdo({0x40, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8), sub, 0, 0, 0, 0});
     EXPECT_EQ(r[8] & 0xE0, 0x40) << "SDO abort " << std::hex << (r[12] | (r[13] << 8) | (r[14] << 16) | (r[15] << 24));
@@ -208,6 +215,27 @@ TEST(drive_slave, a_silent_master_trips_the_watchdog_and_0x6007_acts) {
   ASSERT_EQ(mbx.wkc, 1);
   EXPECT_EQ(mbx.data[7] >> 4, 1) << "CoE emergency";
   EXPECT_EQ(mbx.data[8] | (mbx.data[9] << 8), 0x8130);
+}
+
+TEST(drive_slave, while_the_error_flag_is_up_only_init_or_an_acknowledged_request_is_taken) {
+  // ETG.1000.6 §6.4.1.4: from SAFE-OP+ERR (the watchdog, 0x001B), OP without the acknowledge bit
+  // and SAFE-OP again change nothing; INIT acknowledges by itself; with the bit the way up is open.
+  bench b;
+  b.to_op();
+  for (int i = 0; i < 5; ++i) b.cycle(0x0006);
+  b.run(150);
+  ASSERT_EQ(b.read16(reg::al_status), 0x14);
+  for (std::uint16_t request : {0x08, 0x04, 0x02, 0x03, 0x05}) {
+    EXPECT_EQ(b.request(request), 0x14) << "request 0x" << std::hex << request << " without the acknowledge";
+    EXPECT_EQ(b.read16(reg::al_status_code), al_code::sync_manager_watchdog);
+  }
+  EXPECT_EQ(b.request(0x18), 8) << "OP with the acknowledge";
+  EXPECT_EQ(b.read16(reg::al_status_code), 0);
+  for (int i = 0; i < 5; ++i) b.cycle(0x0006);  // outputs again, so the watchdog runs again
+  b.run(150);
+  ASSERT_EQ(b.read16(reg::al_status), 0x14);
+  EXPECT_EQ(b.request(0x01), 1) << "INIT without the acknowledge is taken, and clears the flag";
+  EXPECT_EQ(b.read16(reg::al_status_code), 0);
 }
 
 TEST(drive_slave, a_mapping_entry_of_0_bits_is_refused_when_it_is_counted_in) {

@@ -160,11 +160,14 @@ bool coe_slave::to_safe_operational() {
 
 void coe_slave::handle_al_control() {
   const std::uint16_t control = esc_.read16(reg::al_control);
-  if ((control & al_acknowledge) && error_) {
+  const unsigned wanted = control & 0x0Fu;
+  if (error_) {
+    // ETG.1000.6 §6.4.1.4, as the ETG's slave code does it: while the error flag is up, a request
+    // without the acknowledge (0x0120 bit 4) changes nothing, but INIT, which acknowledges by itself.
+    if (!(control & al_acknowledge) && wanted != 1) return;
     error_ = false;
     code_ = al_code::none;
   }
-  const unsigned wanted = control & 0x0Fu;
   const auto current = static_cast<unsigned>(state_);
   switch (wanted) {
     case 1: enter(al_state::init); return;

@@ -13,7 +13,8 @@
 // the assigned PDOs and configured as outputs / inputs (0x001D / 0x001E); SAFE-OP -> OP; any state
 // back down; BOOT is refused (0x0013); an unknown or skipped state is refused (0x0011 / 0x0012). A
 // refusal keeps the state, sets the error flag (0x0130 bit 4) and the code, until the master
-// acknowledges it (0x0120 bit 4). In OP the process data watchdog guards the outputs: when it
+// acknowledges it (0x0120 bit 4); until then every request but INIT (which acknowledges by itself,
+// as the ETG's slave code takes it) is ignored: the state, the flag and the code stay. In OP the process data watchdog guards the outputs: when it
 // expires the slave falls to SAFE-OP with 0x001B and tells the device its connection is lost, so a
 // CiA 402 drive applies 0x6007 (S10).
 //
