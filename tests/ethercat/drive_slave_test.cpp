@@ -238,6 +238,34 @@ TEST(drive_slave, while_the_error_flag_is_up_only_init_or_an_acknowledged_reques
   EXPECT_EQ(b.read16(reg::al_status_code), 0);
 }
 
+TEST(drive_slave, leaving_op_applies_0x6007_to_an_enabled_drive_only) {
+  // The master's own request out of OP and the watchdog alike: a drive taken to READY TO SWITCH ON
+  // first has nothing to protect and stays as it is; an enabled one applies 0x6007 (1: a fault).
+  struct run {
+    std::uint16_t last_control_word;
+    bool watchdog;
+    state expected;
+    std::uint16_t code;
+  };
+  for (const run& r : {run{0x0006, false, state::ready_to_switch_on, 0}, run{0x0006, true, state::ready_to_switch_on, 0},
+                       run{0x000F, false, state::fault, 0x8130}, run{0x000F, true, state::fault, 0x8130}}) {
+    bench b;
+    b.to_op();
+    for (std::uint16_t cw : {std::uint16_t{0x0006}, r.last_control_word}) {
+      for (int i = 0; i < 40; ++i) b.cycle(cw);
+    }
+    if (r.watchdog) {
+      b.run(150);
+      EXPECT_EQ(b.read16(reg::al_status), 0x14);
+    } else {
+      EXPECT_EQ(b.request(2), 2) << "PRE-OP as the master asks";
+    }
+    b.run(20);
+    EXPECT_EQ(b.slave.device().drive().view().current(), r.expected) << "watchdog " << r.watchdog;
+    EXPECT_EQ(b.slave.device().drive().view().outputs().error_code, r.code) << "watchdog " << r.watchdog;
+  }
+}
+
 TEST(drive_slave, a_mapping_entry_of_0_bits_is_refused_when_it_is_counted_in) {
   // 0x1600:1 = the control word, 0x1600:2 = 0, then 0x1600:0 = 2: the second entry maps nothing
   // of no length, which OP would have decoded with a shift by -1.

@@ -22,9 +22,8 @@ slave::slave(device& d, channel& out, const slave_config& config)
       sdo_(*this, out, config.node_id, config.sdo_timeout_us) {
   device_->attach(this);
   consumer_.on_change = [this](std::uint8_t, bool) {
-    const bool lost = consumer_.any_lost();
-    device_->set_connection_lost(lost);
-    set_node_error(node_error::heartbeat_lost, lost);
+    tell_connection();
+    set_node_error(node_error::heartbeat_lost, consumer_.any_lost());
   };
   boot();
 }
@@ -58,6 +57,14 @@ void slave::enter(nmt_state s) {
   }
   if (s == nmt_state::stopped) sdo_.reset();
   state_ = s;
+  tell_connection();
+}
+
+void slave::tell_connection() {
+  // CiA 402-2 §6.2.1 (0x6007): a heartbeat or guarding loss and the NMT state STOPPED are the
+  // fieldbus going away; PRE-OPERATIONAL is not (SDO still works, the master is there). The device
+  // decides what a loss does to it (drive402::sim_device: only to an enabled drive).
+  device_->set_connection_lost(consumer_.any_lost() || state_ == nmt_state::stopped);
 }
 
 void slave::on_nmt(const frame& f) {

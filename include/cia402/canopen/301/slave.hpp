@@ -11,7 +11,9 @@
 //   and heartbeats. Reset node restarts the device (power-on) and every object; reset communication
 //   resets 0x1000..0x1FFF. Both send the boot-up message and enter PRE-OPERATIONAL.
 // - A heartbeat consumer timeout (0x1016) tells the device the connection is lost, so 0x6007 acts
-//   (S10), and sends EMCY 0x8130; the next heartbeat from that node clears it.
+//   (S10), and sends EMCY 0x8130; the next heartbeat from that node clears it. Entering STOPPED
+//   tells it too (CiA 402-2 lists "NMT stopped state entered" among 0x6007's events), leaving it
+//   clears it; PRE-OPERATIONAL does not (SDO still works). The device decides what a loss does.
 // - EMCY (0x80 + node-ID) on every new device error (device::error_changed, device.hpp): bytes 0..1
 //   the error code, byte 2 the error register 0x1001, bytes 3..7 the device's
 //   manufacturer_error_field() at that moment (a CiA 402 drive: its status word, then zeros). Node errors (heartbeat lost 0x8130, RPDO too short 0x8210) send their
@@ -155,6 +157,8 @@ class slave final : private dictionary_access, private device_events {
   void resolve_pdos();
   pdo_config resolve(std::uint16_t comm, std::uint16_t mapping);
   void configure_consumer();
+  // The device hears whether the fieldbus is there: no lost heartbeat and not STOPPED.
+  void tell_connection();
 
   void boot();
   void enter(nmt_state s);
