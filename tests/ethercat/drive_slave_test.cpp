@@ -266,6 +266,30 @@ TEST(drive_slave, leaving_op_applies_0x6007_to_an_enabled_drive_only) {
   }
 }
 
+TEST(drive_slave, its_emergencies_are_kept_in_0x1003_newest_first) {
+  // CiA 301 §7.5.2.5 over CoE: two faults injected and reset, then the field read by SDO uploads.
+  bench b;
+  b.to_pre_op();
+  EXPECT_EQ(b.upload(0x1003, 0), 0);
+  for (std::uint32_t code : {0x2310u, 0x3220u}) {
+    EXPECT_EQ(b.download(0x2001, 0, code, 2), 0u);
+    b.drain_mailbox();
+    EXPECT_EQ(b.download(0x2001, 0, 0, 2), 0u);
+    EXPECT_EQ(b.download(0x6040, 0, 0x80, 2), 0u);
+    b.drain_mailbox();
+    EXPECT_EQ(b.download(0x6040, 0, 0x00, 2), 0u);
+    b.drain_mailbox();
+  }
+  ASSERT_EQ(b.upload(0x1003, 0), 2);
+  EXPECT_EQ(b.upload(0x1003, 1) & 0xFFFF, 0x3220);
+  EXPECT_EQ(b.upload(0x1003, 2) & 0xFFFF, 0x2310);
+  EXPECT_EQ((b.upload(0x1003, 1) >> 16) & 0x08, 0x08) << "the status word at the emergency, fault bit set";
+  EXPECT_EQ(b.download(0x1003, 0, 2, 1), 0x06090030u) << "only 0 may be written to sub 0";
+  EXPECT_EQ(b.download(0x1003, 1, 0, 4), 0x06010002u);
+  EXPECT_EQ(b.download(0x1003, 0, 0, 1), 0u);
+  EXPECT_EQ(b.upload(0x1003, 0), 0);
+}
+
 TEST(drive_slave, a_mapping_entry_of_0_bits_is_refused_when_it_is_counted_in) {
   // 0x1600:1 = the control word, 0x1600:2 = 0, then 0x1600:0 = 2: the second entry maps nothing
   // of no length, which OP would have decoded with a shift by -1.

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "cia402/canopen/301/error_history.hpp"
 #include "cia402/canopen/301/object_builders.hpp"
 #include "cia402/ethercat/slave/coe_slave.hpp"
 
@@ -77,6 +78,8 @@ pdo_description pdo_of(const std::vector<object_entry>& t, std::uint16_t index, 
 
 std::vector<object_entry> coe_communication_objects(const coe_slave_config& c) {
   std::vector<object_entry> t;
+  // The emergencies' history (CiA 301 §7.5.2.5), as the CANopen node keeps it.
+  t.push_back(canopen::error_history_object());
   // EtherCAT has no heartbeat (the sync manager watchdog watches the master): 0x1017 is stored and
   // does nothing, so a master that sets it on every bus is not refused.
   t.push_back(canopen::single(0x1017, object_category::optional,

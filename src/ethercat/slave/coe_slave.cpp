@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "cia402/canopen/301/error_history.hpp"
+
 namespace cia402::ethercat {
 namespace {
 
@@ -86,6 +88,7 @@ sdo_abort coe_slave::write_value(canopen::object_dictionary::slot& s, std::int64
   const std::uint16_t index = s.object->index;
   if (s.entry->where == canopen::backing::device) return device_->write(index, s.entry->sub, v);
   if (mapping_object(index) || assignment_object(index)) return write_pdo_configuration(s, v);
+  if (index == canopen::error_history_index) return canopen::write_error_history(od_, s.entry->sub, v);
   s.number = v;
   return sdo_abort::none;
 }
@@ -93,7 +96,10 @@ sdo_abort coe_slave::write_value(canopen::object_dictionary::slot& s, std::int64
 void coe_slave::error_changed(std::uint16_t code) noexcept {
   std::int64_t reg = 0;
   (void)read(0x1001, 0, reg);
-  coe_.emergency(code, static_cast<std::uint8_t>(reg), device_->manufacturer_error_field());
+  const std::array<std::uint8_t, 5> field = device_->manufacturer_error_field();
+  // 0x1003 keeps what the emergencies said, as the CANopen node does (canopen/301/error_history.hpp).
+  canopen::record_error(od_, code, static_cast<std::uint16_t>(field[0] | (field[1] << 8)));
+  coe_.emergency(code, static_cast<std::uint8_t>(reg), field);
 }
 
 // ---- the AL state machine ---------------------------------------------------------------------

@@ -18,6 +18,10 @@
 //   the error code, byte 2 the error register 0x1001, bytes 3..7 the device's
 //   manufacturer_error_field() at that moment (a CiA 402 drive: its status word, then zeros). Node errors (heartbeat lost 0x8130, RPDO too short 0x8210) send their
 //   own EMCY. When the last error is gone, EMCY 0x0000 ("error reset").
+// - 0x1003 (error_history.hpp) holds the last 8 of those errors, newest first, the code with the
+//   first two bytes of the manufacturer field (the drive's status word) above it; it records an
+//   error that arises in STOPPED too, where no EMCY goes out. Reset node and reset communication
+//   empty it, as every object of 0x1000..0x1FFF goes back to its default.
 // - 0x1001 reads as the drive's register, plus bits 0 and 4 (communication) while a node error is
 //   active.
 // - Mapping changes follow CANopenNode: mapping entries need the PDO invalid (COB-ID bit 31) and
@@ -75,7 +79,7 @@ struct slave_config {
 };
 
 /// The communication objects the node serves itself, beside the services that use them (CiA 301
-/// §7.5.2): 0x1005 COB-ID SYNC, 0x1014 COB-ID EMCY, 0x1016 consumer heartbeat times, 0x1017
+/// §7.5.2): 0x1003 pre-defined error field, 0x1005 COB-ID SYNC, 0x1014 COB-ID EMCY, 0x1016 consumer heartbeat times, 0x1017
 /// producer heartbeat time, 0x1200 SDO server, 0x1400..0x1403 / 0x1600..0x1603 RPDO communication
 /// and mapping, 0x1800..0x1803 / 0x1A00..0x1A03 TPDO communication and mapping; defaults from the
 /// predefined connection set (CiA 301 §7.3.5) and `c`.
@@ -169,6 +173,7 @@ class slave final : private dictionary_access, private device_events {
   void send_tpdo(tpdo_state& t, const std::array<std::uint8_t, 8>& data);
   std::uint32_t process_tpdo_events(std::uint32_t elapsed_us);
   void set_node_error(std::uint16_t code, bool active);
+  void note_error(std::uint16_t code) noexcept;
   void send_emcy(std::uint16_t code);
 
   device* device_;

@@ -1,6 +1,7 @@
 // An EtherCAT CoE slave around a device (canopen/301/device.hpp): an emulated controller (esc), the
 // application behind it (the AL state machine, CoE mailboxes, process data) and the device's part of
-// the dictionary, to which it adds the objects of CoE's communication area (ETG.1000.6): 0x1600 /
+// the dictionary, to which it adds the objects of CoE's communication area (ETG.1000.6): 0x1003
+// (CiA 301's pre-defined error field: the last 8 emergencies, canopen/301/error_history.hpp), 0x1600 /
 // 0x1601 RxPDO and 0x1A00 / 0x1A01 TxPDO mappings, 0x1C00 sync manager types, 0x1C12 / 0x1C13 PDO
 // assignment, and 0x1017 (producer heartbeat time: stored and acting on nothing, EtherCAT has no
 // heartbeat, so a master that writes it on every bus is not refused). It knows no device profile:
@@ -86,7 +87,7 @@ struct coe_slave_config {
   std::string group_name;
 };
 
-/// The objects the slave serves itself: 0x1017, 0x1600, 0x1601, 0x1A00, 0x1A01, 0x1C00, 0x1C12, 0x1C13.
+/// The objects the slave serves itself: 0x1003, 0x1017, 0x1600, 0x1601, 0x1A00, 0x1A01, 0x1C00, 0x1C12, 0x1C13.
 std::vector<canopen::object_entry> coe_communication_objects(const coe_slave_config& c);
 /// The whole table of a slave of configuration `c`, by index. Throws std::invalid_argument when the
 /// device's objects hold one of the slave's own.
