@@ -9,6 +9,7 @@
 namespace cia402::ethercat {
 namespace {
 
+using detail::al_event_sm_activation;
 using detail::sm_status_mailbox_full;
 
 constexpr std::uint16_t dl_pdi_operational = 1u << 0;
@@ -261,10 +262,17 @@ void esc::register_written(std::uint16_t address, std::uint16_t length) noexcept
   }
   if (touched(reg::sync_manager0, 8 * sync_manager_count)) {
     for (int n = 0; n < sync_manager_count; ++n) {
-      // A sync manager configured (again), or its activation written, starts empty.
+      // A sync manager configured (again) starts empty. Its activate register (ET1100 datasheet,
+      // 0x0806 + 8 n) resets it only when the enable bit changes: a toggled repeat request (bit 1)
+      // leaves the mailbox as it is and is the application's to answer (ETG.1000.4 mailbox repeat).
       const auto base = static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n);
-      const bool reset = touched(base, 5) || touched(static_cast<std::uint16_t>(base + reg::sm_activate), 1);
-      if (reset) configure_sync_manager(n, true);
+      const auto activate = static_cast<std::uint16_t>(base + reg::sm_activate);
+      if (touched(base, 5)) {
+        configure_sync_manager(n, true);
+      } else if (touched(activate, 1)) {
+        configure_sync_manager(n, false);
+        memory_[reg::al_event_request] |= al_event_sm_activation;
+      }
     }
   }
   if (touched(reg::eeprom_control + 1, 1)) {

@@ -113,7 +113,12 @@ void coe_slave::refuse(std::uint16_t code) {
 void coe_slave::enter(al_state s) {
   const al_state before = state_;
   state_ = s;
-  if (s == al_state::init) coe_.reset();
+  if (s == al_state::init) {
+    coe_.reset();
+    in_send_mailbox_.clear();
+    last_read_.clear();
+    withdrawn_.clear();
+  }
   // Leaving OP the master no longer commands the device; entering it, it does again (a CiA 402
   // drive's 0x6007, S10).
   if (before == al_state::operational && s != al_state::operational) device_->set_connection_lost(true);
@@ -218,10 +223,44 @@ void coe_slave::watch_sync_managers() {
   }
 }
 
+void coe_slave::send_reply(std::vector<std::uint8_t>& reply) {
+  if (esc_.write_mailbox(1, reply)) in_send_mailbox_.swap(reply);
+  reply.clear();
+}
+
+void coe_slave::repeat_last_reply() {
+  if (state_ != al_state::init && esc_.mailbox_full(1)) {
+    // A newer reply waits unread: taken back (SM1 deactivated and activated again by its PDI
+    // control, which empties it) to go out after the one the master lost.
+    const auto pdi_control = static_cast<std::uint16_t>(reg::sync_manager0 + 8 + reg::sm_pdi_control);
+    const std::uint8_t control = esc_.read8(pdi_control);
+    esc_.write8(pdi_control, static_cast<std::uint8_t>(control | 1u));
+    esc_.write8(pdi_control, control);
+    withdrawn_.swap(in_send_mailbox_);
+    in_send_mailbox_.clear();
+  }
+  if (state_ != al_state::init && !last_read_.empty() && esc_.write_mailbox(1, last_read_)) {
+    in_send_mailbox_ = last_read_;
+  }
+  esc_.acknowledge_repeat(1);
+}
+
 void coe_slave::serve_mailbox() {
+  // The master read SM1 whole: what it held is what a repeat request puts back.
+  if (esc_.take_sync_manager_event(1) && !esc_.mailbox_full(1) && !in_send_mailbox_.empty()) {
+    last_read_.swap(in_send_mailbox_);
+    in_send_mailbox_.clear();
+  }
+  if (esc_.repeat_requested(1)) repeat_last_reply();
   if (state_ == al_state::init) return;
   if (esc_.read_mailbox(0, mailbox_)) coe_.on_mailbox(mailbox_);
-  if (coe_.has_reply() && !esc_.mailbox_full(1)) (void)esc_.write_mailbox(1, coe_.take_reply());
+  if (esc_.mailbox_full(1)) return;
+  if (!withdrawn_.empty()) {
+    send_reply(withdrawn_);
+  } else if (coe_.has_reply()) {
+    std::vector<std::uint8_t> reply = coe_.take_reply();
+    send_reply(reply);
+  }
 }
 
 void coe_slave::step(std::uint32_t elapsed_us) {

@@ -147,6 +147,13 @@ class esc {
   /// Fills a mailbox the master reads (marks it full). False when it is still full or too short.
   bool write_mailbox(int n, const std::vector<std::uint8_t>& data) noexcept;
   bool mailbox_full(int n) const noexcept;
+  /// Mailbox repeat (ETG.1000.4 sync manager, ET1100 datasheet 0x0806 / 0x0807): the master asks
+  /// for the last reply again by toggling the repeat request (activate register bit 1), which leaves
+  /// the mailbox as it is and sets 0x0220 bit 4. True while that bit differs from the application's
+  /// repeat acknowledge (PDI control bit 1).
+  bool repeat_requested(int n) const noexcept;
+  /// The application put the reply back: the acknowledge takes the request's value, 0x0220 bit 4 clears.
+  void acknowledge_repeat(int n) noexcept;
   /// The newest whole buffer of outputs (a buffered sync manager the master writes) into `out`, of
   /// the sync manager's length. False, and nothing copied, when n is not such a sync manager or the
   /// size differs. Later reads (read8) see the same buffer.

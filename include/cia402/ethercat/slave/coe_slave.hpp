@@ -32,6 +32,11 @@
 // Sync managers changed under a state that checked them take the slave back (with the error flag):
 // SM0/SM1 in PRE-OP or above to INIT (0x0016), SM2/SM3 in SAFE-OP or OP to PRE-OP (0x001D / 0x001E).
 // The application moves process data through the controller's buffers only, never into registers.
+//
+// Mailbox repeat (ETG.1000.4, as the ETG's slave code answers it): a master that lost a reply
+// toggles SM1's repeat request; the slave puts the reply the master read last back into SM1 (a newer
+// one waiting unread there is taken back first, by deactivating SM1 through its PDI control, and
+// sent after it) and toggles the repeat acknowledge.
 #pragma once
 
 #include <cstdint>
@@ -138,6 +143,8 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
   void watch_sync_managers();
   void exchange_process_data();
   void serve_mailbox();
+  void send_reply(std::vector<std::uint8_t>& reply);
+  void repeat_last_reply();
 
   // dictionary_access
   sdo_abort read_value(const canopen::object_dictionary::slot& s, std::int64_t& v) override;
@@ -163,6 +170,11 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
   unsigned output_bits_ = 0;
   unsigned input_bits_ = 0;
   std::vector<std::uint8_t> mailbox_;  // the last request SM0 brought (its room kept across cycles)
+  // Mailbox repeat (ETG.1000.4): the reply SM1 holds unread, the one the master read last (which a
+  // repeat request puts back), and one taken back from SM1 for a repeat, which goes out next.
+  std::vector<std::uint8_t> in_send_mailbox_;
+  std::vector<std::uint8_t> last_read_;
+  std::vector<std::uint8_t> withdrawn_;
 };
 
 }  // namespace cia402::ethercat
