@@ -2,6 +2,8 @@
 // driven as a master drives it: the feature bits a master checks, receive times latched by a BWR to
 // 0x0900 on a chain whose hops take time, the offset and delay a master computes from them, the
 // drift distribution write (FRMW of 0x0910) leaving no difference when they are right, and SYNC0.
+// Then the virtual drive on it (ETG.1020 §5.3): 0x1C32 / 0x1C33, DC SYNC0 mode chosen on the way to
+// SAFE-OP, and the drive taking its outputs on SYNC0.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -9,6 +11,8 @@
 
 #include "cia402/ethercat/esc/esc.hpp"
 #include "cia402/ethercat/sii/slave_information.hpp"
+#include "cia402/ethercat/slave/coe_slave.hpp"
+#include "drive_bench.hpp"
 
 namespace cia402::ethercat {
 namespace {
@@ -135,6 +139,104 @@ TEST(distributed_clocks, sync0_pulses_at_the_start_time_and_every_cycle_after) {
   l.write(0, reg::dc_activation, 0x00, 1);
   e.advance(3'000'000);
   EXPECT_FALSE(e.take_sync0_event()) << "deactivated";
+}
+
+using testing::bench;
+
+// SYNC0 as a master starts it: cycle, start time `start_in_ns` after the slave's system time, activation.
+void start_sync0(bench& b, std::uint32_t cycle_ns, std::uint64_t start_in_ns) {
+  std::vector<std::uint8_t> now(8, 0);
+  now = b.send(command::fprd, b.fp(reg::dc_system_time), now).data;
+  std::uint64_t st = 0;
+  for (std::size_t k = 8; k-- > 0;) st = (st << 8) | now[k];
+  const std::uint64_t start = st + start_in_ns;
+  std::vector<std::uint8_t> c(4), t(8);
+  for (std::size_t k = 0; k < 4; ++k) c[k] = static_cast<std::uint8_t>(cycle_ns >> (8 * k));
+  for (std::size_t k = 0; k < 8; ++k) t[k] = static_cast<std::uint8_t>(start >> (8 * k));
+  EXPECT_EQ(b.send(command::fpwr, b.fp(reg::dc_sync0_cycle_time), c).wkc, 1);
+  EXPECT_EQ(b.send(command::fpwr, b.fp(reg::dc_start_time), t).wkc, 1);
+  EXPECT_EQ(b.send(command::fpwr, b.fp(reg::dc_activation), {0x03}).wkc, 1);
+}
+
+// PRE-OP to the request for SAFE-OP with the process data set up; the AL status after it.
+std::uint16_t to_safe_op(bench& b) {
+  const slave_description& d = b.slave.description();
+  b.sync_manager(2, d.sync_managers[2]);
+  b.sync_manager(3, d.sync_managers[3]);
+  b.fmmu(0, 0x10000, d.sync_managers[2].length, d.sync_managers[2].start, 2);
+  b.fmmu(1, 0x10100, d.sync_managers[3].length, d.sync_managers[3].start, 1);
+  return b.request(4);
+}
+
+TEST(drive_slave_dc, sync0_started_by_the_master_is_dc_mode_and_the_drive_takes_its_outputs_on_it) {
+  bench b;
+  b.to_pre_op();
+  EXPECT_EQ(b.upload(sync_parameter::outputs, sync_parameter::mode), sync_mode::free_run);
+  EXPECT_EQ(b.upload(sync_parameter::outputs, sync_parameter::supported), 0x0007) << "free run, SM, DC SYNC0";
+  start_sync0(b, 4'000'000, 10'000'000);  // a pulse 10 ms from now, then every 4 ms
+  EXPECT_EQ(to_safe_op(b), 4);
+  EXPECT_EQ(b.request(8), 8);
+  b.drain_mailbox();
+  EXPECT_EQ(b.upload(sync_parameter::outputs, sync_parameter::mode), sync_mode::dc_sync0);
+  EXPECT_EQ(b.upload(sync_parameter::inputs, sync_parameter::mode), sync_mode::dc_sync0);
+  EXPECT_EQ(b.upload(sync_parameter::outputs, sync_parameter::sync0_cycle_time), 4'000'000);
+  // Shutdown (0x0006) from SWITCH ON DISABLED: the drive sees it at the first pulse, not before.
+  const std::uint64_t pulse = b.slave.controller().read32(reg::dc_start_time) |
+                              (std::uint64_t{b.slave.controller().read32(reg::dc_start_time + 4)} << 32);
+  int cycles = 0;
+  std::uint16_t sw = b.cycle(0x0006);
+  while ((sw & 0x6F) != 0x21 && cycles < 30) {
+    EXPECT_LE(b.slave.controller().system_time(), pulse + 2'000'000) << "no change long after the pulse";
+    sw = b.cycle(0x0006);
+    ++cycles;
+  }
+  EXPECT_EQ(sw & 0x6F, 0x21) << "READY TO SWITCH ON";
+  EXPECT_GE(b.slave.controller().system_time(), pulse) << "not before the pulse";
+}
+
+TEST(drive_slave_dc, pulses_that_find_no_new_outputs_are_counted_in_0x1c32_0b) {
+  bench b;
+  b.to_pre_op();
+  start_sync0(b, 1'000'000, 1'000'000);
+  EXPECT_EQ(to_safe_op(b), 4);
+  EXPECT_EQ(b.request(8), 8);
+  for (int i = 0; i < 5; ++i) b.cycle(0x0000);
+  b.drain_mailbox();
+  const std::int64_t fed = b.upload(sync_parameter::outputs, sync_parameter::sync_error_count);
+  b.run(6);  // no outputs for six pulses
+  EXPECT_GE(b.upload(sync_parameter::outputs, sync_parameter::sync_error_count), fed + 5);
+}
+
+TEST(drive_slave_dc, dc_mode_without_sync0_or_with_too_short_a_cycle_is_refused) {
+  {
+    bench b;
+    b.to_pre_op();
+    EXPECT_EQ(b.download(sync_parameter::outputs, sync_parameter::mode, 3, 2), 0x06090030u) << "SYNC1 not offered";
+    EXPECT_EQ(b.download(sync_parameter::outputs, sync_parameter::mode, 2, 2), 0u);
+    EXPECT_EQ(to_safe_op(b), 0x12);
+    EXPECT_EQ(b.read16(reg::al_status_code), al_code::invalid_dc_sync_configuration);
+  }
+  {
+    bench b;
+    b.to_pre_op();
+    start_sync0(b, 500'000, 1'000'000);
+    EXPECT_EQ(to_safe_op(b), 0x12);
+    EXPECT_EQ(b.read16(reg::al_status_code), al_code::invalid_dc_sync_cycle_time);
+  }
+  {
+    bench b;
+    b.to_pre_op();
+    EXPECT_EQ(to_safe_op(b), 4);
+    b.drain_mailbox();
+    EXPECT_EQ(b.download(sync_parameter::outputs, sync_parameter::mode, 1, 2), 0x08000022u) << "PRE-OP only";
+  }
+}
+
+TEST(drive_slave_dc, its_esi_offers_dc_sync0) {
+  bench b;
+  const std::string x = esi_xml(b.slave.description());
+  EXPECT_NE(x.find("<Dc>"), std::string::npos);
+  EXPECT_NE(x.find("<AssignActivate>#x0300</AssignActivate>"), std::string::npos);
 }
 
 }  // namespace

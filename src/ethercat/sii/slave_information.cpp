@@ -425,6 +425,18 @@ std::string esi_xml(const slave_description& d) {
          flag(3) + "\" CompleteAccess=\"" + flag(5) + "\"/>\n";
     x += "        </Mailbox>\n";
   }
+  if (d.dc_sync0) {
+    // ETG.2000 <Dc>: the operation modes a configuration tool offers, with the 0x0980..0x0981 value
+    // each writes (0x0300: cyclic unit and SYNC0 activated).
+    x += "        <Dc>\n";
+    x += "          <OpMode>\n            <Name>SM</Name>\n            <Desc>SM-synchronous</Desc>\n"
+         "            <AssignActivate>#x0000</AssignActivate>\n          </OpMode>\n";
+    x += "          <OpMode>\n            <Name>DC</Name>\n            <Desc>DC SYNC0</Desc>\n"
+         "            <AssignActivate>#x0300</AssignActivate>\n"
+         "            <CycleTimeSync0 Factor=\"1\">0</CycleTimeSync0>\n"
+         "            <ShiftTimeSync0>0</ShiftTimeSync0>\n          </OpMode>\n";
+    x += "        </Dc>\n";
+  }
   const std::vector<std::uint8_t> image = sii_image(d);
   x += "        <Eeprom>\n          <ByteSize>" + std::to_string(image.size()) + "</ByteSize>\n          <ConfigData>";
   char byte[3];

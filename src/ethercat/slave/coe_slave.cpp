@@ -84,9 +84,23 @@ sdo_abort coe_slave::write_pdo_configuration(canopen::object_dictionary::slot& s
   return sdo_abort::none;
 }
 
+sdo_abort coe_slave::write_sync_mode(canopen::object_dictionary::slot& s, std::int64_t v) {
+  // The synchronisation is chosen in PRE-OP, as the process data are.
+  if (state_ != al_state::pre_operational) return sdo_abort::cannot_store_in_present_state;
+  if (s.entry->sub == sync_parameter::mode) {
+    const bool outputs = s.object->index == sync_parameter::outputs;
+    const bool offered = v == sync_mode::free_run || v == sync_mode::sm_synchronous || v == sync_mode::dc_sync0 ||
+                         (!outputs && v == sync_mode::sm2_synchronous);
+    if (!offered) return sdo_abort::invalid_value;
+  }
+  s.number = v;
+  return sdo_abort::none;
+}
+
 sdo_abort coe_slave::write_value(canopen::object_dictionary::slot& s, std::int64_t v) {
   const std::uint16_t index = s.object->index;
   if (s.entry->where == canopen::backing::device) return device_->write(index, s.entry->sub, v);
+  if (index == sync_parameter::outputs || index == sync_parameter::inputs) return write_sync_mode(s, v);
   if (mapping_object(index) || assignment_object(index)) return write_pdo_configuration(s, v);
   if (index == canopen::error_history_index) return canopen::write_error_history(od_, s.entry->sub, v);
   s.number = v;
@@ -164,8 +178,45 @@ bool coe_slave::to_safe_operational() {
     refuse(al_code::invalid_input_configuration);
     return false;
   }
+  if (!choose_sync_mode()) return false;
   outputs_checked_ = esc_.sm(sm_outputs);
   inputs_checked_ = esc_.sm(sm_inputs);
+  return true;
+}
+
+bool coe_slave::choose_sync_mode() {
+  using namespace sync_parameter;
+  const bool dc_asked = od_.number(outputs, mode) == sync_mode::dc_sync0 ||
+                        od_.number(inputs, mode) == sync_mode::dc_sync0;
+  const std::uint32_t cycle = esc_.read32(reg::dc_sync0_cycle_time);
+  if (!esc_.sync0_active()) {
+    // DC SYNC0 asked for by CoE, but the master did not start SYNC0.
+    if (dc_asked) {
+      refuse(al_code::invalid_dc_sync_configuration);
+      return false;
+    }
+    dc_sync0_ = false;
+  } else {
+    // SYNC0 activated by the master (as SOEM's ec_dcsync0 does, writing no CoE object): DC mode.
+    if (cycle == 0) {
+      refuse(al_code::invalid_dc_sync_configuration);  // one pulse is not a cycle to run on
+      return false;
+    }
+    if (cycle < minimum_cycle_ns) {
+      refuse(al_code::invalid_dc_sync_cycle_time);
+      return false;
+    }
+    dc_sync0_ = true;
+  }
+  for (const std::uint16_t index : {outputs, inputs}) {
+    if (dc_sync0_) {
+      od_.set_number(index, mode, sync_mode::dc_sync0);
+      od_.set_number(index, cycle_time, cycle);
+    }
+    od_.set_number(index, sync0_cycle_time, dc_sync0_ ? cycle : 0);
+    od_.set_number(index, sync_error_count, 0);
+  }
+  outputs_waiting_ = false;
   return true;
 }
 

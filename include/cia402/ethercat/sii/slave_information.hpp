@@ -70,6 +70,8 @@ struct slave_description {
   std::vector<pdo_description> rx_pdos;  ///< outputs
   std::vector<pdo_description> tx_pdos;  ///< inputs
   std::uint16_t profile_number = 402;    ///< CiA device profile (ESI <Profile><ProfileNo>)
+  /// The ESI offers DC: operation modes SM-synchronous and DC SYNC0 (AssignActivate 0x0300).
+  bool dc_sync0 = false;
 };
 
 /// The SII EEPROM image: ESC configuration area with its CRC, identity, the standard mailbox (no
