@@ -30,7 +30,7 @@ object_entry pdo_assignment(std::uint16_t index, std::string name, std::uint16_t
 // 0x1C32 / 0x1C33 sync manager output / input parameter (ETG.1020 §5.3, ETG.6010): the sync mode a
 // master chooses (written in PRE-OP; DC SYNC0 also taken from 0x0981 on the way to SAFE-OP), the
 // cycle, the modes this slave offers (free run, SM-synchronous, DC SYNC0) and what SYNC0 ran.
-object_entry sync_manager_parameter(std::uint16_t index, std::string name) {
+object_entry sync_manager_parameter(std::uint16_t index, std::string name, std::uint32_t cycle_us) {
   return canopen::group(
       index, std::move(name), object_code::record, object_category::optional,
       {variable(0, "Number of sub-indices", data_type::unsigned8, access::ro, sync_parameter::sync_error_count),
@@ -40,7 +40,7 @@ object_entry sync_manager_parameter(std::uint16_t index, std::string name) {
        variable(sync_parameter::supported, "Sync modes supported", data_type::unsigned16, access::ro,
                 sync_parameter::supported_modes),
        variable(sync_parameter::minimum_cycle_time, "Minimum cycle time", data_type::unsigned32, access::ro,
-                sync_parameter::minimum_cycle_ns),
+                std::int64_t{cycle_us} * 1000),
        variable(6, "Calc and copy time", data_type::unsigned32, access::ro, 0),
        variable(9, "Delay time", data_type::unsigned32, access::ro, 0),
        variable(sync_parameter::sync0_cycle_time, "Sync0 cycle time", data_type::unsigned32, access::ro, 0),
@@ -116,8 +116,8 @@ std::vector<object_entry> coe_communication_objects(const coe_slave_config& c) {
                               variable(4, "SM3 (inputs)", data_type::unsigned8, access::ro, 4)}));
   t.push_back(pdo_assignment(0x1C12, "RxPDO assign", 0x1600, c.rx_pdo.count != 0));
   t.push_back(pdo_assignment(0x1C13, "TxPDO assign", 0x1A00, c.tx_pdo.count != 0));
-  t.push_back(sync_manager_parameter(sync_parameter::outputs, "SM output parameter"));
-  t.push_back(sync_manager_parameter(sync_parameter::inputs, "SM input parameter"));
+  t.push_back(sync_manager_parameter(sync_parameter::outputs, "SM output parameter", c.application_cycle_us));
+  t.push_back(sync_manager_parameter(sync_parameter::inputs, "SM input parameter", c.application_cycle_us));
   return t;
 }
 

@@ -202,7 +202,7 @@ bool coe_slave::choose_sync_mode() {
       refuse(al_code::invalid_dc_sync_configuration);  // one pulse is not a cycle to run on
       return false;
     }
-    if (cycle < minimum_cycle_ns) {
+    if (cycle < od_.number(outputs, minimum_cycle_time)) {
       refuse(al_code::invalid_dc_sync_cycle_time);
       return false;
     }

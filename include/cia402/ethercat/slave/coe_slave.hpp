@@ -89,8 +89,6 @@ inline constexpr std::uint8_t sync0_cycle_time = 10;
 inline constexpr std::uint8_t sync_error_count = 11;  ///< SYNC0 pulses that found no new outputs, in OP
 /// Bit 0 free run, bit 1 SM-synchronous, bits 2..3 = 01 DC SYNC0.
 inline constexpr std::int64_t supported_modes = 0x0007;
-/// The application's cycle: the shortest SYNC0 cycle it takes (one step of 1 ms).
-inline constexpr std::int64_t minimum_cycle_ns = 1'000'000;
 }  // namespace sync_parameter
 namespace sync_mode {
 inline constexpr std::int64_t free_run = 0x00;
@@ -122,6 +120,9 @@ struct coe_slave_config {
   /// What the SII and ESI name besides the dictionary's identity.
   std::string vendor_name;
   std::string group_name;
+  /// The application's cycle (the time each step() is given): the shortest SYNC0 cycle the slave
+  /// takes (0x1C32:05 / 0x1C33:05), since a pulse more often would find it still in the last one.
+  std::uint32_t application_cycle_us = 1000;
 };
 
 /// The objects the slave serves itself: 0x1003, 0x1017, 0x1600, 0x1601, 0x1A00, 0x1A01, 0x1C00, 0x1C12,
