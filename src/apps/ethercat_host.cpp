@@ -14,7 +14,7 @@ namespace cia402::apps {
 
 ethercat_host::ethercat_host(const profile& p, int nodes, std::uint32_t cycle_us) : cycle_us_(cycle_us) {
   for (int i = 0; i < nodes; ++i) {
-    drives_.push_back(std::make_unique<virtual_drive_slave>(p, static_cast<std::uint32_t>(i + 1)));
+    drives_.push_back(std::make_unique<virtual_drive_slave>(p, static_cast<std::uint32_t>(i + 1), sim::plant_config{}, cycle_us));
     wire_.add(drives_.back()->controller());
   }
 }

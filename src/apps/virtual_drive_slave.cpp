@@ -5,8 +5,9 @@
 
 namespace cia402::apps {
 
-ethercat::coe_slave_config drive_slave_config(std::uint32_t serial) {
+ethercat::coe_slave_config drive_slave_config(std::uint32_t serial, std::uint32_t cycle_us) {
   ethercat::coe_slave_config c;
+  c.application_cycle_us = cycle_us;
   c.objects = drive402::drive_objects(serial);
   c.rx_pdo = pdo_maps::ecat_rxpdo;
   c.tx_pdo = pdo_maps::ecat_txpdo;

@@ -15,11 +15,28 @@ std::uint32_t sim_device::step(std::uint32_t elapsed_us) noexcept {
   pending_us_ = static_cast<std::uint32_t>(
       std::min<std::uint64_t>(pending, static_cast<std::uint64_t>(max_catch_up_cycles) * cycle));
   while (pending_us_ >= cycle) {
+    apply_connection();
     drive_->step();
     pending_us_ -= cycle;
   }
   report_changes();
   return cycle - pending_us_;
+}
+
+void sim_device::set_connection_lost(bool lost) noexcept {
+  fieldbus_lost_ = lost;
+  apply_connection();
+}
+
+void sim_device::apply_connection() noexcept {
+  if (!fieldbus_lost_) {
+    loss_acting_ = false;
+  } else if (!loss_acting_) {
+    const sim::drive_view v = drive_->view();
+    const state s = v.current();
+    loss_acting_ = s == state::operation_enabled || s == state::quick_stop_active || v.outputs().torque;
+  }
+  drive_->view().set_connection_lost(loss_acting_);
 }
 
 void sim_device::report_changes() noexcept {
@@ -83,9 +100,9 @@ sdo_abort sim_device::write(std::uint16_t index, std::uint8_t sub, std::int64_t 
 
 void sim_device::reset() noexcept {
   // The configuration was accepted when the device was made, so this cannot throw.
-  const bool lost = drive_->view().connection_lost();
   drive_ = std::make_unique<sim::virtual_drive>(*profile_, config_);
-  drive_->view().set_connection_lost(lost);
+  loss_acting_ = false;  // a drive at power-on is not enabled: the loss acts again only if it becomes so
+  apply_connection();
   pending_us_ = 0;
   report_changes();
 }

@@ -235,6 +235,67 @@ TEST_P(master_heartbeat_loss, silent_master_makes_the_drive_apply_0x6007) {
 
 INSTANTIATE_TEST_SUITE_P(codes_0_to_3, master_heartbeat_loss, ::testing::Range(0, 4));
 
+TEST(drive_master, a_master_that_disabled_the_drive_then_went_silent_leaves_no_fault) {
+  // An orderly end whose guard outlived the master: the drive was taken to READY TO SWITCH ON
+  // first, so the lost heartbeat has nothing to protect (0x6007 acts on an enabled drive only).
+  drive_master_config guarded;
+  guarded.master_heartbeat_ms = 20;
+  bench b(guarded);
+  ASSERT_EQ(b.node().write(0x6007, 0, 1), sdo_abort::none);  // 1 = fault
+  b.master().set_target(state::operation_enabled);
+  ASSERT_TRUE(b.run_until_reached(2000));
+  b.master().set_target(state::ready_to_switch_on);
+  ASSERT_TRUE(b.run_until_reached(2000));
+  b.run_ms(500, /*master_alive=*/false);
+  EXPECT_TRUE(b.node().connection_lost());
+  EXPECT_EQ(b.drive().view().current(), state::ready_to_switch_on);
+  EXPECT_EQ(b.drive().view().outputs().error_code, 0);
+}
+
+TEST(drive_master, a_drive_enabled_while_the_heartbeat_is_lost_applies_0x6007_then) {
+  // The loss came while the drive was disabled; a control word that enables it while the master
+  // is still gone (a second master, a local tool) brings 0x6007 into play at once.
+  drive_master_config guarded;
+  guarded.master_heartbeat_ms = 20;
+  bench b(guarded);
+  b.master().set_target(state::operation_enabled);
+  ASSERT_TRUE(b.run_until_reached(2000));
+  b.master().set_target(state::switch_on_disabled);
+  ASSERT_TRUE(b.run_until_reached(2000));
+  b.run_ms(500, /*master_alive=*/false);
+  ASSERT_TRUE(b.node().connection_lost());
+  ASSERT_EQ(b.drive().view().current(), state::switch_on_disabled);
+  for (const std::int64_t cw : {0x06, 0x0F}) {
+    ASSERT_EQ(b.node().write(0x6040, 0, cw), sdo_abort::none);
+    b.run_ms(20, /*master_alive=*/false);
+  }
+  EXPECT_EQ(b.drive().view().current(), state::fault);
+  EXPECT_EQ(b.drive().view().outputs().error_code, 0x8130);
+}
+
+class nmt_stop_of_a_drive : public ::testing::TestWithParam<bool> {};
+
+TEST_P(nmt_stop_of_a_drive, acts_as_0x6007_says_when_enabled_and_changes_nothing_when_not) {
+  // CiA 402-2 lists "NMT stopped state entered" among the events 0x6007 reacts to; PRE-OPERATIONAL
+  // is not one (SDO still works, the master is there).
+  const bool enabled = GetParam();
+  bench b;
+  const state target = enabled ? state::operation_enabled : state::ready_to_switch_on;
+  b.master().set_target(target);
+  ASSERT_TRUE(b.run_until_reached(2000));
+  const auto nmt = b.bus().attach();
+  (void)nmt->send(nmt_frame(nmt_command::enter_pre_operational, 1));
+  b.run_ms(50, /*master_alive=*/false);
+  EXPECT_FALSE(b.node().connection_lost());
+  EXPECT_EQ(b.drive().view().current(), target) << "PRE-OPERATIONAL is no lost connection";
+  (void)nmt->send(nmt_frame(nmt_command::stop, 1));
+  b.run_ms(50, /*master_alive=*/false);
+  EXPECT_EQ(b.drive().view().current(), enabled ? state::fault : state::ready_to_switch_on);
+  EXPECT_EQ(b.drive().view().outputs().error_code, enabled ? 0x8130 : 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(enabled_or_not, nmt_stop_of_a_drive, ::testing::Bool());
+
 TEST(drive_master, a_master_without_guard_clears_the_guard_a_gone_master_left_and_resets_the_fault) {
   drive_master_config guarded;
   guarded.master_heartbeat_ms = 20;

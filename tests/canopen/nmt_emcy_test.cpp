@@ -149,6 +149,69 @@ TEST_F(nmt_test, no_emcy_while_stopped) {
   EXPECT_TRUE(net.with_id(0x87).empty());
 }
 
+// 0x1003 (CiA 301 §7.5.2.5): the errors the node signalled, newest first, read by SDO uploads.
+class error_history_test : public nmt_test {
+ protected:
+  std::uint32_t read(std::uint8_t sub) {
+    net.received.clear();
+    net.send(sdo_request(id, 0x40, 0x1003, sub));
+    net.settle();
+    const auto r = net.with_id(cob::sdo_tx + id);
+    EXPECT_FALSE(r.empty());
+    if (r.empty()) return 0xDEADBEEF;
+    EXPECT_EQ(abort_code_of(r.back()), 0u) << "0x1003:" << int(sub);
+    return static_cast<std::uint32_t>(get_le(&r.back().data[4], 4));
+  }
+  void fault(std::uint16_t code) {
+    ASSERT_EQ(write(0x2001, 0, code, 0x2B), 0u);
+    net.run(3000, 1000);
+    ASSERT_EQ(write(0x2001, 0, 0, 0x2B), 0u);
+    ASSERT_EQ(write(0x6040, 0, 0x80, 0x2B), 0u);  // fault reset
+    net.run(3000, 1000);
+    ASSERT_EQ(write(0x6040, 0, 0x00, 0x2B), 0u);
+    net.run(3000, 1000);
+  }
+};
+
+TEST_F(error_history_test, faults_are_kept_newest_first_with_the_status_word_above_the_code) {
+  net.add(id);
+  EXPECT_EQ(read(0), 0u) << "no error yet";
+  fault(0x2310);
+  fault(0x3220);
+  ASSERT_EQ(read(0), 2u);
+  EXPECT_EQ(read(1) & 0xFFFF, 0x3220u);
+  EXPECT_EQ(read(2) & 0xFFFF, 0x2310u);
+  EXPECT_EQ((read(1) >> 16) & 0x08, 0x08u) << "the status word at the EMCY, its fault bit 3 set";
+  EXPECT_EQ(read(3), 0u) << "an empty entry reads 0";
+}
+
+TEST_F(error_history_test, holds_the_newest_8_and_writing_0_to_sub_0_clears_it) {
+  net.add(id);
+  for (std::uint16_t code = 0x1001; code <= 0x100A; ++code) fault(code);
+  EXPECT_EQ(read(0), 8u);
+  EXPECT_EQ(read(1) & 0xFFFF, 0x100Au);
+  EXPECT_EQ(read(8) & 0xFFFF, 0x1003u) << "0x1001 and 0x1002 were dropped";
+  EXPECT_EQ(write(0x1003, 0, 1, 0x2F), 0x06090030u) << "only 0 may be written to sub 0";
+  EXPECT_EQ(read(0), 8u) << "refused: nothing changed";
+  EXPECT_EQ(write(0x1003, 1, 0, 0x23), 0x06010002u) << "the entries are read-only";
+  EXPECT_EQ(write(0x1003, 0, 0, 0x2F), 0u);
+  EXPECT_EQ(read(0), 0u);
+  EXPECT_EQ(read(1), 0u);
+}
+
+TEST_F(error_history_test, the_nodes_own_errors_go_in_too_and_a_reset_node_empties_it) {
+  net.add(id);
+  ASSERT_EQ(write(0x1016, 1, 0x00200064, 0x23), 0u);
+  net.send(heartbeat_frame(0x20, nmt_state::operational));
+  net.run(150000, 1000);
+  ASSERT_TRUE(net.at(0).connection_lost());
+  EXPECT_GE(read(0), 1u);
+  EXPECT_EQ(read(read(0)) & 0xFFFF, 0x8130u) << "the heartbeat loss, the node's own error, is the oldest";
+  net.send(nmt_frame(nmt_command::reset_node, id));
+  net.settle();
+  EXPECT_EQ(read(0), 0u);
+}
+
 // Heartbeat consumer: node 0x20 plays the master; the drive watches it for 100 ms.
 class heartbeat_loss : public nmt_test, public ::testing::WithParamInterface<int> {};
 

@@ -6,130 +6,13 @@
 #include <cstdint>
 #include <vector>
 
-#include "cia402/apps/virtual_drive_slave.hpp"
-#include "cia402/ethercat/coe/mailbox.hpp"
+#include "drive_bench.hpp"
 
 namespace cia402::ethercat {
 namespace {
 
-using drive_slave = apps::virtual_drive_slave;
-
-constexpr std::array<std::uint8_t, 6> broadcast{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
-constexpr std::array<std::uint8_t, 6> master_mac{0x02, 0, 0, 0, 0, 1};
-constexpr std::uint16_t station = 0x1001;
-
-struct bench {
-  drive_slave slave{standard_profile(), 7};
-  chain wire;
-  std::uint8_t counter = 0;
-  bench() { wire.add(slave.controller()); }
-
-  struct answer {
-    std::vector<std::uint8_t> data;
-    std::uint16_t wkc = 0;
-  };
-  answer send(command c, std::uint32_t address, std::vector<std::uint8_t> data) {
-    frame_builder b(broadcast, master_mac);
-    const long at = b.add(c, 0, address, data, static_cast<std::uint16_t>(data.size()));
-    std::vector<std::uint8_t> f = b.finish();
-    EXPECT_EQ(wire.pass(f), frame_error::none);
-    answer a;
-    a.data.assign(f.begin() + at, f.begin() + at + static_cast<long>(data.size()));
-    a.wkc = static_cast<std::uint16_t>(f[static_cast<std::size_t>(at) + data.size()] |
-                                       (f[static_cast<std::size_t>(at) + data.size() + 1] << 8));
-    return a;
-  }
-  std::uint32_t fp(std::uint16_t offset) const { return station | (static_cast<std::uint32_t>(offset) << 16); }
-  std::uint16_t read16(std::uint16_t offset) {
-    const answer a = send(command::fprd, fp(offset), {0, 0});
-    return static_cast<std::uint16_t>(a.data[0] | (a.data[1] << 8));
-  }
-  void write16(std::uint16_t offset, std::uint16_t v) {
-    EXPECT_EQ(send(command::fpwr, fp(offset), {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8)}).wkc, 1);
-  }
-  void run(int cycles) {
-    for (int i = 0; i < cycles; ++i) slave.step(1000);
-  }
-  // Requests an AL state and returns the AL status after the slave's next cycle.
-  std::uint16_t request(std::uint16_t state) {
-    write16(reg::al_control, state);
-    run(1);
-    return read16(reg::al_status);
-  }
-  void sync_manager(int n, const sync_manager_description& d) {
-    std::vector<std::uint8_t> s{static_cast<std::uint8_t>(d.start), static_cast<std::uint8_t>(d.start >> 8),
-                                static_cast<std::uint8_t>(d.length), static_cast<std::uint8_t>(d.length >> 8),
-                                d.control, 0, 1, 0};
-    EXPECT_EQ(send(command::fpwr, fp(static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n)), s).wkc, 1);
-  }
-  void to_pre_op() {
-    EXPECT_EQ(send(command::apwr, 0 | (static_cast<std::uint32_t>(reg::station_address) << 16), {0x01, 0x10}).wkc, 1);
-    sync_manager(0, slave.description().sync_managers[0]);
-    sync_manager(1, slave.description().sync_managers[1]);
-    EXPECT_EQ(request(2), 2);
-  }
-  // A CoE SDO request through the mailbox; the slave's reply mailbox.
-  std::vector<std::uint8_t> sdo(std::vector<std::uint8_t> body) {
-    std::vector<std::uint8_t> m(mailbox_size, 0);
-    mailbox_header h;
-    h.length = static_cast<std::uint16_t>(2 + body.size());
-    h.type = mailbox_type::coe;
-    h.counter = static_cast<std::uint8_t>(++counter % 7 + 1);
-    write_mailbox_header(h, m.data());
-    m[7] = 0x20;  // SDO request
-    std::copy(body.begin(), body.end(), m.begin() + 8);
-    EXPECT_EQ(send(command::fpwr, fp(mailbox_out_start), m).wkc, 1);
-    run(1);
-    const answer a = send(command::fprd, fp(mailbox_in_start), std::vector<std::uint8_t>(mailbox_size, 0));
-    EXPECT_EQ(a.wkc, 1) << "a reply is waiting";
-    return a.data;
-  }
-  std::int64_t upload(std::uint16_t index, std::uint8_t sub) {
-    const std::vector<std::uint8_t> r = sdo({0x40, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8), sub, 0, 0, 0, 0});
-    EXPECT_EQ(r[8] & 0xE0, 0x40) << "SDO abort " << std::hex << (r[12] | (r[13] << 8) | (r[14] << 16) | (r[15] << 24));
-    return r[12] | (r[13] << 8) | (r[14] << 16) | (static_cast<std::int64_t>(r[15]) << 24);
-  }
-  std::uint32_t download(std::uint16_t index, std::uint8_t sub, std::uint32_t v, int bytes) {
-    const std::uint8_t cmd = bytes == 1 ? 0x2F : bytes == 2 ? 0x2B : 0x23;
-    const std::vector<std::uint8_t> r = sdo({cmd, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8), sub,
-                                             static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8),
-                                             static_cast<std::uint8_t>(v >> 16), static_cast<std::uint8_t>(v >> 24)});
-    return r[8] == 0x60 ? 0 : static_cast<std::uint32_t>(r[12] | (r[13] << 8) | (r[14] << 16) | (r[15] << 24));
-  }
-  void fmmu(int i, std::uint32_t log, std::uint16_t len, std::uint16_t phys, std::uint8_t type) {
-    std::vector<std::uint8_t> f(16, 0);
-    for (int k = 0; k < 4; ++k) f[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(log >> (8 * k));
-    f[4] = static_cast<std::uint8_t>(len);
-    f[5] = static_cast<std::uint8_t>(len >> 8);
-    f[7] = 7;
-    f[8] = static_cast<std::uint8_t>(phys);
-    f[9] = static_cast<std::uint8_t>(phys >> 8);
-    f[11] = type;
-    f[12] = 1;
-    EXPECT_EQ(send(command::fpwr, fp(static_cast<std::uint16_t>(reg::fmmu0 + 16 * i)), f).wkc, 1);
-  }
-  void to_op() {
-    to_pre_op();
-    const slave_description& d = slave.description();
-    sync_manager(2, d.sync_managers[2]);
-    sync_manager(3, d.sync_managers[3]);
-    fmmu(0, 0x10000, d.sync_managers[2].length, d.sync_managers[2].start, 2);
-    fmmu(1, 0x10100, d.sync_managers[3].length, d.sync_managers[3].start, 1);
-    EXPECT_EQ(request(4), 4);
-    EXPECT_EQ(request(8), 8);
-  }
-  // One process data cycle: the control word out, the status word back.
-  std::uint16_t cycle(std::uint16_t control_word) {
-    std::vector<std::uint8_t> out(slave.output_bytes(), 0);
-    out[0] = static_cast<std::uint8_t>(control_word);
-    out[1] = static_cast<std::uint8_t>(control_word >> 8);
-    EXPECT_EQ(send(command::lwr, 0x10000, out).wkc, 1);
-    run(1);
-    const answer in = send(command::lrd, 0x10100, std::vector<std::uint8_t>(slave.input_bytes(), 0));
-    EXPECT_EQ(in.wkc, 1);
-    return static_cast<std::uint16_t>(in.data[0] | (in.data[1] << 8));
-  }
-};
+using testing::bench;
+using testing::station;
 
 TEST(drive_slave, powers_up_in_init_and_its_sii_names_the_drive) {
   bench b;
@@ -208,6 +91,79 @@ TEST(drive_slave, a_silent_master_trips_the_watchdog_and_0x6007_acts) {
   ASSERT_EQ(mbx.wkc, 1);
   EXPECT_EQ(mbx.data[7] >> 4, 1) << "CoE emergency";
   EXPECT_EQ(mbx.data[8] | (mbx.data[9] << 8), 0x8130);
+}
+
+TEST(drive_slave, while_the_error_flag_is_up_only_init_or_an_acknowledged_request_is_taken) {
+  // ETG.1000.6 §6.4.1.4: from SAFE-OP+ERR (the watchdog, 0x001B), OP without the acknowledge bit
+  // and SAFE-OP again change nothing; INIT acknowledges by itself; with the bit the way up is open.
+  bench b;
+  b.to_op();
+  for (int i = 0; i < 5; ++i) b.cycle(0x0006);
+  b.run(150);
+  ASSERT_EQ(b.read16(reg::al_status), 0x14);
+  for (std::uint16_t request : {0x08, 0x04, 0x02, 0x03, 0x05}) {
+    EXPECT_EQ(b.request(request), 0x14) << "request 0x" << std::hex << request << " without the acknowledge";
+    EXPECT_EQ(b.read16(reg::al_status_code), al_code::sync_manager_watchdog);
+  }
+  EXPECT_EQ(b.request(0x18), 8) << "OP with the acknowledge";
+  EXPECT_EQ(b.read16(reg::al_status_code), 0);
+  for (int i = 0; i < 5; ++i) b.cycle(0x0006);  // outputs again, so the watchdog runs again
+  b.run(150);
+  ASSERT_EQ(b.read16(reg::al_status), 0x14);
+  EXPECT_EQ(b.request(0x01), 1) << "INIT without the acknowledge is taken, and clears the flag";
+  EXPECT_EQ(b.read16(reg::al_status_code), 0);
+}
+
+TEST(drive_slave, leaving_op_applies_0x6007_to_an_enabled_drive_only) {
+  // The master's own request out of OP and the watchdog alike: a drive taken to READY TO SWITCH ON
+  // first has nothing to protect and stays as it is; an enabled one applies 0x6007 (1: a fault).
+  struct run {
+    std::uint16_t last_control_word;
+    bool watchdog;
+    state expected;
+    std::uint16_t code;
+  };
+  for (const run& r : {run{0x0006, false, state::ready_to_switch_on, 0}, run{0x0006, true, state::ready_to_switch_on, 0},
+                       run{0x000F, false, state::fault, 0x8130}, run{0x000F, true, state::fault, 0x8130}}) {
+    bench b;
+    b.to_op();
+    for (std::uint16_t cw : {std::uint16_t{0x0006}, r.last_control_word}) {
+      for (int i = 0; i < 40; ++i) b.cycle(cw);
+    }
+    if (r.watchdog) {
+      b.run(150);
+      EXPECT_EQ(b.read16(reg::al_status), 0x14);
+    } else {
+      EXPECT_EQ(b.request(2), 2) << "PRE-OP as the master asks";
+    }
+    b.run(20);
+    EXPECT_EQ(b.slave.device().drive().view().current(), r.expected) << "watchdog " << r.watchdog;
+    EXPECT_EQ(b.slave.device().drive().view().outputs().error_code, r.code) << "watchdog " << r.watchdog;
+  }
+}
+
+TEST(drive_slave, its_emergencies_are_kept_in_0x1003_newest_first) {
+  // CiA 301 §7.5.2.5 over CoE: two faults injected and reset, then the field read by SDO uploads.
+  bench b;
+  b.to_pre_op();
+  EXPECT_EQ(b.upload(0x1003, 0), 0);
+  for (std::uint32_t code : {0x2310u, 0x3220u}) {
+    EXPECT_EQ(b.download(0x2001, 0, code, 2), 0u);
+    b.drain_mailbox();
+    EXPECT_EQ(b.download(0x2001, 0, 0, 2), 0u);
+    EXPECT_EQ(b.download(0x6040, 0, 0x80, 2), 0u);
+    b.drain_mailbox();
+    EXPECT_EQ(b.download(0x6040, 0, 0x00, 2), 0u);
+    b.drain_mailbox();
+  }
+  ASSERT_EQ(b.upload(0x1003, 0), 2);
+  EXPECT_EQ(b.upload(0x1003, 1) & 0xFFFF, 0x3220);
+  EXPECT_EQ(b.upload(0x1003, 2) & 0xFFFF, 0x2310);
+  EXPECT_EQ((b.upload(0x1003, 1) >> 16) & 0x08, 0x08) << "the status word at the emergency, fault bit set";
+  EXPECT_EQ(b.download(0x1003, 0, 2, 1), 0x06090030u) << "only 0 may be written to sub 0";
+  EXPECT_EQ(b.download(0x1003, 1, 0, 4), 0x06010002u);
+  EXPECT_EQ(b.download(0x1003, 0, 0, 1), 0u);
+  EXPECT_EQ(b.upload(0x1003, 0), 0);
 }
 
 TEST(drive_slave, a_mapping_entry_of_0_bits_is_refused_when_it_is_counted_in) {

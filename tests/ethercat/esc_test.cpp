@@ -112,13 +112,14 @@ TEST(esc, read_only_registers_keep_their_value) {
 }
 
 TEST(esc, armw_reads_at_one_slave_and_writes_the_rest) {
+  // A plain register (FMMU 0's logical start): 0x0900, used before, latches receive times now.
   bus b(3);
-  b.write16(command::apwr, ap(0, reg::dc_receive_time), 0x4242);
-  const result r = b.send(command::armw, ap(0, reg::dc_receive_time), {0, 0});
+  b.write16(command::apwr, ap(0, reg::fmmu0), 0x4242);
+  const result r = b.send(command::armw, ap(0, reg::fmmu0), {0, 0});
   EXPECT_EQ(r.wkc, 3);
   EXPECT_EQ(b.value16(r), 0x4242);
-  EXPECT_EQ(b.escs[1].read16(reg::dc_receive_time), 0x4242);
-  EXPECT_EQ(b.escs[2].read16(reg::dc_receive_time), 0x4242);
+  EXPECT_EQ(b.escs[1].read16(reg::fmmu0), 0x4242);
+  EXPECT_EQ(b.escs[2].read16(reg::fmmu0), 0x4242);
 }
 
 TEST(esc, an_access_past_the_memory_is_not_served_and_counted) {
@@ -385,12 +386,12 @@ TEST(esc_commands, nop_and_unknown_commands_pass_untouched) {
 TEST(esc_commands, frmw_reads_at_the_station_and_writes_the_others) {
   bus b(3);
   for (std::uint16_t i = 0; i < 3; ++i) b.write16(command::apwr, ap(i, reg::station_address), 0x1001 + i);
-  b.write16(command::apwr, ap(1, reg::dc_receive_time), 0x5150);
-  const result r = b.send(command::frmw, fp(0x1002, reg::dc_receive_time), {0, 0});
+  b.write16(command::apwr, ap(1, reg::fmmu0), 0x5150);
+  const result r = b.send(command::frmw, fp(0x1002, reg::fmmu0), {0, 0});
   EXPECT_EQ(r.wkc, 3);
   EXPECT_EQ(b.value16(r), 0x5150);
-  EXPECT_EQ(b.escs[0].read16(reg::dc_receive_time), 0) << "before the reader: the master's data";
-  EXPECT_EQ(b.escs[2].read16(reg::dc_receive_time), 0x5150);
+  EXPECT_EQ(b.escs[0].read16(reg::fmmu0), 0) << "before the reader: the master's data";
+  EXPECT_EQ(b.escs[2].read16(reg::fmmu0), 0x5150);
 }
 
 TEST(esc_commands, a_write_past_the_memory_changes_nothing_and_is_counted_by_kind) {

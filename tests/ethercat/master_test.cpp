@@ -345,5 +345,43 @@ TEST(ecat_master, a_master_that_stops_leaves_the_drives_to_their_watchdog) {
   EXPECT_EQ(l.link.slaves[0]->device().drive().view().current(), state::fault);
 }
 
+TEST(ecat_master, configures_distributed_clocks_and_runs_the_drives_on_sync0) {
+  // ETG.1000.4 §9.1 on a line of 3 whose controllers were powered on at different times.
+  line l(3);
+  l.link.slaves[1]->controller().advance(3'000'000);
+  l.link.slaves[2]->controller().advance(11'500'000);
+  l.up();
+  ASSERT_EQ(l.master.dc_reference(), std::optional<std::size_t>{0});
+  const std::uint64_t reference = l.link.slaves[0]->controller().system_time();
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(l.link.slaves[i]->controller().system_time(), reference) << "one system time on the line";
+  }
+  for (std::size_t i = 0; i < 3; ++i) {
+    const ecat_slave& s = l.master.slaves()[i];
+    EXPECT_TRUE(s.dc && s.sync0) << i;
+    EXPECT_EQ(s.dc_delay_ns, i * l.link.wire.hop_delay_ns) << "the hops measured from the receive times";
+    esc& e = l.link.slaves[i]->controller();
+    EXPECT_TRUE(e.sync0_active());
+    EXPECT_EQ(e.read32(reg::dc_sync0_cycle_time), 1'000'000u) << "SYNC0 at the master's cycle";
+    EXPECT_EQ(e.read32(reg::dc_system_time_difference), 0u) << "the cyclic drift distribution finds none";
+    const ecat_sdo_result mode = l.master.sdo_read(i, 0x1C32, 1);
+    ASSERT_TRUE(mode.ok) << mode.error;
+    EXPECT_EQ(mode.value(false), 2) << "the drive runs DC SYNC0";
+  }
+  for (std::size_t i = 0; i < 3; ++i) l.master.set_target(i, state::operation_enabled);
+  EXPECT_GT(run_until(l.master, l.link, [&] { return l.all(state::operation_enabled); }), 0);
+}
+
+TEST(ecat_master, a_cycle_shorter_than_a_drive_can_run_leaves_it_free_running) {
+  wire_link link(1);
+  ecat_master m(link, standard_profile(), 500);  // 0x1C32:05 is the drive's 1 ms step
+  ASSERT_TRUE(m.scan()) << m.error();
+  ASSERT_TRUE(m.bring_to_operational()) << m.error();
+  EXPECT_TRUE(m.slaves()[0].dc);
+  EXPECT_FALSE(m.slaves()[0].sync0);
+  EXPECT_FALSE(link.slaves[0]->controller().sync0_active());
+  EXPECT_EQ(m.sdo_read(0, 0x1C32, 1).value(false), 0) << "free run";
+}
+
 }  // namespace
 }  // namespace cia402::ethercat

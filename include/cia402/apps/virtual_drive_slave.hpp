@@ -19,15 +19,17 @@ namespace cia402::apps {
 
 /// A CoE slave configuration serving the virtual drive's objects (drive402::drive_objects(serial))
 /// with the default RxPDO 0x1600 / TxPDO 0x1A00.
-ethercat::coe_slave_config drive_slave_config(std::uint32_t serial = 0);
+/// `cycle_us`: the time each step() is given (0x1C32:05, the shortest SYNC0 cycle it takes).
+ethercat::coe_slave_config drive_slave_config(std::uint32_t serial = 0, std::uint32_t cycle_us = 1000);
 
 class virtual_drive_slave {
  public:
   /// `serial` goes into 0x1018 sub 4 and the SII (the slave's position, say, so drives differ). The
   /// profile must outlive the slave.
-  explicit virtual_drive_slave(const profile& p, std::uint32_t serial = 0, const sim::plant_config& plant = {})
+  explicit virtual_drive_slave(const profile& p, std::uint32_t serial = 0, const sim::plant_config& plant = {},
+                               std::uint32_t cycle_us = 1000)
       : device_(std::make_unique<drive402::sim_device>(p, plant)),
-        slave_(std::make_unique<ethercat::coe_slave>(*device_, drive_slave_config(serial))) {}
+        slave_(std::make_unique<ethercat::coe_slave>(*device_, drive_slave_config(serial, cycle_us))) {}
 
   ethercat::esc& controller() noexcept { return slave_->controller(); }
   /// The application's cycle: AL requests, mailboxes, process data, then `elapsed_us` of the drive

@@ -1,11 +1,12 @@
 // The communication objects of CiA 301 that the node serves itself, beside the services that use
-// them (SYNC 0x1005, EMCY 0x1014, heartbeat 0x1016 / 0x1017, SDO server 0x1200, PDOs 0x1400..0x1BFF),
+// them (the error history 0x1003 and EMCY 0x1014, SYNC 0x1005, heartbeat 0x1016 / 0x1017, SDO server 0x1200, PDOs 0x1400..0x1BFF),
 // with the defaults of the predefined connection set (CiA 301 §7.3.5) and the PDO defaults the
 // layer above gives (slave_config::rpdo / tpdo).
 #include <algorithm>
 #include <stdexcept>
 #include <string>
 
+#include "cia402/canopen/301/error_history.hpp"
 #include "cia402/canopen/301/object_builders.hpp"
 #include "cia402/canopen/301/slave.hpp"
 #include "cia402/canopen/can/frame.hpp"
@@ -54,6 +55,7 @@ void add_pdos(std::vector<object_entry>& t, const slave_config& c) {
 std::vector<object_entry> communication_objects(const slave_config& c) {
   using enum object_category;
   std::vector<object_entry> t;
+  t.push_back(error_history_object());
   t.push_back(single(0x1005, optional, variable(0, "COB-ID SYNC message", data_type::unsigned32, access::rw, cob::sync)));
   t.push_back(single(0x1014, optional,
                      plus_node_id(variable(0, "COB-ID EMCY", data_type::unsigned32, access::ro, cob::emcy))));

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "cia402/canopen/301/error_history.hpp"
+
 
 namespace cia402::canopen {
 namespace {
@@ -22,9 +24,8 @@ slave::slave(device& d, channel& out, const slave_config& config)
       sdo_(*this, out, config.node_id, config.sdo_timeout_us) {
   device_->attach(this);
   consumer_.on_change = [this](std::uint8_t, bool) {
-    const bool lost = consumer_.any_lost();
-    device_->set_connection_lost(lost);
-    set_node_error(node_error::heartbeat_lost, lost);
+    tell_connection();
+    set_node_error(node_error::heartbeat_lost, consumer_.any_lost());
   };
   boot();
 }
@@ -58,6 +59,14 @@ void slave::enter(nmt_state s) {
   }
   if (s == nmt_state::stopped) sdo_.reset();
   state_ = s;
+  tell_connection();
+}
+
+void slave::tell_connection() {
+  // CiA 402-2 §6.2.1 (0x6007): a heartbeat or guarding loss and the NMT state STOPPED are the
+  // fieldbus going away; PRE-OPERATIONAL is not (SDO still works, the master is there). The device
+  // decides what a loss does to it (drive402::sim_device: only to an enabled drive).
+  device_->set_connection_lost(consumer_.any_lost() || state_ == nmt_state::stopped);
 }
 
 void slave::on_nmt(const frame& f) {
@@ -160,6 +169,7 @@ sdo_abort slave::write_value(object_dictionary::slot& s, std::int64_t v) {
   if (is_pdo_parameter(index)) return write_pdo_parameter(s, v);
   const auto u = static_cast<std::uint32_t>(v);
   switch (index) {
+    case error_history_index: return write_error_history(od_, sub, v);
     case 0x1005:
       // This node consumes SYNC only (bit 30 would make it the producer); 11-bit identifiers; an
       // identifier of its own services taken as SYNC would silence them.
@@ -223,6 +233,7 @@ void slave::error_changed(std::uint16_t code) noexcept {
   if (code == drive_error_) return;
   drive_error_ = code;
   if (code != 0) {
+    note_error(code);
     send_emcy(code);
   } else if (!heartbeat_error_ && !pdo_length_error_) {
     send_emcy(0);
@@ -234,10 +245,18 @@ void slave::set_node_error(std::uint16_t code, bool active) {
   if (flag == active) return;
   flag = active;
   if (active) {
+    note_error(code);
     send_emcy(code);
   } else if (drive_error_ == 0 && !heartbeat_error_ && !pdo_length_error_) {
     send_emcy(0);
   }
+}
+
+void slave::note_error(std::uint16_t code) noexcept {
+  // 0x1003 keeps every error the node signals, also one that arises in STOPPED where no EMCY goes:
+  // the code, and the first two bytes of the EMCY's manufacturer field (a drive: its status word).
+  const std::array<std::uint8_t, 5> field = device_->manufacturer_error_field();
+  record_error(od_, code, static_cast<std::uint16_t>(field[0] | (field[1] << 8)));
 }
 
 void slave::send_emcy(std::uint16_t code) {

@@ -46,7 +46,7 @@ std::optional<axes::value_format> coe_object_format(std::uint16_t index, std::ui
 // --- the line -----------------------------------------------------------------------------------
 
 ecat_line::ecat_line(master_link& link, const profile& p, std::uint32_t cycle_us, std::string name)
-    : link_(&link), master_(link, p, cycle_us), name_(std::move(name)) {}
+    : link_(&link), profile_(&p), master_(link, p, cycle_us), name_(std::move(name)) {}
 
 bool ecat_line::scan() { return master_.scan(); }
 
@@ -78,11 +78,25 @@ std::uint32_t ecat_line::service() {
 void ecat_line::detach_closed() {
   if (left_op_ || !std::all_of(drives_.begin(), drives_.end(), [](const ecat_link* d) { return d->closed_; })) return;
   left_op_ = true;
+  // What each drive showed last, before the line goes: a drive reacts to its master going as its
+  // 0x6007 says only when it is enabled (CiA 402-2 §6.2.1: it has something to stop then).
+  std::vector<std::string> left_in;
+  for (const ecat_link* d : drives_) {
+    state s = state::start;
+    const bool known = d->status_known() && decode_status(*profile_, d->status_word(), s);
+    const bool enabled = s == state::operation_enabled || s == state::quick_stop_active;
+    left_in.push_back(!known ? " left in PRE-OP with the drive's state unknown: 0x6007 acts if it was enabled"
+                      : enabled ? std::string(" left in PRE-OP with the drive in ") + state_name(s) +
+                                      ": it applies 0x6007 (abort connection) to its master going"
+                                : std::string(" left in PRE-OP with the drive in ") + state_name(s) +
+                                      ", not enabled: nothing for 0x6007 to stop");
+  }
   // Every drive's session is done: out of OP at once, not by the watchdog 100 ms later.
   const bool ok = up_ && failure_.empty() && master_.leave_operational();
-  for (ecat_link* d : drives_) {
+  for (std::size_t i = 0; i < drives_.size(); ++i) {
+    ecat_link* d = drives_[i];
     if (ok) {
-      d->report_.left.push_back(name_ + " left in PRE-OP: the drive applies 0x6007 to its master going");
+      d->report_.left.push_back(name_ + left_in[i]);
     } else {
       d->report_.left.push_back(name_ + " left as it was: " + (failure_.empty() ? master_.error() : failure_));
     }

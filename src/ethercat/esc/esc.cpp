@@ -9,6 +9,7 @@
 namespace cia402::ethercat {
 namespace {
 
+using detail::al_event_sm_activation;
 using detail::sm_status_mailbox_full;
 
 constexpr std::uint16_t dl_pdi_operational = 1u << 0;
@@ -57,7 +58,8 @@ esc::esc(std::vector<std::uint8_t> eeprom) : eeprom_(std::move(eeprom)) {
   memory_[reg::sync_managers_supported] = sync_manager_count;
   memory_[reg::ram_size] = 4;
   memory_[reg::port_descriptor] = 0x0F;  // ports 0 and 1 in use (MII), 2 and 3 not implemented
-  // 0x0008 features: 0 = bit-oriented FMMUs, no distributed clocks, no 64-bit DC.
+  // 0x0008 features: bit-oriented FMMUs (bit 0 = 0), distributed clocks (bit 2), 64 bits wide (bit 3).
+  memory_[reg::features] = 0x0C;
   if (eeprom_.size() >= 10) {
     memory_[reg::station_alias] = eeprom_[8];
     memory_[reg::station_alias + 1] = eeprom_[9];
@@ -213,6 +215,7 @@ bool esc::sync_managers_allow(std::uint16_t address, std::uint16_t length, bool 
 
 void esc::before_ecat_access(std::uint16_t address, std::uint16_t length, bool read) noexcept {
   if (!read) return;
+  dc_before_read(address, length);
   for (int n = 0; n < sync_manager_count; ++n) {
     sm_state& s = sms_[static_cast<std::size_t>(n)];
     if (!s.triple || s.config.ecat_writes()) continue;
@@ -261,12 +264,20 @@ void esc::register_written(std::uint16_t address, std::uint16_t length) noexcept
   }
   if (touched(reg::sync_manager0, 8 * sync_manager_count)) {
     for (int n = 0; n < sync_manager_count; ++n) {
-      // A sync manager configured (again), or its activation written, starts empty.
+      // A sync manager configured (again) starts empty. Its activate register (ET1100 datasheet,
+      // 0x0806 + 8 n) resets it only when the enable bit changes: a toggled repeat request (bit 1)
+      // leaves the mailbox as it is and is the application's to answer (ETG.1000.4 mailbox repeat).
       const auto base = static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n);
-      const bool reset = touched(base, 5) || touched(static_cast<std::uint16_t>(base + reg::sm_activate), 1);
-      if (reset) configure_sync_manager(n, true);
+      const auto activate = static_cast<std::uint16_t>(base + reg::sm_activate);
+      if (touched(base, 5)) {
+        configure_sync_manager(n, true);
+      } else if (touched(activate, 1)) {
+        configure_sync_manager(n, false);
+        memory_[reg::al_event_request] |= al_event_sm_activation;
+      }
     }
   }
+  dc_written(address, length);
   if (touched(reg::eeprom_control + 1, 1)) {
     std::uint16_t control = read16(reg::eeprom_control);
     const std::uint16_t cmd = control & eeprom_command_mask;
@@ -466,6 +477,8 @@ void esc::process(datagram& d) noexcept {
 }
 
 void esc::advance(std::uint64_t ns) noexcept {
+  local_time_ns_ += ns;
+  dc_advance();
   const std::uint64_t unit_ns = (std::uint64_t{read16(reg::watchdog_divider)} + 2) * 40;
   const std::uint64_t limit = std::uint64_t{read16(reg::watchdog_time_process_data)} * unit_ns;
   bool armed = false;
@@ -496,7 +509,10 @@ frame_error chain::pass(std::vector<std::uint8_t>& frame) noexcept {
     ++refused_by_[static_cast<std::size_t>(e)];
     return e;
   }
-  for (esc* s : escs_) s->process(parsed_);
+  const std::size_t n = escs_.size();
+  for (std::size_t i = 0; i < n; ++i) escs_[i]->process(parsed_, static_cast<std::uint32_t>(i * hop_delay_ns));
+  // Back through every port 1: twice the hops behind each controller.
+  for (std::size_t i = 0; i + 1 < n; ++i) escs_[i]->frame_returned(static_cast<std::uint32_t>(2 * (n - 1 - i) * hop_delay_ns));
   ++frames_;
   return frame_error::none;
 }

@@ -10,6 +10,8 @@
 
 namespace cia402::ethercat {
 
+using detail::al_event_sm_activation;
+using detail::sm_repeat;
 using detail::sm_status_mailbox_full;
 
 bool esc::pdi_writable(std::uint16_t a) noexcept {
@@ -79,6 +81,20 @@ esc::sync_manager esc::sm(int n) const noexcept {
 
 bool esc::mailbox_full(int n) const noexcept {
   return n >= 0 && n < sync_manager_count && sms_[static_cast<std::size_t>(n)].full;
+}
+
+bool esc::repeat_requested(int n) const noexcept {
+  if (n < 0 || n >= sync_manager_count) return false;
+  const auto base = static_cast<std::size_t>(reg::sync_manager0 + 8 * n);
+  return ((memory_[base + reg::sm_activate] ^ memory_[base + reg::sm_pdi_control]) & sm_repeat) != 0;
+}
+
+void esc::acknowledge_repeat(int n) noexcept {
+  if (n < 0 || n >= sync_manager_count) return;
+  const auto base = static_cast<std::size_t>(reg::sync_manager0 + 8 * n);
+  memory_[base + reg::sm_pdi_control] = static_cast<std::uint8_t>((memory_[base + reg::sm_pdi_control] & ~sm_repeat) |
+                                                                   (memory_[base + reg::sm_activate] & sm_repeat));
+  memory_[reg::al_event_request] = static_cast<std::uint8_t>(memory_[reg::al_event_request] & ~al_event_sm_activation);
 }
 
 bool esc::read_mailbox(int n, std::vector<std::uint8_t>& out) noexcept {

@@ -26,6 +26,7 @@ constexpr std::uint16_t reg_eeprom_config = 0x0500;
 constexpr std::uint16_t reg_eeprom_control = 0x0502;
 constexpr std::uint16_t reg_fmmu0 = 0x0600;
 constexpr std::uint16_t reg_sm0 = 0x0800;
+constexpr std::uint16_t reg_dc_system_time = 0x0910;
 constexpr std::uint16_t eeprom_busy = 0x8000;
 constexpr std::uint16_t eeprom_read_8 = 0x0040;
 constexpr std::uint16_t eeprom_errors = 0x6800;  // command error, checksum error, acknowledge error
@@ -167,6 +168,7 @@ bool ecat_master::write_register(const ecat_slave& s, std::uint16_t reg, const s
 
 bool ecat_master::scan() {
   slaves_.clear();
+  dc_reference_.reset();
   pre_operational_ = false;
   cycling_ = false;
   image_.clear();
@@ -539,6 +541,8 @@ bool ecat_master::bring_to_operational() {
     s.last_control = static_cast<std::uint16_t>(
         get_bits(image_, (s.logical_outputs - logical_base) * 8u + s.control_word->bit_offset, 16));
   }
+  // Clocks and SYNC0 before SAFE-OP, where a drive chooses its sync mode.
+  if (!configure_distributed_clocks()) return false;
   cycling_ = true;
   // Outputs are valid before SAFE-OP -> OP: the drives get them from the first cycle on.
   if (!request_state(line_state::safe_operational, true)) return false;
@@ -647,6 +651,10 @@ bool ecat_master::cycle() {
   frame_builder b(broadcast, master_mac);
   const long lrw = b.add(command::lrw, ++index_, logical_base, image_, static_cast<std::uint16_t>(image_.size()));
   const long al = b.add(command::brd, ++index_, static_cast<std::uint32_t>(reg_al_status) << 16, {}, 2);
+  // The drift distribution: the reference clock's system time to every other DC slave.
+  if (dc_reference_) {
+    (void)b.add(command::frmw, ++index_, slaves_[*dc_reference_].station | (std::uint32_t{reg_dc_system_time} << 16), {}, 8);
+  }
   // One slave a cycle, in turn: is its send mailbox full (SM1 status bit 3)? Then an emergency (or
   // anything else it sent unasked) is fetched after the cycle.
   ecat_slave* asked = slaves_.empty() || in_mailbox_ ? nullptr : &slaves_[cycles_ % slaves_.size()];

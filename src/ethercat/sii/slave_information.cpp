@@ -30,6 +30,8 @@ constexpr std::uint16_t category_rxpdo = 51;
 constexpr std::uint16_t category_end = 0xFFFF;
 
 constexpr std::uint16_t mailbox_coe = 0x0004;
+// General category (ETG.2010): byte offset of the physical ports word.
+constexpr std::size_t general_physical_port = 0x10;
 constexpr std::uint16_t pdo_flag_mandatory = 0x0001;
 constexpr std::uint16_t pdo_flag_default = 0x0002;
 constexpr std::uint16_t pdo_flag_fixed = 0x0010;
@@ -132,6 +134,17 @@ const char* esi_type(std::uint16_t t) {
   }
 }
 
+// The ESI's Physics letters of the SII's physical ports (ETG.2000): Y MII, K EBUS, H fast hot connect.
+std::string physics(std::uint16_t ports) {
+  std::string letters;
+  for (int port = 0; port < 4; ++port) {
+    const unsigned kind = (ports >> (4 * port)) & 0xFu;
+    if (kind == 0) break;
+    letters += kind == 1 ? 'Y' : kind == 3 ? 'K' : kind == 4 ? 'H' : ' ';
+  }
+  return letters;
+}
+
 const char* sm_name(sm_type t) {
   switch (t) {
     case sm_type::mailbox_out: return "MBoxOut";
@@ -201,12 +214,12 @@ std::vector<std::uint8_t> sii_image(const slave_description& d) {
   put32(image, word_product * 2, d.product_code);
   put32(image, word_revision * 2, d.revision);
   put32(image, word_serial * 2, d.serial);
-  for (std::size_t base : {word_bootstrap_mailbox, word_standard_mailbox}) {
-    put16(image, base * 2, d.mailbox_out_start);
-    put16(image, base * 2 + 2, d.mailbox_out_size);
-    put16(image, base * 2 + 4, d.mailbox_in_start);
-    put16(image, base * 2 + 6, d.mailbox_in_size);
-  }
+  // Only the standard mailbox: the bootstrap mailbox words (0x14..0x17) stay 0, since no slave
+  // described here has a BOOT state (its AL state machine refuses it with 0x0013).
+  put16(image, word_standard_mailbox * 2, d.mailbox_out_start);
+  put16(image, word_standard_mailbox * 2 + 2, d.mailbox_out_size);
+  put16(image, word_standard_mailbox * 2 + 4, d.mailbox_in_start);
+  put16(image, word_standard_mailbox * 2 + 6, d.mailbox_in_size);
   put16(image, word_mailbox_protocol * 2, d.coe ? mailbox_coe : 0);
   put16(image, word_size * 2, static_cast<std::uint16_t>(image_bytes * 8 / 1024 - 1));
   put16(image, word_version * 2, 1);
@@ -221,6 +234,7 @@ std::vector<std::uint8_t> sii_image(const slave_description& d) {
   general[5] = d.coe ? d.coe_details : 0;
   general[9] = d.profile_number == 402 ? 1 : 0;  // CiA 402 channels
   general[14] = general[0];
+  put16(general, general_physical_port, d.physical_ports);
   std::vector<std::uint8_t> fmmu;
   for (fmmu_use u : d.fmmus) fmmu.push_back(static_cast<std::uint8_t>(u));
   std::vector<std::uint8_t> syncm;
@@ -308,6 +322,7 @@ std::optional<slave_description> parse_sii(const std::vector<std::uint8_t>& imag
         d.group_name = string_at(byte(0));
         d.device_name = string_at(byte(3));
         d.coe_details = byte(5);
+        d.physical_ports = static_cast<std::uint16_t>(byte(general_physical_port) | (byte(general_physical_port + 1) << 8));
         break;
       case category_fmmu:
         for (std::size_t i = 0; i < size; ++i) {
@@ -376,7 +391,7 @@ std::string esi_xml(const slave_description& d) {
        "</Name>\n  </Vendor>\n";
   x += "  <Descriptions>\n    <Groups>\n      <Group>\n        <Type>" + support::xml_escaped(d.group_name) +
        "</Type>\n        <Name>" + support::xml_escaped(d.group_name) + "</Name>\n      </Group>\n    </Groups>\n";
-  x += "    <Devices>\n      <Device Physics=\"YY\">\n";
+  x += "    <Devices>\n      <Device Physics=\"" + physics(d.physical_ports) + "\">\n";
   x += "        <Type ProductCode=\"" + hex(d.product_code, 8) + "\" RevisionNo=\"" + hex(d.revision, 8) +
        "\">" + support::xml_escaped(d.device_name) + "</Type>\n";
   x += "        <Name>" + support::xml_escaped(d.device_name) + "</Name>\n";
@@ -397,6 +412,18 @@ std::string esi_xml(const slave_description& d) {
     x += std::string("          <CoE SdoInfo=\"") + flag(1) + "\" PdoAssign=\"" + flag(2) + "\" PdoConfig=\"" +
          flag(3) + "\" CompleteAccess=\"" + flag(5) + "\"/>\n";
     x += "        </Mailbox>\n";
+  }
+  if (d.dc_sync0) {
+    // ETG.2000 <Dc>: the operation modes a configuration tool offers, with the 0x0980..0x0981 value
+    // each writes (0x0300: cyclic unit and SYNC0 activated).
+    x += "        <Dc>\n";
+    x += "          <OpMode>\n            <Name>SM</Name>\n            <Desc>SM-synchronous</Desc>\n"
+         "            <AssignActivate>#x0000</AssignActivate>\n          </OpMode>\n";
+    x += "          <OpMode>\n            <Name>DC</Name>\n            <Desc>DC SYNC0</Desc>\n"
+         "            <AssignActivate>#x0300</AssignActivate>\n"
+         "            <CycleTimeSync0 Factor=\"1\">0</CycleTimeSync0>\n"
+         "            <ShiftTimeSync0>0</ShiftTimeSync0>\n          </OpMode>\n";
+    x += "        </Dc>\n";
   }
   const std::vector<std::uint8_t> image = sii_image(d);
   x += "        <Eeprom>\n          <ByteSize>" + std::to_string(image.size()) + "</ByteSize>\n          <ConfigData>";

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "cia402/canopen/301/error_history.hpp"
 #include "cia402/canopen/301/object_builders.hpp"
 #include "cia402/ethercat/slave/coe_slave.hpp"
 
@@ -24,6 +25,26 @@ object_entry pdo_assignment(std::uint16_t index, std::string name, std::uint16_t
       {canopen::limited(variable(0, "Number of assigned PDOs", data_type::unsigned8, access::rw, assigned ? 1 : 0), 0, 2),
        variable(1, "PDO 1", data_type::unsigned16, access::rw, assigned ? first_pdo : 0),
        variable(2, "PDO 2", data_type::unsigned16, access::rw, 0)});
+}
+
+// 0x1C32 / 0x1C33 sync manager output / input parameter (ETG.1020 §5.3, ETG.6010): the sync mode a
+// master chooses (written in PRE-OP; DC SYNC0 also taken from 0x0981 on the way to SAFE-OP), the
+// cycle, the modes this slave offers (free run, SM-synchronous, DC SYNC0) and what SYNC0 ran.
+object_entry sync_manager_parameter(std::uint16_t index, std::string name, std::uint32_t cycle_us) {
+  return canopen::group(
+      index, std::move(name), object_code::record, object_category::optional,
+      {variable(0, "Number of sub-indices", data_type::unsigned8, access::ro, sync_parameter::sync_error_count),
+       variable(sync_parameter::mode, "Sync mode", data_type::unsigned16, access::rw, sync_mode::free_run),
+       variable(sync_parameter::cycle_time, "Cycle time", data_type::unsigned32, access::rw, 0),
+       variable(3, "Shift time", data_type::unsigned32, access::ro, 0),
+       variable(sync_parameter::supported, "Sync modes supported", data_type::unsigned16, access::ro,
+                sync_parameter::supported_modes),
+       variable(sync_parameter::minimum_cycle_time, "Minimum cycle time", data_type::unsigned32, access::ro,
+                std::int64_t{cycle_us} * 1000),
+       variable(6, "Calc and copy time", data_type::unsigned32, access::ro, 0),
+       variable(9, "Delay time", data_type::unsigned32, access::ro, 0),
+       variable(sync_parameter::sync0_cycle_time, "Sync0 cycle time", data_type::unsigned32, access::ro, 0),
+       variable(sync_parameter::sync_error_count, "SM event missed", data_type::unsigned16, access::ro, 0)});
 }
 
 const object_entry* find(const std::vector<object_entry>& t, std::uint16_t index) {
@@ -77,6 +98,8 @@ pdo_description pdo_of(const std::vector<object_entry>& t, std::uint16_t index, 
 
 std::vector<object_entry> coe_communication_objects(const coe_slave_config& c) {
   std::vector<object_entry> t;
+  // The emergencies' history (CiA 301 §7.5.2.5), as the CANopen node keeps it.
+  t.push_back(canopen::error_history_object());
   // EtherCAT has no heartbeat (the sync manager watchdog watches the master): 0x1017 is stored and
   // does nothing, so a master that sets it on every bus is not refused.
   t.push_back(canopen::single(0x1017, object_category::optional,
@@ -93,6 +116,8 @@ std::vector<object_entry> coe_communication_objects(const coe_slave_config& c) {
                               variable(4, "SM3 (inputs)", data_type::unsigned8, access::ro, 4)}));
   t.push_back(pdo_assignment(0x1C12, "RxPDO assign", 0x1600, c.rx_pdo.count != 0));
   t.push_back(pdo_assignment(0x1C13, "TxPDO assign", 0x1A00, c.tx_pdo.count != 0));
+  t.push_back(sync_manager_parameter(sync_parameter::outputs, "SM output parameter", c.application_cycle_us));
+  t.push_back(sync_manager_parameter(sync_parameter::inputs, "SM input parameter", c.application_cycle_us));
   return t;
 }
 
@@ -136,6 +161,7 @@ slave_description coe_slave_description(const coe_slave_config& c) {
                      {outputs_start, bytes(d.rx_pdos[0]), 0x64, 1, sm_type::outputs},
                      {inputs_start, bytes(d.tx_pdos[0]), 0x20, 1, sm_type::inputs}};
   d.fmmus = {fmmu_use::outputs, fmmu_use::inputs, fmmu_use::sm_status};
+  d.dc_sync0 = true;  // the controller has the DC unit; the slave runs its outputs on SYNC0
   return d;
 }
 

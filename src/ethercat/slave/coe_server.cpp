@@ -51,6 +51,16 @@ std::vector<std::uint8_t> le32_bytes(std::uint32_t v) {
           static_cast<std::uint8_t>(v >> 24)};
 }
 
+// The data type an object description gives a RECORD (ETG.1000.6's complex types, as the ETG's
+// slave code numbers them): identity 0x0023, PDO mapping 0x0021, sync manager parameter 0x0029, any
+// other record 0x002A. An ARRAY gives the type of its elements, a VAR its own.
+std::uint16_t record_data_type(std::uint16_t index) noexcept {
+  if (index == 0x1018) return 0x0023;
+  if ((index >= 0x1600 && index <= 0x17FF) || (index >= 0x1A00 && index <= 0x1BFF)) return 0x0021;
+  if (index >= 0x1C30 && index <= 0x1C4F) return 0x0029;
+  return 0x002A;
+}
+
 }  // namespace
 
 coe_server::coe_server(canopen::object_access& access, const canopen::object_dictionary& dictionary,
@@ -347,7 +357,8 @@ void coe_server::on_sdo_information(std::span<const std::uint8_t> body) {
       const object_entry* o = dictionary_->object(request->list_or_index);
       if (o == nullptr || o->subs.empty()) return error(sdo_abort::object_does_not_exist);
       const sub_entry& typed = o->subs.size() > 1 ? o->subs[1] : o->subs[0];
-      const auto type = static_cast<std::uint16_t>(o->code == object_code::record ? 0 : static_cast<unsigned>(typed.type));
+      const std::uint16_t type = o->code == object_code::record ? record_data_type(o->index)
+                                                                : static_cast<std::uint16_t>(typed.type);
       return information_reply(sdo_info_opcode::object_description_response,
                                object_description_data(o->index, type, o->subs.back().sub,
                                                        static_cast<std::uint8_t>(o->code), o->name));

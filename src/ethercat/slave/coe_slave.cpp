@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "cia402/canopen/301/error_history.hpp"
+
 namespace cia402::ethercat {
 namespace {
 
@@ -82,10 +84,25 @@ sdo_abort coe_slave::write_pdo_configuration(canopen::object_dictionary::slot& s
   return sdo_abort::none;
 }
 
+sdo_abort coe_slave::write_sync_mode(canopen::object_dictionary::slot& s, std::int64_t v) {
+  // The synchronisation is chosen in PRE-OP, as the process data are.
+  if (state_ != al_state::pre_operational) return sdo_abort::cannot_store_in_present_state;
+  if (s.entry->sub == sync_parameter::mode) {
+    const bool outputs = s.object->index == sync_parameter::outputs;
+    const bool offered = v == sync_mode::free_run || v == sync_mode::sm_synchronous || v == sync_mode::dc_sync0 ||
+                         (!outputs && v == sync_mode::sm2_synchronous);
+    if (!offered) return sdo_abort::invalid_value;
+  }
+  s.number = v;
+  return sdo_abort::none;
+}
+
 sdo_abort coe_slave::write_value(canopen::object_dictionary::slot& s, std::int64_t v) {
   const std::uint16_t index = s.object->index;
   if (s.entry->where == canopen::backing::device) return device_->write(index, s.entry->sub, v);
+  if (index == sync_parameter::outputs || index == sync_parameter::inputs) return write_sync_mode(s, v);
   if (mapping_object(index) || assignment_object(index)) return write_pdo_configuration(s, v);
+  if (index == canopen::error_history_index) return canopen::write_error_history(od_, s.entry->sub, v);
   s.number = v;
   return sdo_abort::none;
 }
@@ -93,7 +110,10 @@ sdo_abort coe_slave::write_value(canopen::object_dictionary::slot& s, std::int64
 void coe_slave::error_changed(std::uint16_t code) noexcept {
   std::int64_t reg = 0;
   (void)read(0x1001, 0, reg);
-  coe_.emergency(code, static_cast<std::uint8_t>(reg), device_->manufacturer_error_field());
+  const std::array<std::uint8_t, 5> field = device_->manufacturer_error_field();
+  // 0x1003 keeps what the emergencies said, as the CANopen node does (canopen/301/error_history.hpp).
+  canopen::record_error(od_, code, static_cast<std::uint16_t>(field[0] | (field[1] << 8)));
+  coe_.emergency(code, static_cast<std::uint8_t>(reg), field);
 }
 
 // ---- the AL state machine ---------------------------------------------------------------------
@@ -107,7 +127,12 @@ void coe_slave::refuse(std::uint16_t code) {
 void coe_slave::enter(al_state s) {
   const al_state before = state_;
   state_ = s;
-  if (s == al_state::init) coe_.reset();
+  if (s == al_state::init) {
+    coe_.reset();
+    in_send_mailbox_.clear();
+    last_read_.clear();
+    withdrawn_.clear();
+  }
   // Leaving OP the master no longer commands the device; entering it, it does again (a CiA 402
   // drive's 0x6007, S10).
   if (before == al_state::operational && s != al_state::operational) device_->set_connection_lost(true);
@@ -153,18 +178,58 @@ bool coe_slave::to_safe_operational() {
     refuse(al_code::invalid_input_configuration);
     return false;
   }
+  if (!choose_sync_mode()) return false;
   outputs_checked_ = esc_.sm(sm_outputs);
   inputs_checked_ = esc_.sm(sm_inputs);
   return true;
 }
 
+bool coe_slave::choose_sync_mode() {
+  using namespace sync_parameter;
+  const bool dc_asked = od_.number(outputs, mode) == sync_mode::dc_sync0 ||
+                        od_.number(inputs, mode) == sync_mode::dc_sync0;
+  const std::uint32_t cycle = esc_.read32(reg::dc_sync0_cycle_time);
+  if (!esc_.sync0_active()) {
+    // DC SYNC0 asked for by CoE, but the master did not start SYNC0.
+    if (dc_asked) {
+      refuse(al_code::invalid_dc_sync_configuration);
+      return false;
+    }
+    dc_sync0_ = false;
+  } else {
+    // SYNC0 activated by the master (as SOEM's ec_dcsync0 does, writing no CoE object): DC mode.
+    if (cycle == 0) {
+      refuse(al_code::invalid_dc_sync_configuration);  // one pulse is not a cycle to run on
+      return false;
+    }
+    if (cycle < od_.number(outputs, minimum_cycle_time)) {
+      refuse(al_code::invalid_dc_sync_cycle_time);
+      return false;
+    }
+    dc_sync0_ = true;
+  }
+  for (const std::uint16_t index : {outputs, inputs}) {
+    if (dc_sync0_) {
+      od_.set_number(index, mode, sync_mode::dc_sync0);
+      od_.set_number(index, cycle_time, cycle);
+    }
+    od_.set_number(index, sync0_cycle_time, dc_sync0_ ? cycle : 0);
+    od_.set_number(index, sync_error_count, 0);
+  }
+  outputs_waiting_ = false;
+  return true;
+}
+
 void coe_slave::handle_al_control() {
   const std::uint16_t control = esc_.read16(reg::al_control);
-  if ((control & al_acknowledge) && error_) {
+  const unsigned wanted = control & 0x0Fu;
+  if (error_) {
+    // ETG.1000.6 §6.4.1.4, as the ETG's slave code does it: while the error flag is up, a request
+    // without the acknowledge (0x0120 bit 4) changes nothing, but INIT, which acknowledges by itself.
+    if (!(control & al_acknowledge) && wanted != 1) return;
     error_ = false;
     code_ = al_code::none;
   }
-  const unsigned wanted = control & 0x0Fu;
   const auto current = static_cast<unsigned>(state_);
   switch (wanted) {
     case 1: enter(al_state::init); return;
@@ -209,10 +274,44 @@ void coe_slave::watch_sync_managers() {
   }
 }
 
+void coe_slave::send_reply(std::vector<std::uint8_t>& reply) {
+  if (esc_.write_mailbox(1, reply)) in_send_mailbox_.swap(reply);
+  reply.clear();
+}
+
+void coe_slave::repeat_last_reply() {
+  if (state_ != al_state::init && esc_.mailbox_full(1)) {
+    // A newer reply waits unread: taken back (SM1 deactivated and activated again by its PDI
+    // control, which empties it) to go out after the one the master lost.
+    const auto pdi_control = static_cast<std::uint16_t>(reg::sync_manager0 + 8 + reg::sm_pdi_control);
+    const std::uint8_t control = esc_.read8(pdi_control);
+    esc_.write8(pdi_control, static_cast<std::uint8_t>(control | 1u));
+    esc_.write8(pdi_control, control);
+    withdrawn_.swap(in_send_mailbox_);
+    in_send_mailbox_.clear();
+  }
+  if (state_ != al_state::init && !last_read_.empty() && esc_.write_mailbox(1, last_read_)) {
+    in_send_mailbox_ = last_read_;
+  }
+  esc_.acknowledge_repeat(1);
+}
+
 void coe_slave::serve_mailbox() {
+  // The master read SM1 whole: what it held is what a repeat request puts back.
+  if (esc_.take_sync_manager_event(1) && !esc_.mailbox_full(1) && !in_send_mailbox_.empty()) {
+    last_read_.swap(in_send_mailbox_);
+    in_send_mailbox_.clear();
+  }
+  if (esc_.repeat_requested(1)) repeat_last_reply();
   if (state_ == al_state::init) return;
   if (esc_.read_mailbox(0, mailbox_)) coe_.on_mailbox(mailbox_);
-  if (coe_.has_reply() && !esc_.mailbox_full(1)) (void)esc_.write_mailbox(1, coe_.take_reply());
+  if (esc_.mailbox_full(1)) return;
+  if (!withdrawn_.empty()) {
+    send_reply(withdrawn_);
+  } else if (coe_.has_reply()) {
+    std::vector<std::uint8_t> reply = coe_.take_reply();
+    send_reply(reply);
+  }
 }
 
 void coe_slave::step(std::uint32_t elapsed_us) {

@@ -72,8 +72,20 @@ void coe_slave::exchange_process_data() {
   // bound entries: the application reaches process RAM only, in the buffer the controller gives it.
   std::array<std::uint8_t, max_process_data> buffer{};
   const bool outputs_arrived = esc_.take_sync_manager_event(sm_outputs);
+  const bool sync0 = esc_.take_sync0_event();
+  // Free run and SM-synchronous: outputs when they arrive. DC SYNC0: the newest on each pulse.
+  bool take_outputs = outputs_arrived;
+  if (dc_sync0_) {
+    outputs_waiting_ = outputs_waiting_ || outputs_arrived;
+    take_outputs = sync0;
+    if (sync0 && state_ == al_state::operational && !outputs_waiting_) {
+      const auto missed = od_.number(sync_parameter::outputs, sync_parameter::sync_error_count);
+      if (missed < 0xFFFF) od_.set_number(sync_parameter::outputs, sync_parameter::sync_error_count, missed + 1);
+    }
+    if (sync0) outputs_waiting_ = false;
+  }
   const std::size_t out_bytes = outputs_checked_.enabled ? outputs_checked_.length : 0;
-  if (state_ == al_state::operational && outputs_arrived && out_bytes <= buffer.size() &&
+  if (state_ == al_state::operational && take_outputs && out_bytes <= buffer.size() &&
       output_bits_ <= 8 * out_bytes && esc_.read_buffer(sm_outputs, std::span(buffer.data(), out_bytes))) {
     for (const bound_entry& e : outputs_) {
       const std::uint64_t raw = get_bytes(buffer, e.bit_offset, e.bits);

@@ -11,11 +11,17 @@
 //   and heartbeats. Reset node restarts the device (power-on) and every object; reset communication
 //   resets 0x1000..0x1FFF. Both send the boot-up message and enter PRE-OPERATIONAL.
 // - A heartbeat consumer timeout (0x1016) tells the device the connection is lost, so 0x6007 acts
-//   (S10), and sends EMCY 0x8130; the next heartbeat from that node clears it.
+//   (S10), and sends EMCY 0x8130; the next heartbeat from that node clears it. Entering STOPPED
+//   tells it too (CiA 402-2 lists "NMT stopped state entered" among 0x6007's events), leaving it
+//   clears it; PRE-OPERATIONAL does not (SDO still works). The device decides what a loss does.
 // - EMCY (0x80 + node-ID) on every new device error (device::error_changed, device.hpp): bytes 0..1
 //   the error code, byte 2 the error register 0x1001, bytes 3..7 the device's
 //   manufacturer_error_field() at that moment (a CiA 402 drive: its status word, then zeros). Node errors (heartbeat lost 0x8130, RPDO too short 0x8210) send their
 //   own EMCY. When the last error is gone, EMCY 0x0000 ("error reset").
+// - 0x1003 (error_history.hpp) holds the last 8 of those errors, newest first, the code with the
+//   first two bytes of the manufacturer field (the drive's status word) above it; it records an
+//   error that arises in STOPPED too, where no EMCY goes out. Reset node and reset communication
+//   empty it, as every object of 0x1000..0x1FFF goes back to its default.
 // - 0x1001 reads as the drive's register, plus bits 0 and 4 (communication) while a node error is
 //   active.
 // - Mapping changes follow CANopenNode: mapping entries need the PDO invalid (COB-ID bit 31) and
@@ -73,7 +79,7 @@ struct slave_config {
 };
 
 /// The communication objects the node serves itself, beside the services that use them (CiA 301
-/// §7.5.2): 0x1005 COB-ID SYNC, 0x1014 COB-ID EMCY, 0x1016 consumer heartbeat times, 0x1017
+/// §7.5.2): 0x1003 pre-defined error field, 0x1005 COB-ID SYNC, 0x1014 COB-ID EMCY, 0x1016 consumer heartbeat times, 0x1017
 /// producer heartbeat time, 0x1200 SDO server, 0x1400..0x1403 / 0x1600..0x1603 RPDO communication
 /// and mapping, 0x1800..0x1803 / 0x1A00..0x1A03 TPDO communication and mapping; defaults from the
 /// predefined connection set (CiA 301 §7.3.5) and `c`.
@@ -155,6 +161,8 @@ class slave final : private dictionary_access, private device_events {
   void resolve_pdos();
   pdo_config resolve(std::uint16_t comm, std::uint16_t mapping);
   void configure_consumer();
+  // The device hears whether the fieldbus is there: no lost heartbeat and not STOPPED.
+  void tell_connection();
 
   void boot();
   void enter(nmt_state s);
@@ -165,6 +173,7 @@ class slave final : private dictionary_access, private device_events {
   void send_tpdo(tpdo_state& t, const std::array<std::uint8_t, 8>& data);
   std::uint32_t process_tpdo_events(std::uint32_t elapsed_us);
   void set_node_error(std::uint16_t code, bool active);
+  void note_error(std::uint16_t code) noexcept;
   void send_emcy(std::uint16_t code);
 
   device* device_;

@@ -15,7 +15,8 @@
 //   name) its manufacturer objects;
 // - close(): nothing in a drive's dictionary was changed (the mapping is read, not written); once
 //   every drive's link is closed the line leaves OP for PRE-OP at once, rather than by the sync
-//   managers' watchdog, and each drive reacts as its 0x6007 says to its master going.
+//   managers' watchdog. A drive left enabled reacts as its 0x6007 says to its master going; one
+//   left disabled (READY TO SWITCH ON, say) has nothing to stop, and the report says which.
 #pragma once
 
 #include <cstdint>
@@ -60,6 +61,7 @@ class ecat_line {
   void detach_closed();
 
   master_link* link_;
+  const profile* profile_;
   ecat_master master_;
   std::string name_;
   bool up_ = false;

@@ -7,8 +7,21 @@
 // a mailbox means, process data contents) is the application's: it reads the events this
 // controller raises and answers through the PDI calls.
 //
-// Memory: registers 0x0000..0x0FFF, process RAM 0x1000..0x1FFF (4 KiB). No distributed clocks: the
-// ESC features register (0x0008) and the SII say so, so masters skip them.
+// Memory: registers 0x0000..0x0FFF, process RAM 0x1000..0x1FFF (4 KiB).
+//
+// Distributed clocks (ET1100 datasheet section II 0x0900..0x09FF, ETG.1000.4 §9.1), 64 bits wide
+// (features 0x0008 bits 2 and 3): a local clock that runs on the time advance() passes (the host
+// clock's, through the application, on a network interface); a write to 0x0900 latches the receive
+// times (0x0900 port 0, 0x0904 port 1 when a slave follows, 0x0918 the processing unit's 64 bits);
+// the system time 0x0910 reads the local time plus the offset 0x0920; a write to it (the master's
+// drift distribution, ARMW/FRMW) sets the difference 0x092C to the value written plus the delay
+// 0x0928 minus the local copy. The clocks of this emulation do not drift (they share one time
+// base), so nothing is slewed: the difference shows how well the master set offsets and delays.
+// The SYNC0 unit: activation 0x0981 (bit 0 cyclic unit, bit 1 SYNC0), start time 0x0990 (it reads
+// as the next pulse), cycle time 0x09A0 (0: one pulse); a pulse sets 0x098E bit 0 and raises
+// take_sync0_event(). On the in-process wire a frame reaches the controller at position i after
+// i x chain::hop_delay_ns, and comes back to its port 1 after twice the hops behind it, so a master
+// measures real propagation delays.
 //
 // Buffered (three-buffer) sync managers, as on a real ESC: the writer (the master for outputs, the
 // application for inputs) fills a buffer of its own, which is published whole when its last byte
@@ -74,7 +87,17 @@ inline constexpr std::uint16_t sm_control = 4;
 inline constexpr std::uint16_t sm_status = 5;
 inline constexpr std::uint16_t sm_activate = 6;
 inline constexpr std::uint16_t sm_pdi_control = 7;
-inline constexpr std::uint16_t dc_receive_time = 0x0900;
+inline constexpr std::uint16_t dc_receive_time = 0x0900;        ///< port 0; a write latches every port
+inline constexpr std::uint16_t dc_receive_time_port1 = 0x0904;
+inline constexpr std::uint16_t dc_system_time = 0x0910;         ///< 64 bits
+inline constexpr std::uint16_t dc_receive_time_unit = 0x0918;   ///< 64 bits, the processing unit's
+inline constexpr std::uint16_t dc_system_time_offset = 0x0920;  ///< 64 bits
+inline constexpr std::uint16_t dc_system_time_delay = 0x0928;
+inline constexpr std::uint16_t dc_system_time_difference = 0x092C;  ///< bit 31: the local copy is smaller
+inline constexpr std::uint16_t dc_activation = 0x0981;          ///< bit 0 cyclic unit, bit 1 SYNC0
+inline constexpr std::uint16_t dc_sync0_status = 0x098E;
+inline constexpr std::uint16_t dc_start_time = 0x0990;          ///< 64 bits; reads as the next SYNC0 pulse
+inline constexpr std::uint16_t dc_sync0_cycle_time = 0x09A0;    ///< ns
 inline constexpr std::uint16_t process_ram = 0x1000;
 }  // namespace reg
 
@@ -98,10 +121,17 @@ class esc {
   /// what it did, ADP incremented for auto-increment and broadcast commands.
   void process(datagram& d) noexcept;
   /// Every datagram of a parsed frame, in order.
-  void process(parsed_frame& f) noexcept {
+  /// `arrival_ns`: how long after the frame left the master it reaches this controller (receive
+  /// times and the system time a datagram reads are taken then).
+  void process(parsed_frame& f, std::uint32_t arrival_ns = 0) noexcept {
+    arrival_ns_ = arrival_ns;
+    latched_ = false;
     for (std::size_t i = 0; i < f.count; ++i) process(f.datagrams[i]);
   }
-  /// Time passes (virtual): the process data watchdog runs down.
+  /// The frame came back to port 1 `downstream_ns` after it passed port 0: the port 1 receive time,
+  /// when this frame latched receive times.
+  void frame_returned(std::uint32_t downstream_ns) noexcept;
+  /// Time passes (virtual): the local clock runs, SYNC0 pulses, the process data watchdog runs down.
   void advance(std::uint64_t ns) noexcept;
 
   // ---- the application (PDI) side ------------------------------------------------------------
@@ -128,6 +158,13 @@ class esc {
   bool take_sync_manager_event(int n) noexcept;
   /// The process data watchdog expired (the master stopped writing outputs).
   bool take_watchdog_event() noexcept;
+  /// A SYNC0 pulse came since the application last asked (0x098E bit 0, cleared by this).
+  bool take_sync0_event() noexcept;
+  /// The local clock (ns since power-on) and the system time (local + offset 0x0920).
+  std::uint64_t local_time() const noexcept { return local_time_ns_; }
+  std::uint64_t system_time() const noexcept;
+  /// SYNC0 runs: the cyclic unit and SYNC0 activated (0x0981 bits 0 and 1).
+  bool sync0_active() const noexcept;
 
   /// Sync manager n as the master configured it. Enabled only when activated (and not deactivated
   /// by the application) with an area inside process RAM (0x1000..0x1FFF), as on an ESC.
@@ -147,6 +184,13 @@ class esc {
   /// Fills a mailbox the master reads (marks it full). False when it is still full or too short.
   bool write_mailbox(int n, const std::vector<std::uint8_t>& data) noexcept;
   bool mailbox_full(int n) const noexcept;
+  /// Mailbox repeat (ETG.1000.4 sync manager, ET1100 datasheet 0x0806 / 0x0807): the master asks
+  /// for the last reply again by toggling the repeat request (activate register bit 1), which leaves
+  /// the mailbox as it is and sets 0x0220 bit 4. True while that bit differs from the application's
+  /// repeat acknowledge (PDI control bit 1).
+  bool repeat_requested(int n) const noexcept;
+  /// The application put the reply back: the acknowledge takes the request's value, 0x0220 bit 4 clears.
+  void acknowledge_repeat(int n) noexcept;
   /// The newest whole buffer of outputs (a buffered sync manager the master writes) into `out`, of
   /// the sync manager's length. False, and nothing copied, when n is not such a sync manager or the
   /// size differs. Later reads (read8) see the same buffer.
@@ -206,6 +250,12 @@ class esc {
   void before_ecat_access(std::uint16_t address, std::uint16_t length, bool read) noexcept;
   void after_ecat_access(std::uint16_t address, std::uint16_t length, bool read, bool write) noexcept;
   void register_written(std::uint16_t address, std::uint16_t length) noexcept;
+  // Distributed clocks (esc_dc.cpp).
+  void dc_before_read(std::uint16_t address, std::uint16_t length) noexcept;
+  void dc_written(std::uint16_t address, std::uint16_t length) noexcept;
+  void dc_advance() noexcept;
+  std::uint64_t read64(std::uint16_t address) const noexcept;
+  void set_register64(std::uint16_t address, std::uint64_t v) noexcept;
   // Logical addressing through the FMMUs: how many FMMUs of each kind the datagram reached.
   void logical(datagram& d, bool read, bool write) noexcept;
 
@@ -216,6 +266,11 @@ class esc {
   bool al_control_event_ = false;
   bool watchdog_event_ = false;
   std::uint64_t since_trigger_ns_ = 0;
+  std::uint64_t local_time_ns_ = 0;
+  std::uint32_t arrival_ns_ = 0;       // of the frame being processed
+  bool latched_ = false;               // the frame being processed latched the receive times
+  bool sync0_event_ = false;
+  std::uint64_t next_sync0_ = 0;       // system time of the next SYNC0 pulse, while active
   error_counters errors_{};
 };
 
@@ -227,6 +282,8 @@ class chain {
   /// Passes a frame through every controller; an error (and the frame untouched) when it is not a
   /// sound EtherCAT frame.
   frame_error pass(std::vector<std::uint8_t>& frame) noexcept;
+  /// Propagation delay from one controller to the next (forwarding and cable), each way.
+  std::uint32_t hop_delay_ns = 500;
   std::uint64_t frames() const noexcept { return frames_; }
   std::uint64_t refused_frames() const noexcept { return refused_frames_; }
   /// Refused frames of one kind.

@@ -7,8 +7,16 @@
 // It is written for real drives, not only ours: every layout comes from what a slave says about
 // itself (SII sync managers and mailbox, 0x1C12/0x1C13 and the PDOs they assign), 0x6040 and 0x6041
 // are found wherever the mapping puts them, AL status codes are read and reported, and a slave
-// that answers late is polled until a time limit rather than assumed ready. No distributed clocks:
-// drives that need DC synchronisation (csp on many real servos) are not served by this master.
+// that answers late is polled until a time limit rather than assumed ready.
+//
+// Distributed clocks (ETG.1000.4 §9.1, ETG.1020 §5.3), when the drives offer them (ESC features
+// 0x0008 bit 2), on the way to SAFE-OP: receive times latched by a BWR to 0x0900, the propagation
+// delay of each from the port time spans of a line (ETG.1000.4's method), offsets making the first
+// DC slave's clock the system time, a static drift distribution (FRMW of 0x0910, 16 times), then
+// SYNC0 at the master's cycle on every DC slave whose 0x1C32:05 (minimum cycle time) allows that
+// cycle (the others run free), starting on a cycle boundary after twice the time the set-up took
+// and two cycles, so every slave is activated before the first pulse. Each cycle's frame then
+// carries the drift distribution (FRMW of the reference clock's 0x0910).
 //
 // The master never reads a clock: time comes from the link (`now_us`, `wait_us`), so the same code
 // runs on a raw socket (src/apps) and on the in-process wire of the tests on virtual time.
@@ -87,6 +95,9 @@ struct ecat_slave {
   std::uint16_t last_control = 0;
   std::uint16_t last_error_code = 0;
   std::vector<std::uint16_t> emergencies;  ///< error codes of the EMCYs the mailbox brought
+  bool dc = false;              ///< its ESC has distributed clocks (0x0008 bit 2)
+  bool sync0 = false;           ///< the master started its SYNC0 at the master's cycle
+  std::uint32_t dc_delay_ns = 0;  ///< propagation delay from the reference clock (0x0928)
 };
 
 /// An SDO transfer's result.
@@ -159,6 +170,8 @@ class ecat_master {
   std::uint64_t cycles() const noexcept { return cycles_; }
   std::uint64_t lost_frames() const noexcept { return lost_frames_; }
   std::uint32_t cycle_us() const noexcept { return cycle_us_; }
+  /// The slave whose clock is the system time, when the line has distributed clocks.
+  std::optional<std::size_t> dc_reference() const noexcept { return dc_reference_; }
   /// Called with every frame exchanged (sent, then answered), for captures.
   std::function<void(const std::vector<std::uint8_t>& sent, const std::vector<std::uint8_t>& answered)> on_frame;
 
@@ -177,6 +190,8 @@ class ecat_master {
   bool configure_mailbox(ecat_slave& s);
   bool learn_mapping(ecat_slave& s);
   bool configure_process_data(ecat_slave& s, std::uint32_t& logical);
+  bool configure_distributed_clocks();
+  bool start_sync0();
   bool mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe);
   std::optional<std::vector<std::uint8_t>> mailbox_receive(ecat_slave& s);
   // The slave `i` names, with its CoE mailbox, or an error in `result`.
@@ -216,6 +231,7 @@ class ecat_master {
   bool cycling_ = false;       // the process data is configured: cycles run, also during SDOs
   bool in_mailbox_ = false;    // an SDO transfer owns the send mailboxes
   std::uint64_t last_cycle_us_ = 0;
+  std::optional<std::size_t> dc_reference_;
   std::string error_;
 };
 

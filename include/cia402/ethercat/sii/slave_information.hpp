@@ -62,14 +62,20 @@ struct slave_description {
   std::uint16_t mailbox_in_size = 128;
   bool coe = true;             ///< mailbox protocol CoE (SII word 0x1C bit 2)
   std::uint8_t coe_details = 0;  ///< SII General: bit 0 SDO, 1 SDO info, 2 PDO assign, 3 PDO config, 5 complete access
+  /// SII General, physical ports (ETG.2010): 4 bits a port, 0 unused, 1 MII, 3 EBUS. Ports 0 and 1 MII,
+  /// as the ESC's port descriptor (0x0007) and the ESI's Physics="YY" say.
+  std::uint16_t physical_ports = 0x0011;
   std::vector<sync_manager_description> sync_managers;  ///< SM0, SM1, ...
   std::vector<fmmu_use> fmmus;
   std::vector<pdo_description> rx_pdos;  ///< outputs
   std::vector<pdo_description> tx_pdos;  ///< inputs
   std::uint16_t profile_number = 402;    ///< CiA device profile (ESI <Profile><ProfileNo>)
+  /// The ESI offers DC: operation modes SM-synchronous and DC SYNC0 (AssignActivate 0x0300).
+  bool dc_sync0 = false;
 };
 
-/// The SII EEPROM image: ESC configuration area with its CRC, identity, mailbox layout, then the
+/// The SII EEPROM image: ESC configuration area with its CRC, identity, the standard mailbox (no
+/// bootstrap mailbox: BOOT is not offered), then the
 /// categories strings, general, FMMU, SyncM, TXPDO, RXPDO and the end marker; padded to a whole
 /// number of KiBit as word 0x3E says.
 std::vector<std::uint8_t> sii_image(const slave_description& d);

@@ -1,6 +1,7 @@
 // An EtherCAT CoE slave around a device (canopen/301/device.hpp): an emulated controller (esc), the
 // application behind it (the AL state machine, CoE mailboxes, process data) and the device's part of
-// the dictionary, to which it adds the objects of CoE's communication area (ETG.1000.6): 0x1600 /
+// the dictionary, to which it adds the objects of CoE's communication area (ETG.1000.6): 0x1003
+// (CiA 301's pre-defined error field: the last 8 emergencies, canopen/301/error_history.hpp), 0x1600 /
 // 0x1601 RxPDO and 0x1A00 / 0x1A01 TxPDO mappings, 0x1C00 sync manager types, 0x1C12 / 0x1C13 PDO
 // assignment, and 0x1017 (producer heartbeat time: stored and acting on nothing, EtherCAT has no
 // heartbeat, so a master that writes it on every bus is not refused). It knows no device profile:
@@ -10,10 +11,12 @@
 // AL state machine (ETG.1000.6 §6.4): INIT -> PRE-OP needs SM0/SM1 as the SII describes them (else
 // 0x0016 invalid mailbox configuration); PRE-OP -> SAFE-OP needs every assigned PDO entry to name an
 // object (else 0x0025 invalid output mapping / 0x0024 invalid input mapping) and SM2/SM3 as long as
-// the assigned PDOs and configured as outputs / inputs (0x001D / 0x001E); SAFE-OP -> OP; any state
+// the assigned PDOs and configured as outputs / inputs (0x001D / 0x001E), and a sync mode it can run
+// (below); SAFE-OP -> OP; any state
 // back down; BOOT is refused (0x0013); an unknown or skipped state is refused (0x0011 / 0x0012). A
 // refusal keeps the state, sets the error flag (0x0130 bit 4) and the code, until the master
-// acknowledges it (0x0120 bit 4). In OP the process data watchdog guards the outputs: when it
+// acknowledges it (0x0120 bit 4); until then every request but INIT (which acknowledges by itself,
+// as the ETG's slave code takes it) is ignored: the state, the flag and the code stay. In OP the process data watchdog guards the outputs: when it
 // expires the slave falls to SAFE-OP with 0x001B and tells the device its connection is lost, so a
 // CiA 402 drive applies 0x6007 (S10).
 //
@@ -30,6 +33,18 @@
 // Sync managers changed under a state that checked them take the slave back (with the error flag):
 // SM0/SM1 in PRE-OP or above to INIT (0x0016), SM2/SM3 in SAFE-OP or OP to PRE-OP (0x001D / 0x001E).
 // The application moves process data through the controller's buffers only, never into registers.
+//
+// Synchronisation (ETG.1020 §5.3, as the ETG's slave code takes it): on the way to SAFE-OP, SYNC0
+// activated by the master (0x0981) means DC SYNC0 mode, and 0x1C32:01 / 0x1C33:01 say so; a mode of
+// DC SYNC0 written without SYNC0 running is refused (0x0030), a SYNC0 cycle below 0x1C32:05 too
+// (0x0035). In DC SYNC0 mode the outputs go to the device on each SYNC0 pulse (the newest whole buffer),
+// not when they arrive; a pulse that finds no new outputs in OP counts in 0x1C32:0B. Free run and
+// SM-synchronous take the outputs when they arrive.
+//
+// Mailbox repeat (ETG.1000.4, as the ETG's slave code answers it): a master that lost a reply
+// toggles SM1's repeat request; the slave puts the reply the master read last back into SM1 (a newer
+// one waiting unread there is taken back first, by deactivating SM1 through its PDI control, and
+// sent after it) and toggles the repeat acknowledge.
 #pragma once
 
 #include <cstdint>
@@ -58,7 +73,29 @@ inline constexpr std::uint16_t invalid_output_configuration = 0x001D;
 inline constexpr std::uint16_t invalid_input_configuration = 0x001E;
 inline constexpr std::uint16_t invalid_input_mapping = 0x0024;
 inline constexpr std::uint16_t invalid_output_mapping = 0x0025;
+inline constexpr std::uint16_t invalid_dc_sync_configuration = 0x0030;
+inline constexpr std::uint16_t invalid_dc_sync_cycle_time = 0x0035;
 }  // namespace al_code
+
+/// 0x1C32 / 0x1C33 (ETG.1020 §5.3): sub-indices, sync modes, what this slave offers.
+namespace sync_parameter {
+inline constexpr std::uint16_t outputs = 0x1C32;
+inline constexpr std::uint16_t inputs = 0x1C33;
+inline constexpr std::uint8_t mode = 1;
+inline constexpr std::uint8_t cycle_time = 2;
+inline constexpr std::uint8_t supported = 4;
+inline constexpr std::uint8_t minimum_cycle_time = 5;
+inline constexpr std::uint8_t sync0_cycle_time = 10;
+inline constexpr std::uint8_t sync_error_count = 11;  ///< SYNC0 pulses that found no new outputs, in OP
+/// Bit 0 free run, bit 1 SM-synchronous, bits 2..3 = 01 DC SYNC0.
+inline constexpr std::int64_t supported_modes = 0x0007;
+}  // namespace sync_parameter
+namespace sync_mode {
+inline constexpr std::int64_t free_run = 0x00;
+inline constexpr std::int64_t sm_synchronous = 0x01;   ///< outputs: SM2 event; inputs: SM3 event
+inline constexpr std::int64_t dc_sync0 = 0x02;
+inline constexpr std::int64_t sm2_synchronous = 0x22;  ///< inputs only: with the SM2 event
+}  // namespace sync_mode
 
 /// Memory: SM0 (mailbox out) 0x1000, 128 bytes; SM1 (mailbox in) 0x1080, 128 bytes; SM2 (outputs)
 /// 0x1100; SM3 (inputs) 0x1180; each process data SM as long as its assigned PDOs.
@@ -83,9 +120,13 @@ struct coe_slave_config {
   /// What the SII and ESI name besides the dictionary's identity.
   std::string vendor_name;
   std::string group_name;
+  /// The application's cycle (the time each step() is given): the shortest SYNC0 cycle the slave
+  /// takes (0x1C32:05 / 0x1C33:05), since a pulse more often would find it still in the last one.
+  std::uint32_t application_cycle_us = 1000;
 };
 
-/// The objects the slave serves itself: 0x1017, 0x1600, 0x1601, 0x1A00, 0x1A01, 0x1C00, 0x1C12, 0x1C13.
+/// The objects the slave serves itself: 0x1003, 0x1017, 0x1600, 0x1601, 0x1A00, 0x1A01, 0x1C00, 0x1C12,
+/// 0x1C13, 0x1C32, 0x1C33.
 std::vector<canopen::object_entry> coe_communication_objects(const coe_slave_config& c);
 /// The whole table of a slave of configuration `c`, by index. Throws std::invalid_argument when the
 /// device's objects hold one of the slave's own.
@@ -127,6 +168,8 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
   bool bind(std::uint16_t assignment, std::vector<bound_entry>& out, unsigned& bits);
   void handle_al_control();
   bool to_safe_operational();
+  bool choose_sync_mode();
+  sdo_abort write_sync_mode(canopen::object_dictionary::slot& s, std::int64_t v);
   void refuse(std::uint16_t code);
   void enter(al_state s);
   bool mailbox_sync_managers_sound() const;
@@ -136,6 +179,8 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
   void watch_sync_managers();
   void exchange_process_data();
   void serve_mailbox();
+  void send_reply(std::vector<std::uint8_t>& reply);
+  void repeat_last_reply();
 
   // dictionary_access
   sdo_abort read_value(const canopen::object_dictionary::slot& s, std::int64_t& v) override;
@@ -160,7 +205,15 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
   std::vector<bound_entry> inputs_;
   unsigned output_bits_ = 0;
   unsigned input_bits_ = 0;
+  // DC SYNC0 mode, as chosen on the way to SAFE-OP: outputs go to the device on a SYNC0 pulse.
+  bool dc_sync0_ = false;
+  bool outputs_waiting_ = false;  // outputs arrived since the last pulse
   std::vector<std::uint8_t> mailbox_;  // the last request SM0 brought (its room kept across cycles)
+  // Mailbox repeat (ETG.1000.4): the reply SM1 holds unread, the one the master read last (which a
+  // repeat request puts back), and one taken back from SM1 for a repeat, which goes out next.
+  std::vector<std::uint8_t> in_send_mailbox_;
+  std::vector<std::uint8_t> last_read_;
+  std::vector<std::uint8_t> withdrawn_;
 };
 
 }  // namespace cia402::ethercat
