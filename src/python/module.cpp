@@ -19,4 +19,6 @@ PYBIND11_MODULE(_cia402, m) {
   py::module_ sim = m.def_submodule("sim", "Virtual drives on virtual time: machines, traces, scenarios.");
   bind_sim(sim);
   bind_sim_traces(sim);
+  py::module_ canopen = m.def_submodule("canopen", "The virtual CAN bus with its drives in process.");
+  bind_canopen(canopen);
 }

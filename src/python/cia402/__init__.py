@@ -2,8 +2,9 @@
 
 A drive of any built-in or file profile on an ideal or simulated plant (Drive), the replay
 interface of `cia402 replay` (Replay, Drive.replay), the master's planner (path), and in
-cia402.sim machines of many virtual drives on virtual time with traces and scenarios. Errors are
-cia402.Error: SdoError carries the SDO abort code and its text. See docs/python.md.
+cia402.sim machines of many virtual drives on virtual time with traces and scenarios; in
+cia402.canopen the virtual CAN bus with its drives in process, for python-can and python-canopen.
+Errors are cia402.Error: SdoError carries the SDO abort code and its text. See docs/python.md.
 """
 from ._cia402 import (
     Drive,
@@ -27,7 +28,7 @@ from ._errors import (
     ScenarioError,
     SdoError,
 )
-from . import sim
+from . import canopen, sim
 
 __all__ = [
     "ArgumentError",
@@ -47,6 +48,7 @@ __all__ = [
     "path",
     "profiles",
     "sdo_abort_text",
+    "canopen",
     "sim",
     "states",
 ]
