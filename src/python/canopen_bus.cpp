@@ -1,150 +1,19 @@
 // cia402.canopen.VirtualBus: the in-process CAN bus of `cia402 bus` (canopen::virtual_bus) with
 // virtual CiA 402 drives on it (apps::virtual_drive_node, the same nodes `cia402 bus` serves), and
 // ports on it for Python (a python-can bus, cia402/_python_can.py, wraps one).
-//
-// Time: on wall time (the default) a thread of its own steps the drives every period with the time
-// that really passed, as `cia402 bus` does; it never touches a Python object, so it never takes the
-// GIL. On virtual time nothing moves until advance(ms). One mutex guards the bus, the drives and the
-// ports, and no thread holding it ever asks for the GIL, so the two locks cannot deadlock; a call
-// that may wait for it (a step is under way) releases the GIL first, so other Python threads run.
+// Time and locking: canopen_bus.hpp.
 #include <pybind11/stl.h>
 
-#include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
-#include <thread>
 
-#include "binding.hpp"
-#include "cia402/apps/elapsed_clock.hpp"
-#include "cia402/apps/virtual_drive_node.hpp"
-#include "cia402/canopen/306/eds.hpp"
-#include "cia402/canopen/transport/virtual_bus.hpp"
-#include "cia402/drive402/sim_device.hpp"
+#include "canopen_bus.hpp"
 
 namespace cia402::python {
 namespace {
 
-using steady = std::chrono::steady_clock;
-
-class bus_core {
- public:
-  bus_core(profile_ptr p, const std::vector<std::uint8_t>& nodes, bool virtual_time,
-           std::uint32_t period_us, std::uint16_t heartbeat_ms)
-      : profile_(std::move(p)), virtual_time_(virtual_time), period_us_(period_us), heartbeat_ms_(heartbeat_ms) {
-    for (const std::uint8_t id : nodes) {
-      drives_.push_back(std::make_unique<apps::virtual_drive_node>(
-          profile_->get(), bus_.attach(), apps::drive_node_config(id, 1000000, heartbeat_ms)));
-      node_ids_.push_back(id);
-    }
-    if (!virtual_time_) stepper_ = std::thread([this] { run(); });
-  }
-  ~bus_core() { close(); }
-  bus_core(const bus_core&) = delete;
-  bus_core& operator=(const bus_core&) = delete;
-
-  /// Stops the stepping thread; the drives stay as they are (advance() still refused on wall time).
-  void close() {
-    {
-      std::lock_guard lock(mutex_);
-      if (closed_) return;
-      closed_ = true;
-    }
-    wake_.notify_all();
-    arrived_.notify_all();
-    if (stepper_.joinable()) stepper_.join();
-  }
-
-  /// Virtual time: `us` of time for every drive, in periods.
-  void advance(std::uint64_t us) {
-    std::lock_guard lock(mutex_);
-    while (us > 0) {
-      const auto slice = static_cast<std::uint32_t>(std::min<std::uint64_t>(us, period_us_));
-      step(slice);
-      us -= slice;
-    }
-    arrived_.notify_all();
-  }
-
-  std::unique_ptr<canopen::virtual_channel> attach() {
-    std::lock_guard lock(mutex_);
-    return bus_.attach();
-  }
-
-  std::string eds(std::uint8_t node) const {
-    // A freshly started node of the same profile and node-ID on a bus of its own: CiA 306 gives the
-    // values at power-up, not those of the running drive.
-    canopen::virtual_bus scratch;
-    auto ch = scratch.attach();
-    drive402::sim_device dev(profile_->get());
-    canopen::slave n(dev, *ch, apps::drive_node_config(node, 1000000, heartbeat_ms_));
-    canopen::eds_info info;
-    info.description += std::string(", profile ") + profile_->get().name;
-    info.created_by = "cia402 Python package";
-    info.node_id = node;
-    std::ostringstream out;
-    canopen::write_eds(n, info, out);
-    return out.str();
-  }
-
-  const std::vector<std::uint8_t>& node_ids() const noexcept { return node_ids_; }
-  bool virtual_time() const noexcept { return virtual_time_; }
-  bool closed() {
-    std::lock_guard lock(mutex_);
-    return closed_;
-  }
-  std::uint64_t elapsed_us() {
-    std::lock_guard lock(mutex_);
-    return elapsed_us_;
-  }
-  std::uint64_t frames() {
-    std::lock_guard lock(mutex_);
-    return bus_.frames();
-  }
-  const profile_ptr& profile_handle_ptr() const noexcept { return profile_; }
-
-  std::mutex mutex_;
-  std::condition_variable arrived_;  ///< a frame may have been queued on a port
-
- private:
-  // One pass as `cia402 bus` makes it (bus_host::advance): the time first, then the frames that came
-  // in meanwhile.
-  void step(std::uint32_t elapsed) {
-    for (auto& d : drives_) (void)d->node().process(elapsed);
-    for (auto& d : drives_) (void)d->poll(0);
-    elapsed_us_ += elapsed;
-  }
-
-  void run() {
-    apps::elapsed_clock clock;
-    const auto period = std::chrono::microseconds(period_us_);
-    auto next = steady::now();
-    std::unique_lock lock(mutex_);
-    while (!closed_) {
-      step(clock.take());
-      arrived_.notify_all();
-      next += period;
-      const auto now = steady::now();
-      if (next < now) next = now;  // held up (a loaded machine): go on from now, not in a burst
-      wake_.wait_until(lock, next, [this] { return closed_; });
-    }
-  }
-
-  profile_ptr profile_;
-  bool virtual_time_;
-  std::uint32_t period_us_;
-  std::uint16_t heartbeat_ms_;
-  canopen::virtual_bus bus_;
-  std::vector<std::unique_ptr<apps::virtual_drive_node>> drives_;
-  std::vector<std::uint8_t> node_ids_;
-  std::uint64_t elapsed_us_ = 0;
-  bool closed_ = false;
-  std::condition_variable wake_;
-  std::thread stepper_;
-};
 
 /// A frame as Python gets it: (arbitration_id, data, is_extended_id, is_remote_frame, dlc).
 using frame_tuple = std::tuple<std::uint32_t, py::bytes, bool, bool, std::uint8_t>;
@@ -302,11 +171,11 @@ void bind_canopen(py::module_& m) {
       .def("close", &bus_port::close, py::call_guard<py::gil_scoped_release>(),
            "Detaches the port from the bus; recv then returns None and send refuses.");
 
-  py::class_<bus_core, std::shared_ptr<bus_core>>(
+  py::class_<bus_core, std::shared_ptr<bus_core>> bus(
       m, "VirtualBus",
       "The virtual CAN bus of `cia402 bus` with its virtual CiA 402 drives in this process "
-      "(see cia402.canopen.VirtualBus).")
-      .def(py::init([](const py::object& nodes, const py::object& profile, bool virtual_time, double period_ms,
+      "(see cia402.canopen.VirtualBus).");
+  bus.def(py::init([](const py::object& nodes, const py::object& profile, bool virtual_time, double period_ms,
                        int heartbeat_ms) {
              if (!(period_ms >= 0.1 && period_ms <= 100.0)) raise_argument_error("period_ms is 0.1 .. 100");
              const auto period_us = static_cast<std::uint32_t>(std::llround(period_ms * 1000.0));
@@ -352,6 +221,7 @@ void bind_canopen(py::module_& m) {
       .def_property_readonly("closed", &bus_core::closed, py::call_guard<py::gil_scoped_release>())
       .def("close", &bus_core::close, py::call_guard<py::gil_scoped_release>(),
            "Stops the stepping thread (wall time); the drives stop where they are.");
+  bind_canopen_axis(m, bus);
 }
 
 }  // namespace cia402::python

@@ -21,6 +21,7 @@ from ._cia402 import (
 )
 from ._errors import (
     ArgumentError,
+    AxisError,
     BusyError,
     Error,
     FileError,
@@ -32,6 +33,7 @@ from . import canopen, sim
 
 __all__ = [
     "ArgumentError",
+    "AxisError",
     "BusyError",
     "Drive",
     "Error",

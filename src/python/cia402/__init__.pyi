@@ -6,6 +6,7 @@ from . import canopen as canopen
 from . import sim as sim
 from ._errors import (
     ArgumentError as ArgumentError,
+    AxisError as AxisError,
     BusyError as BusyError,
     Error as Error,
     FileError as FileError,

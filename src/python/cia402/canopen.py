@@ -5,7 +5,9 @@
     network = canopen.Network(bus=can_bus)
 
 On wall time (the default) a thread of the package steps the drives every millisecond, as
-`cia402 bus` does; with virtual_time=True nothing moves until advance(ms). See docs/python.md.
+`cia402 bus` does; with virtual_time=True nothing moves until advance(ms). bus.axis(node) is the
+project's master for a drive (Axis: enable, mode, move, home, velocity, sdo_read/sdo_write).
+See docs/python.md.
 """
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ from typing import Any
 
 from ._cia402 import canopen as _canopen
 
+Axis = _canopen.Axis
 Port = _canopen.Port
 
 
@@ -41,4 +44,4 @@ class VirtualBus(_canopen.VirtualBus):
         self.close()
 
 
-__all__ = ["Port", "VirtualBus"]
+__all__ = ["Axis", "Port", "VirtualBus"]
