@@ -43,23 +43,12 @@ py::object result_dict(const axes::result& r) {
 
 class axis_handle {
  public:
-  axis_handle(std::shared_ptr<bus_core> core, std::uint8_t node, std::uint32_t cycle_us, bool map_position)
-      : core_(std::move(core)), axis_(std::make_shared<bus_axis>()) {
-    canopen::can_link_config c;
-    c.node_id = node;
-    c.bus_name = "cia402.canopen.VirtualBus";
-    c.cycle_us = cycle_us;
-    c.drive_profile = &core_->profile_handle_ptr()->get();
-    c.map_position = map_position;
-    c.known_objects = canopen::node_objects(apps::drive_node_config(node));
-    axes::session_config s;
-    s.drive_profile = c.drive_profile;
-    axis_->node = node;
+  axis_handle(std::shared_ptr<axis_host> host, std::uint8_t id, const std::function<void(bus_axis&)>& make)
+      : core_(std::move(host)), axis_(std::make_shared<bus_axis>()) {
+    axis_->node = id;
     py::gil_scoped_release nogil;
     std::lock_guard lock(core_->mutex_);
-    axis_->channel = core_->attach_locked();
-    axis_->link = std::make_unique<canopen::can_link>(*axis_->channel, std::move(c));
-    axis_->session = std::make_unique<axes::session>(*axis_->link, s);
+    make(*axis_);
     core_->add_axis_locked(axis_);
   }
   ~axis_handle() {
@@ -240,7 +229,7 @@ class axis_handle {
     return std::nullopt;
   }
 
-  std::shared_ptr<bus_core> core_;
+  std::shared_ptr<axis_host> core_;
   std::shared_ptr<bus_axis> axis_;
 };
 
@@ -339,11 +328,33 @@ otherwise, also when the request did not end in time.)doc")
         for (const std::uint8_t id : core->node_ids()) found = found || id == node;
         if (!found) raise_argument_error("no node " + std::to_string(node) + " on this bus");
         if (!(cycle_ms >= 1 && cycle_ms <= 1000)) raise_argument_error("cycle_ms is 1 .. 1000");
-        return std::make_shared<axis_handle>(core, static_cast<std::uint8_t>(node),
-                                             static_cast<std::uint32_t>(std::llround(cycle_ms * 1000)), map_position);
+        const auto id = static_cast<std::uint8_t>(node);
+        canopen::can_link_config c;
+        c.node_id = id;
+        c.bus_name = "cia402.canopen.VirtualBus";
+        c.cycle_us = static_cast<std::uint32_t>(std::llround(cycle_ms * 1000));
+        c.drive_profile = &core->profile_handle_ptr()->get();
+        c.map_position = map_position;
+        c.known_objects = canopen::node_objects(apps::drive_node_config(id));
+        bus_core* raw = core.get();
+        return make_axis(core, id, [raw, c](bus_axis& a) mutable {
+          auto ch = raw->attach_locked();
+          a.link = std::make_unique<canopen::can_link>(*ch, std::move(c));
+          a.channel = std::move(ch);
+        });
       }, py::arg("node"), py::arg("cycle_ms") = 10.0, py::arg("map_position") = false,
       "The project's master for that node (an Axis): the axis session of `cia402 master` over its own "
       "attachment to this bus, SYNC every `cycle_ms`; `map_position` sets up PDO 3 for csp.");
+}
+
+py::object make_axis(std::shared_ptr<axis_host> host, std::uint8_t id, const std::function<void(bus_axis&)>& make) {
+  const profile* p = &host->profile_handle_ptr()->get();
+  return py::cast(std::make_shared<axis_handle>(std::move(host), id, [&make, p](bus_axis& a) {
+    make(a);
+    axes::session_config s;
+    s.drive_profile = p;
+    a.session = std::make_unique<axes::session>(*a.link, s);
+  }));
 }
 
 }  // namespace cia402::python

@@ -30,17 +30,42 @@
 
 namespace cia402::python {
 
-/// An axis session (the project's master, src/axis) over its own channel on the bus.
+/// An axis session (the project's master, src/axis) over its link: on CAN a can_link on a channel
+/// of its own, on EtherCAT an ecat_link on the line.
 struct bus_axis {
-  std::uint8_t node = 0;
-  std::unique_ptr<canopen::virtual_channel> channel;
-  std::unique_ptr<canopen::can_link> link;
+  std::uint8_t node = 0;  ///< CAN: the node-ID; EtherCAT: the position on the line
+  std::unique_ptr<canopen::channel> channel;
+  std::unique_ptr<axes::drive_link> link;
   std::unique_ptr<axes::session> session;
+};
+
+/// What the sessions run on (a VirtualBus, a VirtualLine): one mutex over everything, the
+/// notification that something moved, and time in periods. The sessions are polled in step().
+class axis_host {
+ public:
+  virtual ~axis_host() = default;
+  virtual bool virtual_time() const noexcept = 0;
+  virtual bool closed_locked() const noexcept = 0;
+  /// One period of time, the mutex held by the caller (an axis request on virtual time).
+  virtual std::uint32_t step_period_locked() = 0;
+  virtual const profile_ptr& profile_handle_ptr() const noexcept = 0;
+
+  /// Puts an axis session on the host (the mutex held by the caller); from now on it is stepped.
+  void add_axis_locked(std::shared_ptr<bus_axis> a) { axes_.push_back(std::move(a)); }
+  void remove_axis_locked(const bus_axis* a) {
+    std::erase_if(axes_, [a](const std::shared_ptr<bus_axis>& x) { return x.get() == a; });
+  }
+
+  std::mutex mutex_;
+  std::condition_variable arrived_;  ///< something moved: a frame queued, a request ended
+
+ protected:
+  std::vector<std::shared_ptr<bus_axis>> axes_;
 };
 
 using steady = std::chrono::steady_clock;
 
-class bus_core {
+class bus_core final : public axis_host {
  public:
   bus_core(profile_ptr p, const std::vector<std::uint8_t>& nodes, bool virtual_time,
            std::uint32_t period_us, std::uint16_t heartbeat_ms)
@@ -79,21 +104,13 @@ class bus_core {
     arrived_.notify_all();
   }
 
-  /// One period of time, the mutex held by the caller (an axis request on virtual time).
-  std::uint32_t step_period_locked() {
+  std::uint32_t step_period_locked() override {
     step(period_us_);
     return period_us_;
   }
-
-  /// Puts an axis session on the bus (the mutex held by the caller); from now on it is stepped with
-  /// the drives.
-  void add_axis_locked(std::shared_ptr<bus_axis> a) { axes_.push_back(std::move(a)); }
-  void remove_axis_locked(const bus_axis* a) {
-    std::erase_if(axes_, [a](const std::shared_ptr<bus_axis>& x) { return x.get() == a; });
-  }
   /// A channel on the bus, the mutex held by the caller.
   std::unique_ptr<canopen::virtual_channel> attach_locked() { return bus_.attach(); }
-  bool closed_locked() const noexcept { return closed_; }
+  bool closed_locked() const noexcept override { return closed_; }
 
   std::unique_ptr<canopen::virtual_channel> attach() {
     std::lock_guard lock(mutex_);
@@ -117,7 +134,7 @@ class bus_core {
   }
 
   const std::vector<std::uint8_t>& node_ids() const noexcept { return node_ids_; }
-  bool virtual_time() const noexcept { return virtual_time_; }
+  bool virtual_time() const noexcept override { return virtual_time_; }
   std::uint32_t period_us() const noexcept { return period_us_; }
   bool closed() {
     std::lock_guard lock(mutex_);
@@ -131,10 +148,7 @@ class bus_core {
     std::lock_guard lock(mutex_);
     return bus_.frames();
   }
-  const profile_ptr& profile_handle_ptr() const noexcept { return profile_; }
-
-  std::mutex mutex_;
-  std::condition_variable arrived_;  ///< a frame may have been queued on a port
+  const profile_ptr& profile_handle_ptr() const noexcept override { return profile_; }
 
  private:
   // One pass as `cia402 bus` makes it (bus_host::advance): the time first, then the frames that came
@@ -172,7 +186,6 @@ class bus_core {
   std::uint16_t heartbeat_ms_;
   canopen::virtual_bus bus_;
   std::vector<std::unique_ptr<apps::virtual_drive_node>> drives_;
-  std::vector<std::shared_ptr<bus_axis>> axes_;
   std::vector<std::uint8_t> node_ids_;
   std::uint64_t elapsed_us_ = 0;
   bool closed_ = false;
@@ -182,5 +195,11 @@ class bus_core {
 
 /// Binds cia402.canopen.Axis and VirtualBus.axis() (canopen_axis.cpp).
 void bind_canopen_axis(py::module_& m, py::class_<bus_core, std::shared_ptr<bus_core>>& bus);
+
+/// Binds cia402.ethercat (ethercat_line.cpp); its Axis is canopen's.
+void bind_ethercat(py::module_& m, const py::module_& canopen);
+
+/// An Axis over a link `make` builds (the mutex held) on `host`, stepped by the host from then on.
+py::object make_axis(std::shared_ptr<axis_host> host, std::uint8_t id, const std::function<void(bus_axis&)>& make);
 
 }  // namespace cia402::python

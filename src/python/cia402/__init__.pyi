@@ -3,6 +3,7 @@
 from typing import Any, Dict, Iterable, List, Literal, Mapping, Optional, Tuple, Union
 
 from . import canopen as canopen
+from . import ethercat as ethercat
 from . import sim as sim
 from ._errors import (
     ArgumentError as ArgumentError,
