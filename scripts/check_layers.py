@@ -97,9 +97,12 @@ ALLOWED = {
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
              "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "ethercat/esc",
              "ethercat/sii", "ethercat/master", "axis", "canopen/axis", "ethercat/axis"},
-    # The Python binding: the core, profile files, the replay and the simulator now; the fieldbus
-    # layers and the axis session join when their bindings do.
-    "python": {"core", "motion", "support", "profile_file", "replay", "sim"},
+    # The Python binding: the core, profile files, the replay, the simulator, and the fieldbuses as
+    # the apps layer composes them (the virtual CAN bus with its drives, the axis session).
+    "python": {"core", "motion", "support", "profile_file", "replay", "sim", "apps", "drive402",
+               "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+               "canopen/monitor", "axis", "canopen/axis", "ethercat/esc", "ethercat/sii",
+               "ethercat/coe", "ethercat/slave", "ethercat/master", "ethercat/axis"},
     "tools": {"core", "motion", "support", "profile_file", "diagram", "replay", "sim", "canopen/can",
               "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "canopen/monitor",
               "drive402", "apps", "page", "axis", "canopen/axis", "ethercat/axis",

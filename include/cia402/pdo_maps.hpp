@@ -36,6 +36,9 @@ inline constexpr std::size_t max_default_pdo_entries = 8;
 /// A PDO's default mapping and, on CANopen, its communication parameters (unused on EtherCAT).
 struct pdo_map {
   std::uint8_t count = 0;  ///< entries in use; 0: the PDO is not used (its COB-ID starts invalid)
+  /// CANopen: the COB-ID starts valid (bit 31 clear, CiA 301 §7.5.2.35); false keeps the mapping for a
+  /// master that enables the PDO, but the node neither sends nor takes it until one does.
+  bool valid = true;
   std::array<pdo_mapping_entry, max_default_pdo_entries> entries{};
   std::uint8_t transmission_type = 255;  ///< 0x1400 / 0x1800 sub 2: 1 every SYNC, 255 on change
   std::uint16_t inhibit_100us = 0;       ///< 0x1800 sub 3 (TPDO)
@@ -58,6 +61,10 @@ constexpr pdo_map make_pdo_map(std::initializer_list<pdo_mapping_entry> entries,
   m.event_timer_ms = event_timer_ms;
   return m;
 }
+constexpr pdo_map not_valid(pdo_map m) noexcept {
+  m.valid = false;
+  return m;
+}
 }  // namespace detail
 
 namespace pdo_maps {
@@ -67,22 +74,29 @@ inline constexpr std::uint8_t on_change = 255;
 inline constexpr std::uint8_t every_sync = 1;
 /// A master can rely on hearing each TPDO at least every second.
 inline constexpr std::uint16_t tpdo_event_timer_ms = 1000;
+/// The status word's TPDOs (TPDO1, and TPDO2 with 0x6061) repeat every 100 ms while nothing
+/// changes: a master that waits for the next one (python-canopen's BaseNode402 waits 0.2 s once it
+/// has seen two) hears one in time without SYNC (docs/canopen.md, "Default PDOs").
+inline constexpr std::uint16_t status_event_timer_ms = 100;
 
 /// RPDO1..4: 0x6040; 0x6040 + 0x6060; 0x6040 + 0x607A; 0x6040 + 0x60FF. RPDO3 carries a cyclic
 /// synchronous position master's set-point and acts at the next SYNC; the others act on receipt.
+/// RPDO2 keeps CiA 402's mapping but starts not valid: a master that writes 0x6060 through it hands
+/// the drive a second control word it may not keep up to date (python-canopen's BaseNode402 sends
+/// its own stale copy, 0 = Disable voltage); one that wants it sets its COB-ID valid.
 inline constexpr std::array<pdo_map, 4> can_rpdo = {
     detail::make_pdo_map({{0x6040, 0, 16}}, on_change),
-    detail::make_pdo_map({{0x6040, 0, 16}, {0x6060, 0, 8}}, on_change),
+    detail::not_valid(detail::make_pdo_map({{0x6040, 0, 16}, {0x6060, 0, 8}}, on_change)),
     detail::make_pdo_map({{0x6040, 0, 16}, {0x607A, 0, 32}}, every_sync),
     detail::make_pdo_map({{0x6040, 0, 16}, {0x60FF, 0, 32}}, on_change)};
 
 /// TPDO1..4: 0x6041; 0x6041 + 0x6061; 0x6041 + 0x6064; 0x6041 + 0x606C. TPDO3 goes out on every
-/// SYNC; the others on change. TPDO4, which carries the velocity, has an inhibit time of 10 ms, so a
-/// ramping drive sends it at most 100 times a second (it sent about 850); TPDO1 has none, so every
-/// state change arrives.
+/// SYNC; the others on change and at least every event timer (TPDO1, TPDO2: 100 ms; TPDO4: 1 s).
+/// TPDO4, which carries the velocity, has an inhibit time of 10 ms, so a ramping drive sends it at
+/// most 100 times a second (it sent about 850); TPDO1 has none, so every state change arrives.
 inline constexpr std::array<pdo_map, 4> can_tpdo = {
-    detail::make_pdo_map({{0x6041, 0, 16}}, on_change, 0, tpdo_event_timer_ms),
-    detail::make_pdo_map({{0x6041, 0, 16}, {0x6061, 0, 8}}, on_change, 0, tpdo_event_timer_ms),
+    detail::make_pdo_map({{0x6041, 0, 16}}, on_change, 0, status_event_timer_ms),
+    detail::make_pdo_map({{0x6041, 0, 16}, {0x6061, 0, 8}}, on_change, 0, status_event_timer_ms),
     detail::make_pdo_map({{0x6041, 0, 16}, {0x6064, 0, 32}}, every_sync, 0, tpdo_event_timer_ms),
     detail::make_pdo_map({{0x6041, 0, 16}, {0x606C, 0, 32}}, on_change, 100, tpdo_event_timer_ms)};
 

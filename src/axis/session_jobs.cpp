@@ -148,6 +148,7 @@ std::uint64_t session::read_object(std::uint16_t index, std::uint8_t sub, comple
       if (f && res.value->what != f->what) res.format.reset();
     } else {
       res.end = outcome::failed;
+      res.abort = r.abort;
       res.error = "reading " + object_name(index, sub) + ": " + transfer_failure(r);
     }
     fill_result(res);
@@ -176,6 +177,7 @@ std::uint64_t session::write_object(std::uint16_t index, std::uint8_t sub, const
   if (const object_description* o = find_drive_object(index, sub)) {
     if (v.what != value_format::kind::integer) return refuse("it is " + res->format->type_name() + ", not " + (v.what == value_format::kind::text ? "a text" : "bytes"));
     if (const sdo_abort a = check_write(*o, v.number); a != sdo_abort::none) {
+      res->abort = a;
       return refuse(std::to_string(v.number) + " is refused by the object table: " + sdo_abort_text(a) + " (" +
                     std::to_string(o->low) + ".." + std::to_string(o->high) + ", " + o->name + ")");
     }
@@ -199,6 +201,7 @@ std::uint64_t session::write_object(std::uint16_t index, std::uint8_t sub, const
   queue_download(index, sub, std::move(bytes), [this, res, index, sub, done](const transfer_result& r) {
     if (!r.ok) {
       res->end = outcome::failed;
+      res->abort = r.abort;
       res->error = "writing " + object_name(index, sub) + ": " + transfer_failure(r);
     }
     fill_result(*res);
@@ -219,6 +222,7 @@ void session::write_object_sized(std::uint16_t index, std::uint8_t sub, std::int
     res->size = size;
     if (!r.ok) {
       res->end = outcome::failed;
+      res->abort = r.abort;
       res->error = "writing " + object_name(index, sub) + " as " + std::to_string(size) + " byte(s): " + transfer_failure(r);
       if (r.abort == sdo_abort::data_type_length_too_high) {
         res->error += "; the object is shorter: " + std::to_string(value) + " does not fit it";

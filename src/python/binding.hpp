@@ -96,6 +96,7 @@ void bind_profiles(py::module_& m);
 void bind_drive(py::module_& m);
 void bind_replay(py::module_& m);
 void bind_sim(py::module_& sim);
+void bind_canopen(py::module_& canopen);
 void bind_sim_traces(py::module_& sim);
 
 }  // namespace cia402::python

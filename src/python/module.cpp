@@ -2,7 +2,7 @@
 // simulator in its submodule `sim`. The package's Python files (cia402/__init__.py, sim.py) re-export
 // them; a later area (CANopen's virtual bus, the EtherCAT chain, the axis session) binds itself in a
 // submodule of its own here.
-#include "binding.hpp"
+#include "canopen_bus.hpp"
 
 #ifndef CIA402_VERSION
 #error "CIA402_VERSION is set by src/python/CMakeLists.txt from the project's version"
@@ -19,4 +19,8 @@ PYBIND11_MODULE(_cia402, m) {
   py::module_ sim = m.def_submodule("sim", "Virtual drives on virtual time: machines, traces, scenarios.");
   bind_sim(sim);
   bind_sim_traces(sim);
+  py::module_ canopen = m.def_submodule("canopen", "The virtual CAN bus with its drives in process.");
+  bind_canopen(canopen);
+  py::module_ ethercat = m.def_submodule("ethercat", "A chain of virtual EtherCAT drives and the master over it.");
+  bind_ethercat(ethercat, canopen);
 }

@@ -76,6 +76,21 @@ TEST(session_objects, a_cia402_object_is_read_and_written_with_its_type) {
   EXPECT_NE(refused.error.find("300 is refused by the object table: value of parameter written too high (-128..127"),
             std::string::npos)
       << refused.error;
+  EXPECT_EQ(refused.abort, sdo_abort::value_too_high) << "the table's refusal carries its abort code";
+}
+
+TEST(session_objects, a_read_or_write_the_drive_refuses_carries_its_abort_code_and_other_failures_none) {
+  bench b({}, standard_profile(), false);
+  b.link.refused[{0x2005, 0}] = sdo_abort::object_does_not_exist;
+  const result r = b.finish([&](completion d) { return b.s->read_object(0x2005, 0, std::move(d)); });
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.abort, sdo_abort::object_does_not_exist);
+  const result w = b.finish([&](completion d) { return b.s->write_object(0x2005, 0, object_value::of_integer(1), std::move(d)); });
+  EXPECT_FALSE(w.ok());
+  EXPECT_EQ(w.abort, sdo_abort::object_does_not_exist);
+  const result ok = b.finish([&](completion d) { return b.s->read_object(0x6081, 0, std::move(d)); });
+  ASSERT_TRUE(ok.ok()) << ok.error;
+  EXPECT_EQ(ok.abort, sdo_abort::none);
 }
 
 TEST(session_objects, a_cyclic_output_is_written_there_not_by_a_transfer) {

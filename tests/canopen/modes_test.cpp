@@ -131,6 +131,8 @@ TEST_F(modes_test, mode_switches_by_sdo_and_by_rpdo2_and_0x6061_follows) {
   ASSERT_EQ(sdo_write(0x6060, 0, 1, 1), 0u);
   run_ms(2);
   EXPECT_EQ(sdo_read(0x6061, 0, 1), 1);
+  EXPECT_EQ(static_cast<std::uint32_t>(sdo_read(0x1401, 1)), 0x80000000u + rpdo2) << "RPDO2 starts not valid";
+  ASSERT_EQ(sdo_write(0x1401, 1, rpdo2, 4), 0u);  // a master that wants RPDO2 makes it valid
   received.clear();
   send(rpdo2, {0x00, 0x00, 8});  // RPDO2 = 0x6040 + 0x6060, on receipt
   run_ms(2);
@@ -168,6 +170,7 @@ TEST_F(modes_test, pp_move_acknowledges_the_set_point_then_reaches_the_target) {
 }
 
 TEST_F(modes_test, homing_37_and_3_end_at_the_home_offset_with_bits_12_and_10) {
+  ASSERT_EQ(sdo_write(0x1401, 1, rpdo2, 4), 0u);  // RPDO2 made valid
   for (const int method : {37, 3}) {
     SCOPED_TRACE(method);
     send(rpdo2, {0x00, 0x00, 6});  // homing, by RPDO2
@@ -187,7 +190,7 @@ TEST_F(modes_test, homing_37_and_3_end_at_the_home_offset_with_bits_12_and_10) {
 }
 
 TEST_F(modes_test, csp_stream_in_rpdo3_is_followed_sync_by_sync) {
-  send(rpdo2, {0x00, 0x00, 8});
+  ASSERT_EQ(sdo_write(0x6060, 0, 8, 1), 0u);  // csp
   run_ms(2);
   const std::int32_t start = static_cast<std::int32_t>(sdo_read(0x6064, 0));
   ASSERT_EQ(sdo_write(0x607A, 0, start, 4), 0u);

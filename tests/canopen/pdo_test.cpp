@@ -51,6 +51,7 @@ TEST_F(pdo_test, defaults_are_the_cia402_predefined_set_with_pdo3_synchronous) {
   EXPECT_EQ(r1.map[0].index, 0x6040);
   EXPECT_EQ(r1.length, 2);
   const pdo_config& r2 = node().rpdo(1);
+  EXPECT_FALSE(r2.valid) << "RPDO2 keeps CiA 402's mapping but starts not valid";
   EXPECT_EQ(r2.can_id, 0x303u);
   ASSERT_EQ(r2.count, 2);
   EXPECT_EQ(r2.map[1].index, 0x6060);
@@ -73,6 +74,33 @@ TEST_F(pdo_test, defaults_are_the_cia402_predefined_set_with_pdo3_synchronous) {
   EXPECT_EQ(node().tpdo(3).can_id, 0x483u);
   EXPECT_EQ(node().tpdo(3).map[1].index, 0x606C);
   for (int n = 0; n < 4; ++n) EXPECT_EQ(node().tpdo(n).transmission_type, n == 2 ? 1 : 255) << n;
+  // The status word's event-driven TPDOs repeat within python-canopen's 0.2 s wait.
+  EXPECT_EQ(node().tpdo(0).event_timer_ms, 100);
+  EXPECT_EQ(node().tpdo(1).event_timer_ms, 100);
+  EXPECT_EQ(node().tpdo(3).event_timer_ms, 1000);
+}
+
+TEST_F(pdo_test, an_unchanged_status_word_repeats_every_100_ms_in_tpdo1_and_tpdo2) {
+  start();
+  net.run(20000, 1000);
+  net.received.clear();
+  net.run(1000000, 1000);  // one second, nothing changes
+  EXPECT_GE(net.with_id(0x183).size(), 9u);
+  EXPECT_LE(net.with_id(0x183).size(), 11u);
+  EXPECT_GE(net.with_id(0x283).size(), 9u);
+  EXPECT_LE(net.with_id(0x283).size(), 11u);
+  EXPECT_LE(net.with_id(0x483).size(), 1u) << "TPDO4 keeps its 1 s";
+}
+
+TEST_F(pdo_test, rpdo2_is_taken_only_once_a_master_makes_it_valid) {
+  start();
+  net.send(make_frame(0x303, {0x06, 0x00, 0x03}));  // 0x6040 = Shutdown, 0x6060 = 3
+  net.run(3000, 1000);
+  EXPECT_EQ(dev().control_word(), 0u) << "a frame to a PDO that is not valid is ignored";
+  ASSERT_EQ(write(0x1401, 1, 0x303, 4), 0u);
+  net.send(make_frame(0x303, {0x06, 0x00, 0x03}));
+  net.run(3000, 1000);
+  EXPECT_EQ(dev().control_word(), 6u);
 }
 
 TEST_F(pdo_test, no_pdo_flows_before_operational) {

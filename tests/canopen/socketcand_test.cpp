@@ -362,7 +362,7 @@ std::string rpdo3_send(std::int32_t set_point) {
 TEST_F(socketcand_server_test, a_held_up_host_steps_its_drives_before_it_answers_the_sync_that_waited) {
   add_drive(1);
   auto a = join();
-  a->send("< send 0 2 1 1 >< send 301 3 0 0 8 >");  // NMT start; RPDO2: 0x6040 + 0x6060 = 8 (csp)
+  a->send("< send 0 2 1 1 >< send 601 8 2f 60 60 0 8 0 0 0 >");  // NMT start; SDO 0x6060 = 8 (csp)
   spin(5);
   a->send("< send 201 2 6 0 >");
   spin(5);

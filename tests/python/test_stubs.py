@@ -1,4 +1,4 @@
-"""The type stubs (__init__.pyi, sim.pyi) name exactly what the package has: every public
+"""The type stubs (__init__.pyi, sim.pyi, canopen.pyi, ethercat.pyi) name exactly what the package has: every public
 function and class, and every public method and property of each class. mypy is not a Debian
 default, so the stubs are checked by parsing them against the module itself."""
 import ast
@@ -8,7 +8,7 @@ import pathlib
 import pytest
 
 import cia402
-from cia402 import sim
+from cia402 import canopen, ethercat, sim
 
 PACKAGE = pathlib.Path(cia402.__file__).parent
 
@@ -43,13 +43,13 @@ def members(node):
     return names
 
 
-@pytest.mark.parametrize("module, file", [(cia402, "__init__.pyi"), (sim, "sim.pyi")])
+@pytest.mark.parametrize("module, file", [(cia402, "__init__.pyi"), (sim, "sim.pyi"), (canopen, "canopen.pyi"), (ethercat, "ethercat.pyi")])
 def test_the_stub_names_every_public_name_of_the_module(module, file):
     assert (PACKAGE / "py.typed").exists()
     assert top_level_names(stub(file)) == set(module.__all__)
 
 
-@pytest.mark.parametrize("module, file", [(cia402, "__init__.pyi"), (sim, "sim.pyi")])
+@pytest.mark.parametrize("module, file", [(cia402, "__init__.pyi"), (sim, "sim.pyi"), (canopen, "canopen.pyi"), (ethercat, "ethercat.pyi")])
 def test_each_stub_class_has_exactly_the_real_classes_members(module, file):
     for name, node in classes(stub(file)).items():
         real = getattr(module, name)
@@ -62,7 +62,7 @@ def test_each_stub_class_has_exactly_the_real_classes_members(module, file):
 
 
 def test_every_public_class_and_function_has_a_docstring():
-    for module in (cia402, sim):
+    for module in (cia402, sim, canopen, ethercat):
         for name in module.__all__:
             value = getattr(module, name)
             if inspect.isclass(value) or callable(value):

@@ -69,6 +69,9 @@ struct result {
   bool bad_input = false;  ///< refused for what was asked, before anything was sent
   std::string error;       ///< why it failed, in words
   std::string note;        ///< a remark on a done request ("not in FAULT, nothing to reset")
+  /// An object read or write the drive (or the core's object table) refused: its CiA 301 SDO abort
+  /// code; none for any other failure.
+  sdo_abort abort = sdo_abort::none;
   std::optional<state> shown;  ///< the state the drive showed at the end
   std::uint16_t status_word = 0;
   std::uint16_t error_code = 0;

@@ -25,7 +25,7 @@ void add_pdos(std::vector<object_entry>& t, const slave_config& c) {
   for (int n = 0; n < pdo_count; ++n) {
     const pdo_map& m = c.rpdo[static_cast<std::size_t>(n)];
     const auto num = std::to_string(n + 1);
-    const std::uint32_t cob_id = (m.count == 0 ? pdo_cob_invalid : 0u) + cob::rpdo1 + 0x100u * static_cast<std::uint32_t>(n);
+    const std::uint32_t cob_id = (m.count == 0 || !m.valid ? pdo_cob_invalid : 0u) + cob::rpdo1 + 0x100u * static_cast<std::uint32_t>(n);
     t.push_back(group(static_cast<std::uint16_t>(0x1400 + n), "RPDO" + num + " communication parameter",
                       object_code::record, object_category::optional,
                       {variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 2),
@@ -37,7 +37,7 @@ void add_pdos(std::vector<object_entry>& t, const slave_config& c) {
   for (int n = 0; n < pdo_count; ++n) {
     const pdo_map& m = c.tpdo[static_cast<std::size_t>(n)];
     const auto num = std::to_string(n + 1);
-    const std::uint32_t cob_id = (m.count == 0 ? pdo_cob_invalid : 0u) + cob::tpdo1 + 0x100u * static_cast<std::uint32_t>(n);
+    const std::uint32_t cob_id = (m.count == 0 || !m.valid ? pdo_cob_invalid : 0u) + cob::tpdo1 + 0x100u * static_cast<std::uint32_t>(n);
     t.push_back(group(static_cast<std::uint16_t>(0x1800 + n), "TPDO" + num + " communication parameter",
                       object_code::record, object_category::optional,
                       {variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 5),

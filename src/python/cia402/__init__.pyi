@@ -2,9 +2,12 @@
 # module _cia402). tests/python/test_stubs.py checks they name exactly what the package has.
 from typing import Any, Dict, Iterable, List, Literal, Mapping, Optional, Tuple, Union
 
+from . import canopen as canopen
+from . import ethercat as ethercat
 from . import sim as sim
 from ._errors import (
     ArgumentError as ArgumentError,
+    AxisError as AxisError,
     BusyError as BusyError,
     Error as Error,
     FileError as FileError,

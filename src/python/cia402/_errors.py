@@ -54,12 +54,26 @@ class ScenarioError(FileError):
     """A simulator scenario refused."""
 
 
+class AxisError(Error):
+    """A request of the master (cia402.canopen.Axis) that failed or did not end in time, in words,
+    with the `state` the drive showed at the end (None where not known), its `status_word` and its
+    `error_code` (0x603F). An object the drive refused raises SdoError instead."""
+
+    def __init__(self, message: str, state: Optional[str] = None, status_word: int = 0,
+                 error_code: int = 0) -> None:
+        self.state = state
+        self.status_word = status_word
+        self.error_code = error_code
+        super().__init__(message)
+
+
 class BusyError(Error):
     """A machine was used from a second thread while it advanced on another (the GIL is released
     while a machine steps)."""
 
 
 # Shown as cia402.SdoError (the package exports them), not as the private module they live in.
-for _cls in (Error, ArgumentError, SdoError, FileError, ProfileError, ScenarioError, BusyError):
+for _cls in (Error, ArgumentError, SdoError, FileError, ProfileError, ScenarioError, BusyError,
+             AxisError):
     _cls.__module__ = "cia402"
 del _cls

@@ -150,13 +150,12 @@ def test_drive_reaches_operation_enabled_over_pdos(client):
 
 def test_tpdo_timing_a_standard_master_can_rely_on(client):
     """CiA 301 0x1800.. sub 3 (inhibit, 100 us) and sub 5 (event timer, ms) as a master reads them,
-    then measured: each TPDO at least once a second while nothing changes, TPDO4 (status word +
-    velocity) at most every 10 ms while the drive ramps."""
+    then measured: each TPDO at least once a second while nothing changes (TPDO1 and TPDO2, the
+    status word's, every 100 ms), TPDO4 (status word + velocity) at most every 10 ms while the
+    drive ramps."""
     send(client, 0x000, [0x01, NODE])
-    for n in range(4):
-        if n == 2:
-            continue  # PDO 3 is synchronous: it goes out on SYNC, not by its event timer
-        assert sdo_upload_expedited(client, NODE, 0x1800 + n, 5) == 1000, "TPDO%d event timer" % (n + 1)
+    for n, event_timer_ms in ((0, 100), (1, 100), (3, 1000)):  # PDO 3 is synchronous: sent on SYNC
+        assert sdo_upload_expedited(client, NODE, 0x1800 + n, 5) == event_timer_ms, "TPDO%d event timer" % (n + 1)
     assert sdo_upload_expedited(client, NODE, 0x1803, 3) == 100  # 10 ms
     # Idle: every TPDO still comes, from the event timer.
     seen = {}
@@ -166,6 +165,7 @@ def test_tpdo_timing_a_standard_master_can_rely_on(client):
         if msg is not None and msg.arbitration_id in (0x181, 0x281, 0x481):
             seen[msg.arbitration_id] = seen.get(msg.arbitration_id, 0) + 1
     assert all(seen.get(i, 0) >= 2 for i in (0x181, 0x281, 0x481)), seen
+    assert seen[0x181] >= 15 and seen[0x281] >= 15, seen  # every 100 ms for 2.5 s
     # Ramping from 0 to 3000 rpm (3 s at the default 1000 rpm/s): count TPDO4 over one second.
     send(client, 0x201, [0x06, 0x00])
     assert wait_for_state(client, "READY_TO_SWITCH_ON") is not None

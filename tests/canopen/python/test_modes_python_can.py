@@ -61,7 +61,10 @@ def test_modes_switch_by_sdo_and_by_rpdo2(client):
     while sdo_upload_expedited(client, NODE, 0x6061, 0) != 1 and time.monotonic() < end:
         time.sleep(0.005)
     assert sdo_upload_expedited(client, NODE, 0x6061, 0) == 1
-    # RPDO2 = 0x6040 + 0x6060; TPDO2 = 0x6041 + 0x6061 shows the switch.
+    # RPDO2 = 0x6040 + 0x6060 starts not valid (COB-ID bit 31): a master that wants it makes it
+    # valid. TPDO2 = 0x6041 + 0x6061 shows the switch.
+    assert sdo_upload_expedited(client, NODE, 0x1401, 1) == 0x80000000 + RPDO2
+    assert sdo_download(client, NODE, 0x1401, 1, RPDO2, 4).data[0] == 0x60
     send(client, RPDO2, [0x00, 0x00, 8])
     shown = wait_for(client, lambda m: m.arbitration_id == TPDO2 and len(m.data) == 3 and m.data[2] == 8, 2)
     assert shown is not None, "0x6061 did not show csp"
@@ -107,6 +110,7 @@ def test_homing_run(client, method):
 
 def test_cyclic_synchronous_position_stream(client):
     send(client, 0x000, [0x01, NODE])
+    assert sdo_download(client, NODE, 0x1401, 1, RPDO2, 4).data[0] == 0x60  # RPDO2 made valid
     send(client, RPDO2, [0x00, 0x00, 8])  # mode 8 by PDO
     time.sleep(0.05)
     assert sdo_upload_expedited(client, NODE, 0x6061, 0) == 8

@@ -1,0 +1,173 @@
+// cia402.ethercat.VirtualLine: a chain of virtual EtherCAT drives (apps::virtual_drive_slave, what
+// `cia402 ecat-slave` puts on a line) and the project's master over it (ethercat::ecat_line, what
+// `cia402 master --ecat` runs), in this process and on virtual time: a frame the master sends goes
+// through every drive's controller in order and back, as on a real line, and the time the master
+// waits is the drives' time. The line is brought to OP when it is made; axis(position) is an Axis
+// (canopen_axis.cpp) over that drive's ecat_link, stepped with the line.
+#include <pybind11/stl.h>
+
+#include <cmath>
+
+#include "canopen_bus.hpp"
+#include "cia402/apps/virtual_drive_slave.hpp"
+#include "cia402/ethercat/axis/ecat_link.hpp"
+#include "cia402/ethercat/esc/esc.hpp"
+
+namespace cia402::python {
+namespace {
+
+/// The in-process wire: frames through the chain of controllers, time through the drives.
+class wire final : public ethercat::master_link {
+ public:
+  bool exchange(std::vector<std::uint8_t>& frame) override {
+    return chain.pass(frame) == ethercat::frame_error::none;
+  }
+  std::uint64_t now_us() override { return now; }
+  void wait_us(std::uint32_t us) override {
+    now += us;
+    for (auto& s : slaves) s->step(us);
+  }
+
+  std::vector<std::unique_ptr<apps::virtual_drive_slave>> slaves;
+  ethercat::chain chain;
+  std::uint64_t now = 0;
+};
+
+class line_core final : public axis_host {
+ public:
+  line_core(profile_ptr p, int drives, std::uint32_t cycle_us) : profile_(std::move(p)), cycle_us_(cycle_us) {
+    for (int i = 0; i < drives; ++i) {
+      wire_.slaves.push_back(std::make_unique<apps::virtual_drive_slave>(profile_->get(), static_cast<std::uint32_t>(i + 1)));
+      wire_.chain.add(wire_.slaves.back()->controller());
+    }
+    line_ = std::make_unique<ethercat::ecat_line>(wire_, profile_->get(), cycle_us, "cia402.ethercat.VirtualLine");
+    if (!line_->scan() || !line_->bring_to_operational()) error_ = line_->error();
+  }
+
+  const std::string& bring_up_error() const noexcept { return error_; }
+  bool virtual_time() const noexcept override { return true; }
+  bool closed_locked() const noexcept override { return false; }
+  const profile_ptr& profile_handle_ptr() const noexcept override { return profile_; }
+  std::uint32_t step_period_locked() override {
+    step(cycle_us_);
+    return cycle_us_;
+  }
+
+  void advance(std::uint64_t us) {
+    std::lock_guard lock(mutex_);
+    while (us > 0) {
+      const auto slice = static_cast<std::uint32_t>(std::min<std::uint64_t>(us, cycle_us_));
+      step(slice);
+      us -= slice;
+    }
+    arrived_.notify_all();
+  }
+
+  std::uint64_t now_us() {
+    std::lock_guard lock(mutex_);
+    return wire_.now;
+  }
+  std::uint64_t cycles() {
+    std::lock_guard lock(mutex_);
+    return line_->cycles();
+  }
+  std::string al_state(std::size_t position) {
+    std::lock_guard lock(mutex_);
+    return ethercat::line_state_name(static_cast<std::uint8_t>(wire_.slaves[position]->state()));
+  }
+  std::size_t drives() const noexcept { return wire_.slaves.size(); }
+  ethercat::ecat_line& line() noexcept { return *line_; }
+
+ private:
+  // The drives' time, then the master's: a cycle when one is due (the line's service, driven by the
+  // first session that polls), each session's work. Without a session the line is cycled here, so
+  // the process data keeps flowing and the drives' watchdogs stay fed.
+  void step(std::uint32_t elapsed) {
+    wire_.wait_us(elapsed);
+    if (axes_.empty()) {
+      if (line_->operational()) (void)line_->service();
+    } else {
+      for (auto& a : axes_) (void)a->session->poll(elapsed);
+    }
+  }
+
+  profile_ptr profile_;
+  std::uint32_t cycle_us_;
+  wire wire_;
+  std::unique_ptr<ethercat::ecat_line> line_;
+  std::string error_;
+};
+
+py::dict slave_dict(const ethercat::ecat_slave& s) {
+  py::dict d;
+  d["position"] = s.position;
+  d["station"] = s.station;
+  d["name"] = s.sii.device_name;
+  d["vendor_id"] = s.sii.vendor_id;
+  d["product_code"] = s.sii.product_code;
+  d["revision"] = s.sii.revision;
+  d["serial"] = s.sii.serial;
+  d["output_bytes"] = s.output_bytes;
+  d["input_bytes"] = s.input_bytes;
+  d["mapping_source"] = s.mapping_source;
+  return d;
+}
+
+}  // namespace
+
+void bind_ethercat(py::module_& m, const py::module_& canopen) {
+  m.attr("Axis") = canopen.attr("Axis");
+  py::class_<line_core, std::shared_ptr<line_core>>(m, "VirtualLine", R"doc(
+A chain of virtual CiA 402 drives as EtherCAT slaves (what `cia402 ecat-slave` runs) and the
+project's EtherCAT master over it (what `cia402 master --ecat` runs), in this process, on virtual
+time. VirtualLine(drives=1, profile=None, cycle_us=1000): the master scans the line, reads each
+drive's SII and PDO mapping and brings the line to OP when it is made (cia402.Error naming why if it
+cannot). axis(position) is the master's Axis for a drive; advance(ms) lets time pass.)doc")
+      .def(py::init([](int drives, const py::object& profile, std::int64_t cycle_us) {
+             checked_integer(drives, 1, 64, "drives");
+             checked_integer(cycle_us, 250, 100000, "cycle_us");
+             auto p = profile_argument(profile);
+             std::shared_ptr<line_core> line;
+             {
+               py::gil_scoped_release nogil;
+               line = std::make_shared<line_core>(std::move(p), drives, static_cast<std::uint32_t>(cycle_us));
+             }
+             if (!line->bring_up_error().empty()) {
+               py::object e = py::module_::import("cia402._errors").attr("Error")("the line did not reach OP: " + line->bring_up_error());
+               PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(e.ptr())), e.ptr());
+               throw py::error_already_set();
+             }
+             return line;
+           }),
+           py::arg("drives") = 1, py::arg("profile") = py::none(), py::arg("cycle_us") = 1000)
+      .def("advance", [](line_core& l, double ms) {
+             if (!(ms >= 0) || ms > 1e9) raise_argument_error("advance takes 0 ms or more");
+             const auto us = static_cast<std::uint64_t>(std::llround(ms * 1000.0));
+             py::gil_scoped_release nogil;
+             l.advance(us);
+           }, py::arg("ms"), "Lets `ms` milliseconds pass for the drives and the master, a cycle at a time.")
+      .def("axis", [](const std::shared_ptr<line_core>& l, std::int64_t position) {
+             checked_integer(position, 0, static_cast<std::int64_t>(l->drives()) - 1, "position");
+             line_core* raw = l.get();
+             const auto pos = static_cast<std::size_t>(position);
+             return make_axis(l, static_cast<std::uint8_t>(position), [raw, pos](bus_axis& a) {
+               a.link = std::make_unique<ethercat::ecat_link>(raw->line(), pos);
+             });
+           }, py::arg("position"),
+           "The master's Axis for the drive at `position` (0: the first after the master), over its "
+           "process data and CoE SDO.")
+      .def_property_readonly("slaves", [](line_core& l) {
+             py::list out;
+             for (const auto& s : l.line().master().slaves()) out.append(slave_dict(s));
+             return out;
+           }, "What the master found on the line: position, station, name, identity, PDO sizes, mapping source.")
+      .def("al_state", [](line_core& l, std::int64_t position) {
+             checked_integer(position, 0, static_cast<std::int64_t>(l.drives()) - 1, "position");
+             return l.al_state(static_cast<std::size_t>(position));
+           }, py::arg("position"), "The drive's own AL state (\"OP\", \"SAFE-OP\", ...).")
+      .def_property_readonly("time_ms", [](line_core& l) { return static_cast<double>(l.now_us()) / 1000.0; },
+                             "Virtual time since the line was made, in ms.")
+      .def_property_readonly("cycles", &line_core::cycles, "Process-data cycles the master ran since OP.");
+}
+
+}  // namespace cia402::python
