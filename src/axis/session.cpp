@@ -47,7 +47,10 @@ session::session(drive_link& link, const session_config& config)
   link_->on_emergency = [this](std::uint16_t code, std::uint8_t reg, std::span<const std::uint8_t> bytes) {
     if (on_emergency) on_emergency(code, reg, bytes);
   };
-  link_->before_cycle = [this] { stream_tick(); };
+  link_->before_cycle = [this] {
+    stream_tick();
+    if (on_cycle) on_cycle();
+  };
   if (link_->phase() == link_phase::running) start_up_reads();
 }
 
@@ -104,6 +107,7 @@ void session::on_link_event(link_event e, const std::string& text) {
         p.value.reset();
         p.absent = false;
       }
+      outputs_.clear();
       if (op_) finish(outcome::failed, e == link_event::failed ? link_->short_name() + ": " + text : text);
       break;
   }
@@ -340,6 +344,17 @@ std::optional<std::int64_t> session::actual(std::uint16_t index) const {
 void session::keep_polled(std::uint16_t index, bool on) {
   polled& p = polled_[index];
   p.wanted = std::max(0, p.wanted + (on ? 1 : -1));
+}
+
+std::optional<std::int64_t> session::output(std::uint16_t index) const {
+  const auto o = outputs_.find(index);
+  return o != outputs_.end() ? std::optional(o->second) : std::nullopt;
+}
+
+bool session::put_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) {
+  if (!link_->set_cyclic_output(index, sub, value)) return false;
+  if (sub == 0) outputs_[index] = value;
+  return true;
 }
 
 std::uint32_t session::next_deadline() const {
