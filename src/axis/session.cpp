@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "cia402/error_codes.hpp"
+#include "cia402/lost_client.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/words.hpp"
 #include "session_internal.hpp"
@@ -287,12 +288,13 @@ std::string session::stop_as_0x6007(const std::string& why) {
   // raise) the quick stop, which stops as 0x605A says; 0 (no action) a halt, which stops the shaft
   // and keeps the drive enabled, or a quick stop where the profile has no halt.
   const int code = option_code(option::abort_connection);
+  const lost_client_stop how = stop_for_lost_client(code, profile_->spec(option::halt).exists());
   std::string action;
   std::vector<step> steps;
-  if (code == 2) {
+  if (how == lost_client_stop::disable_voltage) {
     action = "Disable voltage (0x6007 = 2)";
     steps = {command_step(command::disable_voltage), wait_stopped(false)};
-  } else if (code == 0 && profile_->spec(option::halt).exists()) {
+  } else if (how == lost_client_stop::halt) {
     action = "halt (0x6007 = 0: no action on the drive; the master stops the shaft and keeps it enabled)";
     steps = {call_step([this] {
                set_mode_bits(0);
