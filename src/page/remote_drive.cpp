@@ -19,6 +19,7 @@
 #include "page_names.hpp"
 #include "remote_link.hpp"
 #include "recorder.hpp"
+#include "sign_of_life.hpp"
 #include "snapshot_board.hpp"
 #include "word_change.hpp"
 
@@ -206,7 +207,8 @@ struct remote_drive::impl {
         remote(*link),
         log({c.results_kept, c.settle_quiet_us, c.settle_limit_us,
              "still busy when the page stopped waiting", " (numbers inferred)"},
-            [this] { return how_it_stands(); }) {
+            [this] { return how_it_stands(); }),
+        sign(c.lease_us) {
     if (config.cycle_us == 0) config.cycle_us = 1000;
     if (config.publish_us == 0) config.publish_us = config.cycle_us;
     remote.on_status = [this](std::uint16_t sw) { on_status(sw); };
@@ -248,6 +250,7 @@ struct remote_drive::impl {
   detail::action_log log;
   detail::snapshot_board board;
   detail::recorder recording;
+  detail::sign_of_life sign;
   std::uint8_t transition_this_poll = no_transition;  // for the recorder's row
 
   // The mode display and actual values no PDO of the page carries, read by SDO in rounds.
@@ -407,6 +410,8 @@ struct remote_drive::impl {
     now_us += elapsed_us;
     transition_this_poll = no_transition;
     remote.poll(elapsed_us);
+    // On the wall clock where serve gives one: the drive on the bus stops on wall time too.
+    if (sign.lapsed(config.heartbeat_clock_us ? config.heartbeat_clock_us() : now_us)) stop_for_silence();
     if (handshake) run_handshake();
     read_actuals();
     if (state_known) record_row();
@@ -415,6 +420,15 @@ struct remote_drive::impl {
       next_publish_us = now_us + config.publish_us;
       board.publish([this](bool with_time) { return snapshot(with_time); });
     }
+  }
+
+  // The lease lapsed: a drive left enabled stops as its 0x6007 (as read at set-up) says.
+  void stop_for_silence() {
+    if (!state_known || observed != state::operation_enabled || not_running()) return;
+    const auto known = objects.find(option_index(option::abort_connection));
+    const int code = known != objects.end() ? static_cast<int>(known->second)
+                                            : table.spec(option::abort_connection).default_value;
+    if (const auto w = detail::stop_for_silent_page(table, control_word, code, sign.lease_us())) change_word(*w);
   }
 
   void run_handshake() {
@@ -686,6 +700,8 @@ reply remote_drive::command(page_command c) {
   return accepted{impl_->change_word(std::get<detail::word_change>(change))};
 }
 
+void remote_drive::renew_lease() { impl_->sign.renew(); }
+
 reply remote_drive::toggle_control_bit(int bit) {
   if (bit < 0 || bit > 15) return refused{400, "bit must be 0..15"};
   std::lock_guard lock(impl_->mutex);
@@ -803,6 +819,7 @@ std::string remote_drive::info_json(bool control, bool token_required) const {
   j["control"] = control;
   j["token_required"] = token_required;
   j["cycle_us"] = m.config.cycle_us;
+  j["lease_ms"] = m.sign.lease_us() / 1000;
   j["publish_ms"] = m.config.publish_us / 1000.0;
   j["capabilities"] = m.capabilities();
   // The modes the drive's own 0x6502 announces, where it was read.

@@ -349,6 +349,7 @@ struct server::impl {
     if (const auto e = check_post(req)) return send_error(res, e->status, e->reason);
     backend* inst = axis_of(req, res);
     if (inst == nullptr) return;
+    inst->renew_lease();  // a client that controls is there
     // A key given twice is refused: "last wins" would act on a value the sender may not have meant.
     std::vector<std::set<std::string>> keys;
     bool duplicate = false;
@@ -585,7 +586,10 @@ struct server::impl {
       send_json(res, 200, list);
     });
     http.Get("/api/state", [this](const httplib::Request& req, httplib::Response& res) {
-      if (backend* inst = axis_of(req, res)) res.set_content(inst->snapshot_json(), "application/json");
+      backend* inst = axis_of(req, res);
+      if (inst == nullptr) return;
+      if (may_control(req)) inst->renew_lease();  // a client that polls the state is there
+      res.set_content(inst->snapshot_json(), "application/json");
     });
     http.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
       if (backend* inst = axis_of(req, res)) events(*inst, res);
@@ -672,13 +676,18 @@ struct server::impl {
               if (auto u = inst.wait_for_update(st->seen, slice)) {
                 st->seen = u->version;
                 chunk = "data: " + u->json + "\n\n";
-              } else if (std::chrono::steady_clock::now() - st->last_write >= options.keep_alive) {
+              } else if (std::chrono::steady_clock::now() - st->last_write >=
+                         std::min(options.keep_alive, options.sign_of_life)) {
+                // Also the sign of life's probe: a closed page fails the second write at the latest.
                 chunk = ": keep-alive\n\n";
               }
             }
           }
           st->last_write = std::chrono::steady_clock::now();
-          return sink.write(chunk.data(), chunk.size());
+          if (!sink.write(chunk.data(), chunk.size())) return false;
+          // Only a write that went out renews: a page that has gone stops renewing with its stream.
+          inst.renew_lease();
+          return true;
         },
         [this](bool) { streams.fetch_sub(1); });
   }
