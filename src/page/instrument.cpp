@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "cia402/drive.hpp"
+#include "cia402/error_codes.hpp"
 #include "cia402/master.hpp"
 #include "cia402/words.hpp"
 #include "action_log.hpp"
@@ -214,6 +215,7 @@ struct instrument::impl {
     j["stop_running"] = cia402::stop_running(v.state_of_axis().core);
     j["ramp"] = stop_ramp_name(out.ramp);
     j["error_code"] = hex(out.error_code, 4);
+    j["error_text"] = error_code_text(out.error_code);
     j["error_register"] = hex(out.error_register, 2);
     j["velocity"] = v.velocity_rpm();
     j["target_velocity"] = v.target_velocity();

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/error_codes.hpp"
 #include "cia402/manufacturer_objects.hpp"
 #include "cia402/canopen/301/nmt.hpp"
 #include "cia402/objects.hpp"
@@ -641,6 +642,7 @@ struct remote_drive::impl {
     j["stop_running"] = nullptr;
     j["ramp"] = nullptr;
     j["error_code"] = hex(remote.error_code(), 4);
+    j["error_text"] = error_code_text(remote.error_code());
     j["error_register"] = hex(remote.error_register(), 2);
     // A silent node's last values are history: what is shown live says "unknown" instead.
     j["velocity"] = live && velocity ? json(*velocity) : json(nullptr);

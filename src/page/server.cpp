@@ -577,7 +577,7 @@ struct server::impl {
         const json s = json::parse(axes[k].drive->snapshot_json(), nullptr, false);
         json entry{{"axis", k + 1}, {"label", axes[k].label}};
         if (s.is_object()) {
-          for (const char* key : {"profile", "state", "status_word", "velocity", "error_code"}) {
+          for (const char* key : {"profile", "state", "status_word", "velocity", "error_code", "error_text"}) {
             if (s.contains(key)) entry[key] = s[key];
           }
         }

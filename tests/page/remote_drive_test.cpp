@@ -214,6 +214,7 @@ TEST(remote_drive, fault_through_0x2001_gives_fault_and_fault_reset_gives_switch
   json s = b.snapshot();
   EXPECT_EQ(s["state"], "FAULT");
   EXPECT_EQ(s["error_code"], "0x2310");
+  EXPECT_EQ(s["error_text"], "continuous over-current");  // CiA 402's error code table
   EXPECT_EQ(s["fault_cause"], "0x2310");
   EXPECT_EQ(s["results"][0]["transitions"], json::array({13, 14})) << s["results"][0];
   EXPECT_EQ(s["last_transition"]["number"], 14);
