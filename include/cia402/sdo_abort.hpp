@@ -29,6 +29,7 @@ enum class sdo_abort : std::uint32_t {
   value_too_low = 0x06090032,
   general_error = 0x08000000,
   cannot_store_in_present_state = 0x08000022,
+  no_data_available = 0x08000024,  ///< e.g. 0x1003 sub-index beyond the number of errors (CiA 301 §7.5.2.5)
 };
 
 /// A short English reason, e.g. "value range of parameter exceeded"; never null.

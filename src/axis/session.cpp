@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "cia402/error_codes.hpp"
+#include "cia402/lost_client.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/words.hpp"
 #include "session_internal.hpp"
@@ -47,7 +48,10 @@ session::session(drive_link& link, const session_config& config)
   link_->on_emergency = [this](std::uint16_t code, std::uint8_t reg, std::span<const std::uint8_t> bytes) {
     if (on_emergency) on_emergency(code, reg, bytes);
   };
-  link_->before_cycle = [this] { stream_tick(); };
+  link_->before_cycle = [this] {
+    stream_tick();
+    if (on_cycle) on_cycle();
+  };
   if (link_->phase() == link_phase::running) start_up_reads();
 }
 
@@ -104,6 +108,7 @@ void session::on_link_event(link_event e, const std::string& text) {
         p.value.reset();
         p.absent = false;
       }
+      outputs_.clear();
       if (op_) finish(outcome::failed, e == link_event::failed ? link_->short_name() + ": " + text : text);
       break;
   }
@@ -283,12 +288,13 @@ std::string session::stop_as_0x6007(const std::string& why) {
   // raise) the quick stop, which stops as 0x605A says; 0 (no action) a halt, which stops the shaft
   // and keeps the drive enabled, or a quick stop where the profile has no halt.
   const int code = option_code(option::abort_connection);
+  const lost_client_stop how = stop_for_lost_client(code, profile_->spec(option::halt).exists());
   std::string action;
   std::vector<step> steps;
-  if (code == 2) {
+  if (how == lost_client_stop::disable_voltage) {
     action = "Disable voltage (0x6007 = 2)";
     steps = {command_step(command::disable_voltage), wait_stopped(false)};
-  } else if (code == 0 && profile_->spec(option::halt).exists()) {
+  } else if (how == lost_client_stop::halt) {
     action = "halt (0x6007 = 0: no action on the drive; the master stops the shaft and keeps it enabled)";
     steps = {call_step([this] {
                set_mode_bits(0);
@@ -340,6 +346,17 @@ std::optional<std::int64_t> session::actual(std::uint16_t index) const {
 void session::keep_polled(std::uint16_t index, bool on) {
   polled& p = polled_[index];
   p.wanted = std::max(0, p.wanted + (on ? 1 : -1));
+}
+
+std::optional<std::int64_t> session::output(std::uint16_t index) const {
+  const auto o = outputs_.find(index);
+  return o != outputs_.end() ? std::optional(o->second) : std::nullopt;
+}
+
+bool session::put_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) {
+  if (!link_->set_cyclic_output(index, sub, value)) return false;
+  if (sub == 0) outputs_[index] = value;
+  return true;
 }
 
 std::uint32_t session::next_deadline() const {

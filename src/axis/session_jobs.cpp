@@ -181,7 +181,7 @@ std::uint64_t session::write_object(std::uint16_t index, std::uint8_t sub, const
       return refuse(std::to_string(v.number) + " is refused by the object table: " + sdo_abort_text(a) + " (" +
                     std::to_string(o->low) + ".." + std::to_string(o->high) + ", " + o->name + ")");
     }
-    if (link_->cyclic() && link_->set_cyclic_output(index, sub, v.number)) {
+    if (link_->cyclic() && put_output(index, sub, v.number)) {
       res->note = "written into the cyclic outputs";
       deferred_.push_back([this, res, done] {
         fill_result(*res);

@@ -365,4 +365,27 @@ std::uint64_t session::watch(completion done) {
   return id;
 }
 
+std::uint64_t session::send_word(std::uint16_t word, bool reset_edge, completion done) {
+  std::vector<step> steps{need_cyclic(), call_step([this, word, reset_edge] {
+                            op_->commanded = true;
+                            control_ = control::words;
+                            words_.clear();
+                            // A status word from before this is no answer to it, even if the word is the same.
+                            word_changed_us_ = now_us_;
+                            word_changed_count_ = link_->status_count();
+                            if (!reset_edge) {
+                              words_.emplace_back(word, now_us_);
+                              return;
+                            }
+                            const fault_reset_words edge = fault_reset_edge(sent_.value_or(0), word);
+                            for (std::uint8_t i = 0; i < edge.count; ++i) {
+                              words_.emplace_back(edge.words[i], now_us_ + std::uint64_t{i + 1u} * config_.reset_pulse_us);
+                            }
+                          }),
+                          wait_step([this] { return words_.size() <= 1 && settled(); }, 0, [] { return std::string(); })};
+  const std::uint64_t id = begin(reset_edge ? "fault-reset edge" : "control word", std::move(steps), std::move(done), false);
+  op_->fault_ok = true;
+  return id;
+}
+
 }  // namespace cia402::axes

@@ -120,7 +120,7 @@ session::step session::wait_settled() {
 void session::write_integer(std::uint16_t index, std::uint8_t sub, std::int64_t value,
                             std::function<void(std::string)> done) {
   if (index == object_index::modes_of_operation) mode_written_us_ = now_us_;
-  if (link_->cyclic() && link_->set_cyclic_output(index, sub, value)) {
+  if (link_->cyclic() && put_output(index, sub, value)) {
     word_changed_us_ = now_us_;  // the output goes with the next cycle, as a control word does
     word_changed_count_ = link_->status_count();
     done({});

@@ -68,7 +68,7 @@ void session::stream_tick() {
   }
   last_set_point_ = next;
   ++set_points_;
-  (void)link_->set_cyclic_output(stream_object_, 0, *next);
+  (void)put_output(stream_object_, 0, *next);
 }
 
 std::vector<session::step> session::stream_steps(std::int8_t m, setpoint_source source, std::vector<step> before_mode,
@@ -152,7 +152,7 @@ std::uint64_t session::csp_stream(std::int32_t to, std::uint32_t rpm, completion
   before.push_back(read_step(object_index::position_actual_value, 0, [p](std::int64_t v) { p->start = v; }, false));
   auto written = std::make_shared<std::optional<std::string>>();
   before.push_back(step{[this, p, written] {
-                          (void)link_->set_cyclic_output(object_index::target_position, 0, p->start);
+                          (void)put_output(object_index::target_position, 0, p->start);
                           std::vector<std::uint8_t> bytes;
                           std::string why;
                           (void)encode_value(object_value::of_integer(p->start), value_format::integer(4, true), bytes, why);

@@ -127,6 +127,7 @@ const char* sdo_abort_text(sdo_abort code) noexcept {
     case sdo_abort::general_error: return "general error";
     case sdo_abort::cannot_store_in_present_state:
       return "data cannot be transferred or stored because of the present device state";
+    case sdo_abort::no_data_available: return "no data available";
   }
   return "unknown abort code";
 }

@@ -9,12 +9,14 @@
 #include <stdexcept>
 
 #include "cia402/drive.hpp"
+#include "cia402/error_codes.hpp"
 #include "cia402/master.hpp"
 #include "cia402/words.hpp"
 #include "action_log.hpp"
 #include "page_json.hpp"
 #include "page_names.hpp"
 #include "recorder.hpp"
+#include "sign_of_life.hpp"
 #include "snapshot_board.hpp"
 #include "word_change.hpp"
 
@@ -35,7 +37,8 @@ struct instrument::impl {
         drive(std::make_unique<sim::virtual_drive>(p, c.plant)),
         log({c.results_kept, c.settle_quiet, c.settle_limit,
              "still busy when the instrument stopped waiting", ""},
-            [this] { return how_it_stands(); }) {
+            [this] { return how_it_stands(); }),
+        sign(c.lease_us) {
     if (config.publish_every == 0) config.publish_every = 1;
     if (config.selectable.empty()) {
       for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
@@ -71,6 +74,7 @@ struct instrument::impl {
 
   detail::snapshot_board board;
   detail::recorder recording;
+  detail::sign_of_life sign;
 
   // --- under the lock ------------------------------------------------------------------------
 
@@ -128,7 +132,17 @@ struct instrument::impl {
     return {now, state_name(now), blocking_conditions(), waiting_for};
   }
 
+  // The lease lapsed: a drive left enabled stops as its 0x6007 says (the word goes in this cycle).
+  void stop_for_silence() {
+    if (drive->view().current() != state::operation_enabled) return;
+    std::int64_t code = table->spec(option::abort_connection).default_value;
+    (void)drive->view().read(option_index(option::abort_connection), 0, code);
+    const auto w = detail::stop_for_silent_page(*table, control_word, static_cast<int>(code), sign.lease_us());
+    if (w) change_word(*w);
+  }
+
   void step_locked() {
+    if (sign.lapsed(drive->time_us())) stop_for_silence();
     if (!scripted.empty()) {
       apply_word(scripted.front());
       scripted.pop_front();
@@ -201,6 +215,7 @@ struct instrument::impl {
     j["stop_running"] = cia402::stop_running(v.state_of_axis().core);
     j["ramp"] = stop_ramp_name(out.ramp);
     j["error_code"] = hex(out.error_code, 4);
+    j["error_text"] = error_code_text(out.error_code);
     j["error_register"] = hex(out.error_register, 2);
     j["velocity"] = v.velocity_rpm();
     j["target_velocity"] = v.target_velocity();
@@ -365,6 +380,8 @@ reply instrument::change_plant(const plant_change& change) {
   return accepted{m.track(action, false)};
 }
 
+void instrument::renew_lease() { impl_->sign.renew(); }
+
 std::string instrument::info_json(bool control, bool token_required) const {
   std::lock_guard lock(impl_->mutex);
   json j = detail::profile_info(*impl_->table);
@@ -377,6 +394,7 @@ std::string instrument::info_json(bool control, bool token_required) const {
   j["control"] = control;
   j["token_required"] = token_required;
   j["cycle_us"] = impl_->drive->constants().cycle_us;
+  j["lease_ms"] = impl_->sign.lease_us() / 1000;
   // Snapshots come at most this often (the plot holds a value across a gap between them).
   j["publish_ms"] = impl_->config.publish_every * impl_->drive->constants().cycle_us / 1000.0;
   // The virtual drive's plant takes every input the page offers.

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/error_codes.hpp"
 #include "cia402/manufacturer_objects.hpp"
 #include "cia402/canopen/301/nmt.hpp"
 #include "cia402/objects.hpp"
@@ -19,6 +20,7 @@
 #include "page_names.hpp"
 #include "remote_link.hpp"
 #include "recorder.hpp"
+#include "sign_of_life.hpp"
 #include "snapshot_board.hpp"
 #include "word_change.hpp"
 
@@ -206,7 +208,8 @@ struct remote_drive::impl {
         remote(*link),
         log({c.results_kept, c.settle_quiet_us, c.settle_limit_us,
              "still busy when the page stopped waiting", " (numbers inferred)"},
-            [this] { return how_it_stands(); }) {
+            [this] { return how_it_stands(); }),
+        sign(c.lease_us) {
     if (config.cycle_us == 0) config.cycle_us = 1000;
     if (config.publish_us == 0) config.publish_us = config.cycle_us;
     remote.on_status = [this](std::uint16_t sw) { on_status(sw); };
@@ -248,6 +251,7 @@ struct remote_drive::impl {
   detail::action_log log;
   detail::snapshot_board board;
   detail::recorder recording;
+  detail::sign_of_life sign;
   std::uint8_t transition_this_poll = no_transition;  // for the recorder's row
 
   // The mode display and actual values no PDO of the page carries, read by SDO in rounds.
@@ -407,6 +411,8 @@ struct remote_drive::impl {
     now_us += elapsed_us;
     transition_this_poll = no_transition;
     remote.poll(elapsed_us);
+    // On the wall clock where serve gives one: the drive on the bus stops on wall time too.
+    if (sign.lapsed(config.heartbeat_clock_us ? config.heartbeat_clock_us() : now_us)) stop_for_silence();
     if (handshake) run_handshake();
     read_actuals();
     if (state_known) record_row();
@@ -415,6 +421,15 @@ struct remote_drive::impl {
       next_publish_us = now_us + config.publish_us;
       board.publish([this](bool with_time) { return snapshot(with_time); });
     }
+  }
+
+  // The lease lapsed: a drive left enabled stops as its 0x6007 (as read at set-up) says.
+  void stop_for_silence() {
+    if (!state_known || observed != state::operation_enabled || not_running()) return;
+    const auto known = objects.find(option_index(option::abort_connection));
+    const int code = known != objects.end() ? static_cast<int>(known->second)
+                                            : table.spec(option::abort_connection).default_value;
+    if (const auto w = detail::stop_for_silent_page(table, control_word, code, sign.lease_us())) change_word(*w);
   }
 
   void run_handshake() {
@@ -627,6 +642,7 @@ struct remote_drive::impl {
     j["stop_running"] = nullptr;
     j["ramp"] = nullptr;
     j["error_code"] = hex(remote.error_code(), 4);
+    j["error_text"] = error_code_text(remote.error_code());
     j["error_register"] = hex(remote.error_register(), 2);
     // A silent node's last values are history: what is shown live says "unknown" instead.
     j["velocity"] = live && velocity ? json(*velocity) : json(nullptr);
@@ -685,6 +701,8 @@ reply remote_drive::command(page_command c) {
   if (const refused* no = std::get_if<refused>(&change)) return *no;
   return accepted{impl_->change_word(std::get<detail::word_change>(change))};
 }
+
+void remote_drive::renew_lease() { impl_->sign.renew(); }
 
 reply remote_drive::toggle_control_bit(int bit) {
   if (bit < 0 || bit > 15) return refused{400, "bit must be 0..15"};
@@ -803,6 +821,7 @@ std::string remote_drive::info_json(bool control, bool token_required) const {
   j["control"] = control;
   j["token_required"] = token_required;
   j["cycle_us"] = m.config.cycle_us;
+  j["lease_ms"] = m.sign.lease_us() / 1000;
   j["publish_ms"] = m.config.publish_us / 1000.0;
   j["capabilities"] = m.capabilities();
   // The modes the drive's own 0x6502 announces, where it was read.

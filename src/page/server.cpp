@@ -17,12 +17,12 @@
 #include <functional>
 #include <map>
 #include <mutex>
-#include <random>
 #include <set>
 #include <stdexcept>
 #include <vector>
 #include <thread>
 
+#include "server_http.hpp"
 #include "web_assets.hpp"
 
 namespace cia402::page {
@@ -32,87 +32,17 @@ using json = nlohmann::json;
 
 constexpr const char* token_header = "X-Cia402-Token";
 
-void send_json(httplib::Response& res, int status, const json& body) {
-  res.status = status;
-  res.set_content(body.dump(), "application/json");
-}
+using detail::answer_and_close;
+using detail::host_of;
+using detail::integer_of;
+using detail::length_within;
+using detail::request_error;
+using detail::same_secret;
+using detail::send_error;
+using detail::send_json;
+using detail::unknown_key;
 
-void send_error(httplib::Response& res, int status, const std::string& reason) {
-  send_json(res, status, json{{"error", reason}});
-}
 
-// A Content-Length of digits only, at most `max`.
-bool length_within(const std::string& text, std::size_t max) {
-  std::size_t n = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
-  return ec == std::errc() && end == text.data() + text.size() && !text.empty() && n <= max;
-}
-
-// Equal-time comparison, so the time a refusal takes tells nothing about the token.
-bool same_secret(std::string_view a, std::string_view b) {
-  unsigned char diff = a.size() == b.size() ? 0 : 1;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    diff |= static_cast<unsigned char>(a[i] ^ (i < b.size() ? b[i] : 0));
-  }
-  return diff == 0;
-}
-
-// The host part of a Host header: "127.0.0.1:8402" -> "127.0.0.1", "[::1]:8402" -> "::1".
-std::string_view host_of(std::string_view host_header) {
-  if (!host_header.empty() && host_header.front() == '[') {
-    const std::size_t close = host_header.find(']');
-    return close == std::string_view::npos ? host_header : host_header.substr(1, close - 1);
-  }
-  const std::size_t colon = host_header.find(':');
-  return colon == std::string_view::npos ? host_header : host_header.substr(0, colon);
-}
-
-// An integer from a JSON number or a string "0x605A" / "24666"; nothing for anything else.
-std::optional<std::int64_t> integer_of(const json& v) {
-  if (v.is_number_integer()) return v.get<std::int64_t>();
-  if (v.is_number_unsigned()) {
-    const auto u = v.get<std::uint64_t>();
-    if (u > static_cast<std::uint64_t>(INT64_MAX)) return std::nullopt;
-    return static_cast<std::int64_t>(u);
-  }
-  if (!v.is_string()) return std::nullopt;
-  const std::string& s = v.get_ref<const std::string&>();
-  std::size_t i = 0;
-  bool negative = false;
-  if (i < s.size() && (s[i] == '-' || s[i] == '+')) negative = s[i++] == '-';
-  int base = 10;
-  if (s.size() - i > 2 && s[i] == '0' && (s[i + 1] == 'x' || s[i + 1] == 'X')) {
-    base = 16;
-    i += 2;
-  }
-  if (i >= s.size() || s.size() - i > 12) return std::nullopt;
-  std::int64_t value = 0;
-  for (; i < s.size(); ++i) {
-    const char c = s[i];
-    int d = -1;
-    if (c >= '0' && c <= '9') d = c - '0';
-    if (base == 16 && c >= 'a' && c <= 'f') d = c - 'a' + 10;
-    if (base == 16 && c >= 'A' && c <= 'F') d = c - 'A' + 10;
-    if (d < 0) return std::nullopt;
-    value = value * base + d;
-  }
-  return negative ? -value : value;
-}
-
-// Every key of `body` must be one of `allowed`; the first one that is not is named.
-std::optional<std::string> unknown_key(const json& body, std::initializer_list<const char*> allowed) {
-  for (auto it = body.begin(); it != body.end(); ++it) {
-    bool known = false;
-    for (const char* a : allowed) known = known || it.key() == a;
-    if (!known) return "unknown key '" + it.key() + "'";
-  }
-  return std::nullopt;
-}
-
-struct request_error {
-  int status;
-  std::string reason;
-};
 
 // cpp-httplib 0.11.4 (Debian 12's, a compiled library) reads a request's whole head, every header
 // line of it, before any hook of ours runs, and its per-connection entry point is private. So the
@@ -145,29 +75,6 @@ struct guard_server : httplib::Server {
 
 }  // namespace
 
-std::string make_token() {
-  std::random_device rd;
-  std::string token;
-  char buf[9];
-  for (int i = 0; i < 4; ++i) {
-    std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(rd()));
-    token += buf;
-  }
-  return token;
-}
-
-bool is_loopback_address(std::string_view host) {
-  if (host == "localhost" || host == "::1") return true;
-  in_addr v4{};
-  const std::string h(host);
-  if (inet_pton(AF_INET, h.c_str(), &v4) == 1) {
-    return (ntohl(v4.s_addr) >> 24) == 127;
-  }
-  in6_addr v6{};
-  if (inet_pton(AF_INET6, h.c_str(), &v6) == 1) return IN6_IS_ADDR_LOOPBACK(&v6);
-  return false;
-}
-
 struct server::impl {
   impl(std::vector<axis> a, server_options o) : axes(std::move(a)), options(std::move(o)) {
     if (axes.empty()) throw std::invalid_argument("the page needs at least one drive");
@@ -190,62 +97,8 @@ struct server::impl {
 
   // --- admission: before cpp-httplib reads a byte ---------------------------------------------
 
-  // A refusal written straight to the socket (the request was never parsed).
-  static void answer_and_close(socket_t sock, int status, const std::string& reason) {
-    const char* text = status == 408 ? "Request Timeout"
-                       : status == 431 ? "Request Header Fields Too Large"
-                                       : "Service Unavailable";
-    const std::string body = json{{"error", reason}}.dump();
-    const std::string head = "HTTP/1.1 " + std::to_string(status) + " " + text +
-                             "\r\nContent-Type: application/json\r\nContent-Length: " +
-                             std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n";
-    const std::string all = head + body;
-    (void)::send(sock, all.data(), all.size(), MSG_NOSIGNAL);
-    ::shutdown(sock, SHUT_RDWR);
-    ::close(sock);
-  }
-
-  // Waits (peeking, nothing consumed) until the first request's head is complete. 0: the peer
-  // went away; otherwise the refusal's status and reason, or 200 to go on.
   request_error wait_for_head(socket_t sock) const {
-    const auto deadline = std::chrono::steady_clock::now() + options.read_timeout;
-    std::vector<char> buf(options.max_head + 1);
-    ssize_t seen = -1;
-    for (;;) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-          deadline - std::chrono::steady_clock::now());
-      if (left.count() <= 0) {
-        return {408, "the request head did not arrive within " +
-                         std::to_string(options.read_timeout.count()) + " ms"};
-      }
-      pollfd p{sock, POLLIN | POLLRDHUP, 0};
-      (void)::poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 50)));
-      const bool peer_done = (p.revents & (POLLRDHUP | POLLHUP | POLLERR)) != 0;
-      const ssize_t n = ::recv(sock, buf.data(), buf.size(), MSG_PEEK | MSG_DONTWAIT);
-      if (n == 0) return {0, ""};
-      if (n < 0) {
-        if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) continue;
-        return {0, ""};
-      }
-      const std::string_view text(buf.data(), static_cast<std::size_t>(n));
-      const auto end = text.find("\r\n\r\n");
-      const std::string_view head = text.substr(0, end == std::string_view::npos ? text.size() : end);
-      std::size_t lines = 0;
-      for (std::size_t at = head.find("\r\n"); at != std::string_view::npos; at = head.find("\r\n", at + 2)) {
-        ++lines;
-      }
-      if (lines > options.max_headers) {
-        return {431, "more than " + std::to_string(options.max_headers) + " header lines"};
-      }
-      if (end != std::string_view::npos) return {200, ""};
-      if (peer_done) return {0, ""};  // it stopped sending before its head was complete
-      if (static_cast<std::size_t>(n) > options.max_head) {
-        return {431, "request head larger than " + std::to_string(options.max_head) + " bytes"};
-      }
-      // Data waits unread, so poll returns at once: only a grown head is worth another look.
-      if (n == seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      seen = n;
-    }
+    return detail::wait_for_head(sock, options.read_timeout, options.max_head, options.max_headers);
   }
 
   bool admit(socket_t sock) {
@@ -349,6 +202,7 @@ struct server::impl {
     if (const auto e = check_post(req)) return send_error(res, e->status, e->reason);
     backend* inst = axis_of(req, res);
     if (inst == nullptr) return;
+    inst->renew_lease();  // a client that controls is there
     // A key given twice is refused: "last wins" would act on a value the sender may not have meant.
     std::vector<std::set<std::string>> keys;
     bool duplicate = false;
@@ -576,7 +430,7 @@ struct server::impl {
         const json s = json::parse(axes[k].drive->snapshot_json(), nullptr, false);
         json entry{{"axis", k + 1}, {"label", axes[k].label}};
         if (s.is_object()) {
-          for (const char* key : {"profile", "state", "status_word", "velocity", "error_code"}) {
+          for (const char* key : {"profile", "state", "status_word", "velocity", "error_code", "error_text"}) {
             if (s.contains(key)) entry[key] = s[key];
           }
         }
@@ -585,10 +439,13 @@ struct server::impl {
       send_json(res, 200, list);
     });
     http.Get("/api/state", [this](const httplib::Request& req, httplib::Response& res) {
-      if (backend* inst = axis_of(req, res)) res.set_content(inst->snapshot_json(), "application/json");
+      backend* inst = axis_of(req, res);
+      if (inst == nullptr) return;
+      if (may_control(req)) inst->renew_lease();  // a client that polls the state is there
+      res.set_content(inst->snapshot_json(), "application/json");
     });
     http.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
-      if (backend* inst = axis_of(req, res)) events(*inst, res);
+      if (backend* inst = axis_of(req, res)) detail::serve_events(*inst, res, options, streams, stopping);
     });
     http.Get("/api/recording", [this](const httplib::Request& req, httplib::Response& res) {
       std::uint64_t seen[2] = {0, 0};
@@ -640,47 +497,6 @@ struct server::impl {
         send_error(res, 405, "use POST with a JSON body");
       });
     }
-  }
-
-  void events(backend& inst, httplib::Response& res) {
-    if (streams.fetch_add(1) >= options.max_event_streams) {
-      streams.fetch_sub(1);
-      return send_error(res, 503, "too many event streams open");
-    }
-    struct stream_state {
-      bool started = false;
-      std::uint64_t seen = 0;
-      std::chrono::steady_clock::time_point last_write = std::chrono::steady_clock::now();
-    };
-    auto st = std::make_shared<stream_state>();
-    res.set_chunked_content_provider(
-        "text/event-stream",
-        [this, st, &inst](std::size_t, httplib::DataSink& sink) {
-          std::string chunk;
-          if (!st->started) {
-            st->started = true;
-            st->seen = inst.latest().version;
-            chunk = "retry: 1000\ndata: " + inst.snapshot_json() + "\n\n";
-          } else {
-            // Short waits, so a stopping server ends the stream promptly.
-            const auto slice = std::chrono::milliseconds(200);
-            while (chunk.empty()) {
-              if (stopping || inst.closed()) {
-                sink.done();
-                return true;
-              }
-              if (auto u = inst.wait_for_update(st->seen, slice)) {
-                st->seen = u->version;
-                chunk = "data: " + u->json + "\n\n";
-              } else if (std::chrono::steady_clock::now() - st->last_write >= options.keep_alive) {
-                chunk = ": keep-alive\n\n";
-              }
-            }
-          }
-          st->last_write = std::chrono::steady_clock::now();
-          return sink.write(chunk.data(), chunk.size());
-        },
-        [this](bool) { streams.fetch_sub(1); });
   }
 };
 

@@ -136,6 +136,7 @@ TEST(ecat_page, an_injected_fault_shows_with_its_code_and_a_reset_clears_it) {
   EXPECT_TRUE(b.run_until([&] { return b.state() == "FAULT"; }));
   b.run_ms(20);
   EXPECT_EQ(b.snapshot()["error_code"], "0x2310");
+  EXPECT_EQ(b.snapshot()["error_text"], "continuous over-current");  // CiA 402's error code table
   EXPECT_EQ(b.snapshot()["error_register"], "0x03") << "generic + current, read by SDO when the code changed";
   EXPECT_EQ(b.snapshot()["remote"]["last_emcy"], "0x2310");
   plant_change clear;

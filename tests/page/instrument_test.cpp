@@ -156,6 +156,7 @@ TEST(instrument, fault_reset_is_one_edge_of_bit_7_and_leads_fault_to_switch_on_d
   EXPECT_EQ(fr["transitions"], json::array({13, 14}));
   EXPECT_EQ(snapshot(inst)["state"], "FAULT");
   EXPECT_EQ(snapshot(inst)["error_code"], "0x2310");
+  EXPECT_EQ(snapshot(inst)["error_text"], "continuous over-current");  // CiA 402's error code table
 
   plant_change clear;
   clear.fault = false;

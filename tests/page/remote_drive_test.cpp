@@ -214,6 +214,7 @@ TEST(remote_drive, fault_through_0x2001_gives_fault_and_fault_reset_gives_switch
   json s = b.snapshot();
   EXPECT_EQ(s["state"], "FAULT");
   EXPECT_EQ(s["error_code"], "0x2310");
+  EXPECT_EQ(s["error_text"], "continuous over-current");  // CiA 402's error code table
   EXPECT_EQ(s["fault_cause"], "0x2310");
   EXPECT_EQ(s["results"][0]["transitions"], json::array({13, 14})) << s["results"][0];
   EXPECT_EQ(s["last_transition"]["number"], 14);
@@ -337,6 +338,53 @@ TEST(remote_drive, the_drive_watches_the_pages_heartbeat_and_applies_0x6007_when
   std::int64_t err = 0;
   ASSERT_EQ(b.drive_node().node().read(0x603F, 0, err), cia402::sdo_abort::none);
   EXPECT_EQ(err, 0x8130) << "0x6007 = 1 by default: a fault with the heartbeat error code";
+}
+
+// The page's sign of life (docs/page.md): the page's process is still there, but no page renews the
+// lease (the tab was closed). The drive, enabled and turning, is quick-stopped by the page's master
+// as its 0x6007 (1 by default: a fault, which a master cannot raise) says within the lease plus a
+// cycle, and not before; its heartbeat watch cannot see this, the page's heartbeat goes on.
+TEST(remote_drive, a_silent_page_gets_the_turning_drive_quick_stopped_after_the_lease) {
+  constexpr int lease_ms = 300;
+  remote_config c = test_config();
+  c.lease_us = lease_ms * 1000;
+  remote_bench b(c);
+  auto renewed = [&b](int ms) {
+    for (int i = 0; i < ms; ++i) {
+      if (i % 100 == 0) b.remote().renew_lease();
+      b.run_ms(1);
+    }
+  };
+  b.remote().renew_lease();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  for (page_command cmd : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
+    b.remote().renew_lease();
+    ASSERT_TRUE(is_accepted(b.remote().command(cmd)));
+    renewed(600);
+  }
+  ASSERT_EQ(b.snapshot()["state"], "OPERATION_ENABLED");
+  plant_change v;
+  v.target_velocity = 300;
+  b.remote().renew_lease();
+  ASSERT_TRUE(is_accepted(b.blocking([&] { return b.remote().change_plant(v); })));
+  renewed(2000);  // 300 rpm at 1000 rpm/s, renewed for many lease times
+  ASSERT_EQ(b.drive().view().current(), cia402::state::operation_enabled);
+  ASSERT_EQ(b.drive().view().velocity_rpm(), 300);
+
+  b.remote().renew_lease();
+  b.run_ms(lease_ms - 5);
+  EXPECT_EQ(b.drive().view().current(), cia402::state::operation_enabled) << "stopped before the lease ran out";
+  b.run_ms(10);
+  const json s = b.snapshot();
+  EXPECT_EQ(s["control_word"], "0x0002");  // Quick stop, cia402-reference.md §2.2
+  const std::string action = s["results"][0]["action"];
+  EXPECT_NE(action.find("SIGN OF LIFE LOST"), std::string::npos) << action;
+  // 300 rpm at the quick stop deceleration (0x6085, 10000 rpm/s by default): 30 ms.
+  b.run_ms(100);
+  EXPECT_EQ(b.drive().view().velocity_rpm(), 0);
+  b.run_ms(300);
+  EXPECT_EQ(b.drive().view().current(), cia402::state::switch_on_disabled);  // 0x605A = 2
+  EXPECT_FALSE(b.drive_node().node().connection_lost()) << "the page's heartbeat went on";
 }
 
 // The page's runner on a loaded machine: each step() stands for 1 ms while 4 ms pass on the wall

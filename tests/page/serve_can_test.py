@@ -149,6 +149,7 @@ def main():
         assert result['transitions'] == [13, 14], result
         s = wait_state(base, lambda s: s['state'] == 'FAULT', 'FAULT')
         assert s['error_code'] == '0x2310', s['error_code']
+        assert s['error_text'] == 'continuous over-current', s['error_text']
         status, reply = request(base + 'api/plant', {'fault': False})
         assert status == 200, (status, reply)
         settled_result(base, reply['id'])

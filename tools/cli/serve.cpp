@@ -74,6 +74,12 @@ CLI::App* add_serve_subcommand(CLI::App& app, serve_args& args) {
       ->check(CLI::Range(0, 65535))
       ->default_str("0")
       ->needs(ecat);
+  cmd->add_option("--lease", args.lease_ms,
+                  "the page's sign of life: when no open page (its event stream) or request renewed it "
+                  "for this long, a drive left enabled is stopped as its 0x6007 says; 0: never")
+      ->type_name("MS")
+      ->check(CLI::Range(0, 600000))
+      ->default_str("1000");
   return cmd;
 }
 
@@ -93,6 +99,7 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   std::vector<std::unique_ptr<page::backend>> drives;
   std::vector<page::axis> axes;
   std::unique_ptr<apps::ethercat_link> line;
+  const auto lease_us = static_cast<std::uint64_t>(args.lease_ms) * 1000;
   if (!args.ecat.empty()) {
     // A line answers in microseconds: 20 ms without an answer is a lost frame, and the page says
     // the line is gone within half a second rather than after seconds of waiting.
@@ -104,12 +111,15 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
     }
     page::remote_config rc;
     rc.bus_name = "EtherCAT " + args.ecat;
+    rc.lease_us = lease_us;
     drives.push_back(page::make_ecat_drive(choice.get(), *line, static_cast<std::uint16_t>(args.position), args.ecat, rc));
     axes.push_back({"slave " + std::to_string(args.position), drives.back().get()});
   } else if (args.can.empty()) {
     for (int k = 1; k <= args.virtual_axes; ++k) {
       // Selectable on the page: the built-in profiles and this one (instrument_config's default).
-      drives.push_back(std::make_unique<page::instrument>(choice.get()));
+      page::instrument_config ic;
+      ic.lease_us = lease_us;
+      drives.push_back(std::make_unique<page::instrument>(choice.get(), ic));
       axes.push_back({"axis " + std::to_string(k), drives.back().get()});
     }
   } else {
@@ -139,6 +149,7 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
       page::remote_config rc;
       rc.node_id = static_cast<std::uint8_t>(node);
       rc.bus_name = args.can;
+      rc.lease_us = lease_us;
       rc.heartbeat_clock_us = [] {
         return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
                                               std::chrono::steady_clock::now().time_since_epoch())

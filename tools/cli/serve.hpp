@@ -26,6 +26,9 @@ struct serve_args {
   int virtual_axes = 1;         ///< without --can: how many virtual drives (--nodes N)
   std::string ecat;             ///< a network interface: the drive on that EtherCAT line instead
   int position = 0;             ///< with --ecat: the drive's position on the line, 0 first
+  /// The page's sign of life: a drive left enabled stops as its 0x6007 says when no page renewed it
+  /// for this long (ms); 0: never.
+  int lease_ms = 1000;
 };
 
 /// Registers the subcommand on `app`, filling `args` when it is parsed.

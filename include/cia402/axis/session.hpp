@@ -163,6 +163,13 @@ class session {
   std::uint64_t stream(std::int8_t mode, setpoint_source source, completion done);
   /// The cyclic exchange, never commanding the drive: done once it runs.
   std::uint64_t watch(completion done);
+  /// The client's own control word, every bit as given (the instrument page's command buttons and
+  /// bit toggles, seed 003's screen page): held from now on, the planner does not steer it, the
+  /// running operation is superseded. With `reset_edge` a fault-reset edge goes first
+  /// (cia402::fault_reset_edge: bit 7 low if it was high, then high, then `word` with it low), each
+  /// word held reset_pulse_us. Done once the drive has had the last word; a drive in FAULT takes it
+  /// too (it is how a client resets one by hand).
+  std::uint64_t send_word(std::uint16_t word, bool reset_edge, completion done);
   /// An object with its type (the core's table, then the link's describe()); without one, an
   /// upload gives its bytes.
   std::uint64_t read_object(std::uint16_t index, std::uint8_t sub, completion done);
@@ -177,6 +184,7 @@ class session {
   void renew(std::string_view client = {});
   void set_lease(std::uint64_t lease_us);
   bool lease_lapsed() const noexcept { return lapsed_; }
+  std::uint64_t lease_us() const noexcept { return lease_us_; }
 
   // --- the end ------------------------------------------------------------------------------------
   /// Ends every request (superseded), stops the drive first as 0x6007 says when `stop_first` and it
@@ -196,6 +204,9 @@ class session {
   std::uint16_t error_code() const noexcept;
   /// An actual value: the cyclic input, else the last polled one.
   std::optional<std::int64_t> actual(std::uint16_t index) const;
+  /// The value this session last put into the link's cyclic outputs for `index` (sub-index 0): a
+  /// set-point as the drive is sent it (a stream's, a write carried cyclically); none before one.
+  std::optional<std::int64_t> output(std::uint16_t index) const;
   /// Keeps `index` polled while the link does not carry it (for watching), or stops.
   void keep_polled(std::uint16_t index, bool on);
   bool prepared() const noexcept { return prepared_; }
@@ -216,6 +227,9 @@ class session {
   std::function<void(progress_kind kind, const result& so_far)> on_progress;
   /// The lease lapsed: what the session does about it, in words.
   std::function<void(const std::string& action)> on_lease_lapsed;
+  /// Once per cycle of the link, just before its outputs go (after a stream's next set-point): the
+  /// cyclic inputs are the last cycle's. A client samples the drive's cycles here, each once.
+  std::function<void()> on_cycle;
 
  private:
   struct operation;
@@ -241,6 +255,8 @@ class session {
   void check_lease();
   std::string stop_as_0x6007(const std::string& why);
   std::uint32_t next_deadline() const;
+  /// set_cyclic_output, remembering the value (output()).
+  bool put_output(std::uint16_t index, std::uint8_t sub, std::int64_t value);
   std::uint64_t begin(std::string name, std::vector<step> steps, completion done, bool motion);
   void fill_result(result& r) const;
   std::uint64_t refuse_now(std::string error, completion done, bool bad_input = false);
@@ -357,6 +373,8 @@ class session {
 
   // Jog.
   std::uint64_t jog_until_us_ = 0;
+
+  std::map<std::uint16_t, std::int64_t> outputs_;  // what put_output() gave the link, by index
 
   // The lease.
   std::uint64_t lease_us_ = 0;

@@ -727,6 +727,8 @@ function update(s) {
   el('setpoint-note').textContent = s.effective_target !== s.target_velocity
     ? `(set-points cleared: following ${s.effective_target})` : '';
   el('error-code').textContent = s.error_code;
+  // The code's CiA 301 / CiA 402 text (emergency error codes), where the drive reports one.
+  el('error-text').textContent = s.error_code !== '0x0000' && s.error_text ? s.error_text : '';
   el('error-register').textContent = s.error_register;
   setLamp('lamp-torque', s.torque);
   setLamp('lamp-brake', s.brake_engaged, s.brake_engaged ? 'ON (holding)' : 'OFF (released)');
@@ -923,7 +925,7 @@ function buildAxes() {
         const more = document.createElement('span');
         more.className = 'axis-more';
         more.textContent = `${a.status_word || ''} · ${a.velocity === null || a.velocity === undefined ? '–' : a.velocity} rpm` +
-          (a.error_code && a.error_code !== '0x0000' ? ` · error ${a.error_code}` : '');
+          (a.error_code && a.error_code !== '0x0000' ? ` · error ${a.error_code}${a.error_text ? ` (${a.error_text})` : ''}` : '');
         link.append(name, state, more);
         nav.appendChild(link);
       }

@@ -354,6 +354,7 @@ async function main() {
     await expectAccented(page, 14);
     await page.waitForFunction(() => document.getElementById('error-code').textContent === '0x2310',
       null, { timeout: patience });
+    expect((await page.textContent('#error-text')) === 'continuous over-current', 'the error code\'s text');
     expect((await page.textContent('#lamp-fault b')).startsWith('ON'), 'fault lamp ON');
     expect((await page.textContent('#lamp-torque b')) === 'OFF', 'torque lamp OFF');
   });

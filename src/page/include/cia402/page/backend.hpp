@@ -99,6 +99,11 @@ class backend {
                             ": a drive on a bus keeps the profile `cia402 serve --profile` gave it"};
   }
 
+  /// The page's sign of life: a client is there (its event stream is open, or it sent a request it
+  /// may control with). A backend with a lease (`lease_us`) stops a drive left in OPERATION ENABLED
+  /// as its 0x6007 says when nothing renewed it for that long (docs/page.md, "Sign of life").
+  virtual void renew_lease() = 0;
+
   /// The profile, the bit names, the transition rows, the capabilities: what the page draws once.
   /// `control` tells the page whether its requests will be obeyed.
   virtual std::string info_json(bool control, bool token_required) const = 0;

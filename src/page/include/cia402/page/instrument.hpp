@@ -38,6 +38,9 @@ struct instrument_config {
   std::uint32_t settle_limit = 15000;
   /// Results kept for the page, newest first.
   std::size_t results_kept = 8;
+  /// The sign of life (sign_of_life.hpp): a drive left in OPERATION ENABLED is stopped as its 0x6007
+  /// says once no client renewed the lease for this long (drive time); 0: no lease.
+  std::uint64_t lease_us = 0;
   /// The profiles the page may switch to (each must outlive the instrument); empty: the built-in
   /// ones and the instrument's own.
   std::vector<const profile*> selectable;
@@ -71,6 +74,8 @@ class instrument final : public backend {
   reply write_object(std::uint16_t index, std::int64_t value) override;
   /// Plant inputs: target velocity, fault, DC link, STO.
   reply change_plant(const plant_change& change) override;
+  /// The lease is renewed; the next cycle sees it.
+  void renew_lease() override;
 
   /// The profile, the bit names, the transition rows: what the page draws once. `control` tells the
   /// page whether its requests will be obeyed.

@@ -64,6 +64,9 @@ struct remote_config {
   std::uint32_t reset_pulse_us = 20000;   ///< bit 7 high this long for a fault-reset edge
   std::uint16_t velocity_inhibit_100us = 200;  ///< TPDO2 inhibit time (20 ms)
   std::size_t results_kept = 8;
+  /// The sign of life (sign_of_life.hpp): a drive left in OPERATION ENABLED is stopped as its 0x6007
+  /// says once no client renewed the lease for this long (step() time); 0: no lease.
+  std::uint64_t lease_us = 0;
   /// The clock the page's heartbeat runs on, in microseconds from any start; empty: step() time.
   /// `cia402 serve --can` sets the steady clock: the drive watches that heartbeat on wall time, and
   /// a page slowed down by a loaded machine (its runner skips lost cycles, so step() time lags)
@@ -111,6 +114,8 @@ class remote_drive final : public backend {
   /// Target velocity (SDO 0x60FF) or a fault (SDO 0x2001, on a `cia402 bus` node only), one per
   /// request; DC link and STO are refused. Blocks like write_object.
   reply change_plant(const plant_change& change) override;
+  /// The lease is renewed; the next process() sees it.
+  void renew_lease() override;
 
   std::string info_json(bool control, bool token_required) const override;
   std::string snapshot_json() const override;

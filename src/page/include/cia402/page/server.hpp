@@ -16,6 +16,9 @@
 //   POST /api/object       {"index":"0x605A","value":6}
 //   POST /api/profile      {"profile":"s300-profibus"}: a virtual drive starts again under it
 //
+// The sign of life (docs/page.md): each write of an open event stream, each POST and each GET
+// /api/state of a client that may control renew the drive's lease (backend::renew_lease).
+//
 // Every /api/ path but /api/axes takes ?axis=K (1..N) to name one of several drives; without it,
 // the first.
 //
@@ -56,6 +59,10 @@ struct server_options {
   /// The whole head of a request must arrive within this (408), and each later read too.
   std::chrono::milliseconds read_timeout{2000};
   std::chrono::milliseconds keep_alive{15000};  ///< SSE comment line when nothing was published
+  /// An open event stream renews its drive's lease (backend::renew_lease) with each write that goes
+  /// out, and writes a comment at least this often so a closed page is noticed (its second write
+  /// after the close fails).
+  std::chrono::milliseconds sign_of_life{250};
 };
 
 /// 32 hex digits (128 bits) from std::random_device.

@@ -1,0 +1,235 @@
+#include "server_http.hpp"
+
+#include <arpa/inet.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <random>
+#include <cerrno>
+#include <charconv>
+#include <thread>
+#include <vector>
+
+namespace cia402::page::detail {
+
+using json = nlohmann::json;
+
+void send_json(httplib::Response& res, int status, const json& body) {
+  res.status = status;
+  res.set_content(body.dump(), "application/json");
+}
+
+void send_error(httplib::Response& res, int status, const std::string& reason) {
+  send_json(res, status, json{{"error", reason}});
+}
+
+// A Content-Length of digits only, at most `max`.
+bool length_within(const std::string& text, std::size_t max) {
+  std::size_t n = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+  return ec == std::errc() && end == text.data() + text.size() && !text.empty() && n <= max;
+}
+
+// Equal-time comparison, so the time a refusal takes tells nothing about the token.
+bool same_secret(std::string_view a, std::string_view b) {
+  unsigned char diff = a.size() == b.size() ? 0 : 1;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    diff |= static_cast<unsigned char>(a[i] ^ (i < b.size() ? b[i] : 0));
+  }
+  return diff == 0;
+}
+
+// The host part of a Host header: "127.0.0.1:8402" -> "127.0.0.1", "[::1]:8402" -> "::1".
+std::string_view host_of(std::string_view host_header) {
+  if (!host_header.empty() && host_header.front() == '[') {
+    const std::size_t close = host_header.find(']');
+    return close == std::string_view::npos ? host_header : host_header.substr(1, close - 1);
+  }
+  const std::size_t colon = host_header.find(':');
+  return colon == std::string_view::npos ? host_header : host_header.substr(0, colon);
+}
+
+// An integer from a JSON number or a string "0x605A" / "24666"; nothing for anything else.
+std::optional<std::int64_t> integer_of(const json& v) {
+  if (v.is_number_integer()) return v.get<std::int64_t>();
+  if (v.is_number_unsigned()) {
+    const auto u = v.get<std::uint64_t>();
+    if (u > static_cast<std::uint64_t>(INT64_MAX)) return std::nullopt;
+    return static_cast<std::int64_t>(u);
+  }
+  if (!v.is_string()) return std::nullopt;
+  const std::string& s = v.get_ref<const std::string&>();
+  std::size_t i = 0;
+  bool negative = false;
+  if (i < s.size() && (s[i] == '-' || s[i] == '+')) negative = s[i++] == '-';
+  int base = 10;
+  if (s.size() - i > 2 && s[i] == '0' && (s[i + 1] == 'x' || s[i + 1] == 'X')) {
+    base = 16;
+    i += 2;
+  }
+  if (i >= s.size() || s.size() - i > 12) return std::nullopt;
+  std::int64_t value = 0;
+  for (; i < s.size(); ++i) {
+    const char c = s[i];
+    int d = -1;
+    if (c >= '0' && c <= '9') d = c - '0';
+    if (base == 16 && c >= 'a' && c <= 'f') d = c - 'a' + 10;
+    if (base == 16 && c >= 'A' && c <= 'F') d = c - 'A' + 10;
+    if (d < 0) return std::nullopt;
+    value = value * base + d;
+  }
+  return negative ? -value : value;
+}
+
+// Every key of `body` must be one of `allowed`; the first one that is not is named.
+std::optional<std::string> unknown_key(const json& body, std::initializer_list<const char*> allowed) {
+  for (auto it = body.begin(); it != body.end(); ++it) {
+    bool known = false;
+    for (const char* a : allowed) known = known || it.key() == a;
+    if (!known) return "unknown key '" + it.key() + "'";
+  }
+  return std::nullopt;
+}
+
+// A refusal written straight to the socket (the request was never parsed).
+void answer_and_close(socket_t sock, int status, const std::string& reason) {
+  const char* text = status == 408 ? "Request Timeout"
+                     : status == 431 ? "Request Header Fields Too Large"
+                                     : "Service Unavailable";
+  const std::string body = json{{"error", reason}}.dump();
+  const std::string head = "HTTP/1.1 " + std::to_string(status) + " " + text +
+                           "\r\nContent-Type: application/json\r\nContent-Length: " +
+                           std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n";
+  const std::string all = head + body;
+  (void)::send(sock, all.data(), all.size(), MSG_NOSIGNAL);
+  ::shutdown(sock, SHUT_RDWR);
+  ::close(sock);
+}
+
+// Waits (peeking, nothing consumed) until the first request's head is complete. 0: the peer
+// went away; otherwise the refusal's status and reason, or 200 to go on.
+request_error wait_for_head(socket_t sock, std::chrono::milliseconds read_timeout, std::size_t max_head,
+                            std::size_t max_headers) {
+  const auto deadline = std::chrono::steady_clock::now() + read_timeout;
+  std::vector<char> buf(max_head + 1);
+  ssize_t seen = -1;
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) {
+      return {408, "the request head did not arrive within " +
+                       std::to_string(read_timeout.count()) + " ms"};
+    }
+    pollfd p{sock, POLLIN | POLLRDHUP, 0};
+    (void)::poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 50)));
+    const bool peer_done = (p.revents & (POLLRDHUP | POLLHUP | POLLERR)) != 0;
+    const ssize_t n = ::recv(sock, buf.data(), buf.size(), MSG_PEEK | MSG_DONTWAIT);
+    if (n == 0) return {0, ""};
+    if (n < 0) {
+      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) continue;
+      return {0, ""};
+    }
+    const std::string_view text(buf.data(), static_cast<std::size_t>(n));
+    const auto end = text.find("\r\n\r\n");
+    const std::string_view head = text.substr(0, end == std::string_view::npos ? text.size() : end);
+    std::size_t lines = 0;
+    for (std::size_t at = head.find("\r\n"); at != std::string_view::npos; at = head.find("\r\n", at + 2)) {
+      ++lines;
+    }
+    if (lines > max_headers) {
+      return {431, "more than " + std::to_string(max_headers) + " header lines"};
+    }
+    if (end != std::string_view::npos) return {200, ""};
+    if (peer_done) return {0, ""};  // it stopped sending before its head was complete
+    if (static_cast<std::size_t>(n) > max_head) {
+      return {431, "request head larger than " + std::to_string(max_head) + " bytes"};
+    }
+    // Data waits unread, so poll returns at once: only a grown head is worth another look.
+    if (n == seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    seen = n;
+  }
+}
+
+void serve_events(backend& inst, httplib::Response& res, const server_options& options, std::atomic<int>& streams,
+                  const std::atomic<bool>& stopping) {
+  if (streams.fetch_add(1) >= options.max_event_streams) {
+    streams.fetch_sub(1);
+    return send_error(res, 503, "too many event streams open");
+  }
+  struct stream_state {
+    bool started = false;
+    std::uint64_t seen = 0;
+    std::chrono::steady_clock::time_point last_write = std::chrono::steady_clock::now();
+  };
+  auto st = std::make_shared<stream_state>();
+  res.set_chunked_content_provider(
+      "text/event-stream",
+      [st, &inst, &options, &stopping](std::size_t, httplib::DataSink& sink) {
+        std::string chunk;
+        if (!st->started) {
+          st->started = true;
+          st->seen = inst.latest().version;
+          chunk = "retry: 1000\ndata: " + inst.snapshot_json() + "\n\n";
+        } else {
+          // A comment line this long after the last write: the keep-alive, and the sign of life's
+          // probe (a closed page fails the second write after it went at the latest).
+          const auto comment_after = std::min(options.keep_alive, options.sign_of_life);
+          while (chunk.empty()) {
+            if (stopping || inst.closed()) {
+              sink.done();
+              return true;
+            }
+            // Short waits (at most 200 ms), so a stopping server ends the stream promptly.
+            const auto quiet = std::chrono::duration_cast<std::chrono::milliseconds>(
+                std::chrono::steady_clock::now() - st->last_write);
+            const auto slice = std::clamp(comment_after - quiet, std::chrono::milliseconds(1),
+                                          std::chrono::milliseconds(200));
+            if (auto u = inst.wait_for_update(st->seen, slice)) {
+              st->seen = u->version;
+              chunk = "data: " + u->json + "\n\n";
+            } else if (std::chrono::steady_clock::now() - st->last_write >= comment_after) {
+              chunk = ": keep-alive\n\n";
+            }
+          }
+        }
+        st->last_write = std::chrono::steady_clock::now();
+        if (!sink.write(chunk.data(), chunk.size())) return false;
+        // Only a write that went out renews: a page that has gone stops renewing with its stream.
+        inst.renew_lease();
+        return true;
+      },
+      [&streams](bool) { streams.fetch_sub(1); });
+}
+
+}  // namespace cia402::page::detail
+
+namespace cia402::page {
+
+std::string make_token() {
+  std::random_device rd;
+  std::string token;
+  char buf[9];
+  for (int i = 0; i < 4; ++i) {
+    std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(rd()));
+    token += buf;
+  }
+  return token;
+}
+
+bool is_loopback_address(std::string_view host) {
+  if (host == "localhost" || host == "::1") return true;
+  in_addr v4{};
+  const std::string h(host);
+  if (inet_pton(AF_INET, h.c_str(), &v4) == 1) {
+    return (ntohl(v4.s_addr) >> 24) == 127;
+  }
+  in6_addr v6{};
+  if (inet_pton(AF_INET6, h.c_str(), &v6) == 1) return IN6_IS_ADDR_LOOPBACK(&v6);
+  return false;
+}
+
+}  // namespace cia402::page

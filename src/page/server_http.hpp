@@ -1,0 +1,63 @@
+// The page server's HTTP pieces below the routes: JSON replies, the checks a request's values get,
+// and the admission of a connection before cpp-httplib reads a byte of it (server.cpp explains why
+// the page's server is two). Split from server.cpp.
+#pragma once
+
+#include <httplib.h>
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <initializer_list>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "cia402/page/backend.hpp"
+#include "cia402/page/server.hpp"
+
+namespace cia402::page::detail {
+
+void send_json(httplib::Response& res, int status, const nlohmann::json& body);
+void send_error(httplib::Response& res, int status, const std::string& reason);
+
+/// A Content-Length of digits only, at most `max`.
+bool length_within(const std::string& text, std::size_t max);
+
+/// Equal-time comparison, so the time a refusal takes tells nothing about the token.
+bool same_secret(std::string_view a, std::string_view b);
+
+/// The host part of a Host header: "127.0.0.1:8402" -> "127.0.0.1", "[::1]:8402" -> "::1".
+std::string_view host_of(std::string_view host_header);
+
+/// An integer from a JSON number or a string "0x605A" / "24666"; nothing for anything else.
+std::optional<std::int64_t> integer_of(const nlohmann::json& v);
+
+/// Every key of `body` must be one of `allowed`; the first one that is not is named.
+std::optional<std::string> unknown_key(const nlohmann::json& body, std::initializer_list<const char*> allowed);
+
+struct request_error {
+  int status;
+  std::string reason;
+};
+
+/// A refusal written straight to the socket (the request was never parsed); closes it.
+void answer_and_close(socket_t sock, int status, const std::string& reason);
+
+/// Waits (peeking, nothing consumed) until the first request's head is complete. 0: the peer went
+/// away; otherwise the refusal's status and reason (408 not within `read_timeout`, 431 over
+/// `max_head` bytes or `max_headers` lines), or 200 to go on.
+request_error wait_for_head(socket_t sock, std::chrono::milliseconds read_timeout, std::size_t max_head,
+                            std::size_t max_headers);
+
+/// GET /api/events for one drive: its present snapshot at once, then each one published, and a
+/// comment line after min(keep_alive, sign_of_life) without a write; each write that goes out renews
+/// the drive's lease (backend::renew_lease). At most `max_event_streams` open (`streams` counts them);
+/// ends when `stopping` is set or the drive is closed.
+void serve_events(backend& inst, httplib::Response& res, const server_options& options, std::atomic<int>& streams,
+                  const std::atomic<bool>& stopping);
+
+}  // namespace cia402::page::detail
