@@ -328,6 +328,8 @@ TEST(remote_drive, silent_node_shows_does_not_answer_and_is_picked_up_again_when
 TEST(remote_drive, the_drive_watches_the_pages_heartbeat_and_applies_0x6007_when_the_page_is_gone) {
   remote_bench b;
   ASSERT_TRUE(b.run_until_running());
+  // 0x6007 acts on an enabled drive (CiA 402-2; a disabled one has nothing to protect).
+  enable(b);
   std::int64_t watch = 0;
   ASSERT_EQ(b.drive_node().node().read(0x1016, 1, watch), cia402::sdo_abort::none);
   EXPECT_EQ(watch, (127 << 16) | 300) << "node-ID 127, 3 x 100 ms";
@@ -405,6 +407,15 @@ slowed_page_result run_slowed_page(bool heartbeat_on_wall_clock) {
     b.cycle(1000);
   }
   EXPECT_EQ(b.remote().status(), remote_status::running) << b.remote().status_text();
+  // Enabled, on the wall's time too: 0x6007 acts on an enabled drive only.
+  for (const page_command c : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
+    EXPECT_TRUE(is_accepted(b.remote().command(c)));
+    for (int i = 0; i < 600; ++i) {
+      *wall_us += 1000;
+      b.cycle(1000);
+    }
+  }
+  EXPECT_EQ(b.snapshot()["state"], "OPERATION_ENABLED");
   const auto listener = b.bus().attach();
   slowed_page_result r;
   for (int i = 0; i < 250; ++i) {
