@@ -124,6 +124,10 @@ def check_aborts(pcap):
     # tshark 4.0 decodes an abort's code but not its index: the two refusals differ by code.
     rows = tshark(pcap, "-Y", "ecat_mailbox.coe.abortcode", "-T", "fields", "-e", "frame.number",
                   "-e", "ecat_mailbox.coe.type", "-e", "ecat_mailbox.coe.sdoreq", "-e", "ecat_mailbox.coe.abortcode")
+    # An abort under service 3 (SDO response): tshark shows command specifier 4 and no code.
+    misfiled = tshark(pcap, "-Y", "ecat_mailbox.coe.type == 3 && ecat_mailbox.coe.sdores == 4 && ecat.cnt == 1",
+                      "-T", "fields", "-e", "frame.number")
+    assert not misfiled, "aborts sent as CoE service 3 (SDO response), not 2, in frames %s" % [f for (f,) in misfiled]
     # Only the slaves abort here: the master's requests never carry an abort code.
     got = {int(code, 0): (int(service, 0), int(cmd or "-1", 0)) for _, service, cmd, code in rows}
     for code in (ABORT_READ_ONLY, ABORT_NO_OBJECT):
