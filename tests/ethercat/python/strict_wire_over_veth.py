@@ -67,22 +67,27 @@ def al_status(bus):
     return data[0], struct.unpack("<H", data[4:6])[0]
 
 
-def al_control(bus, value):
+def al_control(bus, value, expect=None):
+    """Requests a state; waits until AL status shows EXPECT (2 s at most), or 0.2 s when nothing may change."""
     bus.one(FPWR, STATION, 0x0120, [value, 0])
-    time.sleep(0.05)
-    return al_status(bus)
+    deadline = time.monotonic() + (2.0 if expect is not None else 0.2)
+    while True:
+        time.sleep(0.01)
+        status = al_status(bus)
+        if status[0] == expect or time.monotonic() > deadline:
+            return status
 
 
 def al_error_and_repeat(iface):
     """Raw frames after the master is gone: the AL error rule, then a mailbox repeat."""
     bus = veth_session.master(iface)
     bus.one(APWR, 0, 0x0010, list(struct.pack("<H", STATION)))
-    al_control(bus, 0x11)  # INIT, acknowledging whatever the master left
+    al_control(bus, 0x11, 0x01)  # INIT, acknowledging whatever the master left
     for n, (start, length, control) in enumerate(((0x1000, 128, 0x26), (0x1080, 128, 0x22))):
         bus.one(FPWR, STATION, 0x0800 + 8 * n, list(struct.pack("<HHBBBB", start, length, control, 0, 1, 0)))
-    seen = [al_control(bus, 0x08)]  # INIT -> OP is no transition: INIT+ERR
+    seen = [al_control(bus, 0x08, 0x11)]  # INIT -> OP is no transition: INIT+ERR
     seen.append(al_control(bus, 0x02))  # PRE-OP without the acknowledge: not honoured
-    seen.append(al_control(bus, 0x12))  # PRE-OP with the acknowledge: taken
+    seen.append(al_control(bus, 0x12, 0x02))  # PRE-OP with the acknowledge: taken
     # An SDO upload of 0x1018:02 (product code); its reply read, then "lost": the repeat request brings it back.
     mbx = struct.pack("<HHBB", 10, 0, 0, 0x13) + struct.pack("<H", 0x2000) + bytes([0x40, 0x18, 0x10, 2, 0, 0, 0, 0])
     bus.one(FPWR, STATION, 0x1000, list(mbx + b"\0" * (128 - len(mbx))))
@@ -153,10 +158,18 @@ def check_distributed_clocks(pcap, dg):
 
 
 def check_al_and_repeat(pcap, seen, first, again):
-    # The AL status answers (FPRD 0x0130 with working counter 1) of the test's own last three requests.
-    rows = tshark(pcap, "-Y", "ecat.cmd == 4 && ecat.ado == 0x0130 && ecat.cnt == 1", "-T", "fields",
-                  "-e", "ecat.reg.alstatus", "-e", "ecat.reg.alstatuscode")
-    wire = [(int(s, 0), int(c, 0)) for s, c in rows[-3:]]
+    # The test's last three AL control writes (FPWR 0x0120) and, after each, the last AL status
+    # answer (FPRD 0x0130, working counter 1) before the next write.
+    writes = [int(f) for (f,) in tshark(pcap, "-Y", "ecat.cmd == 5 && ecat.ado == 0x0120 && ecat.cnt == 1",
+                                        "-T", "fields", "-e", "frame.number")][-3:]
+    rows = [(int(f), int(s, 0), int(c, 0)) for f, s, c in
+            tshark(pcap, "-Y", "ecat.cmd == 4 && ecat.ado == 0x0130 && ecat.cnt == 1 && ecat.reg.alstatuscode",
+                   "-T", "fields", "-e", "frame.number", "-e", "ecat.reg.alstatus", "-e", "ecat.reg.alstatuscode")]
+    wire = []
+    for at, until in zip(writes, writes[1:] + [1 << 62]):
+        answers = [(s, c) for f, s, c in rows if at < f < until]
+        assert answers, "no AL status read after the AL control write in frame %d" % at
+        wire.append(answers[-1])
     assert wire == seen, "the capture (%s) is not what the test read (%s)" % (wire, seen)
     assert wire[0] == (0x11, 0x0011), "INIT -> OP: AL status 0x%02X code 0x%04X, not INIT+ERR 0x0011" % wire[0]
     assert wire[1][0] == 0x11, "PRE-OP without the acknowledge was honoured: AL status 0x%02X, not 0x11" % wire[1][0]
