@@ -54,7 +54,8 @@ def master(cia402, iface, steps):
 
 def refused_sdos(cia402, iface):
     """Each refused step ends the master's run with the abort named: one run for each."""
-    for steps, code in ((["sdo", "write", "0x1000", "0"], ABORT_READ_ONLY), (["sdo", "read", "0x5FFF"], ABORT_NO_OBJECT)):
+    for steps, code in ((["sdo", "write", "0x1000", "0"], ABORT_READ_ONLY),
+                        (["sdo", "read", "0x5FFF"], ABORT_NO_OBJECT)):
         rc, events, err = master(cia402, iface, ["--position", "0", "state"] + steps)
         failed = [e for e in events if e["event"] == "failed"]
         assert rc != 0 and failed, (rc, events[-3:], err)
@@ -148,7 +149,8 @@ def check_distributed_clocks(pcap, dg):
     assert any(c == BWR and a == 0x0900 for _, c, _, a in dg), "no BWR of 0x0900 (receive time latch)"
     for register, name in ((0x0920, "offset"), (0x0928, "delay"), (0x0981, "activation"), (0x09A0, "SYNC0 cycle")):
         for station in (STATION, STATION + 1):
-            assert (register, station) in writes, "no write of 0x%04X (%s) to station 0x%04X" % (register, name, station)
+            assert (register, station) in writes, \
+                "no write of 0x%04X (%s) to station 0x%04X" % (register, name, station)
     cycle_frames = {f for f, c, _, _ in dg if c == LRW}
     with_time = {f for f, c, _, a in dg if c in (FRMW, ARMW) and a == 0x0910}
     assert len(cycle_frames) > 10, "too few cycle frames"
@@ -175,11 +177,14 @@ def check_al_and_repeat(pcap, seen, first, again):
     assert wire[1][0] == 0x11, "PRE-OP without the acknowledge was honoured: AL status 0x%02X, not 0x11" % wire[1][0]
     assert wire[2] == (0x02, 0), "PRE-OP with the acknowledge: AL status 0x%02X code 0x%04X, not 0x02" % wire[2]
     acks = tshark(pcap, "-Y", "ecat.cmd == 4 && ecat.ado == 0x080F && ecat.cnt == 1", "-T", "fields", "-e", "ecat.data")
-    assert acks and int(acks[-1][0].replace(":", "")[0:2], 16) & 0x02, "the repeat acknowledge (0x080F bit 1) never followed"
-    request = [int(f) for (f,) in tshark(pcap, "-Y", "ecat.cmd == 5 && ecat.ado == 0x080D", "-T", "fields", "-e", "frame.number")]
+    assert acks and int(acks[-1][0].replace(":", "")[0:2], 16) & 0x02, \
+        "the repeat acknowledge (0x080F bit 1) never followed"
+    request = [int(f) for (f,) in tshark(pcap, "-Y", "ecat.cmd == 5 && ecat.ado == 0x080D", "-T", "fields",
+                                         "-e", "frame.number")]
     assert request, "no repeat request (FPWR 0x080D..0x080E) on the wire"
     replies = tshark(pcap, "-Y", "ecat_mailbox.coe.sdoidx == 0x1018 && ecat_mailbox.coe.sdosub == 2 && "
-                     "ecat_mailbox.coe.type == 3 && ecat.cnt == 1", "-T", "fields", "-e", "frame.number", "-e", "ecat_mailbox.coe.sdodata")
+                     "ecat_mailbox.coe.type == 3 && ecat.cnt == 1", "-T", "fields",
+                     "-e", "frame.number", "-e", "ecat_mailbox.coe.sdodata")
     before = [d for f, d in replies if int(f) < request[-1]]
     after = [d for f, d in replies if int(f) > request[-1]]
     assert before and int(before[-1], 0) == 0x402, "no 0x1018:02 reply before the repeat request: %s" % replies
