@@ -107,44 +107,67 @@ def al_error_and_repeat(iface):
     return seen, first[:16], again[:16] if wkc == 1 else None
 
 
-def tshark(pcap, *args):
-    r = subprocess.run(["tshark", "-r", pcap] + list(args), capture_output=True, text=True, timeout=60)
+FIELDS = ("frame.number", "ecat.cmd", "ecat.adp", "ecat.ado", "ecat.cnt", "ecat.data", "ecat.reg.alstatus",
+          "ecat.reg.alstatuscode", "ecat_mailbox.coe.type", "ecat_mailbox.coe.sdoreq", "ecat_mailbox.coe.sdores",
+          "ecat_mailbox.coe.abortcode", "ecat_mailbox.coe.sdoidx", "ecat_mailbox.coe.sdosub",
+          "ecat_mailbox.coe.sdodata")
+NUMERIC = set(FIELDS) - {"ecat.data"}
+
+
+def decode(pcap):
+    """One tshark pass (each costs a start-up): every EtherCAT frame as {field: [values, in order]}."""
+    args = ["tshark", "-r", pcap, "-Y", "ecat", "-T", "fields", "-E", "occurrence=a"]
+    for field in FIELDS:
+        args += ["-e", field]
+    r = subprocess.run(args, capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
-    return [line.split("\t") for line in r.stdout.splitlines() if line.strip()]
+    frames = []
+    for line in r.stdout.splitlines():
+        values = [v.split(",") if v else [] for v in line.split("\t")]
+        frames.append({f: [int(x, 0) for x in v] if f in NUMERIC else v for f, v in zip(FIELDS, values)})
+    return frames
 
 
-def datagrams(pcap):
-    """Every datagram as (frame, command, adp, ado), from tshark's fields."""
+def number(frame):
+    return frame["frame.number"][0]
+
+
+def answered(frame, cmd, ado):
+    """A frame whose datagram CMD of ADO came back with working counter 1 (the test's own are single)."""
+    return cmd in frame["ecat.cmd"] and ado in frame["ecat.ado"] and 1 in frame["ecat.cnt"]
+
+
+def datagrams(frames):
+    """Every datagram as (frame, command, adp, ado)."""
     out = []
-    for frame, cmds, adps, ados in tshark(pcap, "-Y", "ecat", "-T", "fields", "-E", "occurrence=a",
-                                          "-e", "frame.number", "-e", "ecat.cmd", "-e", "ecat.adp", "-e", "ecat.ado"):
+    for f in frames:
         # A logical datagram (LRD, LWR, LRW) has a logical address, no ADP/ADO fields.
-        physical = iter(zip(adps.split(","), ados.split(",")))
-        for c in (int(c, 0) for c in cmds.split(",")):
-            p, o = ("-1", "-1") if c in LOGICAL else next(physical)
-            out.append((int(frame), c, int(p, 0), int(o, 0)))
+        physical = iter(zip(f["ecat.adp"], f["ecat.ado"]))
+        for c in f["ecat.cmd"]:
+            p, o = (-1, -1) if c in LOGICAL else next(physical)
+            out.append((number(f), c, p, o))
     return out
 
 
-def check_aborts(pcap):
-    # tshark 4.0 decodes an abort's code but not its index: the two refusals differ by code.
-    rows = tshark(pcap, "-Y", "ecat_mailbox.coe.abortcode", "-T", "fields", "-e", "frame.number",
-                  "-e", "ecat_mailbox.coe.type", "-e", "ecat_mailbox.coe.sdoreq", "-e", "ecat_mailbox.coe.abortcode")
+def check_aborts(frames):
     # An abort under service 3 (SDO response): tshark shows command specifier 4 and no code.
-    misfiled = tshark(pcap, "-Y", "ecat_mailbox.coe.type == 3 && ecat_mailbox.coe.sdores == 4 && ecat.cnt == 1",
-                      "-T", "fields", "-e", "frame.number")
-    assert not misfiled, "aborts sent as CoE service 3 (SDO response), not 2, in frames %s" % [f for (f,) in misfiled]
-    # Only the slaves abort here: the master's requests never carry an abort code.
-    got = {int(code, 0): (int(service, 0), int(cmd or "-1", 0)) for _, service, cmd, code in rows}
+    misfiled = [number(f) for f in frames if f["ecat_mailbox.coe.type"] == [3] and f["ecat_mailbox.coe.sdores"] == [4]
+                and 1 in f["ecat.cnt"]]
+    assert not misfiled, "aborts sent as CoE service 3 (SDO response), not 2, in frames %s" % misfiled
+    # tshark 4.0 decodes an abort's code but not its index: the two refusals differ by code. Only the
+    # slaves abort here: the master's requests never carry an abort code.
+    got = {f["ecat_mailbox.coe.abortcode"][0]:
+           (f["ecat_mailbox.coe.type"][0], (f["ecat_mailbox.coe.sdoreq"] or [-1])[0])
+           for f in frames if f["ecat_mailbox.coe.abortcode"]}
     for code in (ABORT_READ_ONLY, ABORT_NO_OBJECT):
-        assert code in got, "no abort 0x%08X decoded; aborts seen: %s" % (code, rows)
+        assert code in got, "no abort 0x%08X decoded; aborts seen: %s" % (code, got)
         service, cmd = got[code]
         assert service == 2, "abort 0x%08X sent as CoE service %d, not 2 (SDO request)" % (code, service)
         assert cmd == 4, "abort 0x%08X with SDO request command specifier %d, not 4 (abort)" % (code, cmd)
-    return len(rows)
+    return len(got)
 
 
-def check_distributed_clocks(pcap, dg):
+def check_distributed_clocks(dg):
     writes = {(a, p) for _, c, p, a in dg if c in (FPWR, APWR)}
     assert any(c == BWR and a == 0x0900 for _, c, _, a in dg), "no BWR of 0x0900 (receive time latch)"
     for register, name in ((0x0920, "offset"), (0x0928, "delay"), (0x0981, "activation"), (0x09A0, "SYNC0 cycle")):
@@ -159,35 +182,32 @@ def check_distributed_clocks(pcap, dg):
     return len(cycle_frames)
 
 
-def check_al_and_repeat(pcap, seen, first, again):
+def check_al_and_repeat(frames, seen, first, again):
     # The test's last three AL control writes (FPWR 0x0120) and, after each, the last AL status
     # answer (FPRD 0x0130, working counter 1) before the next write.
-    writes = [int(f) for (f,) in tshark(pcap, "-Y", "ecat.cmd == 5 && ecat.ado == 0x0120 && ecat.cnt == 1",
-                                        "-T", "fields", "-e", "frame.number")][-3:]
-    rows = [(int(f), int(s, 0), int(c, 0)) for f, s, c in
-            tshark(pcap, "-Y", "ecat.cmd == 4 && ecat.ado == 0x0130 && ecat.cnt == 1 && ecat.reg.alstatuscode",
-                   "-T", "fields", "-e", "frame.number", "-e", "ecat.reg.alstatus", "-e", "ecat.reg.alstatuscode")]
+    writes = [number(f) for f in frames if answered(f, FPWR, 0x0120)][-3:]
+    rows = [(number(f), f["ecat.reg.alstatus"][0], f["ecat.reg.alstatuscode"][0]) for f in frames
+            if answered(f, FPRD, 0x0130) and f["ecat.reg.alstatuscode"]]
     wire = []
     for at, until in zip(writes, writes[1:] + [1 << 62]):
-        answers = [(s, c) for f, s, c in rows if at < f < until]
+        answers = [(s, c) for n, s, c in rows if at < n < until]
         assert answers, "no AL status read after the AL control write in frame %d" % at
         wire.append(answers[-1])
     assert wire == seen, "the capture (%s) is not what the test read (%s)" % (wire, seen)
     assert wire[0] == (0x11, 0x0011), "INIT -> OP: AL status 0x%02X code 0x%04X, not INIT+ERR 0x0011" % wire[0]
     assert wire[1][0] == 0x11, "PRE-OP without the acknowledge was honoured: AL status 0x%02X, not 0x11" % wire[1][0]
     assert wire[2] == (0x02, 0), "PRE-OP with the acknowledge: AL status 0x%02X code 0x%04X, not 0x02" % wire[2]
-    acks = tshark(pcap, "-Y", "ecat.cmd == 4 && ecat.ado == 0x080F && ecat.cnt == 1", "-T", "fields", "-e", "ecat.data")
+    acks = [f["ecat.data"] for f in frames if answered(f, FPRD, 0x080F)]
     assert acks and int(acks[-1][0].replace(":", "")[0:2], 16) & 0x02, \
         "the repeat acknowledge (0x080F bit 1) never followed"
-    request = [int(f) for (f,) in tshark(pcap, "-Y", "ecat.cmd == 5 && ecat.ado == 0x080D", "-T", "fields",
-                                         "-e", "frame.number")]
+    request = [number(f) for f in frames if FPWR in f["ecat.cmd"] and 0x080D in f["ecat.ado"]]
     assert request, "no repeat request (FPWR 0x080D..0x080E) on the wire"
-    replies = tshark(pcap, "-Y", "ecat_mailbox.coe.sdoidx == 0x1018 && ecat_mailbox.coe.sdosub == 2 && "
-                     "ecat_mailbox.coe.type == 3 && ecat.cnt == 1", "-T", "fields",
-                     "-e", "frame.number", "-e", "ecat_mailbox.coe.sdodata")
-    before = [d for f, d in replies if int(f) < request[-1]]
-    after = [d for f, d in replies if int(f) > request[-1]]
-    assert before and int(before[-1], 0) == 0x402, "no 0x1018:02 reply before the repeat request: %s" % replies
+    replies = [(number(f), f["ecat_mailbox.coe.sdodata"][0]) for f in frames
+               if f["ecat_mailbox.coe.sdoidx"] == [0x1018] and f["ecat_mailbox.coe.sdosub"] == [2]
+               and f["ecat_mailbox.coe.type"] == [3] and 1 in f["ecat.cnt"] and f["ecat_mailbox.coe.sdodata"]]
+    before = [d for n, d in replies if n < request[-1]]
+    after = [d for n, d in replies if n > request[-1]]
+    assert before and before[-1] == 0x402, "no 0x1018:02 reply before the repeat request: %s" % replies
     assert after == before[-1:], "after the repeat request SM1 did not hold the same reply again: %s" % replies
     assert first == again, (first.hex(), again.hex())
 
@@ -217,9 +237,10 @@ def run(cia402, workdir):
             slave.send_signal(signal.SIGTERM)
             slave.wait(timeout=10)
         subprocess.run(["ip", "link", "del", m], capture_output=True)
-    aborts = check_aborts(pcap)
-    cycles = check_distributed_clocks(pcap, datagrams(pcap))
-    check_al_and_repeat(pcap, seen, reply, again)
+    frames = decode(pcap)
+    aborts = check_aborts(frames)
+    cycles = check_distributed_clocks(datagrams(frames))
+    check_al_and_repeat(frames, seen, reply, again)
     print("on the wire: %d SDO aborts as CoE service 2, DC set up on 2 drives, %d cycle frames with FRMW 0x0910, "
           "PRE-OP refused until acknowledged, mailbox repeat answered" % (aborts, cycles))
 
