@@ -54,30 +54,6 @@ std::uint16_t move_in_mode(const plant_constants& k, axis_state& a, const drive_
   }
 }
 
-// Profile velocity towards a software position limit (0x607D): no faster than the shaft can still
-// stop at the limit on the quick-stop ramp 0x6085, and standing exactly there once it arrives.
-// Returns true while the limit cuts the goal.
-bool brake_for_limit(const plant_constants& k, const axis_state& a, const motion::shaft& s,
-                     std::int64_t& goal, std::int64_t& down, std::int64_t& edge) noexcept {
-  const mode_objects& o = a.objects;
-  const std::int64_t quick_stop = std::int64_t{a.quick_stop_deceleration} * k.cycle_us;
-  if (beyond_limit(a, s.position, goal)) {  // at or past the limit: stop (and stay) there
-    goal = 0;
-    down = quick_stop;
-    return true;
-  }
-  if (goal == 0) return false;
-  edge = goal > 0 ? o.max_position : o.min_position;
-  // Farther from the limit than the braking distance from the top speed (and a cycle's travel)
-  // there is nothing to cut: no 128-bit root in the cycles of a shaft far away.
-  if (magnitude(edge - s.position) > std::int64_t{a.pv_braking_reach}) return false;
-  const std::int64_t cap = motion::stopping_speed(s, edge, a.quick_stop_deceleration, k.cycle_us, o.increments_per_rev);
-  if (magnitude(goal) <= cap) return false;
-  goal = sign_of(goal) * cap;
-  if (down < quick_stop) down = quick_stop;
-  return true;
-}
-
 // Profile velocity, and every mode while a stop runs or torque is off: the velocity approaches its
 // goal on the ramps, the position integrates it. Returns bit 11 while profile velocity's set-point
 // is cut (speed limit, software position limit). Here, not in plant_modes/: every cycle of every
@@ -89,8 +65,7 @@ std::uint16_t velocity_follow(const profile& p, const plant_constants& k, axis_s
   std::int64_t up = 0;
   std::int64_t down = 0;
   std::uint16_t status = 0;
-  bool towards_limit = false;
-  std::int64_t edge = 0;
+  limit_approach at;
   if (!out.torque) {
     down = k.coast_step;  // coasting: friction only
   } else if (out.ramp != stop_ramp::none && out.ramp != stop_ramp::coast) {
@@ -100,10 +75,7 @@ std::uint16_t velocity_follow(const profile& p, const plant_constants& k, axis_s
     if (a.pv_set_point_cut) status |= status_bit::internal_limit_active;
     up = std::int64_t{a.acceleration} * cycle;
     down = std::int64_t{a.deceleration} * cycle;
-    if (limits_on(a) && brake_for_limit(k, a, s, goal, down, edge)) {
-      status |= status_bit::internal_limit_active;
-      towards_limit = goal != 0;
-    }
+    if (limits_on(a) && brake_for_limit(k, a, s, goal, down, at)) status |= status_bit::internal_limit_active;
   } else {
     down = std::int64_t{a.deceleration} * cycle;  // torque held without motion (e.g. hold states)
   }
@@ -111,17 +83,11 @@ std::uint16_t velocity_follow(const profile& p, const plant_constants& k, axis_s
     goal = 0;  // an engaged (or still releasing) brake holds the shaft: nothing accelerates
     up = 0;
     down += k.brake_step;
-    towards_limit = false;
+    at.towards = 0;
   }
   const std::int64_t v_new = approach(s.velocity, goal, up, down);
   motion::advance(s, v_new, k.cycle_us, a.objects.increments_per_rev);
-  // Arrived at the limit within a slow last cycle: exactly there, at rest.
-  const bool reached = v_new > 0 ? s.position >= edge : (s.position < edge || (s.position == edge && s.fraction == 0));
-  if (towards_limit && reached && magnitude(v_new) <= down) {
-    s.position = edge;
-    s.fraction = 0;
-    s.velocity = 0;
-  }
+  stand_at_limit(s, at, v_new, down);
   return status;
 }
 
@@ -390,9 +356,9 @@ namespace {
       p.info(out.current).activity == state_activity::run &&
       o.increments_per_rev == k.usual_increments_per_rev && o.interpolation_period_us <= k.cycle_us &&
       speed_limit_rpm(k, a) == k.max_velocity_rpm;
-  // What depends on the objects alone, worked out when one was written. Profile velocity needs to
-  // brake for a software limit only within the braking distance from the top speed (no mode turns
-  // the motor faster): beyond it, no root to draw (velocity_follow). A settled csp axis's demand
+  // What depends on the objects alone, worked out when one was written. Pv, csv and the torque modes
+  // need to brake for a software limit only within the braking distance from the top speed (no mode
+  // turns the motor faster): beyond it, no root to draw (brake_for_limit). A settled csp axis's demand
   // within the following error window and a cycle's travel has no check to count, no cut to make.
   if (a.objects_written) {
     a.objects_written = false;
@@ -404,7 +370,7 @@ namespace {
     const std::uint64_t rpm = std::uint64_t{k.max_velocity_rpm} + 1;
     const std::uint64_t reach = rpm * rpm * o.increments_per_rev / (120u * std::uint64_t{a.quick_stop_deceleration}) +
                                 rpm * o.increments_per_rev * k.cycle_us / 60'000'000u + 2u;
-    a.pv_braking_reach = reach < UINT32_MAX ? static_cast<std::uint32_t>(reach) : UINT32_MAX;
+    a.limit_braking_reach = reach < UINT32_MAX ? static_cast<std::uint32_t>(reach) : UINT32_MAX;
     const std::int64_t window =
         o.following_error_window == 0xFFFFFFFFu ? INT64_MAX : std::int64_t{o.following_error_window};
     a.settled_csp_reach = static_cast<std::uint32_t>(window < k.usual_csp_reach ? window : k.usual_csp_reach);

@@ -69,10 +69,62 @@ inline void set_flag(axis_state& a, std::uint8_t flag, bool on) noexcept {
 // 0x607D: on when the minimum lies below the maximum.
 inline bool limits_on(const axis_state& a) noexcept { return a.objects.min_position < a.objects.max_position; }
 
-// Moving outwards at or past a software limit.
-inline bool beyond_limit(const axis_state& a, std::int64_t position, std::int64_t velocity) noexcept {
-  return limits_on(a) && ((position >= a.objects.max_position && velocity > 0) ||
-                          (position <= a.objects.min_position && velocity < 0));
+// Moving outwards at or past a software limit. A shaft between two increments reads the lower one:
+// at the lower limit it is past it only when it stands exactly there.
+inline bool beyond_limit(const axis_state& a, const motion::shaft& s, std::int64_t velocity) noexcept {
+  const mode_objects& o = a.objects;
+  const bool at_min = s.position < o.min_position || (s.position == o.min_position && s.fraction == 0);
+  return limits_on(a) && ((s.position >= o.max_position && velocity > 0) || (at_min && velocity < 0));
+}
+
+// The software limit a mode brakes for this cycle (brake_for_limit): `towards` is +1 for the upper,
+// -1 for the lower, 0 while none is braked for.
+struct limit_approach {
+  std::int64_t edge = 0;
+  std::int64_t towards = 0;
+};
+
+// Towards a software position limit (0x607D) in pv, csv and the torque modes: no faster than the
+// shaft can still stop at the limit on the quick-stop ramp 0x6085 (the cycle's travel counted, as pp
+// brakes into its target), and at rest once at or past it. Cuts `goal` (micro-rpm, the velocity the
+// mode wants this cycle), raises `down` (micro-rpm a cycle) to the quick-stop ramp, and sets `at` to
+// the limit the shaft heads for. True while the limit cuts the goal (status bit 11).
+inline bool brake_for_limit(const plant_constants& k, const axis_state& a, const motion::shaft& s,
+                            std::int64_t& goal, std::int64_t& down, limit_approach& at) noexcept {
+  const mode_objects& o = a.objects;
+  const std::int64_t quick_stop = std::int64_t{a.quick_stop_deceleration} * k.cycle_us;
+  if (beyond_limit(a, s, goal)) {  // at or past the limit: stop (and stay) there
+    goal = 0;
+    down = quick_stop;
+    return true;
+  }
+  if (goal == 0) return false;
+  const std::int64_t edge = goal > 0 ? o.max_position : o.min_position;
+  // Farther from the limit than the braking distance from the top speed (and a cycle's travel)
+  // there is nothing to cut: no 128-bit root in the cycles of a shaft far away.
+  if (magnitude(edge - s.position) > std::int64_t{a.limit_braking_reach}) return false;
+  const std::int64_t cap = motion::stopping_speed(s, edge, a.quick_stop_deceleration, k.cycle_us, o.increments_per_rev);
+  if (magnitude(goal) <= cap) return false;
+  at.edge = edge;
+  at.towards = sign_of(goal);
+  goal = at.towards * cap;
+  if (down < quick_stop) down = quick_stop;
+  return true;
+}
+
+// After a cycle's move at `v_new` towards the limit brake_for_limit() cut the goal for: arrived
+// within a slow last cycle (no faster than `down` a cycle), the shaft stands exactly there. Arrived
+// means at or past the limit in the direction braked towards (a shaft slowing from the other way
+// has not arrived, however slow); it stood before it at the start of the cycle.
+inline void stand_at_limit(motion::shaft& s, const limit_approach& at, std::int64_t v_new, std::int64_t down) noexcept {
+  if (at.towards == 0) return;
+  const bool reached = at.towards > 0 ? s.position >= at.edge
+                                      : (s.position < at.edge || (s.position == at.edge && s.fraction == 0));
+  if (reached && magnitude(v_new) <= down) {
+    s.position = at.edge;
+    s.fraction = 0;
+    s.velocity = 0;
+  }
 }
 
 // 0x60C2 (value x 10^index s, index -6..0) in microseconds.

@@ -1,12 +1,13 @@
 // The limits a strict drive protects its motor and machine with (CiA 402-2): max profile velocity
 // 0x607F and max motor speed 0x6080 in every mode, max torque 0x6072 in the torque modes, each with
-// status bit 11 while it cuts; profile velocity stopping *at* a software position limit 0x607D; the
-// velocity window and threshold 0x606D..0x6070 behind pv's bits 10 and 12. Expectations come from
-// the ramps and limits as written, never from a run.
+// status bit 11 while it cuts; pv, csv and the torque modes stopping *at* a software position limit
+// 0x607D; the velocity window and threshold 0x606D..0x6070 behind pv's bits 10 and 12. Expectations
+// come from the ramps and limits as written, never from a run.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 
 #include "cia402/words.hpp"
 #include "mode_support.hpp"
@@ -179,6 +180,105 @@ TEST(software_limit, pv_brakes_so_as_to_stand_at_the_limit_not_beyond_it) {
     write(d, 0x60FF, -rpm);
     for (int i = 0; i < 100; ++i) d.step();
     EXPECT_LT(std::llabs(d.view().position()), 300000) << "inwards it moves again";
+  }
+}
+
+// How far the shaft travels in one 1 ms plant cycle at `rpm` (10,000 increments a revolution).
+std::int64_t cycle_travel(std::int64_t rpm) { return std::llabs(rpm) * 10000 / 60000 + 1; }
+
+TEST(software_limit, csv_brakes_so_as_to_stand_at_the_limit_not_beyond_it) {
+  // As pv: 0x60FF towards a limit 30 revolutions out brakes on the quick-stop ramp 0x6085 early
+  // enough to stand at the limit (before, csv braked only once there: 7.5 revolutions beyond).
+  for (const std::int32_t rpm : {3000, -3000, 100, 5999}) {
+    SCOPED_TRACE(rpm);
+    virtual_drive d(standard_profile());
+    write(d, 0x607D, -300000, 1);
+    write(d, 0x607D, 300000, 2);
+    enable_in_mode(d, cia402::mode::cyclic_synchronous_velocity);
+    write(d, 0x60FF, rpm);
+    const std::int64_t limit = rpm > 0 ? 300000 : -300000;
+    std::int64_t farthest = 0;
+    bool limited_before_the_limit = false;
+    const int stopped = cycles_until(d, [&] {
+      farthest = rpm > 0 ? std::max(farthest, d.view().position()) : std::min(farthest, d.view().position());
+      limited_before_the_limit |= (status(d) & bit11) != 0 && d.view().position() != limit;
+      return d.view().velocity_micro_rpm() == 0;
+    }, 400000);
+    ASSERT_GT(stopped, 0);
+    EXPECT_LE(std::llabs(farthest), 300000) << "never past it";
+    EXPECT_GE(std::llabs(d.view().position()), 300000 - cycle_travel(rpm)) << "stands at it";
+    EXPECT_TRUE(limited_before_the_limit) << "bit 11 while braking for it";
+    const std::int64_t stood = d.view().position();
+    for (int i = 0; i < 100; ++i) d.step();
+    EXPECT_EQ(d.view().position(), stood) << "and stays there";
+    EXPECT_NE(status(d) & bit11, 0) << "while 0x60FF points outwards";
+    write(d, 0x60FF, -rpm);
+    for (int i = 0; i < 100; ++i) d.step();
+    EXPECT_LT(std::llabs(d.view().position()), std::llabs(stood)) << "inwards it moves again";
+    EXPECT_EQ(status(d) & bit11, 0) << "nothing cuts the way back";
+  }
+}
+
+TEST(software_limit, the_torque_modes_brake_so_as_to_stand_at_the_limit_not_beyond_it) {
+  // A torque towards a limit 30 revolutions out accelerates the shaft to the motor's top speed; the
+  // drive brakes on 0x6085 so as to stand at the limit, whatever the torque asks.
+  for (const std::int8_t mode : {cia402::mode::cyclic_synchronous_torque, cia402::mode::profile_torque}) {
+    for (const std::int32_t torque : {1000, -1000, 150}) {
+      SCOPED_TRACE(testing::Message() << "mode " << static_cast<int>(mode) << " torque " << torque);
+      virtual_drive d(standard_profile());
+      write(d, 0x607D, -300000, 1);
+      write(d, 0x607D, 300000, 2);
+      write(d, 0x6087, 1000000);
+      enable_in_mode(d, mode);
+      write(d, 0x6071, torque);
+      const std::int64_t limit = torque > 0 ? 300000 : -300000;
+      std::int64_t farthest = 0;
+      std::int64_t fastest = 0;
+      bool limited_before_the_limit = false;
+      const int stopped = cycles_until(d, [&] {
+        const std::int64_t at = d.view().position();
+        farthest = torque > 0 ? std::max(farthest, at) : std::min(farthest, at);
+        fastest = std::max<std::int64_t>(fastest, std::llabs(d.view().velocity_micro_rpm()));
+        limited_before_the_limit |= (status(d) & bit11) != 0 && at != limit;
+        return std::llabs(at) > 100000 && d.view().velocity_micro_rpm() == 0;
+      }, 400000);
+      ASSERT_GT(stopped, 0);
+      EXPECT_LE(std::llabs(farthest), 300000) << "never past it";
+      EXPECT_GE(std::llabs(d.view().position()), 300000 - cycle_travel(fastest / micro)) << "stands at it";
+      EXPECT_TRUE(limited_before_the_limit) << "bit 11 while braking for it";
+      const std::int64_t stood = d.view().position();
+      for (int i = 0; i < 100; ++i) d.step();
+      EXPECT_EQ(d.view().position(), stood) << "and stays there";
+      EXPECT_NE(status(d) & bit11, 0) << "while the torque points outwards";
+      write(d, 0x6071, -torque);
+      for (int i = 0; i < 200; ++i) d.step();
+      EXPECT_LT(std::llabs(d.view().position()), std::llabs(stood)) << "inwards it moves again";
+    }
+  }
+}
+
+TEST(software_limit, turning_back_towards_a_near_limit_moves_the_shaft_no_faster_than_it_turns) {
+  // Away from the upper limit, then towards it: where the limit cuts the way back, the velocity
+  // passes through 0 far from it. The shaft must not take that for arriving and jump to the limit.
+  for (const std::int8_t mode : {cia402::mode::profile_velocity, cia402::mode::cyclic_synchronous_velocity}) {
+    SCOPED_TRACE(static_cast<int>(mode));
+    virtual_drive d(standard_profile());
+    write(d, 0x607D, -300000, 1);
+    write(d, 0x607D, 5000, 2);
+    write(d, 0x6083, 10000);
+    enable_in_mode(d, mode);
+    write(d, 0x60FF, -600);
+    for (int i = 0; i < 500; ++i) d.step();
+    write(d, 0x60FF, 3000);
+    std::int64_t last = d.view().position();
+    std::int64_t largest_step = 0;
+    for (int i = 0; i < 3000; ++i) {
+      d.step();
+      largest_step = std::max<std::int64_t>(largest_step, std::llabs(d.view().position() - last));
+      last = d.view().position();
+    }
+    EXPECT_LE(largest_step, cycle_travel(3000));
+    EXPECT_EQ(last, 5000) << "and it still ends at the limit";
   }
 }
 

@@ -49,7 +49,7 @@ std::string observe(const profile& p, const plant_constants& k, const axis_state
   s << "\nshaft " << a.home_shift << ' ' << a.previous_position << ' ' << a.in_velocity_window_us << ' '
     << a.above_velocity_threshold_us << ' ' << a.interpolation_from << ' ' << a.interpolation_to << ' '
     << a.interpolation_elapsed_us << ' ' << int(a.homing.phase()) << ' ' << digital_inputs(k, a) << ' '
-    << a.pv_set_point << a.pv_set_point_cut << ' ' << a.pv_braking_reach;
+    << a.pv_set_point << a.pv_set_point_cut << ' ' << a.limit_braking_reach;
   s << "\nplant " << a.velocity << ' ' << a.position << ' ' << a.position_fraction << ' ' << a.demand
     << ' ' << a.torque << ' ' << a.torque_demand << ' ' << a.following_error_us << ' '
     << a.mode_status << ' ' << int{a.flags} << ' ' << a.brake_timer << ' ' << int{a.operation_mode};

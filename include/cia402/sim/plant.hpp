@@ -222,14 +222,15 @@ struct axis_state {
   std::uint32_t quick_stop_deceleration = 10000;  ///< 0x6085, rpm/s
   std::uint16_t brake_timer = 0;      ///< cycles until the brake reaches its command
   /// step_axis() only: an object was written since the core last decided, so what it works out
-  /// from the objects (pv_timed, pv_braking_reach, settled_csp_reach) is to be worked out again.
+  /// from the objects (pv_timed, limit_braking_reach, settled_csp_reach) is to be worked out again.
   bool objects_written = true;
   /// step_axis() only: 0x606E or 0x6070 asks profile velocity to time its bits 10 and 12.
   bool pv_timed = false;
-  /// step_axis() only: how near (increments) a software limit the shaft must be before profile
-  /// velocity works out how hard to brake for it: the quick-stop braking distance from the motor's
-  /// top speed and a cycle's travel (UINT32_MAX: always). Worked out with the core's decision.
-  std::uint32_t pv_braking_reach = UINT32_MAX;
+  /// step_axis() only: how near (increments) a software limit 0x607D the shaft must be before pv,
+  /// csv or a torque mode works out how hard to brake for it: the quick-stop braking distance from
+  /// the motor's top speed and a cycle's travel (UINT32_MAX: always). Worked out with the core's
+  /// decision.
+  std::uint32_t limit_braking_reach = UINT32_MAX;
 
   // The operation modes. What a running axis reads every cycle first, in the cache lines after the
   // ones above; what homing, the timed pv bits and interpolation add, after the objects.

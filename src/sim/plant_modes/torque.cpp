@@ -25,11 +25,19 @@ void torque_follow(const plant_constants& k, axis_state& a, motion::shaft& s,
     v_new = clamp(v_new, -limit, limit);
     a.mode_status |= status_bit::internal_limit_active;
   }
-  if (beyond_limit(a, s.position, v_new)) {
-    v_new = approach(v, 0, 0, std::int64_t{a.quick_stop_deceleration} * k.cycle_us);
+  // Towards a software limit the drive overrides the torque as pv brakes: the shaft stops at the
+  // limit, not beyond. Slower than the cut (or reversing) it keeps what the torque gives, up to the
+  // cut; faster, it brakes on the quick-stop ramp.
+  std::int64_t goal = v_new;
+  std::int64_t down = 0;
+  limit_approach at;
+  if (limits_on(a) && brake_for_limit(k, a, s, goal, down, at)) {
+    const bool braking = magnitude(v) > magnitude(goal) && sign_of(v) != -sign_of(goal);
+    v_new = braking ? approach(v, goal, 0, down) : goal;
     a.mode_status |= status_bit::internal_limit_active;
   }
   motion::advance(s, v_new, k.cycle_us, a.objects.increments_per_rev);
+  stand_at_limit(s, at, v_new, down);
 }
 
 }  // namespace

@@ -23,14 +23,15 @@ std::uint16_t csv_cycle(const plant_constants& k, axis_state& a, motion::shaft& 
   const std::int64_t wanted =
       interpolate(k, a, (std::int64_t{cleared ? 0 : a.target_velocity} + o.velocity_offset) * micro);
   const std::int64_t limit = std::int64_t{speed_limit_rpm(k, a)} * micro;
-  const std::int64_t goal = clamp(wanted, -limit, limit);
+  std::int64_t goal = clamp(wanted, -limit, limit);
   if (goal != wanted) status |= status_bit::internal_limit_active;
-  std::int64_t v_new = approach(s.velocity, goal, k.max_acceleration_step, k.max_acceleration_step);
-  if (beyond_limit(a, s.position, v_new)) {
-    v_new = approach(s.velocity, 0, 0, std::int64_t{a.quick_stop_deceleration} * k.cycle_us);
-    status |= status_bit::internal_limit_active;
-  }
+  // Towards a software limit it brakes as pv does: the shaft stops at the limit, not beyond.
+  std::int64_t down = k.max_acceleration_step;
+  limit_approach at;
+  if (limits_on(a) && brake_for_limit(k, a, s, goal, down, at)) status |= status_bit::internal_limit_active;
+  const std::int64_t v_new = approach(s.velocity, goal, k.max_acceleration_step, down);
   motion::advance(s, v_new, k.cycle_us, o.increments_per_rev);
+  stand_at_limit(s, at, v_new, down);
   a.demand = s.position;
   return status;
 }
