@@ -33,7 +33,6 @@
     if (held || button.disabled) return;
     const rpm = speed(button.dataset.speed) * Number(button.dataset.sign);
     if (rpm === 0) return;
-    button.setPointerCapture?.(event.pointerId);
     button.classList.add('held');
     held = { velocity: rpm, button, timer: setInterval(renew, RENEW_MS) };
     renew();
@@ -41,7 +40,8 @@
 
   for (const button of document.querySelectorAll('.jog')) {
     button.addEventListener('pointerdown', (e) => hold(button, e));
-    for (const end of ['pointerup', 'pointercancel', 'pointerleave', 'lostpointercapture']) {
+    // No pointer capture: leaving the button must release it, and a captured pointer never leaves.
+    for (const end of ['pointerup', 'pointercancel', 'pointerleave']) {
       button.addEventListener(end, release);
     }
     // The keyboard: held while Space or Enter is down.

@@ -234,6 +234,24 @@ async function click(page, command) {
   await page.click(`button[data-command="${command}"]`);
 }
 
+// The drive's snapshot as a script sees it (GET /api/state from here, not from the page).
+async function driveState(baseUrl) {
+  return (await fetch(new URL('/api/state', baseUrl))).json();
+}
+
+// Polls the drive until `holds(snapshot)`; fails naming `what` after `timeout` ms.
+async function untilDrive(baseUrl, holds, what, timeout = patience) {
+  const end = Date.now() + timeout;
+  let s = null;
+  while (Date.now() < end) {
+    s = await driveState(baseUrl);
+    if (holds(s)) return s;
+    await new Promise((r) => setTimeout(r, 25));
+  }
+  fail(`${what}; last 0x60FF ${s && s.target_velocity}, velocity ${s && s.velocity}`);
+  return null;
+}
+
 // --- the test --------------------------------------------------------------------------------
 
 async function main() {
@@ -311,6 +329,26 @@ async function main() {
     await click(page, 'enable_operation');
     await waitResult(page, 'nothing to do: already OPERATION_ENABLED');
     expect(await page.getAttribute('#result', 'data-outcome') === 'nothing to do', 'marked nothing to do');
+  });
+
+  await check('jog: runs while held (past its time-to-live), 0x60FF = 0 on release and on leaving the button', async () => {
+    await page.fill('#jog-slow', '120');
+    const button = page.locator('button.jog[data-sign="1"][data-speed="slow"]');
+    await button.hover();
+    await page.mouse.down();
+    await untilDrive(main.url, (s) => s.target_velocity === 120 && s.velocity > 0, 'the jog did not start');
+    await page.waitForTimeout(1000);  // over three times the 300 ms time-to-live: the page renews it
+    expect((await driveState(main.url)).target_velocity === 120, 'the held jog stopped');
+    await page.mouse.up();
+    await untilDrive(main.url, (s) => s.target_velocity === 0, 'the release did not stop the jog');
+    await button.hover();
+    await page.mouse.down();
+    await untilDrive(main.url, (s) => s.target_velocity === 120, 'the jog did not start again');
+    await page.mouse.move(5, 5);  // the pointer leaves the button, still pressed
+    await untilDrive(main.url, (s) => s.target_velocity === 0, 'leaving the button did not stop the jog');
+    await page.mouse.up();
+    await untilDrive(main.url, (s) => s.velocity === 0, 'the motor did not come to rest');
+    expect((await driveState(main.url)).state === 'OPERATION_ENABLED', 'a jog stop leaves the drive enabled');
   });
 
   await check('status word 0x0237 in bits 0..9 and its bits lit', async () => {
