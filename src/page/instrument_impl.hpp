@@ -165,6 +165,13 @@ struct instrument::impl {
 
   void end_walk(const std::string& outcome, const std::string& text) {
     if (!walk) return;
+    // A walk that stops short leaves no Enable operation in the word: it would act by itself once
+    // the blocker (STO, DC link) is gone, a restart nobody asked for.
+    std::uint16_t word = 0;
+    if (outcome != "done" && table->decode(control_word) == command::enable_operation &&
+        encode_command(*table, command::switch_on, control_word, word)) {
+      apply_word(word);
+    }
     log.update({walk->id, "ENABLE", outcome, text, walk->transitions});
     walk.reset();
   }

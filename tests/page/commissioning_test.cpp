@@ -124,6 +124,22 @@ TEST_F(commissioning, enable_stops_at_sto_asserted_during_the_walk_and_names_it)
   EXPECT_NE(r["text"].get<std::string>().find("STO"), std::string::npos) << r;
 }
 
+TEST_F(commissioning, enable_stopped_by_sto_leaves_no_enable_operation_to_act_once_sto_is_gone) {
+  id_of(inst.enable());
+  int cycles = 0;
+  while (snapshot(inst)["decodes_to"] != "ENABLE_OPERATION" && cycles < 50) {
+    inst.step();
+    ++cycles;
+  }
+  ASSERT_NE(snapshot(inst)["state"], "OPERATION_ENABLED");
+  plant(false, true);
+  run(inst, 100);
+  plant(false, false);
+  run(inst, 200);
+  EXPECT_NE(snapshot(inst)["state"], "OPERATION_ENABLED");
+  EXPECT_NE(snapshot(inst)["decodes_to"], "ENABLE_OPERATION");
+}
+
 TEST_F(commissioning, stop_quick_stops_then_disables_voltage) {
   enable();
   plant_change v;
