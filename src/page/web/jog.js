@@ -9,24 +9,39 @@
 (() => {
   const TTL_MS = 300;
   const RENEW_MS = 100;
-  let held = null;  // { velocity, timer }
+  let held = null;  // { velocity, button, timer }
 
   const speed = (which) => {
     const v = Number(document.getElementById(`jog-${which}`).value);
     return Number.isFinite(v) && v > 0 ? Math.round(v) : 0;
   };
 
-  const renew = () => {
-    if (held) post('/api/jog', { velocity: held.velocity, ttl_ms: TTL_MS });
+  // One jog request at a time, in order: a renewal still on its way must not reach the server after
+  // the release and start the jog again.
+  let queue = Promise.resolve();
+  let renewing = false;
+  const send = (body) => {
+    queue = queue.then(() => post('/api/jog', body));
+    return queue;
   };
 
-  const release = () => {
+  const renew = () => {
+    if (!held || renewing) return;
+    const mine = held;
+    renewing = true;
+    send({ velocity: mine.velocity, ttl_ms: TTL_MS }).then((reply) => {
+      renewing = false;
+      if (reply === null && held === mine) release();  // refused (shown): stop asking
+    });
+  };
+
+  function release() {
     if (!held) return;
     clearInterval(held.timer);
     held.button.classList.remove('held');
     held = null;
-    post('/api/jog', { velocity: 0 });
-  };
+    send({ velocity: 0 });
+  }
 
   const hold = (button, event) => {
     event.preventDefault();
