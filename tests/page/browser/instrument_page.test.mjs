@@ -341,6 +341,9 @@ async function main() {
     expect((await driveState(main.url)).target_velocity === 120, 'the held jog stopped');
     await page.mouse.up();
     await untilDrive(main.url, (s) => s.target_velocity === 0, 'the release did not stop the jog');
+    // At rest the panel above stops changing height, so the button stays under the pointer.
+    await untilDrive(main.url, (s) => s.velocity === 0, 'the motor did not come to rest');
+    await page.waitForTimeout(300);
     await button.hover();
     await page.mouse.down();
     await untilDrive(main.url, (s) => s.target_velocity === 120, 'the jog did not start again');
