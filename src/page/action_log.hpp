@@ -85,6 +85,8 @@ class action_log {
   /// Once per cycle: `busy` says something still goes on (it keeps the action from settling).
   void settle(std::uint64_t now, bool busy);
 
+  /// Replaces the result with r's id (an action reported as pending, now over).
+  void update(result_entry r) { push(std::move(r)); }
   json results_json() const;
 
  private:

@@ -19,6 +19,7 @@
 #include <mutex>
 #include <set>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 #include <thread>
 
@@ -492,7 +493,16 @@ struct server::impl {
     http.Post("/api/profile", [this](const httplib::Request& req, httplib::Response& res) {
       post(req, res, [this](backend& d, const json& b) { return on_profile(d, b); });
     });
-    for (const char* path : {"/api/command", "/api/plant", "/api/object", "/api/profile"}) {
+    // One-click enable and stop, and the jog with its dead-man (commissioning.hpp).
+    for (const auto& [path, act] : {std::pair{"/api/enable", &detail::enable_request},
+                                    std::pair{"/api/stop", &detail::stop_request},
+                                    std::pair{"/api/jog", &detail::jog_request}}) {
+      http.Post(path, [this, act = act](const httplib::Request& req, httplib::Response& res) {
+        post(req, res, act);
+      });
+    }
+    for (const char* path : {"/api/command", "/api/plant", "/api/object", "/api/profile", "/api/enable",
+                             "/api/stop", "/api/jog"}) {
       http.Get(path, [](const httplib::Request&, httplib::Response& res) {
         send_error(res, 405, "use POST with a JSON body");
       });

@@ -1,5 +1,7 @@
 #include "server_http.hpp"
 
+#include "commissioning.hpp"
+
 #include <arpa/inet.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -93,6 +95,35 @@ std::optional<std::string> unknown_key(const json& body, std::initializer_list<c
     if (!known) return "unknown key '" + it.key() + "'";
   }
   return std::nullopt;
+}
+
+std::variant<reply, request_error> jog_request(backend& drive, const json& body) {
+  if (auto k = unknown_key(body, {"velocity", "ttl_ms"})) return request_error{400, *k};
+  const auto velocity = body.contains("velocity") && body["velocity"].is_number_integer()
+                            ? integer_of(body["velocity"])
+                            : std::nullopt;
+  if (!velocity) return request_error{400, "'velocity' (an integer, rpm; 0 releases) is required"};
+  std::uint64_t ttl_ms = jog_ttl_default_ms;
+  if (body.contains("ttl_ms")) {
+    const auto t = body["ttl_ms"].is_number_integer() ? integer_of(body["ttl_ms"]) : std::nullopt;
+    if (!t || *t < static_cast<std::int64_t>(jog_ttl_min_ms) ||
+        *t > static_cast<std::int64_t>(jog_ttl_max_ms)) {
+      return request_error{400, "'ttl_ms' must be " + std::to_string(jog_ttl_min_ms) + ".." +
+                                    std::to_string(jog_ttl_max_ms)};
+    }
+    ttl_ms = static_cast<std::uint64_t>(*t);
+  }
+  return drive.jog(*velocity, ttl_ms * 1000);
+}
+
+std::variant<reply, request_error> enable_request(backend& drive, const json& body) {
+  if (auto k = unknown_key(body, {})) return request_error{400, *k};
+  return drive.enable();
+}
+
+std::variant<reply, request_error> stop_request(backend& drive, const json& body) {
+  if (auto k = unknown_key(body, {})) return request_error{400, *k};
+  return drive.stop();
 }
 
 // A refusal written straight to the socket (the request was never parsed).

@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <variant>
 
 #include "cia402/page/backend.hpp"
 #include "cia402/page/server.hpp"
@@ -43,6 +44,12 @@ struct request_error {
   int status;
   std::string reason;
 };
+
+/// POST /api/jog: {"velocity": rpm (signed; 0 releases), "ttl_ms": 20..1000, 300 if not given}.
+std::variant<reply, request_error> jog_request(backend& drive, const nlohmann::json& body);
+/// POST /api/enable and /api/stop take an empty object.
+std::variant<reply, request_error> enable_request(backend& drive, const nlohmann::json& body);
+std::variant<reply, request_error> stop_request(backend& drive, const nlohmann::json& body);
 
 /// A refusal written straight to the socket (the request was never parsed); closes it.
 void answer_and_close(socket_t sock, int status, const std::string& reason);

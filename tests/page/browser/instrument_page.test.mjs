@@ -234,6 +234,24 @@ async function click(page, command) {
   await page.click(`button[data-command="${command}"]`);
 }
 
+// The drive's snapshot as a script sees it (GET /api/state from here, not from the page).
+async function driveState(baseUrl) {
+  return (await fetch(new URL('/api/state', baseUrl))).json();
+}
+
+// Polls the drive until `holds(snapshot)`; fails naming `what` after `timeout` ms.
+async function untilDrive(baseUrl, holds, what, timeout = patience) {
+  const end = Date.now() + timeout;
+  let s = null;
+  while (Date.now() < end) {
+    s = await driveState(baseUrl);
+    if (holds(s)) return s;
+    await new Promise((r) => setTimeout(r, 25));
+  }
+  fail(`${what}; last 0x60FF ${s && s.target_velocity}, velocity ${s && s.velocity}`);
+  return null;
+}
+
 // --- the test --------------------------------------------------------------------------------
 
 async function main() {
@@ -311,6 +329,29 @@ async function main() {
     await click(page, 'enable_operation');
     await waitResult(page, 'nothing to do: already OPERATION_ENABLED');
     expect(await page.getAttribute('#result', 'data-outcome') === 'nothing to do', 'marked nothing to do');
+  });
+
+  // That a renewed jog outlives its time-to-live is the C++ test's (commissioning_test.cpp): here a
+  // loaded machine may delay the page's renewals past 300 ms, and the server then stops it, rightly.
+  await check('jog: runs while held, 0x60FF = 0 on release and on leaving the button', async () => {
+    await page.fill('#jog-slow', '120');
+    const button = page.locator('button.jog[data-sign="1"][data-speed="slow"]');
+    await button.hover();
+    await page.mouse.down();
+    await untilDrive(main.url, (s) => s.target_velocity === 120 && s.velocity > 0, 'the jog did not start');
+    await page.mouse.up();
+    await untilDrive(main.url, (s) => s.target_velocity === 0, 'the release did not stop the jog');
+    // At rest the panel above stops changing height, so the button stays under the pointer.
+    await untilDrive(main.url, (s) => s.velocity === 0, 'the motor did not come to rest');
+    await page.waitForTimeout(300);
+    await button.hover();
+    await page.mouse.down();
+    await untilDrive(main.url, (s) => s.target_velocity === 120, 'the jog did not start again');
+    await page.mouse.move(5, 5);  // the pointer leaves the button, still pressed
+    await untilDrive(main.url, (s) => s.target_velocity === 0, 'leaving the button did not stop the jog');
+    await page.mouse.up();
+    await untilDrive(main.url, (s) => s.velocity === 0, 'the motor did not come to rest');
+    expect((await driveState(main.url)).state === 'OPERATION_ENABLED', 'a jog stop leaves the drive enabled');
   });
 
   await check('status word 0x0237 in bits 0..9 and its bits lit', async () => {

@@ -85,6 +85,22 @@ class backend {
   virtual reply new_setpoint() {
     return refused{409, "this drive offers no new set-point handshake"};
   }
+  /// One-click enable (docs/instrument-page.md, "Enable, Stop and jog"): walks the state machine
+  /// to OPERATION ENABLED one planned step at a time (cia402::plan_path_from_status, S17), each
+  /// step confirmed by the status word before the next. Never resets a fault: in FAULT, under STO
+  /// or without DC link it is refused (409) with what blocks it.
+  virtual reply enable() { return refused{409, "one-click enable is not offered on this drive"}; }
+  /// One-click stop: Quick stop (CiA 402 T11, the ramp 0x605A says), then Disable voltage (T12)
+  /// once the drive left OPERATION ENABLED; ends any jog and enable walk.
+  virtual reply stop() { return refused{409, "one-click stop is not offered on this drive"}; }
+  /// Jog with a dead-man: profile velocity (0x6060 = 3) at `velocity_rpm` (0x60FF) until
+  /// `time_to_live_us` passes without another jog call; then, on a release (velocity 0) or when
+  /// the drive leaves OPERATION ENABLED, 0x60FF = 0. Refused (409) outside OPERATION ENABLED.
+  virtual reply jog(std::int64_t velocity_rpm, std::uint64_t time_to_live_us) {
+    (void)velocity_rpm;
+    (void)time_to_live_us;
+    return refused{409, "jog is not offered on this drive"};
+  }
   /// Writes an object (option codes, ramps, 0x60FF, ...). A write the drive refuses gives its SDO
   /// abort code and changes nothing.
   virtual reply write_object(std::uint16_t index, std::int64_t value) = 0;

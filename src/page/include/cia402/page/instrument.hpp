@@ -66,6 +66,11 @@ class instrument final : public backend {
   reply toggle_control_bit(int bit) override;
   /// Profile position's set-point handshake: bit 4 up until status bit 12, then down (backend.hpp).
   reply new_setpoint() override;
+  /// One-click enable, stop and jog (backend.hpp; the walk and the jog's time-to-live run on the
+  /// drive's cycles).
+  reply enable() override;
+  reply stop() override;
+  reply jog(std::int64_t velocity_rpm, std::uint64_t time_to_live_us) override;
   /// Starts again from power-up under another of the selectable profiles; the recording and the
   /// control word start over, the results say so.
   reply select_profile(std::string_view name) override;
