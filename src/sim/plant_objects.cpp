@@ -2,6 +2,8 @@
 // register), its fault causes and its construction. Every access answers with an SDO abort code; a
 // refused write changes nothing.
 #include <stdexcept>
+#include <type_traits>
+#include <utility>
 
 #include "cia402/sim/virtual_drive.hpp"
 #include "plant_internal.hpp"
@@ -73,6 +75,58 @@ sdo_abort describe(const profile& p, std::uint16_t index, std::uint8_t sub,
   return out != nullptr ? sdo_abort::none : missing(index);
 }
 
+// The settings kept as one field each of mode_objects, read and written alike: one row per object
+// and sub-index, so reading and writing cannot disagree on where a value lives. The objects whose
+// write does more (a set-point, the mode, the homing method, 0x60C2) have cases of their own below.
+constexpr std::uint8_t every_sub = 0xFF;
+
+struct plain_setting {
+  std::uint16_t index;
+  std::uint8_t sub;  ///< the sub-index, or every_sub for an object of one value
+  std::int64_t (*read)(const mode_objects&) noexcept;
+  void (*write)(mode_objects&, std::int64_t) noexcept;
+};
+
+template <auto field>
+constexpr plain_setting setting(std::uint16_t index, std::uint8_t sub = every_sub) noexcept {
+  using value_type = std::remove_reference_t<decltype(std::declval<mode_objects&>().*field)>;
+  return {index, sub, [](const mode_objects& m) noexcept -> std::int64_t { return m.*field; },
+          [](mode_objects& m, std::int64_t v) noexcept { m.*field = static_cast<value_type>(v); }};
+}
+
+constexpr plain_setting plain_settings[] = {
+    setting<&mode_objects::position_offset>(object::position_offset),
+    setting<&mode_objects::velocity_offset>(object::velocity_offset),
+    setting<&mode_objects::torque_offset>(object::torque_offset),
+    setting<&mode_objects::home_offset>(object::home_offset),
+    setting<&mode_objects::min_position>(object::software_position_limit, 1),
+    setting<&mode_objects::max_position>(object::software_position_limit, 2),
+    setting<&mode_objects::profile_velocity>(object::profile_velocity),
+    setting<&mode_objects::end_velocity>(object::end_velocity),
+    setting<&mode_objects::torque_slope>(object::torque_slope),
+    setting<&mode_objects::following_error_window>(object::following_error_window),
+    setting<&mode_objects::following_error_time_out>(object::following_error_time_out),
+    setting<&mode_objects::position_window>(object::position_window),
+    setting<&mode_objects::position_window_time>(object::position_window_time),
+    setting<&mode_objects::homing_switch_speed>(object::homing_speeds, 1),
+    setting<&mode_objects::homing_zero_speed>(object::homing_speeds, 2),
+    setting<&mode_objects::homing_acceleration>(object::homing_acceleration),
+    setting<&mode_objects::max_profile_velocity>(object::max_profile_velocity),
+    setting<&mode_objects::max_motor_speed>(object::max_motor_speed),
+    setting<&mode_objects::max_torque>(object::max_torque),
+    setting<&mode_objects::velocity_window>(object::velocity_window),
+    setting<&mode_objects::velocity_window_time>(object::velocity_window_time),
+    setting<&mode_objects::velocity_threshold>(object::velocity_threshold),
+    setting<&mode_objects::velocity_threshold_time>(object::velocity_threshold_time),
+};
+
+const plain_setting* find_plain_setting(std::uint16_t index, std::uint8_t sub) noexcept {
+  for (const plain_setting& s : plain_settings) {
+    if (s.index == index && (s.sub == every_sub || s.sub == sub)) return &s;
+  }
+  return nullptr;
+}
+
 // The set-point objects end the "set-points cleared" of T4 when written.
 void setpoint_written(axis_state& a) noexcept { set_flag(a, sim_flag::setpoints_cleared, false); }
 
@@ -123,20 +177,6 @@ sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_
       m.target_torque = static_cast<std::int16_t>(value);
       setpoint_written(a);
       break;
-    case object::position_offset: m.position_offset = i32; break;
-    case object::velocity_offset: m.velocity_offset = i32; break;
-    case object::torque_offset: m.torque_offset = static_cast<std::int16_t>(value); break;
-    case object::home_offset: m.home_offset = i32; break;
-    case object::software_position_limit:
-      (sub == 1 ? m.min_position : m.max_position) = i32;
-      break;
-    case object::profile_velocity: m.profile_velocity = u32; break;
-    case object::end_velocity: m.end_velocity = u32; break;
-    case object::torque_slope: m.torque_slope = u32; break;
-    case object::following_error_window: m.following_error_window = u32; break;
-    case object::following_error_time_out: m.following_error_time_out = static_cast<std::uint16_t>(value); break;
-    case object::position_window: m.position_window = u32; break;
-    case object::position_window_time: m.position_window_time = static_cast<std::uint16_t>(value); break;
     case object::position_encoder_resolution:
       if (sub == 1) m.increments_per_rev = u32;
       break;  // sub 2 (motor revolutions) takes only 1: the table's limits
@@ -144,8 +184,6 @@ sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_
       if (!motion::homing::supports(value)) return sdo_abort::invalid_value;
       m.homing_method = static_cast<std::int8_t>(value);
       break;
-    case object::homing_speeds: (sub == 1 ? m.homing_switch_speed : m.homing_zero_speed) = u32; break;
-    case object::homing_acceleration: m.homing_acceleration = u32; break;
     case object::interpolation_time_period:
       if (sub == 1) m.interpolation_value = static_cast<std::uint8_t>(value);
       else m.interpolation_index = static_cast<std::int8_t>(value);
@@ -155,14 +193,12 @@ sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_
                                        : a.operation_mode == cia402::mode::cyclic_synchronous_torque ? a.torque_demand
                                                                                                       : a.demand);
       break;
-    case object::max_profile_velocity: m.max_profile_velocity = u32; break;
-    case object::max_motor_speed: m.max_motor_speed = u32; break;
-    case object::max_torque: m.max_torque = static_cast<std::uint16_t>(value); break;
-    case object::velocity_window: m.velocity_window = static_cast<std::uint16_t>(value); break;
-    case object::velocity_window_time: m.velocity_window_time = static_cast<std::uint16_t>(value); break;
-    case object::velocity_threshold: m.velocity_threshold = static_cast<std::uint16_t>(value); break;
-    case object::velocity_threshold_time: m.velocity_threshold_time = static_cast<std::uint16_t>(value); break;
-    default: return sdo_abort::object_does_not_exist;
+    default:
+      if (const plain_setting* setting = find_plain_setting(index, sub)) {
+        setting->write(m, value);
+        break;
+      }
+      return sdo_abort::object_does_not_exist;
   }
   return sdo_abort::none;
 }
@@ -208,35 +244,19 @@ sdo_abort read_object(const profile& p, const plant_constants& k, const axis_sta
     case object::torque_actual_value: value = a.torque; break;
     case object::target_position: value = m.target_position; break;
     case object::target_torque: value = m.target_torque; break;
-    case object::position_offset: value = m.position_offset; break;
-    case object::velocity_offset: value = m.velocity_offset; break;
-    case object::torque_offset: value = m.torque_offset; break;
-    case object::home_offset: value = m.home_offset; break;
-    case object::software_position_limit: value = sub == 1 ? m.min_position : m.max_position; break;
-    case object::profile_velocity: value = m.profile_velocity; break;
-    case object::end_velocity: value = m.end_velocity; break;
-    case object::torque_slope: value = m.torque_slope; break;
-    case object::following_error_window: value = m.following_error_window; break;
-    case object::following_error_time_out: value = m.following_error_time_out; break;
-    case object::position_window: value = m.position_window; break;
-    case object::position_window_time: value = m.position_window_time; break;
     case object::position_encoder_resolution: value = sub == 1 ? m.increments_per_rev : 1; break;
     case object::homing_method: value = m.homing_method; break;
-    case object::homing_speeds: value = sub == 1 ? m.homing_switch_speed : m.homing_zero_speed; break;
-    case object::homing_acceleration: value = m.homing_acceleration; break;
     case object::interpolation_time_period:
       value = sub == 1 ? m.interpolation_value : m.interpolation_index;
       break;
-    case object::max_profile_velocity: value = m.max_profile_velocity; break;
-    case object::max_motor_speed: value = m.max_motor_speed; break;
-    case object::max_torque: value = m.max_torque; break;
-    case object::velocity_window: value = m.velocity_window; break;
-    case object::velocity_window_time: value = m.velocity_window_time; break;
-    case object::velocity_threshold: value = m.velocity_threshold; break;
-    case object::velocity_threshold_time: value = m.velocity_threshold_time; break;
     case object::supported_homing_methods: value = o->default_value; break;  // the table's own list
     case object::digital_inputs: value = digital_inputs(k, a); break;
-    default: return sdo_abort::object_does_not_exist;
+    default:
+      if (const plain_setting* setting = find_plain_setting(index, sub)) {
+        value = setting->read(m);
+        break;
+      }
+      return sdo_abort::object_does_not_exist;
   }
   return sdo_abort::none;
 }
