@@ -2,8 +2,6 @@
 // register), its fault causes and its construction. Every access answers with an SDO abort code; a
 // refused write changes nothing.
 #include <stdexcept>
-#include <type_traits>
-#include <utility>
 
 #include "cia402/sim/virtual_drive.hpp"
 #include "plant_internal.hpp"
@@ -75,54 +73,9 @@ sdo_abort describe(const profile& p, std::uint16_t index, std::uint8_t sub,
   return out != nullptr ? sdo_abort::none : missing(index);
 }
 
-// The settings kept as one field each of mode_objects, read and written alike: one row per object
-// and sub-index, so reading and writing cannot disagree on where a value lives. The objects whose
-// write does more (a set-point, the mode, the homing method, 0x60C2) have cases of their own below.
-constexpr std::uint8_t every_sub = 0xFF;
-
-struct plain_setting {
-  std::uint16_t index;
-  std::uint8_t sub;  ///< the sub-index, or every_sub for an object of one value
-  std::int64_t (*read)(const mode_objects&) noexcept;
-  void (*write)(mode_objects&, std::int64_t) noexcept;
-};
-
-template <auto field>
-constexpr plain_setting setting(std::uint16_t index, std::uint8_t sub = every_sub) noexcept {
-  using value_type = std::remove_reference_t<decltype(std::declval<mode_objects&>().*field)>;
-  return {index, sub, [](const mode_objects& m) noexcept -> std::int64_t { return m.*field; },
-          [](mode_objects& m, std::int64_t v) noexcept { m.*field = static_cast<value_type>(v); }};
-}
-
-constexpr plain_setting plain_settings[] = {
-    setting<&mode_objects::position_offset>(object::position_offset),
-    setting<&mode_objects::velocity_offset>(object::velocity_offset),
-    setting<&mode_objects::torque_offset>(object::torque_offset),
-    setting<&mode_objects::home_offset>(object::home_offset),
-    setting<&mode_objects::min_position>(object::software_position_limit, 1),
-    setting<&mode_objects::max_position>(object::software_position_limit, 2),
-    setting<&mode_objects::profile_velocity>(object::profile_velocity),
-    setting<&mode_objects::end_velocity>(object::end_velocity),
-    setting<&mode_objects::torque_slope>(object::torque_slope),
-    setting<&mode_objects::following_error_window>(object::following_error_window),
-    setting<&mode_objects::following_error_time_out>(object::following_error_time_out),
-    setting<&mode_objects::position_window>(object::position_window),
-    setting<&mode_objects::position_window_time>(object::position_window_time),
-    setting<&mode_objects::homing_switch_speed>(object::homing_speeds, 1),
-    setting<&mode_objects::homing_zero_speed>(object::homing_speeds, 2),
-    setting<&mode_objects::homing_acceleration>(object::homing_acceleration),
-    setting<&mode_objects::max_profile_velocity>(object::max_profile_velocity),
-    setting<&mode_objects::max_motor_speed>(object::max_motor_speed),
-    setting<&mode_objects::max_torque>(object::max_torque),
-    setting<&mode_objects::velocity_window>(object::velocity_window),
-    setting<&mode_objects::velocity_window_time>(object::velocity_window_time),
-    setting<&mode_objects::velocity_threshold>(object::velocity_threshold),
-    setting<&mode_objects::velocity_threshold_time>(object::velocity_threshold_time),
-};
-
-const plain_setting* find_plain_setting(std::uint16_t index, std::uint8_t sub) noexcept {
-  for (const plain_setting& s : plain_settings) {
-    if (s.index == index && (s.sub == every_sub || s.sub == sub)) return &s;
+const detail::plain_setting* find_plain_setting(std::uint16_t index, std::uint8_t sub) noexcept {
+  for (const detail::plain_setting& s : detail::plain_settings) {
+    if (s.index == index && (s.sub == detail::every_sub || s.sub == sub)) return &s;
   }
   return nullptr;
 }
@@ -194,7 +147,7 @@ sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_
                                                                                                       : a.demand);
       break;
     default:
-      if (const plain_setting* setting = find_plain_setting(index, sub)) {
+      if (const detail::plain_setting* setting = find_plain_setting(index, sub)) {
         setting->write(m, value);
         break;
       }
@@ -252,7 +205,7 @@ sdo_abort read_object(const profile& p, const plant_constants& k, const axis_sta
     case object::supported_homing_methods: value = o->default_value; break;  // the table's own list
     case object::digital_inputs: value = digital_inputs(k, a); break;
     default:
-      if (const plain_setting* setting = find_plain_setting(index, sub)) {
+      if (const detail::plain_setting* setting = find_plain_setting(index, sub)) {
         value = setting->read(m);
         break;
       }
