@@ -4,6 +4,7 @@
 
 #include "cia402/canopen/301/dictionary_access.hpp"
 #include "cia402/canopen/301/object_builders.hpp"
+#include "cia402/canopen/axis/can_link.hpp"
 #include "cia402/drive402/drive_objects.hpp"
 #include "cia402/objects.hpp"
 
@@ -27,17 +28,6 @@ std::vector<object_entry> local_objects(std::uint8_t history) {
   std::vector<object_entry> t = drive402::drive_objects();
   t.push_back(error_field(history));
   return t;
-}
-
-std::optional<axes::value_format> format_of(data_type t) {
-  switch (t) {
-    case data_type::visible_string: return axes::value_format::text();
-    case data_type::boolean: return axes::value_format::integer(1, false);
-    default: break;
-  }
-  const unsigned size = type_size(t);
-  if (size == 0) return std::nullopt;
-  return axes::value_format::integer(size, type_is_signed(t));
 }
 
 }  // namespace
@@ -206,7 +196,7 @@ bool local_link::download(std::uint16_t index, std::uint8_t sub, std::vector<std
 std::optional<axes::value_format> local_link::describe(std::uint16_t index, std::uint8_t sub) const {
   const object_dictionary::slot* s = objects_->table().find(index, sub);
   if (s == nullptr) return std::nullopt;
-  return format_of(s->entry->type);
+  return canopen::value_format_of(s->entry->type);
 }
 
 void local_link::close() {

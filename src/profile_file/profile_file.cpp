@@ -508,19 +508,11 @@ const char* state_activity_name(state_activity a) noexcept {
 
 profile_load_result load_profile_toml(std::string_view text, std::string_view source_name) {
   const std::string name(source_name);
-  if (const auto bad = toml_reading::check_toml_text(text)) {
+  std::optional<custom_profile> loaded;
+  if (const auto bad = toml_reading::parse_and_load(text, name, [&loaded](const toml::table& root) { loaded = load(root); })) {
     return profile_file_error{bad->line, bad->column, bad->reason, name};
   }
-  try {
-    const toml::table root = toml::parse(text, std::string_view(name));
-    return load(root);
-  } catch (const toml::parse_error& e) {
-    return profile_file_error{static_cast<int>(e.source().begin.line),
-                              static_cast<int>(e.source().begin.column),
-                              std::string(e.description()), name};
-  } catch (const refusal& r) {
-    return profile_file_error{r.line, r.column, r.reason, name};
-  }
+  return std::move(*loaded);
 }
 
 profile_load_result load_profile_toml_file(const std::string& path) {

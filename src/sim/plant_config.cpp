@@ -125,27 +125,14 @@ axis_state make_axis_state(const profile& p, const plant_constants& k) noexcept 
   a.quick_stop_deceleration = default_as<std::uint32_t>(object::quick_stop_deceleration);
   a.requested_mode = a.operation_mode = default_as<std::int8_t>(object::modes_of_operation);
   mode_objects& o = a.objects;
-  o.min_position = default_as<std::int32_t>(object::software_position_limit, 1);
-  o.max_position = default_as<std::int32_t>(object::software_position_limit, 2);
-  o.profile_velocity = default_as<std::uint32_t>(object::profile_velocity);
-  o.end_velocity = default_as<std::uint32_t>(object::end_velocity);
-  o.torque_slope = default_as<std::uint32_t>(object::torque_slope);
-  o.following_error_window = default_as<std::uint32_t>(object::following_error_window);
-  o.position_window = default_as<std::uint32_t>(object::position_window);
+  for (const detail::plain_setting& s : detail::plain_settings) {
+    s.write(o, default_of(s.index, s.sub == detail::every_sub ? 0 : s.sub));
+  }
   o.increments_per_rev = default_as<std::uint32_t>(object::position_encoder_resolution, 1);
-  o.homing_switch_speed = default_as<std::uint32_t>(object::homing_speeds, 1);
-  o.homing_zero_speed = default_as<std::uint32_t>(object::homing_speeds, 2);
-  o.homing_acceleration = default_as<std::uint32_t>(object::homing_acceleration);
-  o.following_error_time_out = default_as<std::uint16_t>(object::following_error_time_out);
-  o.position_window_time = default_as<std::uint16_t>(object::position_window_time);
   o.homing_method = default_as<std::int8_t>(object::homing_method);
   o.interpolation_value = default_as<std::uint8_t>(object::interpolation_time_period, 1);
   o.interpolation_index = default_as<std::int8_t>(object::interpolation_time_period, 2);
   o.interpolation_period_us = detail::interpolation_period_us(o.interpolation_value, o.interpolation_index);
-  o.max_profile_velocity = default_as<std::uint32_t>(object::max_profile_velocity);
-  o.max_torque = default_as<std::uint16_t>(object::max_torque);
-  o.velocity_window_time = default_as<std::uint16_t>(object::velocity_window_time);
-  o.velocity_threshold_time = default_as<std::uint16_t>(object::velocity_threshold_time);
   // The plant's own figures: its top speed, its target and standstill windows.
   o.max_motor_speed = k.max_velocity_rpm;
   o.velocity_window = k.target_window_rpm;

@@ -5,7 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 
+#include "cia402/objects.hpp"
 #include "cia402/sim/plant.hpp"
 #include "cia402/words.hpp"
 
@@ -231,5 +234,52 @@ std::uint16_t csp_follow(const plant_constants& k, axis_state& a) noexcept;
 std::uint16_t torque_cycle(const plant_constants& k, axis_state& a, motion::shaft& s) noexcept;
 /// Homing (plant_modes/homing.cpp).
 std::uint16_t homing_cycle(const plant_constants& k, axis_state& a, motion::shaft& s) noexcept;
+
+// The settings kept as one field each of mode_objects, read and written alike: one row per object
+// and sub-index, so reading and writing cannot disagree on where a value lives. The objects whose
+// write does more (a set-point, the mode, the homing method, 0x60C2) have cases of their own in
+// plant_objects.cpp. A new axis starts each at the one table's default.
+inline constexpr std::uint8_t every_sub = 0xFF;
+
+struct plain_setting {
+  std::uint16_t index;
+  std::uint8_t sub;  ///< the sub-index, or every_sub for an object of one value
+  std::int64_t (*read)(const mode_objects&) noexcept;
+  void (*write)(mode_objects&, std::int64_t) noexcept;
+};
+
+template <auto field>
+constexpr plain_setting setting(std::uint16_t index, std::uint8_t sub = every_sub) noexcept {
+  using value_type = std::remove_reference_t<decltype(std::declval<mode_objects&>().*field)>;
+  return {index, sub, [](const mode_objects& m) noexcept -> std::int64_t { return m.*field; },
+          [](mode_objects& m, std::int64_t v) noexcept { m.*field = static_cast<value_type>(v); }};
+}
+
+inline constexpr plain_setting plain_settings[] = {
+    setting<&mode_objects::position_offset>(object_index::position_offset),
+    setting<&mode_objects::velocity_offset>(object_index::velocity_offset),
+    setting<&mode_objects::torque_offset>(object_index::torque_offset),
+    setting<&mode_objects::home_offset>(object_index::home_offset),
+    setting<&mode_objects::min_position>(object_index::software_position_limit, 1),
+    setting<&mode_objects::max_position>(object_index::software_position_limit, 2),
+    setting<&mode_objects::profile_velocity>(object_index::profile_velocity),
+    setting<&mode_objects::end_velocity>(object_index::end_velocity),
+    setting<&mode_objects::torque_slope>(object_index::torque_slope),
+    setting<&mode_objects::following_error_window>(object_index::following_error_window),
+    setting<&mode_objects::following_error_time_out>(object_index::following_error_time_out),
+    setting<&mode_objects::position_window>(object_index::position_window),
+    setting<&mode_objects::position_window_time>(object_index::position_window_time),
+    setting<&mode_objects::homing_switch_speed>(object_index::homing_speeds, 1),
+    setting<&mode_objects::homing_zero_speed>(object_index::homing_speeds, 2),
+    setting<&mode_objects::homing_acceleration>(object_index::homing_acceleration),
+    setting<&mode_objects::max_profile_velocity>(object_index::max_profile_velocity),
+    setting<&mode_objects::max_motor_speed>(object_index::max_motor_speed),
+    setting<&mode_objects::max_torque>(object_index::max_torque),
+    setting<&mode_objects::velocity_window>(object_index::velocity_window),
+    setting<&mode_objects::velocity_window_time>(object_index::velocity_window_time),
+    setting<&mode_objects::velocity_threshold>(object_index::velocity_threshold),
+    setting<&mode_objects::velocity_threshold_time>(object_index::velocity_threshold_time),
+};
+
 
 }  // namespace cia402::sim::detail

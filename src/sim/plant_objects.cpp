@@ -73,6 +73,13 @@ sdo_abort describe(const profile& p, std::uint16_t index, std::uint8_t sub,
   return out != nullptr ? sdo_abort::none : missing(index);
 }
 
+const detail::plain_setting* find_plain_setting(std::uint16_t index, std::uint8_t sub) noexcept {
+  for (const detail::plain_setting& s : detail::plain_settings) {
+    if (s.index == index && (s.sub == detail::every_sub || s.sub == sub)) return &s;
+  }
+  return nullptr;
+}
+
 // The set-point objects end the "set-points cleared" of T4 when written.
 void setpoint_written(axis_state& a) noexcept { set_flag(a, sim_flag::setpoints_cleared, false); }
 
@@ -123,20 +130,6 @@ sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_
       m.target_torque = static_cast<std::int16_t>(value);
       setpoint_written(a);
       break;
-    case object::position_offset: m.position_offset = i32; break;
-    case object::velocity_offset: m.velocity_offset = i32; break;
-    case object::torque_offset: m.torque_offset = static_cast<std::int16_t>(value); break;
-    case object::home_offset: m.home_offset = i32; break;
-    case object::software_position_limit:
-      (sub == 1 ? m.min_position : m.max_position) = i32;
-      break;
-    case object::profile_velocity: m.profile_velocity = u32; break;
-    case object::end_velocity: m.end_velocity = u32; break;
-    case object::torque_slope: m.torque_slope = u32; break;
-    case object::following_error_window: m.following_error_window = u32; break;
-    case object::following_error_time_out: m.following_error_time_out = static_cast<std::uint16_t>(value); break;
-    case object::position_window: m.position_window = u32; break;
-    case object::position_window_time: m.position_window_time = static_cast<std::uint16_t>(value); break;
     case object::position_encoder_resolution:
       if (sub == 1) m.increments_per_rev = u32;
       break;  // sub 2 (motor revolutions) takes only 1: the table's limits
@@ -144,8 +137,6 @@ sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_
       if (!motion::homing::supports(value)) return sdo_abort::invalid_value;
       m.homing_method = static_cast<std::int8_t>(value);
       break;
-    case object::homing_speeds: (sub == 1 ? m.homing_switch_speed : m.homing_zero_speed) = u32; break;
-    case object::homing_acceleration: m.homing_acceleration = u32; break;
     case object::interpolation_time_period:
       if (sub == 1) m.interpolation_value = static_cast<std::uint8_t>(value);
       else m.interpolation_index = static_cast<std::int8_t>(value);
@@ -155,14 +146,12 @@ sdo_abort detail::write_any_object(const profile& p, axis_state& a, std::uint16_
                                        : a.operation_mode == cia402::mode::cyclic_synchronous_torque ? a.torque_demand
                                                                                                       : a.demand);
       break;
-    case object::max_profile_velocity: m.max_profile_velocity = u32; break;
-    case object::max_motor_speed: m.max_motor_speed = u32; break;
-    case object::max_torque: m.max_torque = static_cast<std::uint16_t>(value); break;
-    case object::velocity_window: m.velocity_window = static_cast<std::uint16_t>(value); break;
-    case object::velocity_window_time: m.velocity_window_time = static_cast<std::uint16_t>(value); break;
-    case object::velocity_threshold: m.velocity_threshold = static_cast<std::uint16_t>(value); break;
-    case object::velocity_threshold_time: m.velocity_threshold_time = static_cast<std::uint16_t>(value); break;
-    default: return sdo_abort::object_does_not_exist;
+    default:
+      if (const detail::plain_setting* setting = find_plain_setting(index, sub)) {
+        setting->write(m, value);
+        break;
+      }
+      return sdo_abort::object_does_not_exist;
   }
   return sdo_abort::none;
 }
@@ -208,35 +197,19 @@ sdo_abort read_object(const profile& p, const plant_constants& k, const axis_sta
     case object::torque_actual_value: value = a.torque; break;
     case object::target_position: value = m.target_position; break;
     case object::target_torque: value = m.target_torque; break;
-    case object::position_offset: value = m.position_offset; break;
-    case object::velocity_offset: value = m.velocity_offset; break;
-    case object::torque_offset: value = m.torque_offset; break;
-    case object::home_offset: value = m.home_offset; break;
-    case object::software_position_limit: value = sub == 1 ? m.min_position : m.max_position; break;
-    case object::profile_velocity: value = m.profile_velocity; break;
-    case object::end_velocity: value = m.end_velocity; break;
-    case object::torque_slope: value = m.torque_slope; break;
-    case object::following_error_window: value = m.following_error_window; break;
-    case object::following_error_time_out: value = m.following_error_time_out; break;
-    case object::position_window: value = m.position_window; break;
-    case object::position_window_time: value = m.position_window_time; break;
     case object::position_encoder_resolution: value = sub == 1 ? m.increments_per_rev : 1; break;
     case object::homing_method: value = m.homing_method; break;
-    case object::homing_speeds: value = sub == 1 ? m.homing_switch_speed : m.homing_zero_speed; break;
-    case object::homing_acceleration: value = m.homing_acceleration; break;
     case object::interpolation_time_period:
       value = sub == 1 ? m.interpolation_value : m.interpolation_index;
       break;
-    case object::max_profile_velocity: value = m.max_profile_velocity; break;
-    case object::max_motor_speed: value = m.max_motor_speed; break;
-    case object::max_torque: value = m.max_torque; break;
-    case object::velocity_window: value = m.velocity_window; break;
-    case object::velocity_window_time: value = m.velocity_window_time; break;
-    case object::velocity_threshold: value = m.velocity_threshold; break;
-    case object::velocity_threshold_time: value = m.velocity_threshold_time; break;
     case object::supported_homing_methods: value = o->default_value; break;  // the table's own list
     case object::digital_inputs: value = digital_inputs(k, a); break;
-    default: return sdo_abort::object_does_not_exist;
+    default:
+      if (const detail::plain_setting* setting = find_plain_setting(index, sub)) {
+        value = setting->read(m);
+        break;
+      }
+      return sdo_abort::object_does_not_exist;
   }
   return sdo_abort::none;
 }

@@ -489,24 +489,14 @@ const char* invariant_name(invariant i) noexcept {
 scenario_load_result load_scenario_toml(std::string_view text, std::string_view source_name,
                                         const std::string& base_dir) {
   const std::string name(source_name);
-  if (const auto bad = toml_reading::check_toml_text(text)) {
+  loader l;
+  l.base_dir = base_dir;
+  l.s.source_name = name;
+  if (const auto bad = toml_reading::parse_and_load(text, name, [&l](const toml::table& root) { l.load(root); })) {
     return scenario_error{bad->line, bad->column, bad->reason, name};
   }
-  try {
-    const toml::table root = toml::parse(text, std::string_view(name));
-    loader l;
-    l.base_dir = base_dir;
-    l.s.source_name = name;
-    l.load(root);
-    if (l.s.name.empty()) l.s.name = stem_of(name);
-    return std::move(l.s);
-  } catch (const toml::parse_error& e) {
-    return scenario_error{static_cast<int>(e.source().begin.line),
-                          static_cast<int>(e.source().begin.column), std::string(e.description()),
-                          name};
-  } catch (const refusal& r) {
-    return scenario_error{r.line, r.column, r.reason, name};
-  }
+  if (l.s.name.empty()) l.s.name = stem_of(name);
+  return std::move(l.s);
 }
 
 scenario_load_result load_scenario_file(const std::string& path) {

@@ -239,4 +239,18 @@ std::optional<std::string> read_small_file(const std::string& path, std::string&
   return text;
 }
 
+std::optional<refusal> parse_and_load(std::string_view text, std::string_view source_name,
+                                      const std::function<void(const toml::table& root)>& load) {
+  if (auto bad = check_toml_text(text)) return bad;
+  try {
+    load(toml::parse(text, source_name));
+    return std::nullopt;
+  } catch (const toml::parse_error& e) {
+    return refusal{static_cast<int>(e.source().begin.line), static_cast<int>(e.source().begin.column),
+                   std::string(e.description())};
+  } catch (const refusal& r) {
+    return r;
+  }
+}
+
 }  // namespace cia402::toml_reading

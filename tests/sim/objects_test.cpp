@@ -3,8 +3,11 @@
 // (0x6040 UINT16, 0x60FF INT32, 0x6083..0x6085 UINT32, option codes INT16, 0x6060 INT8).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "cia402/objects.hpp"
 #include "cia402/sim/virtual_drive.hpp"
@@ -193,6 +196,30 @@ TEST(objects, the_virtual_drive_answers_every_object_of_the_one_table) {
     EXPECT_EQ(d.write(o.index, o.sub, o.high), sdo_abort::none);
     ASSERT_EQ(d.read(o.index, o.sub, value), sdo_abort::none);
     EXPECT_EQ(value, o.high);
+  }
+}
+
+// Each writable object holds its value in a place of its own: values written to all of them, each
+// different, read back unchanged (two objects sharing a field would show the later write twice).
+TEST(objects, every_writable_object_keeps_a_value_of_its_own) {
+  virtual_drive d(standard_profile());
+  std::vector<std::pair<const cia402::object_description*, std::int64_t>> written;
+  for (std::size_t i = 0; i < cia402::drive_object_count(); ++i) {
+    const cia402::object_description& o = cia402::drive_object(i);
+    if (o.access == cia402::object_access::read_only || o.index == 0x6040 || o.index == 0x6060 ||
+        o.index == 0x6098 || (o.index >= 0x605A && o.index <= 0x605E) || o.index == 0x6007 || o.low == o.high) {
+      continue;  // the control word acts; these take the profile's or the modes' values only
+    }
+    // A value inside the limits that no other object gets: the high limit less the object's rank.
+    const std::int64_t value = std::max<std::int64_t>(o.low, o.high - static_cast<std::int64_t>(written.size()));
+    ASSERT_EQ(d.write(o.index, o.sub, value), sdo_abort::none) << o.name;
+    written.emplace_back(&o, value);
+  }
+  ASSERT_GT(written.size(), 20u);
+  for (const auto& [o, value] : written) {
+    std::int64_t read_back = 0;
+    ASSERT_EQ(d.read(o->index, o->sub, read_back), sdo_abort::none) << o->name;
+    EXPECT_EQ(read_back, value) << o->name;
   }
 }
 

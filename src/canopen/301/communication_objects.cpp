@@ -22,31 +22,27 @@ std::string hex4(std::uint16_t v) {
 }
 
 void add_pdos(std::vector<object_entry>& t, const slave_config& c) {
-  for (int n = 0; n < pdo_count; ++n) {
-    const pdo_map& m = c.rpdo[static_cast<std::size_t>(n)];
-    const auto num = std::to_string(n + 1);
-    const std::uint32_t cob_id = (m.count == 0 || !m.valid ? pdo_cob_invalid : 0u) + cob::rpdo1 + 0x100u * static_cast<std::uint32_t>(n);
-    t.push_back(group(static_cast<std::uint16_t>(0x1400 + n), "RPDO" + num + " communication parameter",
-                      object_code::record, object_category::optional,
-                      {variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 2),
-                       plus_node_id(variable(1, "COB-ID used by RPDO", data_type::unsigned32, access::rw, cob_id)),
-                       variable(2, "Transmission type", data_type::unsigned8, access::rw, m.transmission_type)}));
-    t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1600 + n), "RPDO" + num + " mapping parameter", m,
-                            max_mapped_objects));
-  }
-  for (int n = 0; n < pdo_count; ++n) {
-    const pdo_map& m = c.tpdo[static_cast<std::size_t>(n)];
-    const auto num = std::to_string(n + 1);
-    const std::uint32_t cob_id = (m.count == 0 || !m.valid ? pdo_cob_invalid : 0u) + cob::tpdo1 + 0x100u * static_cast<std::uint32_t>(n);
-    t.push_back(group(static_cast<std::uint16_t>(0x1800 + n), "TPDO" + num + " communication parameter",
-                      object_code::record, object_category::optional,
-                      {variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 5),
-                       plus_node_id(variable(1, "COB-ID used by TPDO", data_type::unsigned32, access::rw, cob_id)),
-                       variable(2, "Transmission type", data_type::unsigned8, access::rw, m.transmission_type),
-                       variable(3, "Inhibit time", data_type::unsigned16, access::rw, m.inhibit_100us),
-                       variable(5, "Event timer", data_type::unsigned16, access::rw, m.event_timer_ms)}));
-    t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1A00 + n), "TPDO" + num + " mapping parameter", m,
-                            max_mapped_objects));
+  for (const bool transmit : {false, true}) {
+    const std::string kind = transmit ? "TPDO" : "RPDO";
+    const std::uint16_t offset = transmit ? 0x400 : 0;
+    for (int n = 0; n < pdo_count; ++n) {
+      const pdo_map& m = (transmit ? c.tpdo : c.rpdo)[static_cast<std::size_t>(n)];
+      const auto name = kind + std::to_string(n + 1);
+      const std::uint32_t cob_id = (m.count == 0 || !m.valid ? pdo_cob_invalid : 0u) +
+                                   (transmit ? cob::tpdo1 : cob::rpdo1) + 0x100u * static_cast<std::uint32_t>(n);
+      std::vector<sub_entry> parameters = {
+          variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, transmit ? 5 : 2),
+          plus_node_id(variable(1, "COB-ID used by " + kind, data_type::unsigned32, access::rw, cob_id)),
+          variable(2, "Transmission type", data_type::unsigned8, access::rw, m.transmission_type)};
+      if (transmit) {
+        parameters.push_back(variable(3, "Inhibit time", data_type::unsigned16, access::rw, m.inhibit_100us));
+        parameters.push_back(variable(5, "Event timer", data_type::unsigned16, access::rw, m.event_timer_ms));
+      }
+      t.push_back(group(static_cast<std::uint16_t>(0x1400 + offset + n), name + " communication parameter",
+                        object_code::record, object_category::optional, std::move(parameters)));
+      t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1600 + offset + n), name + " mapping parameter", m,
+                              max_mapped_objects));
+    }
   }
 }
 

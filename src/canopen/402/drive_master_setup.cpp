@@ -43,6 +43,14 @@ void drive_master::build_script() {
     j.optional = group != 0;
     return j;
   };
+  // CiA 301's order for a new mapping: sub-index 0 to 0, the entries, then their number.
+  const auto write_mapping = [this, &write](std::uint16_t map_index, const pdo_map& m) {
+    script_.push_back(write(map_index, 0, 0, 1));
+    for (std::uint8_t e = 0; e < m.count; ++e) {
+      script_.push_back(write(map_index, static_cast<std::uint8_t>(e + 1), m.entries[e].word(), 4));
+    }
+    script_.push_back(write(map_index, 0, m.count, 1));
+  };
   const auto note_done = [](bool& worked) {
     return [&worked](const sdo_client& c) { worked = c.state() == sdo_client::status::done; };
   };
@@ -166,11 +174,7 @@ void drive_master::build_script() {
   const std::int64_t rpdo1 = cob::rpdo1 + node;
   script_.push_back(write(0x1400, 1, pdo_cob_invalid | rpdo1, 4));
   const pdo_map& control = pdo_maps::can_rpdo[0];  // the control word alone: CiA 402's RPDO1
-  script_.push_back(write(0x1600, 0, 0, 1));
-  for (std::uint8_t e = 0; e < control.count; ++e) {
-    script_.push_back(write(0x1600, static_cast<std::uint8_t>(e + 1), control.entries[e].word(), 4));
-  }
-  script_.push_back(write(0x1600, 0, control.count, 1));
+  write_mapping(0x1600, control);
   script_.push_back(write(0x1400, 2, 255, 1));
   script_.push_back(write(0x1400, 1, rpdo1, 4));
 
@@ -182,21 +186,13 @@ void drive_master::build_script() {
     const std::int64_t rpdo3_id = cob::rpdo1 + 0x200 + node;
     script_.push_back(write(0x1402, 1, pdo_cob_invalid | rpdo3_id, 4));
     const pdo_map& rpdo3 = pdo_maps::can_rpdo[2];
-    script_.push_back(write(0x1602, 0, 0, 1));
-    for (std::uint8_t e = 0; e < rpdo3.count; ++e) {
-      script_.push_back(write(0x1602, static_cast<std::uint8_t>(e + 1), rpdo3.entries[e].word(), 4));
-    }
-    script_.push_back(write(0x1602, 0, rpdo3.count, 1));
+    write_mapping(0x1602, rpdo3);
     script_.push_back(write(0x1402, 2, rpdo3.transmission_type, 1));
     script_.push_back(write(0x1402, 1, rpdo3_id, 4));
     const std::int64_t tpdo3_id = cob::tpdo1 + 0x200 + node;
     script_.push_back(write(0x1802, 1, pdo_cob_invalid | tpdo3_id, 4));
     const pdo_map& tpdo3 = pdo_maps::can_tpdo[2];
-    script_.push_back(write(0x1A02, 0, 0, 1));
-    for (std::uint8_t e = 0; e < tpdo3.count; ++e) {
-      script_.push_back(write(0x1A02, static_cast<std::uint8_t>(e + 1), tpdo3.entries[e].word(), 4));
-    }
-    script_.push_back(write(0x1A02, 0, tpdo3.count, 1));
+    write_mapping(0x1A02, tpdo3);
     script_.push_back(write(0x1802, 2, tpdo3.transmission_type, 1));
     sdo_job enable3 = write(0x1802, 1, tpdo3_id, 4);
     enable3.then = note_done(position_mapped_);

@@ -31,7 +31,20 @@ axes::transfer_result result_of(const sdo_result& r, const std::string& node, st
   return t;
 }
 
-std::optional<axes::value_format> format_of(data_type t) {
+std::optional<axes::value_format> find_format(const std::vector<object_entry>& table, std::uint16_t index,
+                                              std::uint8_t sub) {
+  for (const object_entry& o : table) {
+    if (o.index != index) continue;
+    for (const sub_entry& e : o.subs) {
+      if (e.sub == sub) return value_format_of(e.type);
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<axes::value_format> value_format_of(data_type t) {
   switch (t) {
     case data_type::visible_string: return axes::value_format::text();
     case data_type::boolean: return axes::value_format::integer(1, false);
@@ -41,19 +54,6 @@ std::optional<axes::value_format> format_of(data_type t) {
   if (size == 0) return std::nullopt;
   return axes::value_format::integer(size, type_is_signed(t));
 }
-
-std::optional<axes::value_format> find_format(const std::vector<object_entry>& table, std::uint16_t index,
-                                              std::uint8_t sub) {
-  for (const object_entry& o : table) {
-    if (o.index != index) continue;
-    for (const sub_entry& e : o.subs) {
-      if (e.sub == sub) return format_of(e.type);
-    }
-  }
-  return std::nullopt;
-}
-
-}  // namespace
 
 can_link::can_link(channel& bus, can_link_config config)
     : bus_(&bus), config_(std::move(config)), sdo_(bus, config_.node_id, config_.sdo_timeout_us) {}

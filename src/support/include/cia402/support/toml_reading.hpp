@@ -52,6 +52,12 @@ inline constexpr std::size_t max_file_bytes = 1 << 20;
 /// format the project reads). The refusal names the line and column of the first offending byte.
 std::optional<refusal> check_toml_text(std::string_view text);
 
+/// Checks the text (check_toml_text), parses it and hands the root table to `load`: what is wrong
+/// with the text, a TOML syntax error, or a refusal `load` throws comes back with its place;
+/// nothing when `load` returned.
+std::optional<refusal> parse_and_load(std::string_view text, std::string_view source_name,
+                                      const std::function<void(const toml::table& root)>& load);
+
 /// The contents of a regular file of at most max_file_bytes, or the reason it cannot be had (not
 /// a regular file: a device, a FIFO, a directory; too large; unreadable). Never echoes the file.
 std::optional<std::string> read_small_file(const std::string& path, std::string& why);
