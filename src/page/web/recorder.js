@@ -21,8 +21,10 @@ export async function pollRecording() {
   try {
     const askedRows = recorder.rowsSeen;
     const askedTransitions = recorder.transitionsSeen;
-    // The drive's time when asking: the answer holds every row up to it at least.
-    const askedAt = page.snapshot ? page.snapshot.time_ms : null;
+    // The drive's time when asking: the answer holds every row up to it at least. An idle drive
+    // sends no snapshots, so its time is the newest snapshot's carried on by the page's clock, less
+    // a margin for a drive running behind the wall clock (a loaded machine skips cycles).
+    const askedAt = page.snapshot ? Math.max(page.snapshot.time_ms, serverNow() - 250) : null;
     const res = await fetch(api(
       `/api/recording?rows_seen=${askedRows}&transitions_seen=${askedTransitions}`));
     if (!res.ok) return;

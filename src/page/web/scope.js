@@ -233,7 +233,8 @@ export function drawScopeFrame() {
     trigger: scope.acq.mode !== 'roll' && c ? c.t : null, reference,
   });
   const rows = viewRows(shown);
-  Object.assign(canvas.dataset, { t0: String(t0), t1: String(t1), span: String(t1 - t0),
+  Object.assign(canvas.dataset, { left: String(scope.mapping.left), width: String(scope.mapping.width),
+    t0: String(t0), t1: String(t1), span: String(t1 - t0),
     samples: String(rows.length), trigger: c && scope.acq.mode !== 'roll' ? String(c.t) : '' });
   el('scope-status').textContent = `${scope.paused ? 'paused · ' : ''}${scope.acq.status()} · ` +
     `${formatSpan(t1 - t0)} shown, ${rows.length} samples` +
@@ -373,6 +374,7 @@ function showCursors(shown) {
     const pts = series(sig);
     const va = a === null ? null : valueAt(sig, a, pts);
     const vb = b === null ? null : valueAt(sig, b, pts);
+    if (sig.part && va === null && vb === null) continue;  // a set-point of a mode not run there
     const tr = document.createElement('tr');
     const diff = typeof va === 'number' && typeof vb === 'number' ? fmt(vb - va) : '';
     for (const text of [sig.label, fmt(va), fmt(vb), diff]) {

@@ -8,7 +8,7 @@ import { publishMs, series, store, transitions } from './scope_data.js';
 
 export const COLOURS = ['#111111', '#b3261e', '#1f5fbf', '#2e7d32', '#8e24aa', '#ef6c00', '#00838f'];
 export const DASHES = [[], [], [2, 2], [8, 3], [1, 3], [10, 3, 2, 3], [4, 4]];
-const LEFT = 64, RIGHT = 64, TOP = 10, ANALOG_H = 190, STATE_H = 20, LANE_H = 13, AXIS_H = 22;
+const LEFT = 64, RIGHT = 64, TOP = 14, ANALOG_H = 190, STATE_H = 20, LANE_H = 13, AXIS_H = 22;
 
 /** A duration as the time base reads it: ms, s or min. */
 export function formatSpan(ms) {
@@ -104,7 +104,7 @@ export function drawScope(canvas, view) {
         g.fillStyle = ink;
         g.fillText(String(+v.toPrecision(6)), i === 0 ? LEFT - 4 : LEFT + pw + 4, y(s, v) + 4);
       }
-      g.fillText(s.unit, i === 0 ? LEFT - 4 : LEFT + pw + 4, top + ANALOG_H + 2);
+      g.fillText(s.unit, i === 0 ? LEFT - 4 : LEFT + pw + 4, TOP - 2);
     });
     const period = publishMs();
     clip(top, ANALOG_H, () => {
@@ -139,7 +139,8 @@ export function drawScope(canvas, view) {
   }
 
   if (stateSig) {
-    const pts = series(stateSig, t0, t1);
+    // One band per state: the recording repeats the state in every row it keeps.
+    const pts = series(stateSig, t0, t1).filter((p, i, all) => i === 0 || p.v !== all[i - 1].v);
     g.fillStyle = ink;
     g.textAlign = 'right';
     g.fillText('state', LEFT - 4, top + STATE_H / 2 + 4);
@@ -203,7 +204,7 @@ export function drawScope(canvas, view) {
     g.stroke();
     g.fillStyle = colour;
     g.textAlign = 'center';
-    if (text) g.fillText(text, xt, TOP - 1 > 9 ? TOP - 1 : 9);
+    if (text) g.fillText(text, xt, TOP - 2);
     g.restore();
   };
   if (view.showTransitions) {

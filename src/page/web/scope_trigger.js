@@ -14,7 +14,7 @@ const edgeMatches = (edge, before, after) =>
  */
 export function findTrigger(cond, after, until) {
   if (cond.type === 'level') {
-    const points = series(cond.signal, after, until);
+    const points = series(cond.signal, after, until).filter((p) => !cond.signal.rec || p.src === 'rec');
     for (let i = 1; i < points.length; i++) {
       const p = points[i - 1], q = points[i];
       if (q.t <= after) continue;
@@ -41,8 +41,10 @@ export function findTrigger(cond, after, until) {
 }
 
 /** How far the samples a condition is looked for in are complete. */
+// A signal the recording carries triggers from the recording alone, exact to the cycle, not from
+// the snapshots of the live edge.
 export function triggerSettled(cond) {
-  return cond.type === 'level' ? settledUntil(cond.signal) : store.recUntil;
+  return cond.type === 'level' && !cond.signal.rec ? settledUntil(cond.signal) : store.recUntil;
 }
 
 /**
