@@ -2,7 +2,7 @@
 // against `cia402 serve --port 0`: a single-shot trigger on a transition captures the samples
 // around it, the cursors snap to the recording's edges and their difference is the recording's to
 // the cycle, zoom changes the span shown, a level trigger fires at the first sample over the level,
-// and the CSV export of the view holds the rows the view shows. The expected times come from the
+// the CSV export of the view holds the rows the view shows, and the first load stays under 300 KB. The expected times come from the
 // server's own recording (/api/recording), never from the page; no wait asserts a duration.
 //
 //   node scope.test.mjs CIA402_BINARY OUTPUT_DIR
@@ -120,6 +120,18 @@ async function main() {
   page.on('pageerror', (e) => problems.push(String(e)));
   await page.goto(server.url);
   await waitState('SWITCH_ON_DISABLED');
+
+  await check('the first load (the page and its modules, as embedded) stays under 300 KB', async () => {
+    const load = await page.evaluate(() => {
+      const files = [...performance.getEntriesByType('navigation'), ...performance.getEntriesByType('resource')]
+        .filter((e) => !e.name.includes('/api/'));
+      // Decoded: the files' own size, whether or not the server compressed them on the wire.
+      return { bytes: files.reduce((sum, e) => sum + e.decodedBodySize, 0),
+        wire: files.reduce((sum, e) => sum + e.encodedBodySize, 0), files: files.length };
+    });
+    console.log(`# first load: ${load.files} files, ${load.bytes} bytes (${load.wire} on the wire)`);
+    expect(load.files >= 4 && load.bytes > 0 && load.bytes < 300 * 1024, `first load ${JSON.stringify(load)}`);
+  });
 
   let t4 = null;
   await check('single shot on transition 4 captures the samples around it, the trigger at the pre-trigger fraction', async () => {
