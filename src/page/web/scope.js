@@ -232,7 +232,7 @@ export function drawScopeFrame() {
     t0, t1, now, shown, colours: map, cursors: scope.cursors, showTransitions: scope.showTransitions,
     trigger: scope.acq.mode !== 'roll' && c ? c.t : null, reference,
   });
-  const rows = viewRows(shown);
+  const rows = viewRows(shown, false);  // the times only: the values are for the export
   Object.assign(canvas.dataset, { left: String(scope.mapping.left), width: String(scope.mapping.width),
     t0: String(t0), t1: String(t1), span: String(t1 - t0),
     samples: String(rows.length), trigger: c && scope.acq.mode !== 'roll' ? String(c.t) : '' });
@@ -390,7 +390,7 @@ function showCursors(shown) {
 
 // The view as rows: one per sample time of a shown signal in the window, each signal's value at
 // that time as drawn (analog interpolated between samples, the others held).
-function viewRows(shown) {
+function viewRows(shown, withValues = true) {
   const { t0, t1 } = scope.window;
   const times = new Set();
   const all = shown.map((sig) => {
@@ -398,7 +398,9 @@ function viewRows(shown) {
     for (const p of pts) if (p.t >= t0) times.add(p.t);
     return pts;
   });
-  return [...times].sort((x, y) => x - y).map((t) => [t, ...shown.map((sig, i) => valueAt(sig, t, all[i]))]);
+  const sorted = [...times].sort((x, y) => x - y);
+  if (!withValues) return sorted;
+  return sorted.map((t) => [t, ...shown.map((sig, i) => valueAt(sig, t, all[i]))]);
 }
 
 function download(blob, name) {

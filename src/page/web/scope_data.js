@@ -172,8 +172,13 @@ function lowerBound(list, t) {
 
 /** The value a signal had at time t as drawn: analog interpolated between samples, others held. */
 export function valueAt(sig, t, points = series(sig)) {
-  let i = points.length - 1;
-  while (i >= 0 && points[i].t > t) i--;
+  // The last sample at or before t, by bisection (the export asks for every sample time).
+  let lo = 0, hi = points.length;
+  while (lo < hi) {
+    const mid = (lo + hi) >> 1;
+    if (points[mid].t <= t) lo = mid + 1; else hi = mid;
+  }
+  const i = lo - 1;
   if (i < 0) return null;
   const p = points[i], q = points[i + 1];
   if (sig.kind !== 'analog' || !q || p.t === t) return p.v;
