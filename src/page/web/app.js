@@ -1,5 +1,5 @@
 // The instrument control page: its parts, started once /api/info is in, and each snapshot of the
-// event stream handed to them. Loaded as an ES module by index.html.
+// event stream handed to them. boot.js loads it and calls start().
 import { buildAxes, buildProfileChoice } from './axes.js';
 import { drawDiagram, updateDiagram } from './diagram.js';
 import { api, el, page, stateLabel, token } from './page.js';
@@ -9,6 +9,7 @@ import { buildScope, drawScopeFrame } from './scope.js';
 import { addRows, addSnapshot } from './scope_data.js';
 import { connect, setControl } from './stream.js';
 import { buildBits, buildCommands, buildModes, showWords } from './words.js';
+import './jog.js';
 
 function update(s, missed) {
   if (s.profile && page.info && s.profile !== page.info.profile.name) {
@@ -36,7 +37,7 @@ function animate() {
   setTimeout(() => requestAnimationFrame(animate), 50);
 }
 
-async function main() {
+export async function start() {
   const headers = token ? { 'X-Cia402-Token': token } : {};
   const res = await fetch(api('/api/info'), { headers });
   page.info = await res.json();
@@ -63,10 +64,3 @@ async function main() {
   pollRecording();
   setInterval(pollRecording, 500);
 }
-
-main().catch((e) => {
-  el('link').textContent = `cannot load the page's data: ${e.message}`;
-  console.error(e);
-});
-
-
