@@ -160,8 +160,8 @@ export function series(sig, t0 = -Infinity, t1 = Infinity) {
   return out;
 }
 
-// The first index whose time is at least t.
-function lowerBound(list, t) {
+/** The first index in a list sorted by time whose time is at least t. */
+export function lowerBound(list, t) {
   let lo = 0, hi = list.length;
   while (lo < hi) {
     const mid = (lo + hi) >> 1;
@@ -204,9 +204,12 @@ export function settledUntil(sig) {
 /** Times of the recording's edges: a transition or a change of a word or the state. */
 export function edges(t0 = -Infinity, t1 = Infinity) {
   const out = [];
+  const rec = store.rec;
+  const first = Math.max(0, lowerBound(rec, t0) - 1);
   let prev = null;
-  for (const r of store.rec) {
-    if (r.t > store.recUntil) break;
+  for (let i = first; i < rec.length; i++) {
+    const r = rec[i];
+    if (r.t > store.recUntil || r.t > t1) break;
     const changed = !prev || r.transition !== null || r.cw !== prev.cw || r.sw !== prev.sw ||
       r.state !== prev.state;
     if (changed && prev && r.t >= t0 && r.t <= t1) out.push(r.t);
@@ -218,8 +221,10 @@ export function edges(t0 = -Infinity, t1 = Infinity) {
 /** The transitions in the recording from t0 to t1: [{t, number}]. */
 export function transitions(t0 = -Infinity, t1 = Infinity) {
   const out = [];
-  for (const r of store.rec) {
-    if (r.t > store.recUntil) break;
+  const rec = store.rec;
+  for (let i = lowerBound(rec, t0); i < rec.length; i++) {
+    const r = rec[i];
+    if (r.t > store.recUntil || r.t > t1) break;
     if (r.transition !== null && r.t >= t0 && r.t <= t1) out.push({ t: r.t, number: r.transition });
   }
   return out;

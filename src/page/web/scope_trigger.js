@@ -2,7 +2,7 @@
 // it (single shot: one capture, then the scope stops; normal: each trigger after the last capture
 // ended gives the next one). Bit edges, states and transitions are found in the recording, exact to
 // the cycle; a level crossing in the signal's samples (the recording where it carries the signal).
-import { series, settledUntil, store } from './scope_data.js';
+import { lowerBound, series, settledUntil, store } from './scope_data.js';
 
 const edgeMatches = (edge, before, after) =>
   (edge !== 'falling' && !before && after) || (edge !== 'rising' && before && !after);
@@ -22,8 +22,11 @@ export function findTrigger(cond, after, until) {
     }
     return null;
   }
+  // From the row before `after` (it holds the words and the state an edge is seen against).
+  const rec = store.rec;
   let prev = null;
-  for (const r of store.rec) {
+  for (let i = Math.max(0, lowerBound(rec, after) - 1); i < rec.length; i++) {
+    const r = rec[i];
     if (r.t > until || r.t > store.recUntil) break;
     if (r.t > after) {
       if (cond.type === 'transition' && r.transition === cond.number) return r.t;
