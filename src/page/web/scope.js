@@ -173,8 +173,10 @@ function zoomStep(dir, anchor) {
   if (i >= 0 && i < DIVS.length) zoomTo(DIVS[i], anchor);
 }
 
+// Panning stops the window following the samples, as Pause does (Run or Live: follow again).
 function pan(fraction) {
   scope.t0 = scope.window.t0 + fraction * span();
+  if (!scope.paused) setPaused(true);
 }
 
 function setPaused(on) {
