@@ -87,99 +87,119 @@ export function drawScope(canvas, view) {
     g.restore();
   };
 
+  const c = { g, ink, grid, t0, t1, pw, x, view, bottom, clip };
   let top = TOP;
-  if (analog.length) {
-    const sc = scales(analog, t0, t1);
-    const y = (s, v) => top + 3 + (1 - (v - s.lo) / (s.hi - s.lo)) * (ANALOG_H - 6);
-    sc.slice(0, 2).forEach((s, i) => {
-      g.textAlign = i === 0 ? 'right' : 'left';
-      for (let v = s.lo; v <= s.hi + s.step * 1e-6; v += s.step) {
-        if (i === 0) {
-          g.strokeStyle = grid;
-          g.beginPath();
-          g.moveTo(LEFT, Math.round(y(s, v)) + 0.5);
-          g.lineTo(LEFT + pw, Math.round(y(s, v)) + 0.5);
-          g.stroke();
-        }
-        g.fillStyle = ink;
-        g.fillText(String(+v.toPrecision(6)), i === 0 ? LEFT - 4 : LEFT + pw + 4, y(s, v) + 4);
-      }
-      g.fillText(s.unit, i === 0 ? LEFT - 4 : LEFT + pw + 4, TOP - 2);
-    });
-    const period = publishMs();
-    clip(top, ANALOG_H, () => {
-      for (const sig of analog) {
-        const s = sc.find((u) => u.unit === sig.unit);
-        const pts = series(sig, t0, t1);
-        if (!pts.length || !s) continue;
-        const k = view.colours.get(sig.key) || 0;
-        g.strokeStyle = COLOURS[k % COLOURS.length];
-        g.setLineDash(sig.dash ? [7, 4] : DASHES[k % DASHES.length]);
-        g.lineWidth = k === 0 ? 2.5 : 1.8;
+  if (analog.length) top = drawAnalog(c, analog, top);
+  if (stateSig) top = drawStateLane(c, stateSig, top);
+  for (const sig of bits) top = drawBitLane(c, sig, top);
+  drawMarks(c);
+  return { left: LEFT, width: pw, x, t: (px) => t0 + ((px - LEFT) / pw) * (t1 - t0) };
+}
+
+// The analog signals, a scale per unit; returns the top of what comes below.
+function drawAnalog(c, analog, top) {
+  const { g, ink, grid, t0, t1, pw, x, view, clip } = c;
+  const sc = scales(analog, t0, t1);
+  const y = (s, v) => top + 3 + (1 - (v - s.lo) / (s.hi - s.lo)) * (ANALOG_H - 6);
+  sc.slice(0, 2).forEach((s, i) => {
+    g.textAlign = i === 0 ? 'right' : 'left';
+    for (let v = s.lo; v <= s.hi + s.step * 1e-6; v += s.step) {
+      if (i === 0) {
+        g.strokeStyle = grid;
         g.beginPath();
-        pts.forEach((p, i) => {
-          if (i === 0) { g.moveTo(x(p.t), y(s, p.v)); return; }
-          const q = pts[i - 1];
-          // Held: a step signal always; an analog one across a gap between snapshots (they come
-          // only on change), up to one period before the next.
-          if (sig.kind === 'step') g.lineTo(x(p.t), y(s, q.v));
-          else if (p.src === 'snap' && p.t - q.t > 1.5 * period) g.lineTo(x(p.t - period), y(s, q.v));
-          g.lineTo(x(p.t), y(s, p.v));
-        });
-        const last = pts[pts.length - 1];
-        g.lineTo(x(Math.min(t1, view.now)), y(s, last.v));
+        g.moveTo(LEFT, Math.round(y(s, v)) + 0.5);
+        g.lineTo(LEFT + pw, Math.round(y(s, v)) + 0.5);
         g.stroke();
       }
-    });
-    g.setLineDash([]);
-    g.lineWidth = 1;
-    g.strokeStyle = grid;
-    g.strokeRect(LEFT + 0.5, top + 0.5, pw, ANALOG_H);
-    top += ANALOG_H + 4;
-  }
-
-  if (stateSig) {
-    // One band per state: the recording repeats the state in every row it keeps.
-    const pts = series(stateSig, t0, t1).filter((p, i, all) => i === 0 || p.v !== all[i - 1].v);
-    g.fillStyle = ink;
-    g.textAlign = 'right';
-    g.fillText('state', LEFT - 4, top + STATE_H / 2 + 4);
-    clip(top, STATE_H, () => {
-      pts.forEach((p, i) => {
-        const xa = Math.max(LEFT, x(p.t));
-        const xb = x(i + 1 < pts.length ? pts[i + 1].t : Math.min(t1, view.now));
-        g.fillStyle = i % 2 ? '#d9d9d9' : '#bdbdbd';
-        g.fillRect(xa, top, Math.max(1, xb - xa - 1), STATE_H);
-        if (xb - xa > 50) {
-          g.fillStyle = '#111';
-          g.textAlign = 'left';
-          g.fillText(stateLabel(p.v), xa + 3, top + STATE_H / 2 + 4);
-        }
-      });
-    });
-    top += STATE_H + 4;
-  }
-
-  for (const sig of bits) {
-    const pts = series(sig, t0, t1);
-    g.fillStyle = ink;
-    g.textAlign = 'right';
-    g.fillText(sig.label.length > 11 ? `${sig.label.slice(0, 10)}…` : sig.label, LEFT - 4, top + LANE_H - 2);
-    clip(top, LANE_H, () => {
-      g.strokeStyle = ink;
-      g.lineWidth = 1.5;
+      g.fillStyle = ink;
+      g.fillText(String(+v.toPrecision(6)), i === 0 ? LEFT - 4 : LEFT + pw + 4, y(s, v) + 4);
+    }
+    g.fillText(s.unit, i === 0 ? LEFT - 4 : LEFT + pw + 4, TOP - 2);
+  });
+  const period = publishMs();
+  clip(top, ANALOG_H, () => {
+    for (const sig of analog) {
+      const s = sc.find((u) => u.unit === sig.unit);
+      const pts = series(sig, t0, t1);
+      if (!pts.length || !s) continue;
+      const k = view.colours.get(sig.key) || 0;
+      g.strokeStyle = COLOURS[k % COLOURS.length];
+      g.setLineDash(sig.dash ? [7, 4] : DASHES[k % DASHES.length]);
+      g.lineWidth = k === 0 ? 2.5 : 1.8;
       g.beginPath();
-      const yb = (v) => top + (v ? 1.5 : LANE_H - 1.5);
       pts.forEach((p, i) => {
-        if (i === 0) g.moveTo(x(p.t), yb(p.v));
-        else { g.lineTo(x(p.t), yb(pts[i - 1].v)); g.lineTo(x(p.t), yb(p.v)); }
+        if (i === 0) { g.moveTo(x(p.t), y(s, p.v)); return; }
+        const q = pts[i - 1];
+        // Held: a step signal always; an analog one across a gap between snapshots (they come
+        // only on change), up to one period before the next.
+        if (sig.kind === 'step') g.lineTo(x(p.t), y(s, q.v));
+        else if (p.src === 'snap' && p.t - q.t > 1.5 * period) g.lineTo(x(p.t - period), y(s, q.v));
+        g.lineTo(x(p.t), y(s, p.v));
       });
-      if (pts.length) g.lineTo(x(Math.min(t1, view.now)), yb(pts[pts.length - 1].v));
+      const last = pts[pts.length - 1];
+      g.lineTo(x(Math.min(t1, view.now)), y(s, last.v));
       g.stroke();
-    });
-    top += LANE_H + 1;
-  }
+    }
+  });
+  g.setLineDash([]);
+  g.lineWidth = 1;
+  g.strokeStyle = grid;
+  g.strokeRect(LEFT + 0.5, top + 0.5, pw, ANALOG_H);
+  top += ANALOG_H + 4;
+  return top;
+}
 
+// The state as bands, one per state, named where there is room.
+function drawStateLane(c, stateSig, top) {
+  const { g, ink, t0, t1, x, view, clip } = c;
+  // One band per state: the recording repeats the state in every row it keeps.
+  const pts = series(stateSig, t0, t1).filter((p, i, all) => i === 0 || p.v !== all[i - 1].v);
+  g.fillStyle = ink;
+  g.textAlign = 'right';
+  g.fillText('state', LEFT - 4, top + STATE_H / 2 + 4);
+  clip(top, STATE_H, () => {
+    pts.forEach((p, i) => {
+      const xa = Math.max(LEFT, x(p.t));
+      const xb = x(i + 1 < pts.length ? pts[i + 1].t : Math.min(t1, view.now));
+      g.fillStyle = i % 2 ? '#d9d9d9' : '#bdbdbd';
+      g.fillRect(xa, top, Math.max(1, xb - xa - 1), STATE_H);
+      if (xb - xa > 50) {
+        g.fillStyle = '#111';
+        g.textAlign = 'left';
+        g.fillText(stateLabel(p.v), xa + 3, top + STATE_H / 2 + 4);
+      }
+    });
+  });
+  top += STATE_H + 4;
+  return top;
+}
+
+// A word bit as a logic lane.
+function drawBitLane(c, sig, top) {
+  const { g, ink, t0, t1, x, view, clip } = c;
+  const pts = series(sig, t0, t1);
+  g.fillStyle = ink;
+  g.textAlign = 'right';
+  g.fillText(sig.label.length > 11 ? `${sig.label.slice(0, 10)}…` : sig.label, LEFT - 4, top + LANE_H - 2);
+  clip(top, LANE_H, () => {
+    g.strokeStyle = ink;
+    g.lineWidth = 1.5;
+    g.beginPath();
+    const yb = (v) => top + (v ? 1.5 : LANE_H - 1.5);
+    pts.forEach((p, i) => {
+      if (i === 0) g.moveTo(x(p.t), yb(p.v));
+      else { g.lineTo(x(p.t), yb(pts[i - 1].v)); g.lineTo(x(p.t), yb(p.v)); }
+    });
+    if (pts.length) g.lineTo(x(Math.min(t1, view.now)), yb(pts[pts.length - 1].v));
+    g.stroke();
+  });
+  top += LANE_H + 1;
+  return top;
+}
+
+// Over all lanes: the missed snapshots, the transitions, the trigger and the cursors.
+function drawMarks(c) {
+  const { g, t0, t1, pw, x, view, bottom } = c;
   // Missed snapshots: hatched, with how many.
   for (const [a, b, n] of store.gaps) {
     if (b < t0 || a > t1) continue;
@@ -232,5 +252,4 @@ export function drawScope(canvas, view) {
     g.textAlign = 'left';
     g.fillText(name, x(t) + 3, TOP + 10);
   }
-  return { left: LEFT, width: pw, x, t: (px) => t0 + ((px - LEFT) / pw) * (t1 - t0) };
 }

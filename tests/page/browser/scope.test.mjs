@@ -2,7 +2,8 @@
 // against `cia402 serve --port 0`: a single-shot trigger on a transition captures the samples
 // around it, the cursors snap to the recording's edges and their difference is the recording's to
 // the cycle, zoom changes the span shown, a level trigger fires at the first sample over the level,
-// the CSV export of the view holds the rows the view shows, and the first load stays under 300 KB. The expected times come from the
+// the CSV export of the view holds the rows the view shows, a status bit's edge triggers on the
+// transition's cycle, and the first load stays under 300 KB. The expected times come from the
 // server's own recording (/api/recording), never from the page; no wait asserts a duration.
 //
 //   node scope.test.mjs CIA402_BINARY OUTPUT_DIR
@@ -87,6 +88,7 @@ async function arm(settings) {
   await page.selectOption('#trig-type', settings.type);
   if (settings.transition !== undefined) await page.selectOption('#trig-transition', String(settings.transition));
   if (settings.signal) await page.selectOption('#trig-signal', settings.signal);
+  if (settings.bit) await page.selectOption('#trig-bit', settings.bit);
   if (settings.level !== undefined) await page.fill('#trig-level', String(settings.level));
   if (settings.edge) await page.selectOption('#trig-edge', settings.edge);
   await page.fill('#trig-pre', String(settings.pre));
@@ -217,10 +219,15 @@ async function main() {
   });
 
   await check('the CSV export of the view has the rows the view shows, in its window', async () => {
+    const before = await page.evaluate(() => document.getElementById('plot').clientHeight);
+    await page.check('input[data-signal="cw3"]');  // a control-word bit as a lane of its own
+    await page.waitForFunction((h) => document.getElementById('plot').clientHeight > h, before, { timeout: patience });
     const d = await dataset();
     const text = fs.readFileSync(await download('scope-csv'), 'utf8').trim().split('\n');
     const header = text[0].split(',');
     expect(header[0] === 'time_ms' && header.includes('velocity 0x606C'), `header ${text[0]}`);
+    const bit = header.findIndex((h) => h.startsWith('CW 3 '));
+    expect(bit > 0 && text.slice(1).every((l) => l.split(',')[bit] === '1'), 'CW 3 (enable operation) is 1 throughout');
     const times = text.slice(1).map((l) => Number(l.split(',')[0]));
     expect(times.length === d.samples, `${times.length} CSV rows, ${d.samples} samples shown`);
     expect(times.every((t, i) => t >= d.t0 && t <= d.t1 && (i === 0 || t > times[i - 1])),
@@ -228,6 +235,16 @@ async function main() {
     expect(times.includes(d.trigger), 'the trigger sample is a row');
     const png = fs.readFileSync(await download('scope-png'));
     expect(png.subarray(1, 4).toString() === 'PNG', 'the PNG export is a PNG');
+  });
+
+  await check("a trigger on a status bit's falling edge fires on the cycle of the transition that clears it", async () => {
+    await arm({ mode: 'single', type: 'bit', bit: 'sw2', edge: 'falling', pre: 50, div: 50 });
+    await command('disable_operation');
+    await waitState('SWITCHED_ON');
+    await page.waitForSelector('#scope-status[data-state="stopped"]', { timeout: patience });
+    const t5 = (await recording()).transitions.find((t) => t.number === 5);
+    const d = await dataset();
+    expect(t5 && d.trigger === t5.time_ms, `trigger at ${d.trigger}, T5 (operation enabled bit 2 falls) at ${t5 && t5.time_ms}`);
   });
 
   await check('no errors in the browser console', async () => {
