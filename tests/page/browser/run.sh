@@ -2,6 +2,7 @@
 # The browser test of the instrument page, as CTest runs it:
 #   run.sh CIA402_BINARY WORK_DIR SCREENSHOT_PNG   (SCREENSHOT_PNG, and three more pictures beside
 #                                                  it, are written with CIA402_UPDATE_SCREENSHOT=1)
+# Then scope.test.mjs, the scope's checks, on a server of its own.
 # Installs playwright-core with `npm ci` from this folder's package-lock.json into WORK_DIR (no
 # browser download: Debian's /usr/bin/chromium is used), then runs instrument_page.test.mjs.
 # Exit 77 (CTest: skipped) with the reason printed when node, npm or chromium is missing, or when
@@ -38,6 +39,7 @@ fi
 export CIA402_NODE_MODULES="$work/node_modules"
 export CIA402_CHROMIUM="$chromium"
 node "$here/instrument_page.test.mjs" "$cia402" "$work/output" "$screenshot"
+node "$here/scope.test.mjs" "$cia402" "$work/output"
 # With CIA402_UPDATE_SCREENSHOT=1 the docs' other pictures follow: phone width, several axes, the
 # recorder (the whole page at 1280 px), profile position after a move.
 if [ "${CIA402_UPDATE_SCREENSHOT:-0}" = 1 ]; then
@@ -46,4 +48,5 @@ if [ "${CIA402_UPDATE_SCREENSHOT:-0}" = 1 ]; then
   cp "$work/output/axes-1280x800.png" "$images/axes.png"
   cp "$work/output/full-1280.png" "$images/instrument-page-full.png"
   cp "$work/output/pp-1280x800.png" "$images/instrument-page-pp.png"
+  cp "$work/output/scope-1280.png" "$images/instrument-page-scope.png"
 fi

@@ -1,0 +1,95 @@
+// What every part of the instrument page shares: the token and the axis from the URL, requests to
+// the server, the newest /api/info and snapshot, and a few helpers. The page shows what the server
+// sends and sends commands; every decision of the state machine is the server's (the core's):
+// nothing here knows which transition a command leads to.
+
+const params = new URLSearchParams(location.search);
+// The token printed by `cia402 serve` arrives in the URL once; it is kept for this tab only
+// (sessionStorage) and taken out of the address bar and the history at once.
+export const token = (() => {
+  const given = params.get('token');
+  if (given) {
+    try { sessionStorage.setItem('cia402-token', given); } catch (e) { /* storage off: URL only */ }
+    params.delete('token');
+    const rest = params.toString();
+    history.replaceState(null, '', `${location.pathname}${rest ? `?${rest}` : ''}${location.hash}`);
+    return given;
+  }
+  try { return sessionStorage.getItem('cia402-token') || ''; } catch (e) { return ''; }
+})();
+// Which of the server's drives this page shows (?axis=K; the first without it).
+const axisParam = params.get('axis') || '';
+
+/** The page's shared state: /api/info, the newest snapshot and when it came (performance.now()). */
+export const page = { info: null, snapshot: null, received: 0 };
+
+// An API path for this page's axis.
+export function api(path) {
+  if (!axisParam) return path;
+  return `${path}${path.includes('?') ? '&' : '?'}axis=${encodeURIComponent(axisParam)}`;
+}
+export const el = (id) => document.getElementById(id);
+
+// The drive's time now in ms: the newest snapshot's, carried on by the time since it came.
+export function serverNow() {
+  return page.snapshot ? page.snapshot.time_ms + (performance.now() - page.received) : 0;
+}
+
+export async function post(path, body) {
+  const headers = { 'Content-Type': 'application/json' };
+  if (token) headers['X-Cia402-Token'] = token;
+  let reply;
+  try {
+    const res = await fetch(api(path), { method: 'POST', headers, body: JSON.stringify(body) });
+    reply = await res.json().catch(() => ({}));
+    if (!res.ok) {
+      showResult('refused', reply.error || `HTTP ${res.status}`);
+      return null;
+    }
+  } catch (e) {
+    showResult('refused', `no connection to the server (${e.message})`);
+    return null;
+  }
+  return reply;
+}
+
+export function showResult(outcome, text) {
+  const r = el('result');
+  r.textContent = text;
+  r.dataset.outcome = outcome;
+}
+
+export function label(name) {
+  return name.replace(/_/g, ' ');
+}
+
+// A state as the profile's documents name it (info.state_names), else the CiA 402 name.
+export function stateLabel(name) {
+  const info = page.info;
+  return (info && info.state_names && info.state_names[name]) || label(name);
+}
+
+export function hexBits(hex) {
+  return parseInt(hex, 16);
+}
+
+// A canvas sized to its CSS box at the screen's pixel ratio, cleared: its context and CSS size.
+export function fitCanvas(canvas) {
+  const dpr = window.devicePixelRatio || 1;
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
+    canvas.width = Math.round(w * dpr);
+    canvas.height = Math.round(h * dpr);
+  }
+  const g = canvas.getContext('2d');
+  g.setTransform(dpr, 0, 0, dpr, 0, 0);
+  g.clearRect(0, 0, w, h);
+  return { g, w, h };
+}
+
+// A step of 1, 2 or 5 times a power of ten at least `raw`.
+export function niceStep(raw) {
+  const p = Math.pow(10, Math.floor(Math.log10(raw)));
+  for (const m of [1, 2, 5, 10]) if (raw <= m * p) return m * p;
+  return 10 * p;
+}

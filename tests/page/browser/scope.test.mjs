@@ -1,0 +1,279 @@
+// The instrument page's scope in a real browser (Debian's chromium, headless, playwright-core)
+// against `cia402 serve --port 0`: a single-shot trigger on a transition captures the samples
+// around it, the cursors snap to the recording's edges and their difference is the recording's to
+// the cycle, zoom changes the span shown, a level trigger fires at the first sample over the level,
+// the CSV export of the view holds the rows the view shows, a status bit's edge triggers on the
+// transition's cycle, and the first load stays under 300 KB. The expected times come from the
+// server's own recording (/api/recording), never from the page; no wait asserts a duration.
+//
+//   node scope.test.mjs CIA402_BINARY OUTPUT_DIR
+// Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
+import { spawn } from 'node:child_process';
+import fs from 'node:fs';
+import { createRequire } from 'node:module';
+import os from 'node:os';
+import path from 'node:path';
+
+const [cia402, outDir] = process.argv.slice(2).map((a) => path.resolve(a));
+if (!cia402 || !outDir) {
+  console.error('usage: node scope.test.mjs CIA402_BINARY OUTPUT_DIR');
+  process.exit(2);
+}
+const modules = path.resolve(process.env.CIA402_NODE_MODULES || 'node_modules');
+const { chromium } = createRequire(path.join(modules, 'resolve-from-here.js'))('playwright-core');
+fs.mkdirSync(outDir, { recursive: true });
+
+// Generous: a wait ends as soon as its condition holds, so only a failing check pays for it.
+const patience = 30000;
+let passed = 0;
+let server = null;
+let context = null;
+let page = null;
+
+function expect(condition, message) {
+  if (!condition) throw new Error(message);
+}
+
+async function check(name, fn) {
+  await fn();
+  passed += 1;
+  console.log(`ok ${passed} - scope: ${name}`);
+}
+
+function startServer() {
+  return new Promise((resolve, reject) => {
+    const proc = spawn(cia402, ['serve', '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
+    const s = { proc, output: '', url: null };
+    const timer = setTimeout(() => reject(new Error(`no URL from cia402 serve:\n${s.output}`)), 15000);
+    proc.stdout.on('data', (d) => {
+      s.output += d;
+      const m = /(http:\/\/\S+)/.exec(s.output);
+      if (m && !s.url) {
+        s.url = m[1];
+        clearTimeout(timer);
+        resolve(s);
+      }
+    });
+    proc.stderr.on('data', (d) => { s.output += d; });
+    proc.on('exit', (code) => { if (!s.url) reject(new Error(`cia402 serve exited ${code}:\n${s.output}`)); });
+  });
+}
+
+// The server's recording, as the page could fetch it.
+function recording() {
+  return page.evaluate(async () => (await fetch('/api/recording')).json());
+}
+
+const dataset = () => page.evaluate(() => {
+  const d = document.getElementById('plot').dataset;
+  return { t0: Number(d.t0), t1: Number(d.t1), span: Number(d.span), samples: Number(d.samples),
+    trigger: d.trigger === '' ? null : Number(d.trigger), left: Number(d.left), width: Number(d.width) };
+});
+
+const cursorMs = (id) => page.evaluate((i) => {
+  const v = document.getElementById(i).dataset.ms;
+  return v === '' ? null : Number(v);
+}, id);
+
+async function command(key) {
+  await page.click(`button[data-command="${key}"]`);
+}
+
+async function waitState(state) {
+  await page.waitForSelector(`#diagram [id="state.${state}"].present`, { timeout: patience });
+}
+
+async function arm(settings) {
+  await page.selectOption('#trig-mode', settings.mode);
+  await page.selectOption('#trig-type', settings.type);
+  if (settings.transition !== undefined) await page.selectOption('#trig-transition', String(settings.transition));
+  if (settings.signal) await page.selectOption('#trig-signal', settings.signal);
+  if (settings.bit) await page.selectOption('#trig-bit', settings.bit);
+  if (settings.level !== undefined) await page.fill('#trig-level', String(settings.level));
+  if (settings.edge) await page.selectOption('#trig-edge', settings.edge);
+  await page.fill('#trig-pre', String(settings.pre));
+  await page.selectOption('#scope-div', String(settings.div));
+  await page.click('#trig-arm');
+  await page.waitForFunction(() => document.getElementById('scope-status').textContent.includes('armed'),
+    null, { timeout: patience });
+}
+
+async function download(id) {
+  const [d] = await Promise.all([page.waitForEvent('download'), page.click(`#${id}`)]);
+  const file = path.join(outDir, d.suggestedFilename());
+  await d.saveAs(file);
+  return file;
+}
+
+async function main() {
+  server = await startServer();
+  const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'cia402-scope-'));
+  context = await chromium.launchPersistentContext(userDataDir, {
+    executablePath: process.env.CIA402_CHROMIUM || '/usr/bin/chromium',
+    headless: true,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+    viewport: { width: 1280, height: 900 },
+    acceptDownloads: true,
+  });
+  page = context.pages()[0] || await context.newPage();
+  const problems = [];
+  page.on('console', (m) => { if (m.type() === 'error') problems.push(m.text()); });
+  page.on('pageerror', (e) => problems.push(String(e)));
+  // The first request for one module fails, as Chromium fails the requests in flight when the
+  // machine's network interfaces change: the page must load anyway (boot.js reloads it).
+  let aborted = 0;
+  await page.route('**/words.js', (route) => (aborted++ === 0 ? route.abort('failed') : route.continue()));
+  await page.goto(server.url);
+  await check('a module that did not arrive once does not leave the page dead', async () => {
+    await waitState('SWITCH_ON_DISABLED');
+    expect(aborted >= 2, `words.js asked for ${aborted} times`);
+  });
+  await page.unroute('**/words.js');
+  problems.length = 0;  // the aborted request's console error was the point
+
+  await check('the first load (the page and its modules, as embedded) stays under 300 KB', async () => {
+    const load = await page.evaluate(() => {
+      const files = [...performance.getEntriesByType('navigation'), ...performance.getEntriesByType('resource')]
+        .filter((e) => !e.name.includes('/api/'));
+      // Decoded: the files' own size, whether or not the server compressed them on the wire.
+      return { bytes: files.reduce((sum, e) => sum + e.decodedBodySize, 0),
+        wire: files.reduce((sum, e) => sum + e.encodedBodySize, 0), files: files.length };
+    });
+    console.log(`# first load: ${load.files} files, ${load.bytes} bytes (${load.wire} on the wire)`);
+    expect(load.files >= 4 && load.bytes > 0 && load.bytes < 300 * 1024, `first load ${JSON.stringify(load)}`);
+  });
+
+  let t4 = null;
+  await check('single shot on transition 4 captures the samples around it, the trigger at the pre-trigger fraction', async () => {
+    await arm({ mode: 'single', type: 'transition', transition: 4, pre: 50, div: 20 });
+    await command('shutdown');
+    await waitState('READY_TO_SWITCH_ON');
+    await command('switch_on');
+    await waitState('SWITCHED_ON');
+    await command('enable_operation');
+    await waitState('OPERATION_ENABLED');
+    await page.waitForSelector('#scope-status[data-state="stopped"]', { timeout: patience });
+    const rec = await recording();
+    const fired = rec.transitions.filter((t) => t.number === 4);
+    expect(fired.length === 1, `one T4 in the recording: ${JSON.stringify(rec.transitions)}`);
+    t4 = fired[0].time_ms;
+    const d = await dataset();
+    expect(d.trigger === t4, `trigger at ${d.trigger}, the recording's T4 at ${t4}`);
+    expect(d.span === 200, `20 ms/div is a span of 200 ms, not ${d.span}`);
+    expect(d.t0 === t4 - 100 && d.t1 === t4 + 100, `window ${d.t0}..${d.t1} around ${t4}`);
+    // The recording's rows on either side of the trigger are in the view.
+    const rows = rec.rows.filter((r) => r[0] >= d.t0 && r[0] <= d.t1);
+    expect(rows.some((r) => r[0] < t4) || rec.rows.some((r) => r[0] < d.t0), 'something before the trigger');
+    expect(d.samples >= rows.length && d.samples > 0, `${d.samples} samples shown, ${rows.length} recording rows in the window`);
+  });
+
+  let t3 = null;
+  await check('cursors snap to the transitions and read their difference to the cycle', async () => {
+    const d = await dataset();
+    // A click on the trigger's line puts cursor A on the transition's cycle.
+    const x = d.left + ((t4 - d.t0) / (d.t1 - d.t0)) * d.width;
+    await page.click('#plot', { position: { x: Math.round(x), y: 60 } });
+    await page.waitForFunction(() => document.getElementById('cursor-a-time').dataset.ms !== '', null, { timeout: patience });
+    expect(await cursorMs('cursor-a-time') === t4, `cursor A at ${await cursorMs('cursor-a-time')}, T4 at ${t4}`);
+    // B steps back edge by edge (transitions and word changes) to transition 3.
+    const rec = await recording();
+    t3 = rec.transitions.find((t) => t.number === 3).time_ms;
+    for (let i = 0; i < 40; i++) {
+      const b = await cursorMs('cursor-b-time');
+      if (b !== null && b <= t3) break;
+      await page.click('#cur-b-prev');
+      await page.waitForFunction((old) => document.getElementById('cursor-b-time').dataset.ms !== String(old ?? ''),
+        b, { timeout: patience });
+    }
+    expect(await cursorMs('cursor-b-time') === t3, `cursor B at ${await cursorMs('cursor-b-time')}, T3 at ${t3}`);
+    expect(await cursorMs('cursor-dt') === t3 - t4, `Δt ${await cursorMs('cursor-dt')}, the recording says ${t3 - t4}`);
+    const cycleMs = (await page.evaluate(async () => (await fetch('/api/info')).json())).cycle_us / 1000;
+    const text = await page.textContent('#cursor-dt');
+    expect(text.includes(`${(t3 - t4) / cycleMs} cycles`), `Δt in cycles: "${text}"`);
+  });
+
+  await check('zoom changes the time span shown', async () => {
+    await page.click('#scope-live');
+    await page.selectOption('#scope-div', '100');
+    await page.waitForFunction(() => document.getElementById('plot').dataset.span === '1000', null, { timeout: patience });
+    await page.click('#scope-zoom-out');
+    await page.waitForFunction(() => document.getElementById('plot').dataset.span === '2000', null, { timeout: patience });
+    await page.click('#scope-zoom-in');
+    await page.click('#scope-zoom-in');
+    await page.waitForFunction(() => document.getElementById('plot').dataset.span === '500', null, { timeout: patience });
+    expect((await page.inputValue('#scope-div')) === '50', 'the time base follows the zoom');
+  });
+
+  await check('a level trigger fires at the first recorded sample of the velocity over the level', async () => {
+    await arm({ mode: 'single', type: 'level', signal: 'v', level: 500, edge: 'rising', pre: 25, div: 200 });
+    const armedAt = (await recording()).rows.at(-1)[0];
+    await page.fill('#target-input', '1500');
+    await page.click('#target-form button[type="submit"]');
+    await page.waitForSelector('#scope-status[data-state="stopped"]', { timeout: patience });
+    const rec = await recording();
+    const first = rec.rows.find((r, i) => i > 0 && r[0] > armedAt && r[5] >= 500 && rec.rows[i - 1][5] < 500);
+    const d = await dataset();
+    expect(first && d.trigger === first[0], `trigger at ${d.trigger}, the first row over 500 rpm: ${JSON.stringify(first)}`);
+    expect(d.t0 === first[0] - 500 && d.span === 2000, `25 % of 2 s before the trigger: ${d.t0}..${d.t1}`);
+  });
+
+  await check('the CSV export of the view has the rows the view shows, in its window', async () => {
+    const before = await page.evaluate(() => document.getElementById('plot').clientHeight);
+    await page.check('input[data-signal="cw3"]');  // a control-word bit as a lane of its own
+    await page.waitForFunction((h) => document.getElementById('plot').clientHeight > h, before, { timeout: patience });
+    const d = await dataset();
+    const text = fs.readFileSync(await download('scope-csv'), 'utf8').trim().split('\n');
+    const header = text[0].split(',');
+    expect(header[0] === 'time_ms' && header.includes('velocity 0x606C'), `header ${text[0]}`);
+    const bit = header.findIndex((h) => h.startsWith('CW 3 '));
+    expect(bit > 0 && text.slice(1).every((l) => l.split(',')[bit] === '1'), 'CW 3 (enable operation) is 1 throughout');
+    const times = text.slice(1).map((l) => Number(l.split(',')[0]));
+    expect(times.length === d.samples, `${times.length} CSV rows, ${d.samples} samples shown`);
+    expect(times.every((t, i) => t >= d.t0 && t <= d.t1 && (i === 0 || t > times[i - 1])),
+      `times rising within ${d.t0}..${d.t1}`);
+    expect(times.includes(d.trigger), 'the trigger sample is a row');
+    const png = fs.readFileSync(await download('scope-png'));
+    expect(png.subarray(1, 4).toString() === 'PNG', 'the PNG export is a PNG');
+  });
+
+  await check("a trigger on a status bit's falling edge fires on the cycle of the transition that clears it", async () => {
+    await arm({ mode: 'single', type: 'bit', bit: 'sw2', edge: 'falling', pre: 50, div: 50 });
+    await command('disable_operation');
+    await waitState('SWITCHED_ON');
+    await page.waitForSelector('#scope-status[data-state="stopped"]', { timeout: patience });
+    const t5 = (await recording()).transitions.find((t) => t.number === 5);
+    const d = await dataset();
+    expect(t5 && d.trigger === t5.time_ms, `trigger at ${d.trigger}, T5 (operation enabled bit 2 falls) at ${t5 && t5.time_ms}`);
+  });
+
+  await check('no errors in the browser console', async () => {
+    expect(problems.length === 0, `console errors: ${JSON.stringify(problems)}`);
+  });
+  // The picture for docs/instrument-page.md: cursor A on the trigger, B late in the ramp.
+  const d = await dataset();
+  await page.click('#cur-clear');
+  await page.click('#plot', { position: { x: Math.round(d.left + 0.25 * d.width), y: 60 } });
+  await page.click('#plot', { position: { x: Math.round(d.left + 0.6 * d.width), y: 60 } });
+  await page.waitForFunction(() => document.getElementById('cursor-dt').dataset.ms !== '', null, { timeout: patience });
+  const scopePanel = await page.$('.panel-scope');
+  await scopePanel.screenshot({ path: path.join(outDir, 'scope-1280.png') });
+
+  await context.close();
+  fs.rmSync(userDataDir, { recursive: true, force: true });
+  server.proc.kill('SIGINT');
+  console.log(`# ${passed} scope checks passed`);
+}
+
+main().then(() => process.exit(0), async (e) => {
+  console.error(`not ok ${passed + 1} - scope: ${e.message}`);
+  try {
+    if (page) await page.screenshot({ path: path.join(outDir, 'scope-failure.png'), fullPage: true });
+  } catch { /* the page may be gone */ }
+  if (server) {
+    server.proc.kill('SIGKILL');
+    console.error(`--- cia402 serve output ---\n${server.output}`);
+  }
+  if (context) await context.close().catch(() => {});
+  process.exit(1);
+});
