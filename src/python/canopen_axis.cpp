@@ -360,60 +360,10 @@ std::int8_t mode_argument(const py::handle& m) {
   raise_argument_error("a mode is pp, pv, tq, hm, csp, csv, cst or its number");
 }
 
-}  // namespace
-
-void bind_canopen_axis(py::module_& m, py::class_<bus_core, std::shared_ptr<bus_core>>& bus) {
-  py::class_<axis_handle, std::shared_ptr<axis_handle>>(m, "Axis", R"doc(
-The project's master for one drive on a VirtualBus: the axis session of `cia402 master` over its
-CAN link (SDO, then PDOs with SYNC every `cycle_ms`). Each call starts one request and waits for its
-end (`timeout` s: wall clock, or virtual time on a virtual-time bus, which the call then advances);
-it returns a dict with what the drive showed at the end (state, status_word, error_code, mode,
-position, velocity, torque, note). A refusal raises SdoError (with the abort code) where the drive
-or the object table refused an object, AxisError (with the state, status word and error code)
-otherwise, also when the request did not end in time.)doc")
-      .def("enable", [](axis_handle& a, double t) {
-             return a.run("enable", [](axes::session& s, axes::completion d) { return s.go_to(state::operation_enabled, std::move(d)); }, t);
-           }, py::arg("timeout") = 5.0, "To OPERATION ENABLED through the core's planner.")
-      .def("disable", [](axis_handle& a, double t) {
-             return a.run("disable", [](axes::session& s, axes::completion d) { return s.go_to(state::switch_on_disabled, std::move(d)); }, t);
-           }, py::arg("timeout") = 5.0, "To SWITCH ON DISABLED.")
-      .def("reset", [](axis_handle& a, double t) {
-             return a.run("reset", [](axes::session& s, axes::completion d) { return s.reset(std::move(d)); }, t);
-           }, py::arg("timeout") = 5.0, "A fault-reset edge on a drive in FAULT; done in SWITCH ON DISABLED.")
-      .def("quick_stop", [](axis_handle& a, double t) {
-             return a.run("quick stop", [](axes::session& s, axes::completion d) { return s.quick_stop(std::move(d)); }, t);
-           }, py::arg("timeout") = 10.0, "Quick stop, done when the stop has ended as 0x605A says.")
-      .def("stop", [](axis_handle& a, double t) {
-             return a.run("stop", [](axes::session& s, axes::completion d) { return s.stop(std::move(d)); }, t);
-           }, py::arg("timeout") = 10.0, "Ends the motion and stops the shaft (halt), done at standstill.")
-      .def("mode", [](axis_handle& a, const py::object& wanted, double t) {
-             const std::int8_t code = mode_argument(wanted);
-             return a.run("mode", [code](axes::session& s, axes::completion d) { return s.set_mode(code, std::move(d)); }, t);
-           }, py::arg("mode"), py::arg("timeout") = 5.0, "0x6060 (\"pp\", \"pv\", \"hm\", ... or the number), done when 0x6061 shows it.")
-      .def("move", [](axis_handle& a, std::int64_t target, bool relative, std::optional<std::int64_t> rpm, double t) {
-             axes::move_request r;
-             r.target = static_cast<std::int32_t>(checked_integer(target, INT32_MIN, INT32_MAX, "target"));
-             r.relative = relative;
-             if (rpm) r.velocity = static_cast<std::uint32_t>(checked_integer(*rpm, 1, UINT32_MAX, "velocity"));
-             return a.run("move", [r](axes::session& s, axes::completion d) { return s.move(r, std::move(d)); }, t);
-           }, py::arg("target"), py::arg("relative") = false, py::arg("velocity") = py::none(), py::arg("timeout") = 30.0,
-           "A profile position move (switching to pp first): the set-point handshake, done at the target.")
-      .def("home", [](axis_handle& a, std::optional<std::int64_t> method, std::optional<std::int64_t> offset, double t) {
-             axes::home_request r;
-             if (method) r.method = static_cast<std::int8_t>(checked_integer(*method, -128, 127, "method"));
-             if (offset) r.offset = static_cast<std::int32_t>(checked_integer(*offset, INT32_MIN, INT32_MAX, "offset"));
-             return a.run("home", [r](axes::session& s, axes::completion d) { return s.home(r, std::move(d)); }, t);
-           }, py::arg("method") = py::none(), py::arg("offset") = py::none(), py::arg("timeout") = 30.0,
-           "Homing (switching to hm first) with method 0x6098 and offset 0x607C where given.")
-      .def("velocity", [](axis_handle& a, std::int64_t rpm, double t) {
-             const auto v = static_cast<std::int32_t>(checked_integer(rpm, INT32_MIN, INT32_MAX, "velocity"));
-             return a.run("velocity", [v](axes::session& s, axes::completion d) { return s.velocity(v, std::move(d)); }, t);
-           }, py::arg("rpm"), py::arg("timeout") = 30.0, "Profile velocity (switching to pv first), done at the velocity.")
-      .def("torque", [](axis_handle& a, std::int64_t permille, double t) {
-             const auto v = static_cast<std::int16_t>(checked_integer(permille, INT16_MIN, INT16_MAX, "torque"));
-             return a.run("torque", [v](axes::session& s, axes::completion d) { return s.torque(v, std::move(d)); }, t);
-           }, py::arg("permille"), py::arg("timeout") = 10.0, "Profile torque (switching to tq first).")
-      .def("halt", [](axis_handle& a, bool on, double t) {
+/// Jog, halt and the cyclic synchronous streams (the requests that run on past their call, or
+/// sample each cycle).
+void bind_axis_motion(py::class_<axis_handle, std::shared_ptr<axis_handle>>& axis) {
+  axis      .def("halt", [](axis_handle& a, bool on, double t) {
              return a.run(on ? "halt on" : "halt off", [on](axes::session& s, axes::completion d) { return s.halt(on, std::move(d)); }, t);
            }, py::arg("on") = true, py::arg("timeout") = 5.0,
            "Control bit 8 (halt, 0x605D) set or cleared beside the running motion: a halted move resumes "
@@ -472,7 +422,63 @@ otherwise, also when the request did not end in time.)doc")
            "last; the result as csp_stream's. The set-point object must be in the cyclic outputs.")
       .def_property_readonly("busy", [](axis_handle& a) {
              return a.with_session<bool>([](axes::session& s) { return s.busy(); });
-           }, "A request runs (a jog until it has stopped).")
+           }, "A request runs (a jog until it has stopped).");
+}
+
+}  // namespace
+
+void bind_canopen_axis(py::module_& m, py::class_<bus_core, std::shared_ptr<bus_core>>& bus) {
+  py::class_<axis_handle, std::shared_ptr<axis_handle>> axis(m, "Axis", R"doc(
+The project's master for one drive on a VirtualBus: the axis session of `cia402 master` over its
+CAN link (SDO, then PDOs with SYNC every `cycle_ms`). Each call starts one request and waits for its
+end (`timeout` s: wall clock, or virtual time on a virtual-time bus, which the call then advances);
+it returns a dict with what the drive showed at the end (state, status_word, error_code, mode,
+position, velocity, torque, note). A refusal raises SdoError (with the abort code) where the drive
+or the object table refused an object, AxisError (with the state, status word and error code)
+otherwise, also when the request did not end in time.)doc");
+  bind_axis_motion(axis);
+  axis.def("enable", [](axis_handle& a, double t) {
+             return a.run("enable", [](axes::session& s, axes::completion d) { return s.go_to(state::operation_enabled, std::move(d)); }, t);
+           }, py::arg("timeout") = 5.0, "To OPERATION ENABLED through the core's planner.")
+      .def("disable", [](axis_handle& a, double t) {
+             return a.run("disable", [](axes::session& s, axes::completion d) { return s.go_to(state::switch_on_disabled, std::move(d)); }, t);
+           }, py::arg("timeout") = 5.0, "To SWITCH ON DISABLED.")
+      .def("reset", [](axis_handle& a, double t) {
+             return a.run("reset", [](axes::session& s, axes::completion d) { return s.reset(std::move(d)); }, t);
+           }, py::arg("timeout") = 5.0, "A fault-reset edge on a drive in FAULT; done in SWITCH ON DISABLED.")
+      .def("quick_stop", [](axis_handle& a, double t) {
+             return a.run("quick stop", [](axes::session& s, axes::completion d) { return s.quick_stop(std::move(d)); }, t);
+           }, py::arg("timeout") = 10.0, "Quick stop, done when the stop has ended as 0x605A says.")
+      .def("stop", [](axis_handle& a, double t) {
+             return a.run("stop", [](axes::session& s, axes::completion d) { return s.stop(std::move(d)); }, t);
+           }, py::arg("timeout") = 10.0, "Ends the motion and stops the shaft (halt), done at standstill.")
+      .def("mode", [](axis_handle& a, const py::object& wanted, double t) {
+             const std::int8_t code = mode_argument(wanted);
+             return a.run("mode", [code](axes::session& s, axes::completion d) { return s.set_mode(code, std::move(d)); }, t);
+           }, py::arg("mode"), py::arg("timeout") = 5.0, "0x6060 (\"pp\", \"pv\", \"hm\", ... or the number), done when 0x6061 shows it.")
+      .def("move", [](axis_handle& a, std::int64_t target, bool relative, std::optional<std::int64_t> rpm, double t) {
+             axes::move_request r;
+             r.target = static_cast<std::int32_t>(checked_integer(target, INT32_MIN, INT32_MAX, "target"));
+             r.relative = relative;
+             if (rpm) r.velocity = static_cast<std::uint32_t>(checked_integer(*rpm, 1, UINT32_MAX, "velocity"));
+             return a.run("move", [r](axes::session& s, axes::completion d) { return s.move(r, std::move(d)); }, t);
+           }, py::arg("target"), py::arg("relative") = false, py::arg("velocity") = py::none(), py::arg("timeout") = 30.0,
+           "A profile position move (switching to pp first): the set-point handshake, done at the target.")
+      .def("home", [](axis_handle& a, std::optional<std::int64_t> method, std::optional<std::int64_t> offset, double t) {
+             axes::home_request r;
+             if (method) r.method = static_cast<std::int8_t>(checked_integer(*method, -128, 127, "method"));
+             if (offset) r.offset = static_cast<std::int32_t>(checked_integer(*offset, INT32_MIN, INT32_MAX, "offset"));
+             return a.run("home", [r](axes::session& s, axes::completion d) { return s.home(r, std::move(d)); }, t);
+           }, py::arg("method") = py::none(), py::arg("offset") = py::none(), py::arg("timeout") = 30.0,
+           "Homing (switching to hm first) with method 0x6098 and offset 0x607C where given.")
+      .def("velocity", [](axis_handle& a, std::int64_t rpm, double t) {
+             const auto v = static_cast<std::int32_t>(checked_integer(rpm, INT32_MIN, INT32_MAX, "velocity"));
+             return a.run("velocity", [v](axes::session& s, axes::completion d) { return s.velocity(v, std::move(d)); }, t);
+           }, py::arg("rpm"), py::arg("timeout") = 30.0, "Profile velocity (switching to pv first), done at the velocity.")
+      .def("torque", [](axis_handle& a, std::int64_t permille, double t) {
+             const auto v = static_cast<std::int16_t>(checked_integer(permille, INT16_MIN, INT16_MAX, "torque"));
+             return a.run("torque", [v](axes::session& s, axes::completion d) { return s.torque(v, std::move(d)); }, t);
+           }, py::arg("permille"), py::arg("timeout") = 10.0, "Profile torque (switching to tq first).")
       .def("state_of", [](axis_handle& a, double t) {
              return a.run("read state", [](axes::session& s, axes::completion d) { return s.read_state(std::move(d)); }, t);
            }, py::arg("timeout") = 5.0, "The state, status word and error code, read now.")
