@@ -134,6 +134,12 @@ class line_core final : public axis_host {
                               : static_cast<std::uint8_t>(wire_.slaves[position]->state());
     return ethercat::line_state_name(static_cast<std::uint8_t>(state));
   }
+  /// What the master found, copied under the mutex (over an interface its thread cycles the line).
+  std::vector<ethercat::ecat_slave> slaves() {
+    py::gil_scoped_release nogil;
+    std::lock_guard lock(mutex_);
+    return line_->master().slaves();
+  }
   std::size_t drives() const noexcept { return drives_; }
   ethercat::ecat_line& line() noexcept { return *line_; }
 
@@ -262,7 +268,7 @@ out on master_if through the kernel, on wall time.)doc")
            "process data and CoE SDO.")
       .def_property_readonly("slaves", [](line_core& l) {
              py::list out;
-             for (const auto& s : l.line().master().slaves()) out.append(slave_dict(s));
+             for (const auto& s : l.slaves()) out.append(slave_dict(s));
              return out;
            }, "What the master found on the line: position, station, name, identity, PDO sizes, mapping source.")
       .def("al_state", [](line_core& l, std::int64_t position) {
