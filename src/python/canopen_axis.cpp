@@ -74,6 +74,11 @@ class axis_handle {
     if (!(timeout_s > 0) || timeout_s > 1e6) raise_argument_error("timeout is more than 0 s");
     auto b = std::make_shared<pending>();
     bool closed = false;
+    // Taken under the mutex: a request that returned when it started (a jog) ends later on the
+    // stepping thread, which writes *b then.
+    bool done = false;
+    bool began = false;
+    axes::result out;
     {
       py::gil_scoped_release nogil;
       std::unique_lock lock(core_->mutex_);
@@ -94,39 +99,46 @@ class axis_handle {
         });
         if (started) running_ = b;
         wait_locked(lock, *b, timeout_s);
-        if (b->started && !b->done) b->result.shown = s.status_known() ? std::optional<state>(s.observed()) : std::nullopt;
+        done = b->done;
+        began = b->started;
+        out = b->result;
+        if (began && !done) out.shown = s.status_known() ? std::optional<state>(s.observed()) : std::nullopt;
       }
     }
     if (closed) raise_argument_error("the bus or the axis is closed");
-    if (!b->done && !b->started) {
+    if (!done && !began) {
       axes::result r2;
       r2.shown = observed();
       raise_axis_error(std::string(what) + " did not end within " + std::to_string(timeout_s) + " s", r2);
     }
-    return b->result;
+    return out;
   }
 
   /// Waits for the end of the last request (one that returned when it started: a jog).
   py::object wait(double timeout_s) {
     if (!(timeout_s > 0) || timeout_s > 1e6) raise_argument_error("timeout is more than 0 s");
-    std::shared_ptr<pending> b;
+    bool any = false;
+    bool done = false;
+    axes::result out;
     {
       py::gil_scoped_release nogil;
       std::unique_lock lock(core_->mutex_);
-      b = running_;
-      if (b) {
+      if (const std::shared_ptr<pending> b = running_) {
+        any = true;
         b->started = false;  // only the end counts now
         wait_locked(lock, *b, timeout_s);
+        done = b->done;
+        out = b->result;
       }
     }
-    if (!b) raise_argument_error("no request to wait for");
-    if (!b->done) {
+    if (!any) raise_argument_error("no request to wait for");
+    if (!done) {
       axes::result r2;
       r2.shown = observed();
       raise_axis_error("the request did not end within " + std::to_string(timeout_s) + " s", r2);
     }
-    if (!b->result.ok()) fail(b->result);
-    return result_dict(b->result);
+    if (!out.ok()) fail(out);
+    return result_dict(out);
   }
 
   /// A cyclic synchronous stream (or the csp ramp) with each cycle sampled as it goes: the

@@ -223,3 +223,13 @@ def test_wait_without_a_request_and_a_jog_time_to_live_out_of_range_are_refused(
     for bad in (0, -1, 3601):
         with pytest.raises(cia402.ArgumentError):
             axis.jog(100, hold=bad)
+
+
+def test_a_jog_on_wall_time_lapses_on_the_bus_thread_and_wait_sees_it_end():
+    with VirtualBus(nodes=[NODE]) as bus:
+        a = bus.axis(NODE)
+        a.enable()
+        assert a.jog(200, hold=0.2)["velocity"] == 200
+        ended = a.wait(timeout=20)
+        assert abs(ended["velocity"]) <= 1 and not a.busy and a.state == "OPERATION_ENABLED"
+        a.close()
