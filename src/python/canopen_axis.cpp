@@ -20,7 +20,7 @@ namespace {
 using steady = std::chrono::steady_clock;
 using request = std::function<std::uint64_t(axes::session&, axes::completion)>;
 
-py::object result_dict(const axes::result& r) {
+py::dict result_dict(const axes::result& r) {
   py::dict d;
   d["state"] = r.shown ? py::object(py::str(state_name(*r.shown))) : py::object(py::none());
   d["status_word"] = r.status_word;
@@ -65,43 +65,129 @@ class axis_handle {
     return result_dict(res);
   }
 
-  /// The result of `r`, unchecked (AxisError only when it did not end in time).
-  axes::result wait_for(const char* what, const request& r, double timeout_s) {
+  /// The result of `r`, unchecked (AxisError only when it did not end in time). With `started`, the
+  /// wait ends once the request reports that progress (a jog turning): the request runs on, and
+  /// wait() waits for its end later.
+  axes::result wait_for(const char* what, const request& r, double timeout_s,
+                        std::optional<axes::progress_kind> started = std::nullopt,
+                        std::function<void(axes::progress_kind)> on_progress = nullptr) {
     if (!(timeout_s > 0) || timeout_s > 1e6) raise_argument_error("timeout is more than 0 s");
-    struct box {
-      bool done = false;
-      axes::result result;
-    };
-    auto b = std::make_shared<box>();
+    auto b = std::make_shared<pending>();
     bool closed = false;
+    // Taken under the mutex: a request that returned when it started (a jog) ends later on the
+    // stepping thread, which writes *b then.
+    bool done = false;
+    bool began = false;
+    axes::result out;
     {
       py::gil_scoped_release nogil;
       std::unique_lock lock(core_->mutex_);
       if (axis_->session == nullptr || (core_->closed_locked() && !core_->virtual_time())) {
         closed = true;
       } else {
-        (void)r(*axis_->session, [b](const axes::result& res) {
+        axes::session& s = *axis_->session;
+        s.on_progress = [b, started, on_progress](axes::progress_kind kind, const axes::result& so_far) {
+          if (on_progress) on_progress(kind);
+          if (started && kind == *started && !b->started) {
+            b->started = true;
+            b->result = so_far;
+          }
+        };
+        (void)r(s, [b](const axes::result& res) {
           b->result = res;
           b->done = true;
         });
-        if (core_->virtual_time()) {
-          const auto limit = static_cast<std::uint64_t>(timeout_s * 1e6);
-          for (std::uint64_t passed = 0; !b->done && passed < limit;) passed += core_->step_period_locked();
-          core_->arrived_.notify_all();
-        } else {
-          const auto deadline = steady::now() + std::chrono::duration_cast<steady::duration>(
-                                                    std::chrono::duration<double>(timeout_s));
-          core_->arrived_.wait_until(lock, deadline, [&] { return b->done || core_->closed_locked(); });
-        }
+        if (started) running_ = b;
+        wait_locked(lock, *b, timeout_s);
+        done = b->done;
+        began = b->started;
+        out = b->result;
+        if (began && !done) out.shown = s.status_known() ? std::optional<state>(s.observed()) : std::nullopt;
       }
     }
     if (closed) raise_argument_error("the bus or the axis is closed");
-    if (!b->done) {
+    if (!done && !began) {
       axes::result r2;
       r2.shown = observed();
       raise_axis_error(std::string(what) + " did not end within " + std::to_string(timeout_s) + " s", r2);
     }
-    return b->result;
+    return out;
+  }
+
+  /// Waits for the end of the last request (one that returned when it started: a jog).
+  py::object wait(double timeout_s) {
+    if (!(timeout_s > 0) || timeout_s > 1e6) raise_argument_error("timeout is more than 0 s");
+    bool any = false;
+    bool done = false;
+    axes::result out;
+    {
+      py::gil_scoped_release nogil;
+      std::unique_lock lock(core_->mutex_);
+      if (const std::shared_ptr<pending> b = running_) {
+        any = true;
+        b->started = false;  // only the end counts now
+        wait_locked(lock, *b, timeout_s);
+        done = b->done;
+        out = b->result;
+      }
+    }
+    if (!any) raise_argument_error("no request to wait for");
+    if (!done) {
+      axes::result r2;
+      r2.shown = observed();
+      raise_axis_error("the request did not end within " + std::to_string(timeout_s) + " s", r2);
+    }
+    if (!out.ok()) fail(out);
+    return result_dict(out);
+  }
+
+  /// A cyclic synchronous stream (or the csp ramp) with each cycle sampled as it goes: the
+  /// set-point sent and the actual value the drive showed, as the session sees them (on_cycle).
+  py::object run_stream(const char* what, const request& r, std::uint16_t set_point, std::uint16_t actual,
+                        double timeout_s) {
+    auto samples = std::make_shared<std::vector<std::pair<std::optional<std::int64_t>, std::optional<std::int64_t>>>>();
+    auto streaming = std::make_shared<bool>(false);  // from the first set-point of this stream on
+    {
+      py::gil_scoped_release nogil;
+      std::lock_guard lock(core_->mutex_);
+      if (axis_->session != nullptr) {
+        axes::session& s = *axis_->session;
+        s.on_cycle = [samples, streaming, &s, set_point, actual] {
+          if (*streaming && s.busy()) samples->emplace_back(s.output(set_point), s.actual(actual));
+        };
+      }
+    }
+    const auto stop_sampling = [this] {
+      py::gil_scoped_release nogil;
+      std::lock_guard lock(core_->mutex_);
+      if (axis_->session != nullptr) axis_->session->on_cycle = nullptr;
+    };
+    axes::result res;
+    try {
+      res = wait_for(what, r, timeout_s, std::nullopt, [streaming](axes::progress_kind kind) {
+        if (kind == axes::progress_kind::stream_started) *streaming = true;
+      });
+    } catch (...) {
+      stop_sampling();
+      throw;
+    }
+    stop_sampling();
+    if (!res.ok()) fail(res);
+    py::dict d = result_dict(res);
+    d["stream_from"] = res.stream_from;
+    d["stream_to"] = res.stream_to;
+    d["set_points"] = res.set_points;
+    d["max_following_error"] = res.max_following_error;
+    py::list sent, shown;
+    for (const auto& [out, in] : *samples) {
+      sent.append(out ? py::object(py::int_(*out)) : py::object(py::none()));
+      shown.append(in ? py::object(py::int_(*in)) : py::object(py::none()));
+    }
+    py::dict trace;
+    trace["set_point"] = sent;
+    trace["actual"] = shown;
+    d["trace"] = trace;
+    return d;
   }
 
   [[noreturn]] void fail(const axes::result& res) { raise_axis_error(res.error, res); }
@@ -229,9 +315,55 @@ class axis_handle {
     return std::nullopt;
   }
 
+  struct pending {
+    bool done = false;
+    bool started = false;  ///< the progress asked for came (the request runs on)
+    axes::result result;
+  };
+
+  /// Until `b` ends (or starts, where asked), `timeout_s` at most: on virtual time by stepping the
+  /// host, on wall time by waiting for its thread. The mutex is held.
+  void wait_locked(std::unique_lock<std::mutex>& lock, pending& b, double timeout_s) {
+    if (core_->virtual_time()) {
+      const auto limit = static_cast<std::uint64_t>(timeout_s * 1e6);
+      for (std::uint64_t passed = 0; !b.done && !b.started && passed < limit;) passed += core_->step_period_locked();
+      core_->arrived_.notify_all();
+    } else {
+      const auto deadline = steady::now() + std::chrono::duration_cast<steady::duration>(
+                                                std::chrono::duration<double>(timeout_s));
+      core_->arrived_.wait_until(lock, deadline, [&] { return b.done || b.started || core_->closed_locked(); });
+    }
+  }
+
   std::shared_ptr<axis_host> core_;
   std::shared_ptr<bus_axis> axis_;
+  std::shared_ptr<pending> running_;  ///< the last request started (guarded by the host's mutex)
 };
+
+std::uint64_t hold_us(double seconds) {
+  if (!(seconds > 0) || seconds > 3600) raise_argument_error("hold is more than 0 s, 3600 s at most");
+  return static_cast<std::uint64_t>(std::llround(seconds * 1e6));
+}
+
+/// A stream's set-point and actual objects, and the set-point's range (CiA 402-2: 0x607A and 0x60FF
+/// INTEGER32, 0x6071 INTEGER16).
+struct stream_objects {
+  std::uint16_t set_point;
+  std::uint16_t actual;
+  std::int64_t low;
+  std::int64_t high;
+};
+stream_objects stream_objects_of(std::int8_t m) {
+  switch (m) {
+    case mode::cyclic_synchronous_position:
+      return {object_index::target_position, object_index::position_actual_value, INT32_MIN, INT32_MAX};
+    case mode::cyclic_synchronous_velocity:
+      return {object_index::target_velocity, object_index::velocity_actual_value, INT32_MIN, INT32_MAX};
+    case mode::cyclic_synchronous_torque:
+      return {object_index::target_torque, object_index::torque_actual_value, INT16_MIN, INT16_MAX};
+    default: raise_argument_error("a stream runs in csp, csv or cst");
+  }
+}
 
 std::int8_t mode_argument(const py::handle& m) {
   if (py::isinstance<py::int_>(m)) return static_cast<std::int8_t>(checked_integer(m.cast<std::int64_t>(), -128, 127, "a mode"));
@@ -240,18 +372,84 @@ std::int8_t mode_argument(const py::handle& m) {
   raise_argument_error("a mode is pp, pv, tq, hm, csp, csv, cst or its number");
 }
 
+/// Jog, halt and the cyclic synchronous streams (the requests that run on past their call, or
+/// sample each cycle).
+void bind_axis_motion(py::class_<axis_handle, std::shared_ptr<axis_handle>>& axis) {
+  axis      .def("halt", [](axis_handle& a, bool on, double t) {
+             return a.run(on ? "halt on" : "halt off", [on](axes::session& s, axes::completion d) { return s.halt(on, std::move(d)); }, t);
+           }, py::arg("on") = true, py::arg("timeout") = 5.0,
+           "Control bit 8 (halt, 0x605D) set or cleared beside the running motion: a halted move resumes "
+           "when it is cleared; a motion command is refused while it is set.")
+      .def("jog", [](axis_handle& a, std::int64_t rpm, double hold_s, double t) {
+             const auto v = static_cast<std::int32_t>(checked_integer(rpm, INT32_MIN, INT32_MAX, "velocity"));
+             const std::uint64_t hold = hold_us(hold_s);
+             const axes::result res = a.wait_for("jog", [v, hold](axes::session& s, axes::completion d) {
+               return s.jog(v, hold, std::move(d));
+             }, t, axes::progress_kind::jog_started);
+             if (!res.ok()) a.fail(res);
+             return result_dict(res);
+           }, py::arg("rpm"), py::arg("hold") = 0.5, py::arg("timeout") = 5.0,
+           "Jogs in pv (switching to it first) at `rpm`: returns once the velocity is set; the jog then "
+           "lives `hold` s (renew_jog extends it, as a button still held) and brings the shaft to "
+           "standstill by itself when it lapses. wait() waits for that end.")
+      .def("renew_jog", [](axis_handle& a, double hold_s) {
+             const std::uint64_t hold = hold_us(hold_s);
+             a.with_session<bool>([hold](axes::session& s) {
+               s.renew_jog(hold);
+               return true;
+             });
+           }, py::arg("hold") = 0.5, "The running jog lives on for `hold` s from now (nothing without a jog).")
+      .def("wait", &axis_handle::wait, py::arg("timeout") = 30.0,
+           "Waits for the end of the last request (a jog runs on after jog() returns); its result.")
+      .def("csp_stream", [](axis_handle& a, std::int64_t to, std::int64_t rpm, double t) {
+             const auto target = static_cast<std::int32_t>(checked_integer(to, INT32_MIN, INT32_MAX, "to"));
+             const auto v = static_cast<std::uint32_t>(checked_integer(rpm, 1, UINT32_MAX, "rpm"));
+             return a.run_stream("csp stream", [target, v](axes::session& s, axes::completion d) {
+               return s.csp_stream(target, v, std::move(d));
+             }, object_index::target_position, object_index::position_actual_value, t);
+           }, py::arg("to"), py::arg("rpm"), py::arg("timeout") = 30.0,
+           "csp: a ramp of 0x607A from where the drive stands to `to` at `rpm`, one set-point a cycle, done "
+           "when 0x6064 shows `to`. The result adds stream_from, stream_to, set_points, "
+           "max_following_error and trace (set_point and actual, one entry a cycle).")
+      .def("stream", [](axis_handle& a, const py::iterable& points, const py::object& wanted, double t) {
+             const std::int8_t code = mode_argument(wanted);
+             const auto objects = stream_objects_of(code);
+             auto values = std::make_shared<std::vector<std::int64_t>>();
+             for (const py::handle v : points) {
+               if (py::isinstance<py::bool_>(v) || !py::hasattr(v, "__index__")) raise_argument_error("a set-point is an int");
+               values->push_back(checked_integer(py::reinterpret_borrow<py::object>(v).attr("__index__")().cast<std::int64_t>(),
+                                                 objects.low, objects.high, "a set-point"));
+             }
+             if (values->empty()) raise_argument_error("a stream has one set-point at least");
+             auto next = std::make_shared<std::size_t>(0);
+             return a.run_stream("stream", [code, values, next](axes::session& s, axes::completion d) {
+               return s.stream(code, [values, next]() -> std::optional<std::int64_t> {
+                 if (*next >= values->size()) return std::nullopt;
+                 return (*values)[(*next)++];
+               }, std::move(d));
+             }, objects.set_point, objects.actual, t);
+           }, py::arg("set_points"), py::arg("mode") = "csp", py::arg("timeout") = 30.0,
+           "A cyclic synchronous stream (csp 0x607A, csv 0x60FF, cst 0x6071), one set-point a cycle "
+           "from `set_points` (checked whole before anything is sent), done when the drive stands at the "
+           "last; the result as csp_stream's. The set-point object must be in the cyclic outputs.")
+      .def_property_readonly("busy", [](axis_handle& a) {
+             return a.with_session<bool>([](axes::session& s) { return s.busy(); });
+           }, "A request runs (a jog until it has stopped).");
+}
+
 }  // namespace
 
 void bind_canopen_axis(py::module_& m, py::class_<bus_core, std::shared_ptr<bus_core>>& bus) {
-  py::class_<axis_handle, std::shared_ptr<axis_handle>>(m, "Axis", R"doc(
+  py::class_<axis_handle, std::shared_ptr<axis_handle>> axis(m, "Axis", R"doc(
 The project's master for one drive on a VirtualBus: the axis session of `cia402 master` over its
 CAN link (SDO, then PDOs with SYNC every `cycle_ms`). Each call starts one request and waits for its
 end (`timeout` s: wall clock, or virtual time on a virtual-time bus, which the call then advances);
 it returns a dict with what the drive showed at the end (state, status_word, error_code, mode,
 position, velocity, torque, note). A refusal raises SdoError (with the abort code) where the drive
 or the object table refused an object, AxisError (with the state, status word and error code)
-otherwise, also when the request did not end in time.)doc")
-      .def("enable", [](axis_handle& a, double t) {
+otherwise, also when the request did not end in time.)doc");
+  bind_axis_motion(axis);
+  axis.def("enable", [](axis_handle& a, double t) {
              return a.run("enable", [](axes::session& s, axes::completion d) { return s.go_to(state::operation_enabled, std::move(d)); }, t);
            }, py::arg("timeout") = 5.0, "To OPERATION ENABLED through the core's planner.")
       .def("disable", [](axis_handle& a, double t) {

@@ -111,3 +111,125 @@ def test_the_master_runs_on_wall_time_too():
         assert a.enable()["state"] == "OPERATION_ENABLED"
         assert a.move(2000, velocity=3000)["position"] == 2000
         a.close()
+
+
+def velocity_now(axis):
+    return axis.sdo_read(0x606C)
+
+
+def test_a_jog_left_unrenewed_stops_by_itself_once_its_time_to_live_lapses():
+    with VirtualBus(nodes=[NODE], virtual_time=True) as bus:
+        a = bus.axis(NODE)
+        a.enable()
+        started = a.jog(400, hold=1.0)
+        assert started["velocity"] == 400 and a.busy
+        t0 = bus.time_ms
+        bus.advance(800)  # up to speed on 0x6083 (1000 rpm/s) within its time to live
+        assert a.busy and abs(velocity_now(a) - 400) <= 4, "within its time to live it turns"
+        ended = a.wait(timeout=5)
+        assert not a.busy and abs(ended["velocity"]) <= 1
+        assert ended["state"] == "OPERATION_ENABLED" and ended["mode"] == 3
+        assert bus.time_ms - t0 >= 1000, "it ran its whole time to live"
+        a.close()
+
+
+def test_a_renewed_jog_runs_past_its_time_to_live_until_the_renewals_stop():
+    with VirtualBus(nodes=[NODE], virtual_time=True) as bus:
+        a = bus.axis(NODE)
+        a.enable()
+        a.jog(-250, hold=0.1)
+        for _ in range(10):  # 1 s of renewals every 50 ms, ten times the time to live
+            bus.advance(50)
+            a.renew_jog(0.1)
+        assert a.busy and abs(velocity_now(a) + 250) <= 3
+        t_released = bus.time_ms
+        assert abs(a.wait()["velocity"]) <= 1
+        assert bus.time_ms - t_released >= 100 - 50  # the last renewal's time to live, less the read
+        a.renew_jog(0.1)  # nothing to renew: no jog runs
+        assert not a.busy
+
+
+def test_halt_stops_a_jog_where_it_is_and_clearing_it_lets_the_jog_go_on():
+    with VirtualBus(nodes=[NODE], virtual_time=True) as bus:
+        a = bus.axis(NODE)
+        a.enable()
+        a.jog(300, hold=5)
+        bus.advance(500)
+        a.halt(True)
+        bus.advance(1000)
+        assert abs(velocity_now(a)) <= 1 and a.busy and a.state == "OPERATION_ENABLED"
+        with pytest.raises(cia402.AxisError, match="halt is on"):
+            a.move(1000)
+        a.halt(False)
+        a.jog(300, hold=1)
+        bus.advance(500)
+        assert abs(velocity_now(a) - 300) <= 3
+        a.close()
+
+
+def test_a_csp_stream_is_sent_one_set_point_a_cycle_and_the_drive_reports_each_two_syncs_later():
+    with VirtualBus(nodes=[NODE], virtual_time=True) as bus:
+        a = bus.axis(NODE, map_position=True)
+        a.enable()
+        ramp = [37 * k for k in range(1, 301)]
+        done = a.stream(ramp)
+        assert done["state"] == "OPERATION_ENABLED" and done["mode"] == 8
+        assert done["position"] == ramp[-1] and done["set_points"] == len(ramp)
+        sent, actual = done["trace"]["set_point"], done["trace"]["actual"]
+        assert sent[:len(ramp)] == ramp and set(sent[len(ramp):]) == {ramp[-1]}
+        # RPDO3's set-point is taken at the SYNC after it; TPDO3 answers that SYNC with the
+        # position, which the master has before its next cycle: two cycles from sending to seeing.
+        # The stream is done in the cycle that brings the last (done["position"]): no sample after it.
+        assert actual[2:] == ramp[:-1] and len(sent) == len(ramp) + 1
+        assert done["max_following_error"] == 0  # against the set-point the drive had had a cycle to reach
+        a.close()
+
+
+def test_csp_stream_ramps_from_where_the_drive_stands_to_the_target():
+    with VirtualBus(nodes=[NODE], virtual_time=True) as bus:
+        a = bus.axis(NODE, map_position=True)
+        a.enable()
+        assert a.stream([500, 1000])["position"] == 1000
+        done = a.csp_stream(-3000, 60)  # 60 rpm: 100 increments a 10 ms cycle
+        assert done["stream_from"] == 1000 and done["stream_to"] == -3000 and done["position"] == -3000
+        sent = done["trace"]["set_point"]
+        assert sent[:done["set_points"]] == list(range(900, -3000, -100)) + [-3000]
+        assert set(sent[done["set_points"]:]) == {-3000}
+        a.close()
+
+
+def test_a_stream_refuses_a_bad_set_point_before_sending_any_and_needs_the_position_mapped():
+    with VirtualBus(nodes=[NODE], virtual_time=True) as bus:
+        a = bus.axis(NODE, map_position=True)
+        a.enable()
+        before = bus.frames
+        for bad in ([1, 2, 2**31], [], [1.5], ["x"]):
+            with pytest.raises(cia402.ArgumentError):
+                a.stream(bad)
+        with pytest.raises(cia402.ArgumentError):
+            a.stream([1, 2], mode="pp")
+        assert bus.frames == before and a.position == 0
+        a.close()
+        b = bus.axis(NODE)  # no PDO 3: nothing carries 0x607A each cycle
+        with pytest.raises(cia402.AxisError, match="cyclic outputs"):
+            b.stream([10, 20])
+        b.close()
+
+
+def test_wait_without_a_request_and_a_jog_time_to_live_out_of_range_are_refused(axis):
+    with pytest.raises(cia402.ArgumentError):
+        axis.wait()
+    axis.enable()
+    for bad in (0, -1, 3601):
+        with pytest.raises(cia402.ArgumentError):
+            axis.jog(100, hold=bad)
+
+
+def test_a_jog_on_wall_time_lapses_on_the_bus_thread_and_wait_sees_it_end():
+    with VirtualBus(nodes=[NODE]) as bus:
+        a = bus.axis(NODE)
+        a.enable()
+        assert a.jog(200, hold=0.2)["velocity"] == 200
+        ended = a.wait(timeout=20)
+        assert abs(ended["velocity"]) <= 1 and not a.busy and a.state == "OPERATION_ENABLED"
+        a.close()

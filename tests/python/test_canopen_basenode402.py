@@ -93,13 +93,26 @@ class Node402:
     def controlword(self, word):
         self.bus.send(can.Message(arbitration_id=RPDO1, data=word.to_bytes(2, "little"), is_extended_id=False))
 
+    def latest_status(self):
+        """Every frame already queued taken: the status word the drive sent last."""
+        while (msg := self.bus.recv(timeout=0)) is not None:
+            self._take(msg)
+        return self.status_word
+
+    def until_state(self, state, end_ms, why):
+        """check_statusword until the state shows, by `end_ms` of the drives' time. A test process
+        held up on a loaded host finds status words queued from before the time was up: those are
+        not late, so the last one queued decides."""
+        while state_of(self.check_statusword()) != state:
+            if self.clock.time_ms >= end_ms:
+                assert state_of(self.latest_status()) == state, f"{why}: {state_of(self.status_word)}"
+                return
+
     def go(self, word, state):
         """One step of BaseNode402's state setter: the control word by RPDO1, then check_statusword
         until the state shows, within 0.4 s."""
         self.controlword(word)
-        end_ms = self.clock.time_ms + SWITCH_STATE_S * 1000
-        while state_of(self.check_statusword()) != state:
-            assert self.clock.time_ms < end_ms, f"not {state} within {SWITCH_STATE_S} s: {state_of(self.status_word)}"
+        self.until_state(state, self.clock.time_ms + SWITCH_STATE_S * 1000, f"not {state} within {SWITCH_STATE_S} s")
 
     def enable(self):
         self.go(0x06, "READY TO SWITCH ON")
@@ -162,9 +175,7 @@ def test_basenode402_resets_a_fault_and_walks_back_to_operation_enabled(node):
     node.enable()
     node.sdo_write(0x2001, 0, 0x2310, 2)  # fault injection: continuous over-current
     node.sdo_write(0x2001, 0, 0, 2)       # the cause gone; the fault stays until reset
-    end_ms = node.clock.time_ms + SWITCH_STATE_S * 1000
-    while state_of(node.check_statusword()) != "FAULT":
-        assert node.clock.time_ms < end_ms, "no fault"
+    node.until_state("FAULT", node.clock.time_ms + SWITCH_STATE_S * 1000, "no fault")
     # reset_from_fault: Disable voltage, then the walk to OPERATION ENABLED (fault reset first).
     node.controlword(0x00)
     assert state_of(node.check_statusword()) == "FAULT", "no automatic restart"

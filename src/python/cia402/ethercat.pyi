@@ -1,12 +1,13 @@
 # Type stubs of cia402.ethercat (VirtualLine comes from the extension module _cia402.ethercat; Axis
 # is cia402.canopen.Axis). tests/python/test_stubs.py checks the names match the module.
-from typing import Any, Dict, List, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 from . import Profile
 from .canopen import Axis as Axis
 
 class VirtualLine:
-    def __init__(self, drives: int = 1, profile: Union[None, str, Profile] = None, cycle_us: int = 1000) -> None: ...
+    def __init__(self, drives: int = 1, profile: Union[None, str, Profile] = None, cycle_us: int = 1000, *,
+                 interfaces: Optional[Tuple[str, str]] = None) -> None: ...
     def advance(self, ms: float) -> None: ...
     def axis(self, position: int) -> Axis: ...
     @property
