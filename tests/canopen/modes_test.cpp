@@ -293,7 +293,7 @@ TEST(modes_master, with_pdo_3_mapped_a_pp_target_and_its_new_set_point_bit_arriv
   apps::virtual_drive_node drive(standard_profile(), bus.attach(), apps::drive_node_config(id));
   auto ch = bus.attach();
   drive_master_config mc;
-  mc.cycle_us = 1000;
+  mc.cycle_us = 10000;  // a SYNC every 10 ms: a word given between two goes out before the next
   mc.map_position = true;
   drive_master m(*ch, mc);
   const auto run_ms = [&](int ms) {
