@@ -285,6 +285,47 @@ TEST(modes_master, map_position_streams_rpdo3_and_reads_tpdo3) {
   EXPECT_EQ(m.status_word() & bit13, 0);
 }
 
+// A pp move with PDO 3 mapped: the target goes in the synchronous RPDO3, so the new-set-point bit
+// must not reach the drive before it (by RPDO1, which acts at once) or the drive takes the old target
+// and never moves. Both take effect at one SYNC.
+TEST(modes_master, with_pdo_3_mapped_a_pp_target_and_its_new_set_point_bit_arrive_together) {
+  virtual_bus bus;
+  apps::virtual_drive_node drive(standard_profile(), bus.attach(), apps::drive_node_config(id));
+  auto ch = bus.attach();
+  drive_master_config mc;
+  mc.cycle_us = 10000;  // a SYNC every 10 ms: a word given between two goes out before the next
+  mc.map_position = true;
+  drive_master m(*ch, mc);
+  const auto run_ms = [&](int ms) {
+    for (int i = 0; i < ms; ++i) {
+      m.poll(*ch, 1000);
+      drive.poll(1000);
+      m.poll(*ch, 0);
+      drive.poll(0);
+      m.poll(*ch, 0);
+    }
+  };
+  run_ms(100);
+  ASSERT_EQ(m.phase(), master_phase::running) << m.failure_text();
+  ASSERT_EQ(drive.drive().write(0x6060, 0, 1), sdo_abort::none);  // profile position
+  m.set_position_set_point(0);
+  m.set_target(state::operation_enabled);
+  for (int i = 0; i < 300 && m.outcome() != master_outcome::reached; ++i) run_ms(1);
+  ASSERT_EQ(m.outcome(), master_outcome::reached);
+  run_ms(20);
+  constexpr std::uint16_t enable_operation = 0x000F, new_set_point = 1u << 4;
+  m.set_position_set_point(20000);
+  m.send_control_word(enable_operation | new_set_point);
+  for (int i = 0; i < 200 && (m.status_word() & bit12) == 0; ++i) run_ms(1);
+  ASSERT_NE(m.status_word() & bit12, 0) << "the set-point was never acknowledged";
+  m.send_control_word(enable_operation);
+  for (int i = 0; i < 5000 && (m.status_word() & bit10) == 0; ++i) run_ms(1);
+  std::int64_t at = 0;
+  ASSERT_EQ(drive.drive().read(0x6064, 0, at), sdo_abort::none);
+  EXPECT_EQ(at, 20000) << "the drive took the old target";
+  EXPECT_NE(m.status_word() & bit10, 0);
+}
+
 }  // namespace
 }  // namespace cia402::canopen
 

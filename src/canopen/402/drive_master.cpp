@@ -426,6 +426,13 @@ void drive_master::send_control_word(std::uint16_t word, bool fault_reset_edge) 
 }
 
 void drive_master::send_word(std::uint16_t cw) {
+  if (position_mapped_ && position_set_point_ && set_point_unsent_) {
+    // RPDO3 carries it with the set-point at the next SYNC.
+    last_sent_ = cw;
+    word_sent_ = true;
+    if (on_sent) on_sent(cw);
+    return;
+  }
   frame f;
   f.id = cob::rpdo1 + config_.node_id;
   f.len = 2;
@@ -439,14 +446,16 @@ void drive_master::send_word(std::uint16_t cw) {
 void drive_master::send_sync() {
   if (before_sync) before_sync();
   if (position_mapped_ && position_set_point_ && word_sent_) {
-    // RPDO3 takes effect at the SYNC that follows it: the control word it carries is the one the
-    // drive already has (RPDO1 acts at once), the set-point is this cycle's.
+    // RPDO3 takes effect at the SYNC that follows it: the control word it carries is the last one
+    // given (sent in RPDO1 already, or held for this RPDO3 with a new set-point), the set-point is
+    // this cycle's.
     frame f;
     f.id = cob::rpdo1 + 0x200 + config_.node_id;
     f.len = 6;
     put_le(f.data.data(), last_sent_, 2);
     put_le(f.data.data() + 2, static_cast<std::uint32_t>(*position_set_point_), 4);
     (void)out_->send(f);
+    set_point_unsent_ = false;
   }
   (void)out_->send(make_frame(cob::sync, {}));
 }

@@ -29,7 +29,9 @@
 // target or a command is set, the master answers with RPDO1 at once. With `map_position` and a
 // set-point given (set_position_set_point), RPDO3 (the last control word sent and the set-point) goes
 // out just before each SYNC, after `before_sync` has had the chance to move the set-point on; TPDO3's
-// position is kept (position()) and reported (on_position). Words set with
+// position is kept (position()) and reported (on_position); a control word given while the set-point
+// has changed since the last RPDO3 goes in the next RPDO3 instead of RPDO1, so a pp handshake's
+// bit 4 and its target take effect at the same SYNC. Words set with
 // `send_control_word` go out when given (a fault-reset edge as bit 7 high for `reset_pulse_us`).
 // Nothing is sent in RPDO1 until a target, command or word is given, so watching a drive never
 // commands it. Requests (`read`, `write`) run one at a time between polls of what no PDO carries
@@ -137,7 +139,10 @@ class drive_master {
   std::uint16_t mode_bits() const noexcept { return mode_bits_; }
   /// With `map_position`: the target position RPDO3 carries before every SYNC (with the last control
   /// word sent), once a control word has been sent; nullopt stops RPDO3.
-  void set_position_set_point(std::optional<std::int32_t> position) noexcept { position_set_point_ = position; }
+  void set_position_set_point(std::optional<std::int32_t> position) noexcept {
+    if (position != position_set_point_) set_point_unsent_ = true;
+    position_set_point_ = position;
+  }
   std::optional<std::int32_t> position_set_point() const noexcept { return position_set_point_; }
 
   /// Queue an SDO transfer for when the master is running; `done` is called in process() or
@@ -301,6 +306,9 @@ class drive_master {
   std::uint16_t mode_bits_ = 0;
   bool word_sent_ = false;  // a control word went out since running: RPDO3 may carry it
   std::optional<std::int32_t> position_set_point_;
+  // A set-point newer than the last RPDO3: a control word given now waits for that RPDO3, so the
+  // drive takes both at one SYNC (a new-set-point bit never meets the old target).
+  bool set_point_unsent_ = false;
 
   bool status_known_ = false;
   std::uint16_t status_word_ = 0;
