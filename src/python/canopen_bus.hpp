@@ -60,7 +60,28 @@ class axis_host {
   std::condition_variable arrived_;  ///< something moved: a frame queued, a request ended
 
  protected:
+  /// One step of `elapsed_us` of time, the mutex held.
+  virtual void step_locked(std::uint32_t elapsed_us) = 0;
+
+  /// The stepping thread of a host on wall time: a step every `period_us` until closed, the mutex
+  /// held but while waiting, waiters on arrived_ woken after each step; wake_ ends a wait early.
+  void run_on_wall_time(std::uint32_t period_us) {
+    apps::elapsed_clock clock;
+    const auto period = std::chrono::microseconds(period_us);
+    auto next = std::chrono::steady_clock::now();
+    std::unique_lock lock(mutex_);
+    while (!closed_locked()) {
+      step_locked(clock.take());
+      arrived_.notify_all();
+      next += period;
+      const auto now = std::chrono::steady_clock::now();
+      if (next < now) next = now;  // held up (a loaded machine): go on from now, not in a burst
+      wake_.wait_until(lock, next, [this] { return closed_locked(); });
+    }
+  }
+
   std::vector<std::shared_ptr<bus_axis>> axes_;
+  std::condition_variable wake_;
 };
 
 using steady = std::chrono::steady_clock;
@@ -75,7 +96,7 @@ class bus_core final : public axis_host {
           profile_->get(), bus_.attach(), apps::drive_node_config(id, 1000000, heartbeat_ms)));
       node_ids_.push_back(id);
     }
-    if (!virtual_time_) stepper_ = std::thread([this] { run(); });
+    if (!virtual_time_) stepper_ = std::thread([this] { run_on_wall_time(period_us_); });
   }
   ~bus_core() { close(); }
   bus_core(const bus_core&) = delete;
@@ -165,20 +186,7 @@ class bus_core final : public axis_host {
     elapsed_us_ += elapsed;
   }
 
-  void run() {
-    apps::elapsed_clock clock;
-    const auto period = std::chrono::microseconds(period_us_);
-    auto next = steady::now();
-    std::unique_lock lock(mutex_);
-    while (!closed_) {
-      step(clock.take());
-      arrived_.notify_all();
-      next += period;
-      const auto now = steady::now();
-      if (next < now) next = now;  // held up (a loaded machine): go on from now, not in a burst
-      wake_.wait_until(lock, next, [this] { return closed_; });
-    }
-  }
+  void step_locked(std::uint32_t elapsed) override { step(elapsed); }
 
   profile_ptr profile_;
   bool virtual_time_;
@@ -189,7 +197,6 @@ class bus_core final : public axis_host {
   std::vector<std::uint8_t> node_ids_;
   std::uint64_t elapsed_us_ = 0;
   bool closed_ = false;
-  std::condition_variable wake_;
   std::thread stepper_;
 };
 

@@ -80,7 +80,8 @@ class line_core final : public axis_host {
       error_ = line_->error();
       return;
     }
-    stepper_ = std::thread([this] { run(); });
+    // Over an interface: a cycle of the master every cycle_us of wall time, as `cia402 master --ecat`.
+    stepper_ = std::thread([this] { run_on_wall_time(cycle_us_); });
   }
 
   ~line_core() override {
@@ -157,21 +158,7 @@ class line_core final : public axis_host {
     elapsed_us_ += elapsed;
   }
 
-  // Over an interface: a cycle of the master every cycle_us of wall time, as `cia402 master --ecat`.
-  void run() {
-    apps::elapsed_clock clock;
-    const auto period = std::chrono::microseconds(cycle_us_);
-    auto next = steady::now();
-    std::unique_lock lock(mutex_);
-    while (!closed_) {
-      step(clock.take());
-      arrived_.notify_all();
-      next += period;
-      const auto now = steady::now();
-      if (next < now) next = now;  // held up: go on from now, not in a burst
-      wake_.wait_until(lock, next, [this] { return closed_; });
-    }
-  }
+  void step_locked(std::uint32_t elapsed) override { step(elapsed); }
 
   profile_ptr profile_;
   std::uint32_t cycle_us_;
@@ -182,7 +169,6 @@ class line_core final : public axis_host {
   std::string error_;
   std::uint64_t elapsed_us_ = 0;
   bool closed_ = false;
-  std::condition_variable wake_;
   std::thread stepper_;
 };
 
