@@ -52,6 +52,9 @@ class hostile_line final : public master_link {
   std::function<bool()> lose_frame;
   /// Changes the frame on its way back, after every slave served it.
   std::function<void(std::vector<std::uint8_t>& frame)> tamper;
+  /// The frame's answer is lost on its way back, after every slave served it (a read that emptied
+  /// a mailbox whose data never reached the master).
+  std::function<bool(const std::vector<std::uint8_t>& frame)> lose_answer;
   std::uint64_t time_limit_us = 3'600'000'000ull;
   std::uint32_t exchange_us = 20;  // a frame takes time on any line: every loop of the master moves on
 
@@ -73,7 +76,7 @@ class hostile_line final : public master_link {
       }
     }
     if (tamper) tamper(frame);
-    return true;
+    return !(lose_answer && lose_answer(frame));
   }
   std::uint64_t now_us() override { return now; }
   void wait_us(std::uint32_t us) override { advance(us); }

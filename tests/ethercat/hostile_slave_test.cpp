@@ -186,3 +186,53 @@ TEST(ecat_master_hostile, a_cycle_before_any_bring_up_is_refused_and_sends_nothi
 
 }  // namespace
 }  // namespace cia402::ethercat
+
+namespace cia402::ethercat {
+namespace {
+
+// ETG.1000.4 mailbox repeat, master side: a read that emptied the send mailbox but whose answer was
+// lost leaves nothing to read; the master toggles SM1's repeat request (0x080E bit 1), waits for the
+// repeat acknowledge (0x080F bit 1) and reads the reply again, instead of waiting out its timeout.
+TEST(ecat_master_mailbox_repeat, a_reply_whose_answer_was_lost_is_read_again_after_a_repeat_request) {
+  hostile_line line(2);
+  ecat_master m(line, standard_profile());
+  ASSERT_TRUE(m.scan()) << m.error();
+  ASSERT_TRUE(m.bring_to_pre_operational()) << m.error();
+  const std::uint16_t station = m.slaves()[1].station;
+  const std::uint16_t send_mailbox = m.slaves()[1].sii.mailbox_in_start;
+  int lost = 0;
+  std::vector<std::uint8_t> repeat_writes;
+  line.lose_answer = [&](const std::vector<std::uint8_t>& frame) {
+    parsed_frame parsed;
+    std::vector<std::uint8_t> copy = frame;
+    if (parse_frame(copy, parsed) != frame_error::none) return false;
+    for (std::size_t k = 0; k < parsed.count; ++k) {
+      const datagram& d = parsed.datagrams[k];
+      if (d.position() != station) continue;
+      if (d.cmd == command::fpwr && d.offset() <= 0x080E && d.offset() + d.length > 0x080E) {
+        repeat_writes.push_back(d.data[0x080E - d.offset()]);
+      }
+      if (d.cmd == command::fprd && d.offset() == send_mailbox && d.working_counter() == 1 && lost == 0) {
+        ++lost;  // the reply left the slave's mailbox, its bytes never reach the master
+        return true;
+      }
+    }
+    return false;
+  };
+  const ecat_sdo_result r = m.sdo_read(1, 0x1018, 2);
+  EXPECT_EQ(lost, 1);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.value(false), 0x402);
+  ASSERT_EQ(repeat_writes.size(), 1u) << "one repeat request";
+  EXPECT_EQ(repeat_writes[0] & 0x02, 0x02) << "bit 1 of 0x080E toggled from 0";
+  // A second loss: the repeat request toggles back.
+  lost = 0;
+  repeat_writes.clear();
+  const ecat_sdo_result again = m.sdo_read(1, 0x1018, 1);
+  ASSERT_TRUE(again.ok) << again.error;
+  ASSERT_EQ(repeat_writes.size(), 1u);
+  EXPECT_EQ(repeat_writes[0] & 0x02, 0x00);
+}
+
+}  // namespace
+}  // namespace cia402::ethercat

@@ -2,7 +2,10 @@
 // A raw socket (AF_PACKET, EtherType 0x88A4) bound to the interface takes each frame a master
 // sends, passes it through every drive's controller in order, and sends it back, as the last slave
 // of a real line does. Between frames each drive's application runs once per cycle of wall time
-// (AL state machine, mailboxes, process data, the simulator). Linux; needs CAP_NET_RAW (root).
+// (AL state machine, mailboxes, process data, the simulator), one drive at a time with the socket
+// looked at between any two: a frame waits at most one drive's step, never a whole cycle of every
+// drive or a catch-up after a stall, so its answer time depends on the frame alone. Linux; needs
+// CAP_NET_RAW (root).
 #pragma once
 
 #include <csignal>
@@ -38,15 +41,23 @@ class ethercat_host {
   bool pass(std::vector<std::uint8_t>& frame);
   /// One application cycle of every drive.
   void cycle(std::uint32_t elapsed_us);
+  /// `elapsed_us` more wall time, then at most one drive's application cycle of those it made due
+  /// (at most 10 cycles are owed after a stall): true while drives' steps are still owed, so the
+  /// caller answers frames between any two steps.
+  bool step_one_drive(std::uint32_t elapsed_us);
 
   std::vector<std::unique_ptr<virtual_drive_slave>>& drives() noexcept { return drives_; }
   std::uint64_t frames_answered() const noexcept { return wire_.frames(); }
   std::uint64_t frames_refused() const noexcept { return wire_.refused_frames(); }
 
  private:
+  void answer_waiting_frames(std::vector<std::uint8_t>& frame);
+
   std::vector<std::unique_ptr<virtual_drive_slave>> drives_;
   ethercat::chain wire_;
   std::uint32_t cycle_us_;
+  std::uint32_t owed_us_ = 0;   // wall time not yet given to the drives, at most 10 cycles
+  std::size_t next_drive_ = 0;  // the next drive to step in the cycle under way; size(): none under way
   detail::raw_socket socket_;
 };
 

@@ -98,6 +98,16 @@ bool esc::any_triple_in(std::uint16_t address, std::uint16_t length) const noexc
   return false;
 }
 
+const esc::sm_state* esc::only_triple_holding(std::uint16_t address, std::uint16_t length) const noexcept {
+  const sm_state* holder = nullptr;
+  for (const sm_state& s : sms_) {
+    if (!s.triple || !overlaps(address, length, s.config.start, s.config.length)) continue;
+    if (holder != nullptr || address < s.config.start || address + length - s.config.start > s.config.length) return nullptr;
+    holder = &s;
+  }
+  return holder;
+}
+
 std::uint8_t* esc::ecat_byte(std::uint16_t address) noexcept {
   const sm_state* s = triple_at(address);
   if (s == nullptr) return memory_.data() + address;
@@ -384,13 +394,26 @@ void esc::logical(datagram& d, bool read, bool write) noexcept {
       before_ecat_access(phys_byte, phys_bytes, !writing);
       const bool plain = phys_byte >= reg::process_ram && !any_triple_in(phys_byte, phys_bytes);
       const auto dg_bit = static_cast<std::uint32_t>(first - dg_first);
-      if (plain && (first % 8) == 0 && (phys_first % 8) == 0 && (bits % 8) == 0) {
+      const bool whole_bytes = (first % 8) == 0 && (phys_first % 8) == 0 && (bits % 8) == 0;
+      // Process data as drives map it: whole bytes inside one three-buffer sync manager, copied at
+      // once from or into the buffer the master sees (as ecat_byte() would find it byte by byte,
+      // which made every LRW cost a search per bit of every slave's process data).
+      const sm_state* within = whole_bytes ? only_triple_holding(phys_byte, phys_bytes) : nullptr;
+      if (plain && whole_bytes) {
         std::uint8_t* mem = memory_.data() + phys_first / 8;
         std::uint8_t* dat = d.data + dg_bit / 8;
         if (writing) {
           std::memcpy(mem, dat, bits / 8);
         } else {
           std::memcpy(dat, mem, bits / 8);
+        }
+      } else if (within != nullptr) {
+        std::uint8_t* mem = ecat_byte(phys_byte);
+        std::uint8_t* dat = d.data + dg_bit / 8;
+        if (writing) {
+          std::memcpy(mem, dat, phys_bytes);
+        } else {
+          std::memcpy(dat, mem, phys_bytes);
         }
       } else {
         // Bit by bit, each byte where it belongs (a buffer, or a register the master may write).

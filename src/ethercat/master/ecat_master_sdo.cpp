@@ -61,9 +61,31 @@ std::optional<std::vector<std::uint8_t>> ecat_master::mailbox_receive(ecat_slave
     const single r = one(command::fprd, s.station | (static_cast<std::uint32_t>(s.sii.mailbox_in_start) << 16),
                          std::vector<std::uint8_t>(s.sii.mailbox_in_size, 0));
     if (r.ok && r.wkc == 1) return r.data;  // 0: nothing in the mailbox yet
+    // No answer at all: the read may have emptied the mailbox on its way, so the reply is asked for
+    // again rather than waited for until the time runs out.
+    if (!r.ok && !request_mailbox_repeat(s)) return std::nullopt;
     if (link_->now_us() - start > mailbox_us) return std::nullopt;
     pause(poll_us);
   }
+}
+
+bool ecat_master::request_mailbox_repeat(ecat_slave& s) {
+  // ETG.1000.4 mailbox repeat: toggle SM1's repeat request (activate 0x080E bit 1, the enable bit
+  // written as it is), then the slave has put its last reply back when its repeat acknowledge (PDI
+  // control 0x080F bit 1) equals the request.
+  constexpr std::uint16_t sm1_activate = 0x0800 + 8 + 6;
+  constexpr std::uint16_t sm1_pdi_control = sm1_activate + 1;
+  constexpr std::uint8_t repeat_bit = 0x02;
+  const single before = read_register(s, sm1_activate, 1);
+  if (!before.ok || before.wkc != 1 || before.data.size() != 1) return false;
+  const auto request = static_cast<std::uint8_t>(before.data[0] ^ repeat_bit);
+  if (!write_register(s, sm1_activate, {request})) return false;
+  for (const std::uint64_t start = link_->now_us(); link_->now_us() - start <= mailbox_us;) {
+    const single ack = read_register(s, sm1_pdi_control, 1);
+    if (ack.ok && ack.wkc == 1 && ack.data.size() == 1 && (ack.data[0] & repeat_bit) == (request & repeat_bit)) return true;
+    pause(poll_us);
+  }
+  return false;  // the slave never acknowledged: the caller's transfer ends as unanswered
 }
 
 void ecat_master::note_emergency(ecat_slave& s, std::span<const std::uint8_t> mailbox) {

@@ -132,6 +132,8 @@ void coe_slave::enter(al_state s) {
     in_send_mailbox_.clear();
     last_read_.clear();
     withdrawn_.clear();
+    repeat_in_send_mailbox_ = false;
+    last_read_in_send_mailbox_ = false;
   }
   // Leaving OP the master no longer commands the device; entering it, it does again (a CiA 402
   // drive's 0x6007, S10).
@@ -275,11 +277,19 @@ void coe_slave::watch_sync_managers() {
 }
 
 void coe_slave::send_reply(std::vector<std::uint8_t>& reply) {
-  if (esc_.write_mailbox(1, reply)) in_send_mailbox_.swap(reply);
+  if (esc_.write_mailbox(1, reply)) {
+    in_send_mailbox_.swap(reply);
+    repeat_in_send_mailbox_ = false;
+    last_read_in_send_mailbox_ = false;
+  }
   reply.clear();
 }
 
 void coe_slave::repeat_last_reply() {
+  if (state_ != al_state::init && esc_.mailbox_full(1) && last_read_in_send_mailbox_) {
+    esc_.acknowledge_repeat(1);  // what a repeat puts back is there already
+    return;
+  }
   if (state_ != al_state::init && esc_.mailbox_full(1)) {
     // A newer reply waits unread: taken back (SM1 deactivated and activated again by its PDI
     // control, which empties it) to go out after the one the master lost.
@@ -292,15 +302,41 @@ void coe_slave::repeat_last_reply() {
   }
   if (state_ != al_state::init && !last_read_.empty() && esc_.write_mailbox(1, last_read_)) {
     in_send_mailbox_ = last_read_;
+    repeat_in_send_mailbox_ = true;
   }
   esc_.acknowledge_repeat(1);
+}
+
+void coe_slave::send_next_as_last_read() {
+  std::vector<std::uint8_t> next;
+  if (!withdrawn_.empty()) {
+    next.swap(withdrawn_);
+  } else if (coe_.has_reply()) {
+    next = coe_.take_reply();
+  } else {
+    return;
+  }
+  if (!esc_.write_mailbox(1, next)) {
+    withdrawn_.swap(next);  // goes out when SM1 takes it
+    return;
+  }
+  last_read_ = next;
+  in_send_mailbox_.swap(next);
+  last_read_in_send_mailbox_ = true;
 }
 
 void coe_slave::serve_mailbox() {
   // The master read SM1 whole: what it held is what a repeat request puts back.
   if (esc_.take_sync_manager_event(1) && !esc_.mailbox_full(1) && !in_send_mailbox_.empty()) {
+    const bool read_a_repeat = repeat_in_send_mailbox_;
+    repeat_in_send_mailbox_ = false;
+    last_read_in_send_mailbox_ = false;
     last_read_.swap(in_send_mailbox_);
     in_send_mailbox_.clear();
+    // As SOES does: once a repeated reply is read, the reply waiting behind it goes out at once and
+    // is what a further repeat request puts back. SOEM 1.4.0 asks for a repeat after every emergency
+    // it reads; without this each repeat put the emergency back and the reply never left.
+    if (read_a_repeat && state_ != al_state::init) send_next_as_last_read();
   }
   if (esc_.repeat_requested(1)) repeat_last_reply();
   if (state_ == al_state::init) return;

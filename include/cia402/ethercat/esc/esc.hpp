@@ -235,6 +235,9 @@ class esc {
   // The sync manager (three-buffer) whose area holds this byte, or nullptr.
   const sm_state* triple_at(std::uint16_t address) const noexcept;
   bool any_triple_in(std::uint16_t address, std::uint16_t length) const noexcept;
+  // The one three-buffer sync manager that holds all of [address, address + length) and that no
+  // other overlaps; nullptr otherwise.
+  const sm_state* only_triple_holding(std::uint16_t address, std::uint16_t length) const noexcept;
   // Where the master's access of this byte lands (its own buffer inside a buffered sync manager).
   std::uint8_t* ecat_byte(std::uint16_t address) noexcept;
   void publish(int n) noexcept;        // the writer's buffer becomes the newest

@@ -194,6 +194,7 @@ class ecat_master {
   bool start_sync0();
   bool mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe);
   std::optional<std::vector<std::uint8_t>> mailbox_receive(ecat_slave& s);
+  bool request_mailbox_repeat(ecat_slave& s);
   // The slave `i` names, with its CoE mailbox, or an error in `result`.
   ecat_slave* sdo_slave(std::size_t i, ecat_sdo_result& result);
   // Sends one SDO request (a mailbox's CoE data) and waits for the answer of kind `expected` (for an

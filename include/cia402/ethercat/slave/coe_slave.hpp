@@ -181,6 +181,7 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
   void serve_mailbox();
   void send_reply(std::vector<std::uint8_t>& reply);
   void repeat_last_reply();
+  void send_next_as_last_read();
 
   // dictionary_access
   sdo_abort read_value(const canopen::object_dictionary::slot& s, std::int64_t& v) override;
@@ -214,6 +215,10 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
   std::vector<std::uint8_t> in_send_mailbox_;
   std::vector<std::uint8_t> last_read_;
   std::vector<std::uint8_t> withdrawn_;
+  // SM1 holds a reply put back by a repeat request; SM1 holds last_read_ itself (a repeat request
+  // then only acknowledges).
+  bool repeat_in_send_mailbox_ = false;
+  bool last_read_in_send_mailbox_ = false;
 };
 
 }  // namespace cia402::ethercat
