@@ -38,6 +38,16 @@ std::optional<axes::value_format> coe_object_format(std::uint16_t index, std::ui
   // PDO mapping (entries of 32 bits: index, sub-index, length) and PDO assignment (16-bit indices).
   if ((index >= 0x1600 && index <= 0x17FF) || (index >= 0x1A00 && index <= 0x1BFF)) return sub == 0 ? u(1) : u(4);
   if (index >= 0x1C10 && index <= 0x1C2F) return sub == 0 ? u(1) : u(2);
+  // SM output / input parameter (ETG.1020 §5.3): the sync mode, cycle and shift times, the counters.
+  if (index == 0x1C32 || index == 0x1C33) {
+    switch (sub) {
+      case 0x00: return u(1);
+      case 0x01: case 0x04: case 0x08: case 0x0B: case 0x0C: return u(2);  // modes, get cycle time, counters
+      case 0x02: case 0x03: case 0x05: case 0x06: case 0x07: case 0x09: case 0x0A: return u(4);  // times, ns
+      case 0x20: return u(1);  // sync error (BOOLEAN)
+      default: return std::nullopt;
+    }
+  }
   return std::nullopt;
 }
 

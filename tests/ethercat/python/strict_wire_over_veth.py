@@ -12,6 +12,8 @@ written out, not taken from our code). Checked from tshark's fields:
    leaves AL status at 0x11; with the acknowledge it is taken (0x02);
  - the mailbox repeat (ETG.1000.4 SM, 0x080E bit 1 / 0x080F bit 1): after a toggled repeat request
    the repeat acknowledge follows and SM1 holds the same CoE reply again.
+ - csp on SYNC0 (ETG.1020 §5.3): with DC set up, drive 0's 0x1C32:01 reads 0x02 (DC SYNC0
+   synchronous) and a csp stream run by our master ends at its target, each set-point taken on SYNC0.
 Needs root and tshark (scripts/install-deps.sh); skips (exit 77) without root or tshark.
 Usage: strict_wire_over_veth.py CIA402_BINARY [KEEP_DIR]."""
 import json
@@ -60,6 +62,19 @@ def refused_sdos(cia402, iface):
         failed = [e for e in events if e["event"] == "failed"]
         assert rc != 0 and failed, (rc, events[-3:], err)
         assert "0x%08x" % code in failed[0]["error"].lower(), failed
+
+
+def csp_on_sync0(cia402, iface):
+    """One run of our master: the synchronisation mode, then enable and a csp stream to 20000."""
+    rc, events, err = master(cia402, iface, ["--position", "0", "sdo", "read", "0x1C32:1", "enable",
+                                             "csp-stream", "--to", "20000", "--velocity", "300", "disable"])
+    assert rc == 0, (rc, events[-3:], err)
+    sync_mode = [e for e in events if e.get("object") == "0x1C32:1"]
+    assert sync_mode and sync_mode[0]["value"] == 2, \
+        "0x1C32:01 is %s, not 2 (DC SYNC0): the drive does not run its cycle on SYNC0" % sync_mode
+    streamed = [e for e in events if e["event"] == "streamed"]
+    assert streamed and streamed[0]["position"] == 20000, "the csp stream did not end at 20000: %s" % streamed
+    return streamed[0]["set_points"]
 
 
 def al_status(bus):
@@ -227,6 +242,7 @@ def run(cia402, workdir):
         assert "2 drive(s) on %s" % s in first, first + slave.stderr.read()
         capture = start_capture(m, pcap)
         refused_sdos(cia402, m)
+        set_points = csp_on_sync0(cia402, m)
         seen, reply, again = al_error_and_repeat(m)
         time.sleep(0.3)  # the last answers into the capture
     finally:
@@ -242,7 +258,7 @@ def run(cia402, workdir):
     cycles = check_distributed_clocks(datagrams(frames))
     check_al_and_repeat(frames, seen, reply, again)
     print("on the wire: %d SDO aborts as CoE service 2, DC set up on 2 drives, %d cycle frames with FRMW 0x0910, "
-          "PRE-OP refused until acknowledged, mailbox repeat answered" % (aborts, cycles))
+          "PRE-OP refused until acknowledged, mailbox repeat answered, csp on SYNC0 (%d set-points)" % (aborts, cycles, set_points))
 
 
 def main():
