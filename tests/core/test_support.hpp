@@ -189,4 +189,21 @@ inline std::vector<int> seed_transitions(const profile& p) {
   return t;
 }
 
+// The states some chain of rows leads to from START. A row may list a source state its profile never
+// enters (no-quick-stop shares "every state but FAULT" for T13, QUICK STOP ACTIVE included).
+inline std::uint16_t reachable_states(const profile& p) {
+  std::uint16_t seen = state_bit(state::start);
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (std::size_t i = 0; i < p.row_count; ++i) {
+      const transition_row r = p.row(i);
+      if ((r.from & seen) != 0 && (seen & state_bit(r.to)) == 0) {
+        seen = static_cast<std::uint16_t>(seen | state_bit(r.to));
+        grew = true;
+      }
+    }
+  }
+  return seen;
+}
+
 }  // namespace cia402::test

@@ -1,0 +1,96 @@
+// A chain of emulated ESCs for the ESC tests (esc_test.cpp, esc_commands_test.cpp): datagrams sent
+// through it as a master sends them, and the FMMU and sync-manager registers written as ETG.1000.4
+// lays them out.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "cia402/ethercat/esc/esc.hpp"
+#include "cia402/ethercat/sii/slave_information.hpp"
+
+namespace cia402::ethercat::esc_bus {
+
+inline constexpr std::array<std::uint8_t, 6> broadcast{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
+inline constexpr std::array<std::uint8_t, 6> master_mac{0x02, 0, 0, 0, 0, 1};
+
+inline std::vector<std::uint8_t> eeprom() {
+  slave_description d;
+  d.vendor_id = 0x1234;
+  d.product_code = 0x402;
+  d.station_alias = 0x77;
+  return sii_image(d);
+}
+
+inline std::uint32_t ap(std::uint16_t position, std::uint16_t offset) {
+  return static_cast<std::uint16_t>(-position) | (static_cast<std::uint32_t>(offset) << 16);
+}
+inline std::uint32_t fp(std::uint16_t station, std::uint16_t offset) {
+  return station | (static_cast<std::uint32_t>(offset) << 16);
+}
+
+// One datagram through the chain: its data and working counter as they came back.
+struct result {
+  std::vector<std::uint8_t> data;
+  std::uint16_t wkc = 0;
+  std::uint16_t adp = 0;
+};
+
+struct bus {
+  std::vector<esc> escs;
+  chain wire;
+  explicit bus(int n) {
+    escs.reserve(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) escs.emplace_back(eeprom());
+    for (esc& e : escs) wire.add(e);
+  }
+  result send(command c, std::uint32_t address, std::vector<std::uint8_t> data) {
+    frame_builder b(broadcast, master_mac);
+    const long at = b.add(c, 1, address, data, static_cast<std::uint16_t>(data.size()));
+    std::vector<std::uint8_t> f = b.finish();
+    EXPECT_EQ(wire.pass(f), frame_error::none);
+    result r;
+    const auto* p = f.data() + at;
+    r.data.assign(p, p + data.size());
+    r.wkc = static_cast<std::uint16_t>(p[data.size()] | (p[data.size() + 1] << 8));
+    r.adp = static_cast<std::uint16_t>(f[static_cast<std::size_t>(at) - 8] | (f[static_cast<std::size_t>(at) - 7] << 8));
+    return r;
+  }
+  result write16(command c, std::uint32_t address, std::uint16_t v) {
+    return send(c, address, {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8)});
+  }
+  std::uint16_t value16(const result& r) { return static_cast<std::uint16_t>(r.data[0] | (r.data[1] << 8)); }
+};
+
+
+// FMMU i: logical start, length, start bit, end bit, physical start, physical bit, type, active.
+inline void fmmu(bus& b, int slave, int i, std::uint32_t log, std::uint16_t len, std::uint8_t sbit, std::uint8_t ebit,
+          std::uint16_t phys, std::uint8_t pbit, std::uint8_t type) {
+  std::vector<std::uint8_t> f(16, 0);
+  f[0] = static_cast<std::uint8_t>(log);
+  f[1] = static_cast<std::uint8_t>(log >> 8);
+  f[2] = static_cast<std::uint8_t>(log >> 16);
+  f[3] = static_cast<std::uint8_t>(log >> 24);
+  f[4] = static_cast<std::uint8_t>(len);
+  f[5] = static_cast<std::uint8_t>(len >> 8);
+  f[6] = sbit;
+  f[7] = ebit;
+  f[8] = static_cast<std::uint8_t>(phys);
+  f[9] = static_cast<std::uint8_t>(phys >> 8);
+  f[10] = pbit;
+  f[11] = type;
+  f[12] = 1;
+  EXPECT_EQ(b.send(command::apwr, ap(static_cast<std::uint16_t>(slave), static_cast<std::uint16_t>(reg::fmmu0 + 16 * i)), f).wkc, 1);
+}
+
+// SM n: start, length, control, enabled.
+inline void sync_manager(bus& b, int n, std::uint16_t start, std::uint16_t len, std::uint8_t control) {
+  std::vector<std::uint8_t> s{static_cast<std::uint8_t>(start), static_cast<std::uint8_t>(start >> 8),
+                              static_cast<std::uint8_t>(len), static_cast<std::uint8_t>(len >> 8), control, 0, 1, 0};
+  EXPECT_EQ(b.send(command::apwr, ap(0, static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n)), s).wkc, 1);
+}
+
+}  // namespace cia402::ethercat::esc_bus
