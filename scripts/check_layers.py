@@ -91,7 +91,8 @@ ALLOWED = {
     "axis": {"core"},
     "canopen/axis": {"core", "axis", "support", "canopen/can", "canopen/301", "canopen/306", "canopen/402"},
     "ethercat/axis": {"core", "axis", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/master"},
-    "apps": {"axis", "ethercat/master", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/slave", "drive402", "sim", "motion", "support",
+    # The compositions: canopen/axis for the CiA 301 types' value formats the local link shares.
+    "apps": {"axis", "canopen/axis", "ethercat/master", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/slave", "drive402", "sim", "motion", "support",
              "core", "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
              "canopen/monitor"},
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
