@@ -75,7 +75,8 @@ bool session::poll_due() {
     p.next_us = now_us_ + config_.poll_us;
     const std::uint16_t i = index;
     const object_description* o = find_drive_object(i, 0);
-    const std::optional<value_format> f = o != nullptr ? std::optional(axes::format_of(o->type)) : std::nullopt;
+    // The core's table, else what the link knows of its bus's objects (0x1001, the error register).
+    const std::optional<value_format> f = o != nullptr ? std::optional(axes::format_of(o->type)) : link_->describe(i, 0);
     transfer_busy_ = true;
     const bool queued = link_->upload(i, 0, [this, i, f](const transfer_result& r) {
       transfer_busy_ = false;

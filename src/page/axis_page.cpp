@@ -19,16 +19,16 @@ namespace {
 using json = nlohmann::ordered_json;
 using detail::hex;
 
+constexpr const char* not_remote = "not available on a remote drive";
+
 constexpr std::uint16_t following_error_actual = 0x60F4;  // CiA 402-2
 constexpr std::uint16_t error_register = 0x1001;          // CiA 301
 
-constexpr const char* not_remote = "not available on a remote drive";
-
 // What a drive on a bus does not carry cyclically and the snapshots show: polled by the session.
 constexpr std::uint16_t shown_actuals[] = {
-    object_index::modes_of_operation_display, object_index::position_actual_value,
+    object_index::modes_of_operation, object_index::modes_of_operation_display, object_index::position_actual_value,
     object_index::torque_actual_value, following_error_actual,
-    object_index::velocity_actual_value};
+    object_index::velocity_actual_value, error_register};
 
 }  // namespace
 
@@ -36,12 +36,12 @@ axis_page::impl::impl(const profile& p, connection_factory f, axis_page_config c
     : table(&p),
       connect(std::move(f)),
       config(std::move(c)),
+      drive(connect ? connect(p) : drive_connection{}),
       log({config.results_kept, config.settle_quiet_us, config.settle_limit_us,
-           "still busy when the page stopped waiting", ""},
+           "still busy when the page stopped waiting", drive.plant == nullptr ? " (numbers inferred)" : ""},
           [this] { return how_it_stands(); }) {
   if (config.cycle_us == 0) config.cycle_us = 1000;
-  if (!connect) throw std::invalid_argument("axis_page: no connection factory");
-  open(p);
+  start_session(p);
   if (drive.plant != nullptr) {
     if (config.selectable.empty()) {
       for (std::size_t i = 0; i < builtin_profile_count(); ++i) config.selectable.push_back(&builtin_profile(i));
@@ -54,9 +54,7 @@ axis_page::impl::impl(const profile& p, connection_factory f, axis_page_config c
 
 axis_page::impl::~impl() = default;
 
-void axis_page::impl::open(const profile& p) {
-  session.reset();
-  drive = connect(p);
+void axis_page::impl::start_session(const profile& p) {
   if (!drive.link) throw std::invalid_argument("axis_page: the connection gave no link");
   table = &p;
   axes::session_config sc;
@@ -78,6 +76,9 @@ void axis_page::impl::open(const profile& p) {
     } else if (e == axes::link_event::running) {
       drive.link->start_cyclic();
     }
+  };
+  session->on_emergency = [this](std::uint16_t code, std::uint8_t, std::span<const std::uint8_t>) {
+    last_emergency = code;
   };
   session->on_lease_lapsed = [this](const std::string& what) {
     const std::string action = "SIGN OF LIFE LOST (no page for " + std::to_string(session->lease_us() / 1000) +
@@ -324,6 +325,7 @@ json axis_page::impl::remote_json() const {
   r["device_name"] = session->device_name();
   r["cyclic"] = l.cyclic();
   r["lease_lapsed"] = session->lease_lapsed();
+  r["last_emcy"] = last_emergency ? json(hex(*last_emergency, 4)) : json(nullptr);
   return r;
 }
 

@@ -95,28 +95,29 @@ std::optional<axes::result> axis_page::impl::await(std::unique_lock<std::mutex>&
     *out = r;
     answered.notify_all();
   });
-  // A drive in this process answers without time passing; a bus is the cycle thread's alone.
-  for (int i = 0; i < 8 && drive.plant != nullptr && !*out; ++i) session->poll(0);
+  // A drive in this process answers without time passing, and a request refused before anything is
+  // sent at once; the rest comes with the cycle thread's polls.
+  for (int i = 0; i < 8 && !*out; ++i) session->poll(0);
   answered.wait_for(lock, config.request_timeout, [&] { return out->has_value() || board.closed(); });
   return *out;
 }
 
 reply axis_page::impl::write_reply(const std::optional<axes::result>& r, const std::string& action,
-                                   std::optional<std::string> track_action) {
-  if (!r) {
-    log.report_now(action, "refused", "refused: no answer in time");
-    return refused{504, action + ": no answer from " + session->link().short_name() + " in time"};
-  }
+                                   std::optional<std::uint64_t> tracked) {
+  const auto refuse = [&](int status, const std::string& why, sdo_abort abort) -> reply {
+    if (tracked) {
+      log.refuse_pending("refused: " + why);
+    } else {
+      log.report_now(action, "refused", "refused: " + why);
+    }
+    return refused{status, action + ": " + why, abort};
+  };
+  if (!r) return refuse(504, "no answer from " + session->link().short_name() + " in time", sdo_abort::none);
   if (r->abort != sdo_abort::none) {
-    const bool silent = r->abort == sdo_abort::sdo_protocol_timed_out;
-    log.report_now(action, "refused", "refused: " + abort_text(r->abort));
-    return refused{silent ? 504 : 422, action + ": " + abort_text(r->abort), r->abort};
+    return refuse(r->abort == sdo_abort::sdo_protocol_timed_out ? 504 : 422, abort_text(r->abort), r->abort);
   }
-  if (!r->ok()) {
-    log.report_now(action, "refused", "refused: " + r->error);
-    return refused{r->bad_input ? 422 : 503, action + ": " + r->error};
-  }
-  if (track_action) return accepted{log.track(*track_action, false, observed, now_us)};
+  if (!r->ok()) return refuse(r->bad_input ? 422 : 503, r->error, sdo_abort::none);
+  if (tracked) return accepted{*tracked};
   return accepted{log.report_now(action, "done", "done")};
 }
 
@@ -275,7 +276,9 @@ reply axis_page::select_profile(std::string_view name) {
   m.observed.reset();
   m.last_transition.reset();
   m.recording.clear();
-  m.open(*chosen);
+  m.session.reset();  // before the link it uses
+  m.drive = m.connect(*chosen);
+  m.start_session(*chosen);
   return accepted{m.log.report_now("PROFILE " + std::string(chosen->name), "done",
                                    std::string("done: ") + chosen->title + ", from power-up")};
 }
@@ -348,11 +351,12 @@ reply axis_page::impl::change_bus_plant(std::unique_lock<std::mutex>& lock, cons
   if (auto no = not_running()) return *no;
   if (change.target_velocity) {
     const std::int64_t v = *change.target_velocity;
+    const std::uint64_t id = log.track("TARGET_VELOCITY=" + std::to_string(v), false, observed, now_us);
     const auto r = await(lock, [this, v](axes::completion done) {
       session->write_object(object_index::target_velocity, 0, axes::object_value::of_integer(v), std::move(done));
     });
     if (r && r->ok()) objects[object_index::target_velocity] = v;
-    return write_reply(r, "WRITE 0x60FF = " + std::to_string(v), "TARGET_VELOCITY=" + std::to_string(v));
+    return write_reply(r, "WRITE 0x60FF = " + std::to_string(v), id);
   }
   if (session->device_name() != virtual_drive_device_name) {
     return refused{409, std::string("fault injection is ") + not_remote + " (" + session->link().short_name() +
@@ -362,11 +366,13 @@ reply axis_page::impl::change_bus_plant(std::unique_lock<std::mutex>& lock, cons
   std::string action = *change.fault ? "FAULT " + hex(code, 4) + " ON" : std::string("FAULT OFF");
   // 0x2001 takes an error code only; the drive raises it with its default class.
   if (*change.fault && table->error_classes) action += " (class not sent: 0x2001 takes a code)";
+  // Tracked from before it is sent: the drive may answer and fault in the same cycle.
+  const std::uint64_t id = log.track(action, false, observed, now_us);
   const auto r = await(lock, [this, code](axes::completion done) {
     session->write_object(fault_injection_index, 0, axes::object_value::of_integer(code), std::move(done));
   });
   if (r && r->ok()) injected_fault = code;
-  return write_reply(r, action, action);
+  return write_reply(r, action, id);
 }
 
 void axis_page::renew_lease() {

@@ -52,6 +52,7 @@ struct axis_page::impl {
   bool reset_sent_since_change = false;  // for the inference (a fault-reset edge went out)
   std::map<std::uint16_t, std::int64_t> objects;  // a bus drive's objects as read at start or written
   std::uint16_t injected_fault = 0;               // what the page wrote to 0x2001 (a bus node)
+  std::optional<std::uint16_t> last_emergency;    // the newest emergency's error code
 
   // What the page asked for.
   std::optional<std::uint16_t> requested_word;  // a word given to the session, not yet sent
@@ -88,7 +89,7 @@ struct axis_page::impl {
   std::optional<jog_run> jogging;
 
   // --- axis_page.cpp ------------------------------------------------------------------------------
-  void open(const profile& p);  // the connection and its session
+  void start_session(const profile& p);  // the session over the connection `drive`
   void advance(std::uint32_t elapsed_us);
   void on_state(state from, state to, std::uint16_t status_word);
   void note_transition(std::optional<int> number, state from, state to, bool inferred,
@@ -125,8 +126,10 @@ struct axis_page::impl {
   /// at once), then the cycle thread brings it. Nothing when the page closed or the time ran out.
   std::optional<axes::result> await(std::unique_lock<std::mutex>& lock,
                                     const std::function<void(axes::completion)>& start);
+  /// The reply to an object write; `tracked`: the action was tracked from before it was sent (a
+  /// plant input whose transitions the page reports), and is refused if the write failed.
   reply write_reply(const std::optional<axes::result>& r, const std::string& action,
-                    std::optional<std::string> track_action = std::nullopt);
+                    std::optional<std::uint64_t> tracked = std::nullopt);
   reply change_bus_plant(std::unique_lock<std::mutex>& lock, const plant_change& change);
 };
 

@@ -59,6 +59,7 @@ int open_ecat(const serve_args& args, const profile& p, page::axis_page_config p
     err << "cia402 serve: EtherCAT " << args.ecat << ": " << d.ecat->error() << "\n";
     return unreachable;
   }
+  d.ecat->set_retry_us(1000000);  // a line that answers again is brought to OP again
   if (static_cast<std::size_t>(args.position) >= d.ecat->master().slaves().size()) {
     err << "cia402 serve: --position " << args.position << ": the line has " << d.ecat->master().slaves().size()
         << " slave(s)\n";
@@ -115,6 +116,7 @@ int open_can(const serve_args& args, const profile& p, page::axis_page_config pc
     // The page's own heartbeat, watched by the drive (0x1016), on the wall clock: a page slowed
     // down by a loaded machine must still send it every 100 ms of wall time.
     c.master_heartbeat_ms = 100;
+    c.retry_us = 1000000;  // a node that comes back (or restarts) is set up again
     c.known_objects = canopen::node_objects(apps::drive_node_config(static_cast<std::uint8_t>(node)));
     c.heartbeat_clock_us = [] {
       return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
