@@ -28,7 +28,7 @@ constexpr std::uint16_t error_register = 0x1001;          // CiA 301
 constexpr std::uint16_t shown_actuals[] = {
     object_index::modes_of_operation, object_index::modes_of_operation_display, object_index::position_actual_value,
     object_index::torque_actual_value, following_error_actual,
-    object_index::velocity_actual_value, error_register};
+    object_index::velocity_actual_value, object_index::target_velocity, error_register};
 
 }  // namespace
 
