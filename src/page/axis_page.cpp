@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <thread>
 
 #include "cia402/error_codes.hpp"
 #include "cia402/manufacturer_objects.hpp"
@@ -429,12 +430,22 @@ json axis_page::impl::bus_snapshot(json j) const {
 axis_page::axis_page(const profile& p, connection_factory connect, axis_page_config config)
     : impl_(std::make_unique<impl>(p, std::move(connect), std::move(config))) {}
 
-axis_page::~axis_page() {
+axis_page::~axis_page() { close(); }
+
+void axis_page::shut_down(std::chrono::milliseconds wait) {
   close();
   std::lock_guard lock(impl_->mutex);
-  // The link puts back what it changed on the node; a drive in this process has nothing to put back.
-  impl_->session->close(false);
-  for (int i = 0; i < 200 && !impl_->session->closed(); ++i) impl_->session->poll(impl_->config.cycle_us);
+  axes::session& s = *impl_->session;
+  s.close(true);
+  using clock = std::chrono::steady_clock;
+  const auto end = clock::now() + wait;
+  auto last = clock::now();
+  while (!s.closed() && clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const auto now = clock::now();
+    s.poll(static_cast<std::uint32_t>(std::chrono::duration_cast<std::chrono::microseconds>(now - last).count()));
+    last = now;
+  }
 }
 
 void axis_page::step() { advance(impl_->config.cycle_us); }

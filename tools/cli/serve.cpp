@@ -41,7 +41,7 @@ struct served_drives {
   std::unique_ptr<apps::ethercat_link> line;
   std::unique_ptr<ethercat::ecat_line> ecat;
   std::vector<std::unique_ptr<canopen::channel>> channels;
-  std::vector<std::unique_ptr<page::backend>> drives;
+  std::vector<std::unique_ptr<page::axis_page>> drives;
   std::vector<page::axis> axes;
 };
 
@@ -277,6 +277,9 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   for (auto& d : drives) d->close();
   http.stop();
   for (auto& r : runners) r->stop();
+  // Each link puts back what it changed on its node (a drive left enabled stops first, as 0x6007
+  // says).
+  for (auto& d : served.drives) d->shut_down(std::chrono::seconds(2));
   pthread_sigmask(SIG_SETMASK, &previous, nullptr);
   return 0;
 }

@@ -99,6 +99,10 @@ class axis_page : public backend {
   void close() override;
   bool closed() const override;
 
+  /// The end, once the cycle thread stopped: the session stops a drive left enabled as its 0x6007
+  /// says, then the link puts back what it changed on the node (PDO mappings, heartbeats; an
+  /// EtherCAT line leaves OP), polled on the steady clock for at most `wait`. Then close().
+  void shut_down(std::chrono::milliseconds wait);
   /// Cycles stepped so far.
   std::uint64_t cycle() const;
   /// Where the link stands, in words ("" while it runs): "node 1 does not answer (...)".
