@@ -78,6 +78,9 @@ void axis_page::impl::start_session(const profile& p) {
       drive.link->start_cyclic();
     }
   };
+  session->on_progress = [this](axes::progress_kind k, const axes::result&) {
+    if (k == axes::progress_kind::jog_started && jogging) jogging->turning = true;
+  };
   session->on_emergency = [this](std::uint16_t code, std::uint8_t, std::span<const std::uint8_t>) {
     last_emergency = code;
   };
@@ -224,6 +227,9 @@ void axis_page::impl::check_enable_walk() {
   if (!enabling || !observed) return;
   const std::string why = enable_blocker(*observed);
   if (why.empty()) return;
+  // Over before the word goes: the session ends the walk it supersedes from inside send_word.
+  const operation walk = *enabling;
+  enabling.reset();
   std::uint16_t word = 0;
   if (table->decode(word_shown()) == command::enable_operation &&
       encode_command(*table, command::switch_on, word_shown(), word)) {
@@ -231,9 +237,8 @@ void axis_page::impl::check_enable_walk() {
   } else {
     send_word(word_shown(), false);  // the walk ends where it stands
   }
-  log.update({enabling->id, enabling->action, "refused", "refused in " + std::string(state_name(*observed)) + ": " + why,
-              enabling->transitions});
-  enabling.reset();
+  log.update({walk.id, walk.action, "refused", "refused in " + std::string(state_name(*observed)) + ": " + why,
+              walk.transitions});
 }
 
 // Something still goes on that keeps the tracked action from settling: a word not yet sent, a stop

@@ -176,6 +176,10 @@ reply axis_page::enable() {
     return refused{409, text};
   }
   m.handshake.reset();
+  if (m.enabling) {
+    m.log.update({m.enabling->id, "ENABLE", "refused", "refused: Enable pressed again", m.enabling->transitions});
+    m.enabling.reset();
+  }
   const std::uint64_t id = m.log.report_now("ENABLE", "pending", "walking to OPERATION_ENABLED");
   m.enabling = impl::operation{id, "ENABLE", {}};
   m.session->go_to(state::operation_enabled, [&m, id](const axes::result& r) {
@@ -190,6 +194,10 @@ reply axis_page::stop() {
   if (auto no = m.not_running()) return *no;
   if (m.jogging) m.jogging->why_ended = "Stop pressed";
   m.handshake.reset();
+  if (m.stopping) {
+    m.log.update({m.stopping->id, "STOP", "refused", "refused: Stop pressed again", m.stopping->transitions});
+    m.stopping.reset();
+  }
   const state s = m.observed.value_or(state::start);
   const bool quick = s == state::operation_enabled;
   const std::uint64_t id =
@@ -220,12 +228,20 @@ reply axis_page::jog(std::int64_t velocity_rpm, std::uint64_t time_to_live_us) {
   if (auto no = m.not_running()) return *no;
   if (velocity_rpm == 0) {
     if (!m.jogging) return accepted{m.log.report_now("JOG RELEASE", "nothing to do", "nothing to do: no jog runs")};
+    const std::uint64_t id = m.jogging->id;
     m.jogging->why_ended = "released";
-    m.session->renew_jog(0);  // the session's dead-man ends it in its next poll
+    if (!m.jogging->turning) {
+      // Released before it turned (the mode switch still under way): the jog must not start.
+      m.session->stop([](const axes::result&) {});
+    } else {
+      m.session->renew_jog(0);  // the session's dead-man ends it in its next poll: 0x60FF = 0
+    }
     if (m.drive.plant != nullptr) {
       for (int i = 0; i < 4; ++i) m.session->poll(0);
     }
-    return accepted{m.jogging ? m.jogging->id : m.log.report_now("JOG RELEASE", "done", "done: released")};
+    // Reported at once, as the button's release is: the session ramps the shaft to rest meanwhile.
+    if (m.jogging) m.end_jog(axes::result{});
+    return accepted{id};
   }
   const state now = m.observed.value_or(state::start);
   if (now != state::operation_enabled) {
@@ -236,15 +252,18 @@ reply axis_page::jog(std::int64_t velocity_rpm, std::uint64_t time_to_live_us) {
     return refused{422, "JOG " + std::to_string(velocity_rpm) + " rpm: " + abort_text(sdo_abort::invalid_value),
                    sdo_abort::invalid_value};
   }
-  if (m.jogging && m.jogging->velocity_rpm == velocity_rpm && m.jogging->time_to_live_us == time_to_live_us) {
-    m.session->renew_jog(time_to_live_us);  // the keep-alive
+  // The keep-alive of the jog that runs; a jog released (or ending) is not renewed but started anew.
+  if (m.jogging && m.jogging->why_ended.empty() && m.now_us < m.jogging->expires_us &&
+      m.jogging->velocity_rpm == velocity_rpm && m.jogging->time_to_live_us == time_to_live_us) {
+    m.session->renew_jog(time_to_live_us);
+    m.jogging->expires_us = m.now_us + time_to_live_us;
     return accepted{m.jogging->id};
   }
-  if (m.jogging) m.jogging->why_ended = "another jog velocity";
+  if (m.jogging && m.jogging->why_ended.empty()) m.jogging->why_ended = "another jog velocity";
   const std::string action = "JOG " + std::to_string(velocity_rpm) + " rpm";
   const std::uint64_t id = m.log.report_now(
       action, "pending", "running in profile velocity while renewed within " + std::to_string(time_to_live_us / 1000) + " ms");
-  impl::jog_run j{id, 0, action, velocity_rpm, time_to_live_us, m.now_us, ""};
+  impl::jog_run j{id, 0, action, velocity_rpm, time_to_live_us, m.now_us, m.now_us + time_to_live_us, ""};
   j.session_id = m.session->jog(static_cast<std::int32_t>(velocity_rpm), time_to_live_us, [&m, id](const axes::result& r) {
     if (m.jogging && m.jogging->id == id) m.end_jog(r);
   });

@@ -84,7 +84,11 @@ struct axis_page::impl {
     std::int64_t velocity_rpm = 0;
     std::uint64_t time_to_live_us = 0;
     std::uint64_t started_us = 0;
-    std::string why_ended;
+    /// The page's own reckoning of the dead-man (the session's counts from when the drive turns, so
+    /// it is never earlier): a keep-alive after it starts the jog anew rather than renew an ending one.
+    std::uint64_t expires_us = 0;
+    std::string why_ended;  // released, Stop, another velocity; empty while it runs
+    bool turning = false;   // the session switched to profile velocity and set 0x60FF
   };
   std::optional<jog_run> jogging;
 

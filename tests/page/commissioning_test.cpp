@@ -204,6 +204,18 @@ TEST_F(commissioning, jog_released_stops_at_once) {
   EXPECT_EQ(snapshot(inst)["target_velocity"], 0);
 }
 
+TEST_F(commissioning, jog_released_before_it_turned_never_turns) {
+  enable();
+  id_of(inst.jog(jog_rpm, ttl_us));  // the switch to profile velocity is still under way
+  id_of(inst.jog(0, ttl_us));
+  for (int i = 0; i < 50; ++i) {
+    run(inst, 10);
+    ASSERT_EQ(snapshot(inst)["target_velocity"], 0) << "after " << 10 * (i + 1) << " cycles";
+  }
+  EXPECT_EQ(snapshot(inst)["velocity"], 0);
+  EXPECT_EQ(snapshot(inst)["state"], "OPERATION_ENABLED");
+}
+
 TEST_F(commissioning, jog_outside_operation_enabled_is_refused_and_sets_nothing) {
   const reply r = inst.jog(jog_rpm, ttl_us);
   ASSERT_TRUE(std::holds_alternative<refused>(r));
