@@ -95,9 +95,8 @@ ALLOWED = {
     "apps": {"axis", "canopen/axis", "ethercat/master", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/slave", "drive402", "sim", "motion", "support",
              "core", "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
              "canopen/monitor"},
-    "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "canopen/can",
-             "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "ethercat/esc",
-             "ethercat/sii", "ethercat/master", "axis", "canopen/axis", "ethercat/axis"},
+    # The page is a client of the axis session; `cia402 serve` (tools) builds the link.
+    "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "axis"},
     # The Python binding: the core, profile files, the replay, the simulator, and the fieldbuses as
     # the apps layer composes them (the virtual CAN bus with its drives, the axis session).
     "python": {"core", "motion", "support", "profile_file", "replay", "sim", "apps", "drive402",
@@ -113,13 +112,17 @@ ALLOWED = {
 # What a layer may never see, whatever ALLOWED says: the fieldbuses know no simulated drive (the
 # drive402 device sits above canopen/301, the compositions that put it on a bus are the apps layer's),
 # the CoE codec sees only the core so the master can use it, the master nothing of the slave side,
-# and the drive no fieldbus beyond the device interface of canopen/301. check_rules() holds ALLOWED to
+# the drive no fieldbus beyond the device interface of canopen/301, and the page no fieldbus at all
+# (a client of the axis session; `cia402 serve` builds the link). check_rules() holds ALLOWED to
 # these before any file is read, so the table cannot be widened past them by accident.
 NEVER = [
     ("canopen/", {"sim", "motion", "drive402", "apps", "page"}),
     ("ethercat/", {"sim", "motion", "drive402", "apps", "page"}),
     ("ethercat/coe", {"canopen/can", "canopen/301"}),
     ("ethercat/master", {"ethercat/slave", "canopen/301"}),
+    ("page", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+              "canopen/monitor", "canopen/axis", "ethercat/esc", "ethercat/sii", "ethercat/coe",
+              "ethercat/slave", "ethercat/master", "ethercat/axis", "apps", "drive402"}),
     ("drive402", {"canopen/can", "canopen/transport", "canopen/402", "ethercat/esc", "ethercat/sii",
                   "ethercat/coe", "ethercat/slave", "ethercat/master"}),
 ]

@@ -299,6 +299,8 @@ std::string session::stop_as_0x6007(const std::string& why) {
     steps = {call_step([this] {
                set_mode_bits(0);
                halt_by_stop_ = true;
+               // A client's own words carry no halt of the session's: the state it is in is held.
+               if (control_ == control::words && observed_ == state::operation_enabled) set_target(observed_);
              }),
              wait_stopped(true)};
   } else {

@@ -75,7 +75,8 @@ bool session::poll_due() {
     p.next_us = now_us_ + config_.poll_us;
     const std::uint16_t i = index;
     const object_description* o = find_drive_object(i, 0);
-    const std::optional<value_format> f = o != nullptr ? std::optional(axes::format_of(o->type)) : std::nullopt;
+    // The core's table, else what the link knows of its bus's objects (0x1001, the error register).
+    const std::optional<value_format> f = o != nullptr ? std::optional(axes::format_of(o->type)) : link_->describe(i, 0);
     transfer_busy_ = true;
     const bool queued = link_->upload(i, 0, [this, i, f](const transfer_result& r) {
       transfer_busy_ = false;
@@ -198,11 +199,15 @@ std::uint64_t session::write_object(std::uint16_t index, std::uint8_t sub, const
   std::string why;
   if (res->format && !encode_value(v, *res->format, bytes, why)) return refuse(why);
   if (!res->format) bytes = v.what == value_format::kind::text ? std::vector<std::uint8_t>(v.text.begin(), v.text.end()) : v.bytes;
-  queue_download(index, sub, std::move(bytes), [this, res, index, sub, done](const transfer_result& r) {
+  const std::int64_t number = v.what == value_format::kind::integer ? v.number : 0;
+  queue_download(index, sub, std::move(bytes), [this, res, index, sub, number, done](const transfer_result& r) {
     if (!r.ok) {
       res->end = outcome::failed;
       res->abort = r.abort;
       res->error = "writing " + object_name(index, sub) + ": " + transfer_failure(r);
+    } else if (sub == 0) {
+      // An option code written is the drive's from now on: the planner and the lease use it.
+      (void)write_option(*profile_, options_, index, static_cast<std::int32_t>(number));
     }
     fill_result(*res);
     if (done) done(*res);

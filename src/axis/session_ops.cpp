@@ -200,7 +200,7 @@ std::uint64_t session::halt(bool on, completion done) {
   std::vector<step> steps{need_prepared(), need_cyclic(), check(false), step{[this, apply] {
                             apply();
                             // Taking control holds the drive where it is, with the halt bit.
-                            if (control_ == control::none && holdable(observed_)) set_target(observed_);
+                            if ((control_ == control::none || control_ == control::words) && holdable(observed_)) set_target(observed_);
                           }, [this] {
                             if (control_ == control::none) return fail_step("the drive shows " + state_text() + ": no state to hold");
                             return step_state::done;
@@ -214,7 +214,7 @@ std::uint64_t session::stop(completion done) {
                             if (!has_halt) return set_command(command::quick_stop);
                             halt_by_stop_ = true;
                             set_mode_bits(0);
-                            if (control_ == control::none && holdable(observed_)) set_target(observed_);
+                            if ((control_ == control::none || control_ == control::words) && holdable(observed_)) set_target(observed_);
                           }, nullptr}, wait_settled(), wait_stopped(has_halt)};
   const std::uint64_t id = begin("stop", std::move(steps), std::move(done), false);
   op_->res.note = has_halt ? "halted: control bit 8 stays set until the next motion command or halt off" : "quick stop";

@@ -53,6 +53,13 @@ std::uint64_t action_log::report_now(std::string action, std::string outcome, st
   return id;
 }
 
+void action_log::refuse_pending(std::string text) {
+  if (!pending_) return;
+  result_entry r{pending_->id, pending_->action, "refused", std::move(text), pending_->transitions};
+  pending_.reset();
+  push(std::move(r));
+}
+
 void action_log::finish_pending(const char* why_unsettled) {
   if (!pending_) return;
   const tracked a = std::move(*pending_);

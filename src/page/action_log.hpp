@@ -82,6 +82,8 @@ class action_log {
   tracked* pending() { return pending_ ? &*pending_ : nullptr; }
   /// Reports the tracked action as it stands; `why_unsettled` (if any) is added in parentheses.
   void finish_pending(const char* why_unsettled);
+  /// Reports the tracked action as refused with `text`: what it asked for never took effect.
+  void refuse_pending(std::string text);
   /// Once per cycle: `busy` says something still goes on (it keeps the action from settling).
   void settle(std::uint64_t now, bool busy);
 

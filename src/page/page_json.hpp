@@ -1,4 +1,4 @@
-// What both backends of the page (instrument.cpp, remote_drive.cpp) share: the command buttons'
+// What the page's drive (axis_page.cpp) and the server share: the command buttons'
 // table and the profile part of /api/info. One source, so the page draws the same buttons, rows and
 // bit names whichever drive it shows. What else they share has a file of its own: the results
 // (action_log.hpp), publishing snapshots (snapshot_board.hpp), the buttons' control words

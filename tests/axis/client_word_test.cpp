@@ -78,6 +78,28 @@ TEST(client_word, a_lapsed_lease_stops_a_drive_the_client_enabled_by_its_own_wor
   EXPECT_NE(b.lapses[0].find("page stopped renewing its lease"), std::string::npos) << b.lapses[0];
 }
 
+TEST(client_word, a_lapsed_lease_with_0x6007_written_0_halts_a_drive_the_client_enabled_by_its_words) {
+  session_config c;
+  c.lease_us = 100'000;
+  bench b(c);
+  b.s->renew("page");
+  // 0x6007 = 0 (no action) written by the client after start-up: the lease uses it, not the code
+  // read at start (1 by default, a quick stop).
+  ASSERT_TRUE(b.finish([&](completion d) {
+                 return b.s->write_object(0x6007, 0, object_value::of_integer(0), std::move(d));
+               }).ok());
+  EXPECT_EQ(b.s->option_code(option::abort_connection), 0);
+  ASSERT_TRUE(send(b, 0x0006).ok());
+  ASSERT_TRUE(send(b, 0x000F).ok());
+  b.s->renew("page");
+  ASSERT_TRUE(b.run_until([&] { return b.link.drive.view().current() == state::operation_enabled; }, 100));
+  ASSERT_TRUE(b.run_until([&] { return !b.lapses.empty(); }, 300));
+  b.run_ms(50);
+  // A halt (control bit 8) on the client's own word: the drive stays enabled and stops the shaft.
+  EXPECT_EQ(b.link.drive.view().current(), state::operation_enabled);
+  EXPECT_NE(b.link.drive.view().control_word() & control_bit::halt, 0) << b.lapses[0];
+}
+
 TEST(client_word, on_cycle_is_called_once_a_cycle_before_the_outputs_go) {
   bench b;
   int calls = 0;

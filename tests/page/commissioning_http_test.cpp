@@ -10,13 +10,13 @@
 #include <memory>
 #include <string>
 
-#include "cia402/page/instrument.hpp"
+#include "virtual_axis_page.hpp"
 #include "cia402/page/server.hpp"
 #include "cia402/profile.hpp"
 
 namespace {
 
-using cia402::page::instrument;
+using cia402::page::testing::virtual_axis_page;
 using cia402::page::server;
 using cia402::page::server_options;
 using json = nlohmann::json;
@@ -52,7 +52,7 @@ class commissioning_http : public ::testing::Test {
   }
   json state() { return json::parse(inst.snapshot_json()); }
 
-  instrument inst{cia402::standard_profile()};
+  virtual_axis_page inst{cia402::standard_profile()};
   std::unique_ptr<server> http;
   std::unique_ptr<httplib::Client> client;
 };
@@ -63,9 +63,10 @@ TEST_F(commissioning_http, enable_jog_and_stop_reach_the_drive) {
   step(50);
   EXPECT_EQ(state()["state"], "OPERATION_ENABLED");
   EXPECT_EQ(post("/api/jog", R"({"velocity":-300,"ttl_ms":500})"), 200);
-  step(1);
+  step(50);  // the session switches to profile velocity first, confirmed by 0x6061
   EXPECT_EQ(state()["target_velocity"], -300);
   EXPECT_EQ(post("/api/jog", R"({"velocity":0})"), 200);
+  step(1);  // 0x60FF = 0 goes out in the next cycle
   EXPECT_EQ(state()["target_velocity"], 0);
   EXPECT_EQ(post("/api/stop", "{}"), 200);
   step(2000);

@@ -10,13 +10,13 @@
 #include <string>
 #include <variant>
 
-#include "cia402/page/instrument.hpp"
+#include "virtual_axis_page.hpp"
 #include "cia402/profile.hpp"
 
 namespace {
 
 using cia402::page::accepted;
-using cia402::page::instrument;
+using cia402::page::testing::virtual_axis_page;
 using cia402::page::page_command;
 using cia402::page::plant_change;
 using cia402::page::refused;
@@ -26,13 +26,13 @@ using json = nlohmann::json;
 constexpr std::uint64_t ttl_us = 300000;  // 300 cycles of 1 ms
 constexpr std::int64_t jog_rpm = 300;
 
-json snapshot(const instrument& inst) { return json::parse(inst.snapshot_json()); }
+json snapshot(const virtual_axis_page& inst) { return json::parse(inst.snapshot_json()); }
 
-void run(instrument& inst, int cycles) {
+void run(virtual_axis_page& inst, int cycles) {
   for (int i = 0; i < cycles; ++i) inst.step();
 }
 
-json result_of(const instrument& inst, std::uint64_t id) {
+json result_of(const virtual_axis_page& inst, std::uint64_t id) {
   const json s = snapshot(inst);
   for (const json& r : s["results"]) {
     if (r["id"] == id) return r;
@@ -52,7 +52,7 @@ std::string refusal_of(const reply& r) {
 
 // Power-up, then SWITCH ON DISABLED.
 struct commissioning : ::testing::Test {
-  instrument inst{cia402::standard_profile()};
+  virtual_axis_page inst{cia402::standard_profile()};
   void SetUp() override {
     run(inst, 10);
     ASSERT_EQ(snapshot(inst)["state"], "SWITCH_ON_DISABLED");
@@ -182,9 +182,12 @@ TEST_F(commissioning, jog_runs_in_profile_velocity_while_renewed) {
 TEST_F(commissioning, jog_not_renewed_stops_within_its_time_to_live_plus_one_cycle) {
   enable();
   id_of(inst.jog(jog_rpm, ttl_us));
-  run(inst, 300);
+  run(inst, 100);  // the session switches to profile velocity (0x6061 confirms it), then turns
+  ASSERT_EQ(snapshot(inst)["target_velocity"], jog_rpm);
+  id_of(inst.jog(jog_rpm, ttl_us));  // the last keep-alive
+  run(inst, 299);
   EXPECT_EQ(snapshot(inst)["target_velocity"], jog_rpm);
-  run(inst, 1);
+  run(inst, 2);  // the time-to-live, plus one cycle for the word to go out
   EXPECT_EQ(snapshot(inst)["target_velocity"], 0);
   run(inst, 1000);
   EXPECT_EQ(snapshot(inst)["velocity"], 0);
@@ -197,7 +200,20 @@ TEST_F(commissioning, jog_released_stops_at_once) {
   run(inst, 100);
   EXPECT_EQ(snapshot(inst)["target_velocity"], -jog_rpm);
   id_of(inst.jog(0, ttl_us));
+  run(inst, 1);  // the release goes out in the next cycle
   EXPECT_EQ(snapshot(inst)["target_velocity"], 0);
+}
+
+TEST_F(commissioning, jog_released_before_it_turned_never_turns) {
+  enable();
+  id_of(inst.jog(jog_rpm, ttl_us));  // the switch to profile velocity is still under way
+  id_of(inst.jog(0, ttl_us));
+  for (int i = 0; i < 50; ++i) {
+    run(inst, 10);
+    ASSERT_EQ(snapshot(inst)["target_velocity"], 0) << "after " << 10 * (i + 1) << " cycles";
+  }
+  EXPECT_EQ(snapshot(inst)["velocity"], 0);
+  EXPECT_EQ(snapshot(inst)["state"], "OPERATION_ENABLED");
 }
 
 TEST_F(commissioning, jog_outside_operation_enabled_is_refused_and_sets_nothing) {

@@ -1,4 +1,4 @@
-// The instrument behind the page, without HTTP: commands reach the drive as the control words the
+// The virtual_axis_page behind the page, without HTTP: commands reach the drive as the control words the
 // standard gives them, each action is reported as done (with its transitions) or refused, and
 // snapshots are published only when something changed. Expected words and transition numbers come
 // from the standard's tables (cia402-reference.md §2.2) and the seeds, not from the code.
@@ -8,13 +8,13 @@
 
 #include <set>
 
-#include "cia402/page/instrument.hpp"
+#include "virtual_axis_page.hpp"
 #include "cia402/profile.hpp"
 
 namespace {
 
 using cia402::page::accepted;
-using cia402::page::instrument;
+using cia402::page::testing::virtual_axis_page;
 using cia402::page::page_command;
 using cia402::page::plant_change;
 using cia402::page::refused;
@@ -26,15 +26,15 @@ const cia402::profile& by_name(const char* name) {
   return p != nullptr ? *p : cia402::standard_profile();
 }
 
-void run(instrument& inst, int cycles) {
+void run(virtual_axis_page& inst, int cycles) {
   for (int i = 0; i < cycles; ++i) inst.step();
 }
 
-json snapshot(const instrument& inst) { return json::parse(inst.snapshot_json()); }
+json snapshot(const virtual_axis_page& inst) { return json::parse(inst.snapshot_json()); }
 
 // The newest result, after the drive had time to settle (an action settles 50 quiet cycles after
 // its last transition).
-json settled_result(instrument& inst) {
+json settled_result(virtual_axis_page& inst) {
   run(inst, 300);
   const json s = snapshot(inst);
   EXPECT_FALSE(s["results"].empty());
@@ -50,7 +50,7 @@ std::uint64_t id_of(const cia402::page::reply& r) {
 int hex_value(const json& v) { return std::stoi(v.get<std::string>(), nullptr, 16); }
 
 TEST(instrument, power_up_reaches_switch_on_disabled_by_t0_t1) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   const json s = snapshot(inst);
   EXPECT_EQ(s["state"], "SWITCH_ON_DISABLED");
@@ -59,7 +59,7 @@ TEST(instrument, power_up_reaches_switch_on_disabled_by_t0_t1) {
 }
 
 TEST(instrument, shutdown_switch_on_enable_operation_reach_operation_enabled_with_t4_last) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.command(page_command::shutdown);
   EXPECT_EQ(settled_result(inst)["transitions"], json::array({2}));
@@ -80,7 +80,7 @@ TEST(instrument, shutdown_switch_on_enable_operation_reach_operation_enabled_wit
 }
 
 TEST(instrument, enable_operation_from_switch_on_disabled_is_reported_refused) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.command(page_command::enable_operation);
   const json r = settled_result(inst);
@@ -91,7 +91,7 @@ TEST(instrument, enable_operation_from_switch_on_disabled_is_reported_refused) {
 
 TEST(instrument, enable_operation_from_ready_to_switch_on_reports_t3_then_t4) {
   // S3: T3 then T4 in consecutive steps, one action.
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.command(page_command::shutdown);
   run(inst, 100);
@@ -100,7 +100,7 @@ TEST(instrument, enable_operation_from_ready_to_switch_on_reports_t3_then_t4) {
 }
 
 TEST(instrument, commands_keep_the_bits_the_state_machine_does_not_own) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.toggle_control_bit(4);   // operation-mode specific
   inst.toggle_control_bit(13);  // manufacturer specific
@@ -110,7 +110,7 @@ TEST(instrument, commands_keep_the_bits_the_state_machine_does_not_own) {
 }
 
 TEST(instrument, halt_toggles_bit_8_and_keeps_the_command) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.command(page_command::shutdown);
   run(inst, 5);
@@ -124,7 +124,7 @@ TEST(instrument, halt_toggles_bit_8_and_keeps_the_command) {
 
 TEST(instrument, halt_is_not_offered_where_bit_8_is_not_a_halt) {
   for (const char* name : {"s300-profibus", "ax2000-profibus"}) {
-    instrument inst(by_name(name));
+    virtual_axis_page inst(by_name(name));
     run(inst, 10);
     const json info = json::parse(inst.info_json(true, false));
     bool listed = false;
@@ -146,7 +146,7 @@ TEST(instrument, halt_is_not_offered_where_bit_8_is_not_a_halt) {
 }
 
 TEST(instrument, fault_reset_is_one_edge_of_bit_7_and_leads_fault_to_switch_on_disabled_by_t15) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   plant_change fault;
   fault.fault = true;
@@ -174,7 +174,7 @@ TEST(instrument, fault_reset_is_one_edge_of_bit_7_and_leads_fault_to_switch_on_d
 }
 
 TEST(instrument, fault_reset_after_bit_7_was_left_set_still_makes_an_edge) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.toggle_control_bit(7);
   plant_change fault;
@@ -191,7 +191,7 @@ TEST(instrument, fault_reset_after_bit_7_was_left_set_still_makes_an_edge) {
 }
 
 TEST(instrument, fault_reset_while_the_cause_persists_is_refused_and_names_the_cause) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   plant_change fault;
   fault.fault = true;
@@ -207,7 +207,7 @@ TEST(instrument, fault_reset_while_the_cause_persists_is_refused_and_names_the_c
 }
 
 TEST(instrument, switch_on_without_dc_link_waits_for_it_and_acts_when_it_returns) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.command(page_command::shutdown);
   run(inst, 100);
@@ -227,7 +227,7 @@ TEST(instrument, switch_on_without_dc_link_waits_for_it_and_acts_when_it_returns
 }
 
 TEST(instrument, a_command_that_leads_where_the_drive_is_has_nothing_to_do) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.command(page_command::shutdown);
   run(inst, 100);
@@ -242,7 +242,7 @@ TEST(instrument, a_command_that_leads_where_the_drive_is_has_nothing_to_do) {
 }
 
 TEST(instrument, shutdown_under_sto_waits_for_sto_to_be_released) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   plant_change sto;
   sto.sto = true;
@@ -255,7 +255,7 @@ TEST(instrument, shutdown_under_sto_waits_for_sto_to_be_released) {
 }
 
 TEST(instrument, a_command_with_no_row_from_the_state_is_still_refused) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.command(page_command::enable_operation);  // SWITCH ON DISABLED has no row for it
   const json r = settled_result(inst);
@@ -264,7 +264,7 @@ TEST(instrument, a_command_with_no_row_from_the_state_is_still_refused) {
 }
 
 TEST(instrument, option_write_the_profile_refuses_is_an_sdo_abort_and_changes_nothing) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   const auto r = inst.write_object(0x605A, 9);  // 9..32767 reserved (§3)
   const auto* no = std::get_if<refused>(&r);
@@ -277,7 +277,7 @@ TEST(instrument, option_write_the_profile_refuses_is_an_sdo_abort_and_changes_no
 }
 
 TEST(instrument, target_velocity_outside_int32_is_refused_and_nothing_else_changes) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   plant_change c;
   c.target_velocity = std::int64_t{1} << 40;
@@ -292,7 +292,7 @@ TEST(instrument, target_velocity_outside_int32_is_refused_and_nothing_else_chang
 }
 
 TEST(instrument, toggle_of_a_bit_outside_0_to_15_is_refused) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   EXPECT_TRUE(std::holds_alternative<refused>(inst.toggle_control_bit(16)));
   EXPECT_TRUE(std::holds_alternative<refused>(inst.toggle_control_bit(-1)));
 }
@@ -300,7 +300,7 @@ TEST(instrument, toggle_of_a_bit_outside_0_to_15_is_refused) {
 TEST(instrument, ax2000_enable_operation_word_sets_fast_stop_bit_4) {
   // 004_e07fd68605b3a8c6.txt: fast stop is bit 4 (T11 "Bit 4 is canceled", T16 "Bit 4 is set"),
   // so enabling needs bits 0..4: 0x001F.
-  instrument inst(by_name("ax2000-profibus"));
+  virtual_axis_page inst(by_name("ax2000-profibus"));
   run(inst, 10);
   inst.command(page_command::shutdown);
   run(inst, 100);
@@ -310,20 +310,20 @@ TEST(instrument, ax2000_enable_operation_word_sets_fast_stop_bit_4) {
 }
 
 TEST(instrument, drivecom_profiles_name_bits_as_stw_and_zsw) {
-  instrument s300(by_name("s300-profibus"));
+  virtual_axis_page s300(by_name("s300-profibus"));
   const json info = json::parse(s300.info_json(true, false));
   // STW bits 1 and 2 act when cleared: their names say so, as the standard's do.
   EXPECT_EQ(info["control_bits"][1]["name"], "Inhibit voltage (active low)");  // §6.1 STW
   EXPECT_EQ(info["control_bits"][2]["name"], "Fast stop, switch-on inhibited (active low)");
   EXPECT_EQ(info["control_bits"][8]["name"], "Jog");
   EXPECT_EQ(info["status_bits"][6]["name"], "Switch-on inhibit");  // §6.1 ZSW
-  instrument standard(cia402::standard_profile());
+  virtual_axis_page standard(cia402::standard_profile());
   const json std_info = json::parse(standard.info_json(true, false));
   EXPECT_EQ(std_info["control_bits"][8]["name"], "Halt");
 }
 
 TEST(instrument, info_rows_come_from_the_profile_table_with_t13_from_six_states) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   const json info = json::parse(inst.info_json(false, true));
   EXPECT_EQ(info["control"], false);
   EXPECT_EQ(info["token_required"], true);
@@ -341,7 +341,7 @@ TEST(instrument, info_rows_come_from_the_profile_table_with_t13_from_six_states)
 }
 
 TEST(instrument, a_snapshot_is_published_only_when_something_changed) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 400);  // power-up settles
   const std::uint64_t before = inst.latest().version;
   run(inst, 400);  // nothing happens
@@ -352,7 +352,7 @@ TEST(instrument, a_snapshot_is_published_only_when_something_changed) {
 }
 
 TEST(instrument, snapshots_are_published_at_most_once_per_40_cycles) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.command(page_command::shutdown);
   run(inst, 5);
@@ -369,7 +369,7 @@ TEST(instrument, snapshots_are_published_at_most_once_per_40_cycles) {
 }
 
 TEST(instrument, wait_for_update_returns_after_close_without_an_update) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   inst.close();
   const auto t0 = std::chrono::steady_clock::now();
   EXPECT_FALSE(inst.wait_for_update(0, std::chrono::seconds(5)).has_value());
@@ -383,7 +383,7 @@ namespace {
 // The page offers the modes 0x6502 announces and the homing methods the drive runs as choices, and
 // the snapshot carries the mode and its actual values.
 TEST(instrument, modes_are_a_choice_and_the_snapshot_shows_mode_position_and_torque) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   const json info = json::parse(inst.info_json(true, false));
   json modes, methods;
@@ -418,7 +418,7 @@ TEST(instrument, modes_are_a_choice_and_the_snapshot_shows_mode_position_and_tor
 
 namespace {
 
-void enable(instrument& inst) {
+void enable(virtual_axis_page& inst) {
   for (const page_command c :
        {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
     id_of(inst.command(c));
@@ -427,7 +427,7 @@ void enable(instrument& inst) {
 }
 
 // Steps until the snapshot shows status bit `bit` set (or `limit` cycles passed).
-json run_until_status_bit(instrument& inst, int bit, int limit) {
+json run_until_status_bit(virtual_axis_page& inst, int bit, int limit) {
   json s = snapshot(inst);
   for (int i = 0; i < limit && ((hex_value(s["status_word"]) >> bit) & 1) == 0; i += 10) {
     run(inst, 10);
@@ -440,7 +440,7 @@ json run_until_status_bit(instrument& inst, int bit, int limit) {
 // status bit 12, then down: CiA 402-2's set-point handshake), the move to the target (bit 10), a
 // relative move adding to it (bit 6).
 TEST(instrument, the_new_setpoint_handshake_moves_in_profile_position) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   id_of(inst.write_object(0x6060, 1));
   EXPECT_EQ(snapshot(inst)["requested_mode"], 1);
@@ -485,7 +485,7 @@ TEST(instrument, the_new_setpoint_handshake_moves_in_profile_position) {
 
 // A set-point the drive does not acknowledge (not enabled): bit 4 falls after a second, reported.
 TEST(instrument, an_unacknowledged_setpoint_lets_bit_4_fall_and_says_so) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   id_of(inst.write_object(0x6060, 1));
   run(inst, 5);
@@ -502,7 +502,7 @@ TEST(instrument, an_unacknowledged_setpoint_lets_bit_4_fall_and_says_so) {
 // The names of the mode-specific bits per mode, as CiA 402-2 gives them; a DRIVECOM profile keeps
 // the names it gives its control bits, and has no set-point handshake on bit 4.
 TEST(instrument, info_names_the_mode_specific_bits_per_mode) {
-  instrument inst(cia402::standard_profile());
+  virtual_axis_page inst(cia402::standard_profile());
   const json info = json::parse(inst.info_json(true, false));
   EXPECT_EQ(info["mode_names"]["1"], "Profile position");
   EXPECT_EQ(info["mode_names"]["8"], "Cyclic synchronous position");
@@ -520,7 +520,7 @@ TEST(instrument, info_names_the_mode_specific_bits_per_mode) {
   EXPECT_FALSE(info["mode_bits"]["1"]["control"].contains("8")) << "halt is the profile's";
   EXPECT_TRUE(info["new_setpoint"]);
 
-  instrument s300(by_name("s300-profibus"));
+  virtual_axis_page s300(by_name("s300-profibus"));
   const json d = json::parse(s300.info_json(true, false));
   EXPECT_TRUE(d["mode_bits"]["1"]["control"].empty()) << "STW bits 4, 5, 6 and 9 have names";
   EXPECT_EQ(d["mode_bits"]["6"]["status"]["12"], "Homing attained") << "ZSW 12 is \"Mode specific\"";

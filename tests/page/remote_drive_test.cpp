@@ -14,8 +14,9 @@
 #include <thread>
 
 #include "cia402/apps/virtual_drive_node.hpp"
+#include "cia402/canopen/axis/can_link.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
-#include "cia402/page/remote_drive.hpp"
+#include "cia402/page/axis_page.hpp"
 #include "cia402/profile.hpp"
 
 namespace {
@@ -26,17 +27,27 @@ using cia402::page::accepted;
 using cia402::page::page_command;
 using cia402::page::plant_change;
 using cia402::page::refused;
-using cia402::page::remote_config;
-using cia402::page::remote_drive;
-using cia402::page::remote_status;
+using cia402::page::axis_page;
 using cia402::page::reply;
 using json = nlohmann::json;
 
+// The page's drive as `cia402 serve --can` builds it: an axis page over a can_link to the node.
+struct remote_config {
+  co::can_link_config link;
+  cia402::page::axis_page_config page;
+};
+
 remote_config test_config(std::uint8_t node = 1) {
   remote_config c;
-  c.node_id = node;
-  c.bus_name = "virtual (test)";
-  c.request_timeout = std::chrono::milliseconds(20000);
+  c.link.node_id = node;
+  c.link.bus_name = "virtual (test)";
+  c.link.master_heartbeat_ms = 100;  // the page's own heartbeat, watched by the drive (0x1016)
+  c.link.retry_us = 1000000;         // as serve sets it: a node that comes back is taken up again
+  c.link.known_objects = co::node_objects(apps::drive_node_config(node));
+  c.page.node = node;
+  c.page.reset_pulse_us = 20000;
+  c.page.settle_quiet_us = 150000;
+  c.page.request_timeout = std::chrono::milliseconds(20000);
   return c;
 }
 
@@ -50,7 +61,14 @@ class remote_bench {
       : node_(std::make_unique<apps::virtual_drive_node>(p, bus_.attach(), apps::drive_node_config(1))) {
     for (int i = 0; i < 10; ++i) node_->poll(1000);  // power-up: T0, T1
     page_ch_ = bus_.attach();
-    remote_ = std::make_unique<remote_drive>(p, *page_ch_, config);
+    config.link.drive_profile = &p;
+    co::channel* ch = page_ch_.get();
+    remote_ = std::make_unique<axis_page>(
+        p,
+        [ch, link = config.link](const cia402::profile&) {
+          return cia402::page::drive_connection{std::make_unique<co::can_link>(*ch, link), nullptr};
+        },
+        config.page);
   }
 
   void run_ms(int ms) {
@@ -62,9 +80,9 @@ class remote_bench {
   void cycle(std::uint32_t drive_us) {
     remote_->step();
     if (alive_) node_->poll(drive_us);
-    remote_->process(0);
+    remote_->advance(0);
     if (alive_) node_->poll(0);
-    remote_->process(0);
+    remote_->advance(0);
     if (!alive_) {
       co::frame f;
       while (node_->bus_channel().receive(f)) {}
@@ -74,7 +92,7 @@ class remote_bench {
   bool run_until_running(int ms = 2000) {
     for (int i = 0; i < ms; ++i) {
       run_ms(1);
-      if (remote_->status() == remote_status::running) return true;
+      if (status() == "running") return true;
     }
     return false;
   }
@@ -109,14 +127,16 @@ class remote_bench {
     const json s = snapshot();
     return s["results"].empty() ? json::object() : s["results"][0];
   }
-  remote_drive& remote() { return *remote_; }
+  axis_page& remote() { return *remote_; }
+  /// Where the link stands, as the snapshots' `remote` part says it.
+  std::string status() const { return snapshot()["remote"]["status"].get<std::string>(); }
   cia402::sim::virtual_drive& drive() { return node_->drive(); }
 
  private:
   co::virtual_bus bus_;
   std::unique_ptr<apps::virtual_drive_node> node_;
   std::unique_ptr<co::virtual_channel> page_ch_;
-  std::unique_ptr<remote_drive> remote_;
+  std::unique_ptr<axis_page> remote_;
   bool alive_ = true;
 };
 
@@ -138,14 +158,14 @@ void enable(remote_bench& b) {
 
 TEST(remote_drive, set_up_reads_the_drive_and_shows_switch_on_disabled) {
   remote_bench b;
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
-  b.run_ms(250);  // a heartbeat (0x1017 = 100 ms) tells the NMT state
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
+  b.run_ms(250);
   const json s = b.snapshot();
   EXPECT_EQ(s["state"], "SWITCH_ON_DISABLED");
   EXPECT_EQ(s["remote"]["status"], "running");
   EXPECT_EQ(s["remote"]["device_name"], "cia402 virtual drive");
-  EXPECT_EQ(s["remote"]["nmt"], "OPERATIONAL");
-  EXPECT_TRUE(s["remote"]["heartbeat_watched"].get<bool>());
+  // The link's own state (NMT, PDOs, heartbeats) is the link's: the page sees the cyclic exchange run.
+  EXPECT_TRUE(s["remote"]["cyclic"].get<bool>());
   // The option codes' defaults (semantics.md S5, S7, S9, S10), read from the node.
   EXPECT_EQ(s["objects"]["0x605A"], 2);
   EXPECT_EQ(s["objects"]["0x605E"], 2);
@@ -156,7 +176,7 @@ TEST(remote_drive, set_up_reads_the_drive_and_shows_switch_on_disabled) {
 
 TEST(remote_drive, shutdown_switch_on_enable_operation_reach_operation_enabled_by_inferred_2_3_4) {
   remote_bench b;
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   const json r2 = command_result(b, page_command::shutdown);
   EXPECT_EQ(r2["outcome"], "done") << r2;
   EXPECT_EQ(r2["transitions"], json::array({2}));
@@ -182,7 +202,7 @@ TEST(remote_drive, shutdown_switch_on_enable_operation_reach_operation_enabled_b
 
 TEST(remote_drive, enable_operation_from_ready_to_switch_on_is_inferred_as_3_then_4) {
   remote_bench b;
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   command_result(b, page_command::shutdown);
   const json r = command_result(b, page_command::enable_operation);
   EXPECT_EQ(r["transitions"], json::array({3, 4})) << r;
@@ -194,7 +214,7 @@ TEST(remote_drive, a_vendor_profile_is_decoded_with_that_profile_and_disable_vol
   const cia402::profile* ax = cia402::find_builtin_profile("ax2000-profibus");
   ASSERT_NE(ax, nullptr);
   remote_bench b(test_config(), *ax);
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   enable(b);
   const json r = command_result(b, page_command::disable_voltage);
   EXPECT_EQ(r["transitions"], json::array({9})) << r;
@@ -204,7 +224,7 @@ TEST(remote_drive, a_vendor_profile_is_decoded_with_that_profile_and_disable_vol
 
 TEST(remote_drive, fault_through_0x2001_gives_fault_and_fault_reset_gives_switch_on_disabled_by_15) {
   remote_bench b;
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   enable(b);
   plant_change fault;
   fault.fault = true;
@@ -241,7 +261,7 @@ TEST(remote_drive, fault_through_0x2001_gives_fault_and_fault_reset_gives_switch
 
 TEST(remote_drive, option_write_the_drive_refuses_carries_its_abort_code_and_changes_nothing) {
   remote_bench b;
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   const reply no = b.blocking([&] { return b.remote().write_object(0x605A, 12); });
   ASSERT_TRUE(std::holds_alternative<refused>(no));
   EXPECT_EQ(std::get<refused>(no).http_status, 422);
@@ -261,18 +281,20 @@ TEST(remote_drive, option_write_the_drive_refuses_carries_its_abort_code_and_cha
 
 TEST(remote_drive, value_outside_the_objects_type_is_refused_before_sending) {
   remote_bench b;
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   const reply r = b.remote().write_object(0x605A, 70000);  // INTEGER16
   ASSERT_TRUE(std::holds_alternative<refused>(r));
   EXPECT_EQ(std::get<refused>(r).abort, cia402::sdo_abort::value_too_high);
-  const reply unknown = b.remote().write_object(0x1234, 1);
+  // An object the core's table does not know goes to the drive, which says it has none.
+  const reply unknown = b.blocking([&] { return b.remote().write_object(0x1234, 1); });
   ASSERT_TRUE(std::holds_alternative<refused>(unknown));
-  EXPECT_EQ(std::get<refused>(unknown).http_status, 400);
+  EXPECT_EQ(std::get<refused>(unknown).http_status, 422);
+  EXPECT_EQ(std::get<refused>(unknown).abort, cia402::sdo_abort::object_does_not_exist);
 }
 
 TEST(remote_drive, target_velocity_goes_out_by_sdo_and_actual_velocity_comes_back) {
   remote_bench b;
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   enable(b);
   plant_change c;
   c.target_velocity = 300;
@@ -281,13 +303,12 @@ TEST(remote_drive, target_velocity_goes_out_by_sdo_and_actual_velocity_comes_bac
   const json s = b.snapshot();
   EXPECT_EQ(s["target_velocity"], 300);
   EXPECT_EQ(s["velocity"], 300);
-  EXPECT_TRUE(s["remote"]["velocity_in_pdo"].get<bool>());
   EXPECT_EQ(b.drive().view().target_velocity(), 300);
 }
 
 TEST(remote_drive, dc_link_and_sto_are_refused_and_the_capabilities_say_why) {
   remote_bench b;
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   const json info = json::parse(b.remote().info_json(true, false));
   EXPECT_EQ(info["backend"], "remote");
   EXPECT_FALSE(info["capabilities"]["dc_link"].get<bool>());
@@ -305,13 +326,13 @@ TEST(remote_drive, dc_link_and_sto_are_refused_and_the_capabilities_say_why) {
 
 TEST(remote_drive, silent_node_shows_does_not_answer_and_is_picked_up_again_when_it_returns) {
   remote_bench b;
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   command_result(b, page_command::shutdown);
   b.silence();
   b.run_ms(500);  // heartbeat 100 ms, watched at 300 ms
-  EXPECT_EQ(b.remote().status(), remote_status::no_answer);
-  EXPECT_NE(b.remote().status_text().find("node 1 does not answer"), std::string::npos)
-      << b.remote().status_text();
+  EXPECT_EQ(b.status(), "no_answer");
+  EXPECT_NE(b.remote().link_text().find("node 1 does not answer"), std::string::npos)
+      << b.remote().link_text();
   const json s = b.snapshot();
   EXPECT_EQ(s["state"], "UNKNOWN");
   EXPECT_EQ(s["remote"]["status"], "no_answer");
@@ -321,7 +342,7 @@ TEST(remote_drive, silent_node_shows_does_not_answer_and_is_picked_up_again_when
   EXPECT_NE(std::get<refused>(r).reason.find("does not answer"), std::string::npos);
 
   b.revive();
-  ASSERT_TRUE(b.run_until_running(5000)) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running(5000)) << b.remote().link_text();
   EXPECT_EQ(b.snapshot()["state"], "READY_TO_SWITCH_ON");
 }
 
@@ -349,7 +370,7 @@ TEST(remote_drive, the_drive_watches_the_pages_heartbeat_and_applies_0x6007_when
 TEST(remote_drive, a_silent_page_gets_the_turning_drive_quick_stopped_after_the_lease) {
   constexpr int lease_ms = 300;
   remote_config c = test_config();
-  c.lease_us = lease_ms * 1000;
+  c.page.lease_us = lease_ms * 1000;
   remote_bench b(c);
   auto renewed = [&b](int ms) {
     for (int i = 0; i < ms; ++i) {
@@ -358,7 +379,7 @@ TEST(remote_drive, a_silent_page_gets_the_turning_drive_quick_stopped_after_the_
     }
   };
   b.remote().renew_lease();
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   for (page_command cmd : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
     b.remote().renew_lease();
     ASSERT_TRUE(is_accepted(b.remote().command(cmd)));
@@ -400,13 +421,13 @@ struct slowed_page_result {
 slowed_page_result run_slowed_page(bool heartbeat_on_wall_clock) {
   auto wall_us = std::make_shared<std::uint64_t>(0);
   remote_config c = test_config();
-  if (heartbeat_on_wall_clock) c.heartbeat_clock_us = [wall_us] { return *wall_us; };
+  if (heartbeat_on_wall_clock) c.link.heartbeat_clock_us = [wall_us] { return *wall_us; };
   remote_bench b(c);
-  for (int i = 0; i < 2000 && b.remote().status() != remote_status::running; ++i) {
+  for (int i = 0; i < 2000 && b.status() != "running"; ++i) {
     *wall_us += 1000;
     b.cycle(1000);
   }
-  EXPECT_EQ(b.remote().status(), remote_status::running) << b.remote().status_text();
+  EXPECT_EQ(b.status(), "running") << b.remote().link_text();
   // Enabled, on the wall's time too: 0x6007 acts on an enabled drive only.
   for (const page_command c : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
     EXPECT_TRUE(is_accepted(b.remote().command(c)));
@@ -443,10 +464,10 @@ TEST(remote_drive, a_page_slower_than_the_wall_sends_its_heartbeat_on_its_heartb
 TEST(remote_drive, node_that_is_not_on_the_bus_does_not_answer_set_up) {
   remote_bench b(test_config(5));  // the bench's drive is node 1
   b.run_ms(700);
-  EXPECT_EQ(b.remote().status(), remote_status::no_answer);
-  EXPECT_NE(b.remote().status_text().find("node 5 does not answer (SDO timeout reading 0x1000:0)"),
+  EXPECT_EQ(b.status(), "no_answer");
+  EXPECT_NE(b.remote().link_text().find("node 5 does not answer (SDO timeout"),
             std::string::npos)
-      << b.remote().status_text();
+      << b.remote().link_text();
   EXPECT_EQ(b.snapshot()["state"], "UNKNOWN");
 }
 
@@ -460,7 +481,7 @@ namespace {
 // the recording.
 TEST(remote_drive, reads_mode_and_actual_values_and_moves_by_the_setpoint_handshake) {
   remote_bench b;
-  ASSERT_TRUE(b.run_until_running()) << b.remote().status_text();
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
   b.run_ms(300);
   json s = b.snapshot();
   EXPECT_EQ(s["mode"], 3);

@@ -16,14 +16,14 @@
 #include <mutex>
 #include <thread>
 
-#include "cia402/page/instrument.hpp"
+#include "virtual_axis_page.hpp"
 #include "cia402/page/runner.hpp"
 #include "cia402/page/server.hpp"
 #include "cia402/profile.hpp"
 
 namespace {
 
-using cia402::page::instrument;
+using cia402::page::testing::virtual_axis_page;
 using cia402::page::server;
 using cia402::page::server_options;
 using json = nlohmann::json;
@@ -80,7 +80,7 @@ class page_server : public ::testing::Test {
         << body["error"];
   }
 
-  instrument inst{cia402::standard_profile()};
+  virtual_axis_page inst{cia402::standard_profile()};
   std::unique_ptr<server> http;
   std::unique_ptr<httplib::Client> client;
 };
@@ -89,7 +89,7 @@ class page_server : public ::testing::Test {
 // commands go to the other: the second bind is refused with a message that says why.
 TEST_F(page_server, a_second_server_on_the_same_port_is_refused) {
   start(false);
-  instrument other{cia402::standard_profile()};
+  virtual_axis_page other{cia402::standard_profile()};
   server_options o;
   o.bind = "127.0.0.1";
   o.port = http->bound_port();
@@ -494,8 +494,8 @@ namespace {
 // Several drives behind one page: each request names its axis, and one axis's command, profile
 // and recording leave the others alone.
 TEST(page_server_axes, each_axis_is_its_own_drive_and_may_switch_profile) {
-  instrument one{cia402::standard_profile()};
-  instrument two{cia402::standard_profile()};
+  virtual_axis_page one{cia402::standard_profile()};
+  virtual_axis_page two{cia402::standard_profile()};
   server_options o;
   o.port = 0;
   server http({{"axis 1", &one}, {"axis 2", &two}}, o);
@@ -691,7 +691,7 @@ TEST(page_server_guard, connections_per_client_address_are_bounded_beyond_loopba
     ::freeifaddrs(list);
   }
   if (address.empty()) GTEST_SKIP() << "no IPv4 address beyond loopback on this machine";
-  instrument inst{cia402::standard_profile()};
+  virtual_axis_page inst{cia402::standard_profile()};
   server_options o;
   o.bind = address;
   o.port = 0;

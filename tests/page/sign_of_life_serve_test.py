@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
-"""The page's sign of life end to end, as CTest runs it:  sign_of_life_serve_test.py CIA402_BINARY
+"""The page's sign of life end to end, as CTest runs it:  sign_of_life_serve_test.py CIA402_BINARY [ecat]
 
 For `cia402 serve --lease 500` (a virtual drive in the server's process) and for
-`cia402 serve --can socketcand://... --lease 500` against `cia402 bus` (a free loopback port): an
+`cia402 serve --can socketcand://... --lease 500` against `cia402 bus` (a free loopback port); with
+`ecat`, for `cia402 serve --ecat IF --lease 500` against `cia402 ecat-slave` on the other end of a
+veth pair (root and iproute2; skipped with exit 77 saying why otherwise): an
 open event stream (the page) enables the drive through the HTTP API and sets it turning at 600 rpm;
 for three lease times only the stream is open and the drive keeps turning; then the stream is closed
 (the tab) and the drive must stand still, quick-stopped as its 0x6007 (1 by default) says, within
@@ -19,6 +21,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from serve_can_test import Process, request, wait_state, settled_result  # noqa: E402
+from commissioning_serve_test import over_ecat  # noqa: E402
 
 LEASE_MS = 500
 PROBE_MS = 250
@@ -103,10 +106,12 @@ def check(base, label):
 
 
 def main():
-    if len(sys.argv) != 2:
-        print('usage: sign_of_life_serve_test.py CIA402_BINARY', file=sys.stderr)
+    if len(sys.argv) not in (2, 3) or (len(sys.argv) == 3 and sys.argv[2] != 'ecat'):
+        print('usage: sign_of_life_serve_test.py CIA402_BINARY [ecat]', file=sys.stderr)
         return 2
     cia402 = sys.argv[1]
+    if len(sys.argv) == 3:
+        return over_ecat(cia402, check, ('--lease', str(LEASE_MS)))
     bus = serve = None
     try:
         serve = Process([cia402, 'serve', '--port', '0', '--lease', str(LEASE_MS)])

@@ -11,13 +11,13 @@
 #include <cstdlib>
 #include <string>
 
-#include "cia402/page/instrument.hpp"
+#include "virtual_axis_page.hpp"
 #include "cia402/profile.hpp"
 
 namespace {
 
-using cia402::page::instrument;
-using cia402::page::instrument_config;
+using cia402::page::testing::virtual_axis_page;
+using cia402::page::axis_page_config;
 using cia402::page::page_command;
 using cia402::page::plant_change;
 using json = nlohmann::json;
@@ -25,20 +25,20 @@ using json = nlohmann::json;
 constexpr int lease_ms = 200;  // cycles of 1 ms
 constexpr int turning_rpm = 600;
 
-json snapshot(const instrument& inst) { return json::parse(inst.snapshot_json()); }
+json snapshot(const virtual_axis_page& inst) { return json::parse(inst.snapshot_json()); }
 
 // `cycles` cycles with a renewal every `every` cycles (0: none).
-void run(instrument& inst, int cycles, int every = 0) {
+void run(virtual_axis_page& inst, int cycles, int every = 0) {
   for (int i = 0; i < cycles; ++i) {
     if (every > 0 && i % every == 0) inst.renew_lease();
     inst.step();
   }
 }
 
-std::unique_ptr<instrument> turning_drive(std::int64_t abort_connection) {
-  instrument_config c;
+std::unique_ptr<virtual_axis_page> turning_drive(std::int64_t abort_connection) {
+  axis_page_config c;
   c.lease_us = lease_ms * 1000;
-  auto inst = std::make_unique<instrument>(cia402::standard_profile(), c);
+  auto inst = std::make_unique<virtual_axis_page>(cia402::standard_profile(), c);
   run(*inst, 10, 50);
   EXPECT_TRUE(std::holds_alternative<cia402::page::accepted>(inst->write_object(0x6007, abort_connection)));
   for (page_command cmd : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
@@ -57,7 +57,7 @@ std::unique_ptr<instrument> turning_drive(std::int64_t abort_connection) {
 }
 
 // Cycles from the last renewal until the drive stands (velocity 0), at most `limit`.
-int cycles_to_standstill(instrument& inst, int limit) {
+int cycles_to_standstill(virtual_axis_page& inst, int limit) {
   for (int k = 1; k <= limit; ++k) {
     inst.step();
     if (snapshot(inst)["velocity"] == 0) return k;
@@ -140,7 +140,7 @@ TEST(sign_of_life, a_page_that_comes_back_rearms_the_lease) {
 }
 
 TEST(sign_of_life, without_a_lease_a_silent_page_changes_nothing) {
-  instrument inst(cia402::standard_profile());  // lease_us = 0, the library's default
+  virtual_axis_page inst(cia402::standard_profile());  // lease_us = 0, the library's default
   run(inst, 10);
   for (page_command cmd : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
     inst.command(cmd);

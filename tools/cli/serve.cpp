@@ -9,10 +9,12 @@
 #include <pthread.h>
 
 #include "cia402/apps/ethercat_link.hpp"
+#include "cia402/apps/local_link.hpp"
+#include "cia402/apps/virtual_drive_node.hpp"
+#include "cia402/canopen/axis/can_link.hpp"
 #include "cia402/canopen/transport/channel_url.hpp"
-#include "cia402/page/ecat_drive.hpp"
-#include "cia402/page/instrument.hpp"
-#include "cia402/page/remote_drive.hpp"
+#include "cia402/ethercat/axis/ecat_link.hpp"
+#include "cia402/page/axis_page.hpp"
 #include "cia402/page/runner.hpp"
 #include "cia402/page/server.hpp"
 #include "cli/common.hpp"
@@ -22,6 +24,118 @@ namespace {
 
 constexpr int refused = 2;
 constexpr int unreachable = 1;
+
+// A virtual drive in this process behind the session, under the profile the page runs (again at
+// each profile switch): the page sets its plant inputs through the simulator.
+page::drive_connection virtual_drive(const profile& p) {
+  auto link = std::make_unique<apps::local_link>(p);
+  sim::virtual_drive* plant = &link->drive();
+  return {std::move(link), plant};
+}
+
+// The drives behind the page, each an axis session's link: virtual drives here (local_link), or
+// drives on a bus (can_link on a channel of its own, so each sees every frame; ecat_link on a line
+// brought to OP here). The page itself holds no fieldbus code.
+struct served_drives {
+  // Declared before the drives, whose links use them: they go after the drives.
+  std::unique_ptr<apps::ethercat_link> line;
+  std::unique_ptr<ethercat::ecat_line> ecat;
+  std::vector<std::unique_ptr<canopen::channel>> channels;
+  std::vector<std::unique_ptr<page::axis_page>> drives;
+  std::vector<page::axis> axes;
+};
+
+// The drive at --position on the line --ecat names; 0 or the exit status.
+int open_ecat(const serve_args& args, const profile& p, page::axis_page_config pc, served_drives& d, std::ostream& err) {
+  // A line answers in microseconds: 20 ms without an answer is a lost frame.
+  d.line = std::make_unique<apps::ethercat_link>(20000);
+  if (const std::error_code ec = d.line->open(args.ecat)) {
+    err << "cia402 serve: cannot open " << args.ecat << ": " << ec.message()
+        << (ec.value() == EPERM ? " (a raw socket needs root or CAP_NET_RAW)" : "") << "\n";
+    return unreachable;
+  }
+  d.ecat = std::make_unique<ethercat::ecat_line>(*d.line, p, 1000, args.ecat);
+  if (!d.ecat->scan() || !d.ecat->bring_to_operational()) {
+    err << "cia402 serve: EtherCAT " << args.ecat << ": " << d.ecat->error() << "\n";
+    return unreachable;
+  }
+  d.ecat->set_retry_us(1000000);  // a line that answers again is brought to OP again
+  if (static_cast<std::size_t>(args.position) >= d.ecat->master().slaves().size()) {
+    err << "cia402 serve: --position " << args.position << ": the line has " << d.ecat->master().slaves().size()
+        << " slave(s)\n";
+    return refused;
+  }
+  pc.reset_pulse_us = 20000;
+  pc.settle_quiet_us = 150000;
+  pc.node = args.position;
+  pc.bus = "EtherCAT " + args.ecat;
+  pc.where = "slave " + std::to_string(args.position) + " on EtherCAT " + args.ecat;
+  auto* on_line = d.ecat.get();
+  const auto position = static_cast<std::size_t>(args.position);
+  d.drives.push_back(std::make_unique<page::axis_page>(
+      p,
+      [on_line, position](const profile&) {
+        return page::drive_connection{std::make_unique<ethercat::ecat_link>(*on_line, position), nullptr};
+      },
+      pc));
+  d.axes.push_back({"slave " + std::to_string(args.position), d.drives.back().get()});
+  return 0;
+}
+
+// The nodes --node names on the bus --can names, a channel each; 0 or the exit status.
+int open_can(const serve_args& args, const profile& p, page::axis_page_config pc, served_drives& d, std::ostream& err) {
+  canopen::channel_url url;
+  std::string why;
+  if (!canopen::parse_channel_url(args.can, url, why)) {
+    err << "cia402 serve: --can " << args.can << ": " << why << "\n";
+    return refused;
+  }
+  if (url.type == canopen::channel_url::kind::virtual_bus) {
+    err << "cia402 serve: --can virtual: without --can, serve runs a virtual drive here; for one "
+           "on a CAN bus start `cia402 bus` and give its socketcand:// URL\n";
+    return refused;
+  }
+  pc.reset_pulse_us = 20000;
+  pc.settle_quiet_us = 150000;
+  for (const int node : args.nodes) {
+    for (const page::axis& a : d.axes) {
+      if (a.label == "node " + std::to_string(node)) {
+        err << "cia402 serve: --node " << node << " is given twice\n";
+        return refused;
+      }
+    }
+    d.channels.push_back(canopen::open_channel(url, why));
+    if (!d.channels.back()) {
+      err << "cia402 serve: cannot reach the bus " << args.can << ": " << why << "\n";
+      return unreachable;
+    }
+    canopen::can_link_config c;
+    c.node_id = static_cast<std::uint8_t>(node);
+    c.bus_name = args.can;
+    c.drive_profile = &p;
+    // The page's own heartbeat, watched by the drive (0x1016), on the wall clock: a page slowed
+    // down by a loaded machine must still send it every 100 ms of wall time.
+    c.master_heartbeat_ms = 100;
+    c.retry_us = 1000000;  // a node that comes back (or restarts) is set up again
+    c.known_objects = canopen::node_objects(apps::drive_node_config(static_cast<std::uint8_t>(node)));
+    c.heartbeat_clock_us = [] {
+      return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                            std::chrono::steady_clock::now().time_since_epoch())
+                                            .count());
+    };
+    canopen::channel* bus = d.channels.back().get();
+    pc.node = node;
+    pc.bus = args.can;
+    d.drives.push_back(std::make_unique<page::axis_page>(
+        p,
+        [bus, c](const profile&) {
+          return page::drive_connection{std::make_unique<canopen::can_link>(*bus, c), nullptr};
+        },
+        pc));
+    d.axes.push_back({"node " + std::to_string(node), d.drives.back().get()});
+  }
+  return 0;
+}
 
 }  // namespace
 
@@ -93,72 +207,22 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   const bool loopback = page::is_loopback_address(args.bind);
   options.token_required = args.token_required || !loopback;
 
-  // The drives behind the page: virtual drives here, or remote ones on a bus (a channel each, so
-  // each master sees every frame).
-  std::vector<std::unique_ptr<canopen::channel>> channels;
-  std::vector<std::unique_ptr<page::backend>> drives;
-  std::vector<page::axis> axes;
-  std::unique_ptr<apps::ethercat_link> line;
-  const auto lease_us = static_cast<std::uint64_t>(args.lease_ms) * 1000;
+  served_drives served;
+  page::axis_page_config pc;
+  pc.lease_us = static_cast<std::uint64_t>(args.lease_ms) * 1000;
   if (!args.ecat.empty()) {
-    // A line answers in microseconds: 20 ms without an answer is a lost frame, and the page says
-    // the line is gone within half a second rather than after seconds of waiting.
-    line = std::make_unique<apps::ethercat_link>(20000);
-    if (const std::error_code ec = line->open(args.ecat)) {
-      err << "cia402 serve: cannot open " << args.ecat << ": " << ec.message()
-          << (ec.value() == EPERM ? " (a raw socket needs root or CAP_NET_RAW)" : "") << "\n";
-      return unreachable;
-    }
-    page::remote_config rc;
-    rc.bus_name = "EtherCAT " + args.ecat;
-    rc.lease_us = lease_us;
-    drives.push_back(page::make_ecat_drive(choice.get(), *line, static_cast<std::uint16_t>(args.position), args.ecat, rc));
-    axes.push_back({"slave " + std::to_string(args.position), drives.back().get()});
-  } else if (args.can.empty()) {
-    for (int k = 1; k <= args.virtual_axes; ++k) {
-      // Selectable on the page: the built-in profiles and this one (instrument_config's default).
-      page::instrument_config ic;
-      ic.lease_us = lease_us;
-      drives.push_back(std::make_unique<page::instrument>(choice.get(), ic));
-      axes.push_back({"axis " + std::to_string(k), drives.back().get()});
-    }
+    if (const int status = open_ecat(args, choice.get(), pc, served, err)) return status;
+  } else if (!args.can.empty()) {
+    if (const int status = open_can(args, choice.get(), pc, served, err)) return status;
   } else {
-    canopen::channel_url url;
-    std::string why;
-    if (!canopen::parse_channel_url(args.can, url, why)) {
-      err << "cia402 serve: --can " << args.can << ": " << why << "\n";
-      return refused;
-    }
-    if (url.type == canopen::channel_url::kind::virtual_bus) {
-      err << "cia402 serve: --can virtual: without --can, serve runs a virtual drive here; for one "
-             "on a CAN bus start `cia402 bus` and give its socketcand:// URL\n";
-      return refused;
-    }
-    for (const int node : args.nodes) {
-      for (const page::axis& a : axes) {
-        if (a.label == "node " + std::to_string(node)) {
-          err << "cia402 serve: --node " << node << " is given twice\n";
-          return refused;
-        }
-      }
-      channels.push_back(canopen::open_channel(url, why));
-      if (!channels.back()) {
-        err << "cia402 serve: cannot reach the bus " << args.can << ": " << why << "\n";
-        return unreachable;
-      }
-      page::remote_config rc;
-      rc.node_id = static_cast<std::uint8_t>(node);
-      rc.bus_name = args.can;
-      rc.lease_us = lease_us;
-      rc.heartbeat_clock_us = [] {
-        return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
-                                              std::chrono::steady_clock::now().time_since_epoch())
-                                              .count());
-      };
-      drives.push_back(std::make_unique<page::remote_drive>(choice.get(), *channels.back(), rc));
-      axes.push_back({"node " + std::to_string(node), drives.back().get()});
+    for (int k = 1; k <= args.virtual_axes; ++k) {
+      // Selectable on the page: the built-in profiles and this one (axis_page_config's default).
+      served.drives.push_back(std::make_unique<page::axis_page>(choice.get(), virtual_drive, pc));
+      served.axes.push_back({"axis " + std::to_string(k), served.drives.back().get()});
     }
   }
+  auto& drives = served.drives;
+  auto& axes = served.axes;
   page::server http(axes, options);
 
   // SIGINT and SIGTERM are blocked in every thread (the server's and the cycle thread inherit the
@@ -213,6 +277,9 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   for (auto& d : drives) d->close();
   http.stop();
   for (auto& r : runners) r->stop();
+  // Each link puts back what it changed on its node (a drive left enabled stops first, as 0x6007
+  // says).
+  for (auto& d : served.drives) d->shut_down(std::chrono::seconds(2));
   pthread_sigmask(SIG_SETMASK, &previous, nullptr);
   return 0;
 }

@@ -1,8 +1,8 @@
 // `cia402 serve`: the instrument control page (seed 003_83442f2f4b0b2bb9.txt) for virtual drives
 // run in real time (--nodes N: N axes), or with --can URL --node N [--node M ...] for drives on a
-// CAN bus (a `cia402 bus` node or a
-// real drive; src/page/include/cia402/page/remote_drive.hpp), served over HTTP; see
-// src/page/include/cia402/page/server.hpp.
+// CAN bus (a `cia402 bus` node or a real drive), or with --ecat IF --position N for a drive on an
+// EtherCAT line; each drive an axis session over the link built here (src/page/include/cia402/page/
+// axis_page.hpp), served over HTTP; see src/page/include/cia402/page/server.hpp.
 #pragma once
 
 #include <iosfwd>

@@ -272,6 +272,7 @@ void can_link::make_master() {
   mc.master_heartbeat_ms = config_.master_heartbeat_ms;
   mc.heartbeat_clock_us = config_.heartbeat_clock_us;
   mc.sdo_timeout_us = config_.sdo_timeout_us;
+  mc.retry_us = config_.retry_us;
   mc.drive_profile = config_.drive_profile;
   mc.timing = pdo_timing::sync;
   mc.map_velocity = true;

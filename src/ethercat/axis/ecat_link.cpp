@@ -69,15 +69,29 @@ bool ecat_line::bring_to_operational() {
 void ecat_line::attach(ecat_link* l) { drives_.push_back(l); }
 
 std::uint32_t ecat_line::service() {
-  if (!up_ || left_op_ || !failure_.empty()) return 0xFFFFFFFFu;
+  if (!up_ || left_op_) return 0xFFFFFFFFu;
   const std::uint64_t now = link_->now_us();
+  if (!failure_.empty()) {
+    if (retry_us_ == 0) return 0xFFFFFFFFu;
+    if (now < retry_at_us_) return static_cast<std::uint32_t>(retry_at_us_ - now);
+    retry_at_us_ = now + retry_us_;
+    if (!master_.scan() || !master_.bring_to_operational()) return retry_us_;
+    failure_.clear();
+    lost_in_a_row_ = 0;
+    next_cycle_us_ = link_->now_us();
+    for (ecat_link* d : drives_) d->restart();
+    return 0;
+  }
   if (now < next_cycle_us_) return static_cast<std::uint32_t>(next_cycle_us_ - now);
   for (ecat_link* d : drives_) {
     if (!d->closed_ && d->before_cycle) d->before_cycle();
   }
   const bool ok = master_.cycle();
   lost_in_a_row_ = ok ? 0 : lost_in_a_row_ + 1;
-  if (lost_in_a_row_ > lost_cycles_limit) failure_ = "the line does not answer (" + master_.error() + ")";
+  if (lost_in_a_row_ > lost_cycles_limit) {
+    failure_ = "the line does not answer (" + master_.error() + ")";
+    retry_at_us_ = now + retry_us_;
+  }
   for (ecat_link* d : drives_) d->after_cycle(ok);
   // Late: go on from now rather than rush to catch up.
   next_cycle_us_ = std::max(next_cycle_us_ + master_.cycle_us(), now);
@@ -183,6 +197,15 @@ void ecat_link::after_cycle(bool ok) {
   for (; emergencies_seen_ < s.emergencies.size(); ++emergencies_seen_) {
     if (on_emergency) on_emergency(s.emergencies[emergencies_seen_], 0, {});
   }
+}
+
+void ecat_link::restart() {
+  if (closed_) return;
+  failure_.clear();
+  started_ = false;  // the next poll announces the link running again, with the new mapping
+  inputs_.clear();
+  outputs_.clear();
+  emergencies_seen_ = 0;
 }
 
 void ecat_link::fail(std::string why) {

@@ -47,6 +47,9 @@ struct can_link_config {
   std::uint16_t drive_heartbeat_ms = 100;  ///< 0x1017, watched at 3x
   std::uint16_t master_heartbeat_ms = 0;   ///< the master's own, watched by the drive (0x1016)
   std::uint32_t sdo_timeout_us = 500000;
+  /// Set-up starts again this long after the node stopped answering (drive_master_config::retry_us);
+  /// 0: the link stays failed.
+  std::uint32_t retry_us = 0;
   const profile* drive_profile = nullptr;
   bool map_position = false;               ///< PDO 3 for a csp stream
   /// The node's objects as an EDS describes them (read_eds), if the user gave one.

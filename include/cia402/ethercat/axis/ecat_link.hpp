@@ -54,6 +54,10 @@ class ecat_line {
   std::uint64_t cycles() const noexcept { return master_.cycles(); }
   bool failed() const noexcept { return !failure_.empty(); }
   const std::string& failure() const noexcept { return failure_; }
+  /// A line that stopped answering is scanned and brought to OP again this long after it failed,
+  /// and again each retry_us until it answers; its drives' links then run afresh (their sessions
+  /// read the drives again). 0 (the default): a failed line stays failed.
+  void set_retry_us(std::uint32_t retry_us) noexcept { retry_us_ = retry_us; }
 
  private:
   friend class ecat_link;
@@ -69,6 +73,8 @@ class ecat_line {
   std::uint64_t next_cycle_us_ = 0;
   int lost_in_a_row_ = 0;
   std::string failure_;
+  std::uint32_t retry_us_ = 0;
+  std::uint64_t retry_at_us_ = 0;
   std::vector<ecat_link*> drives_;
 };
 
@@ -119,6 +125,7 @@ class ecat_link final : public axes::drive_link {
   const ecat_slave& slave() const { return line_->master().slaves()[position_]; }
   void after_cycle(bool ok);
   void fail(std::string why);
+  void restart();  // the line is back in OP: the link runs afresh
   void run_one_transfer();
 
   ecat_line* line_;

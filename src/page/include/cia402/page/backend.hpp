@@ -1,7 +1,8 @@
-// What the instrument page's server talks to: one drive behind the page. Two kinds exist: the
-// in-process virtual drive (instrument.hpp) and a remote drive on a CAN bus (remote_drive.hpp). The
-// server (server.hpp) and the cycle thread (runner.hpp) see only this interface; the page learns
-// from /api/info and the snapshots which kind it shows and what it can do.
+// What the instrument page's server talks to: one drive behind the page. One implementation exists,
+// axis_page.hpp: an axis session over the link `cia402 serve` builds (a virtual drive in this
+// process, a node on a CAN bus, a slave on an EtherCAT line). The server (server.hpp) and the cycle
+// thread (runner.hpp) see only this interface, so tests may give them a drive of their own; the page
+// learns from /api/info and the snapshots which kind it shows and what it can do.
 #pragma once
 
 #include <chrono>

@@ -79,7 +79,7 @@ struct axis {
 
 class server {
  public:
-  /// The backend (the in-process instrument or a remote drive) must outlive the server.
+  /// The backend (axis_page.hpp, or a test's own) must outlive the server.
   server(backend& inst, server_options options);
   /// Several drives (at least one), each an axis of the page: every /api/ path takes ?axis=K
   /// (1..N, the first without it). The backends must outlive the server. Throws

@@ -1,0 +1,140 @@
+// The page's drive inside: shared by axis_page.cpp (the session's cycle, what the drive shows, the
+// snapshots) and axis_page_actions.cpp (the page's requests, each handed to the session).
+#pragma once
+
+#include "cia402/page/axis_page.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <optional>
+
+#include "action_log.hpp"
+#include "cia402/axis/session.hpp"
+#include "cia402/sim/trace.hpp"
+#include "recorder.hpp"
+#include "snapshot_board.hpp"
+#include "word_change.hpp"
+
+namespace cia402::page {
+
+struct axis_page::impl {
+  using json = nlohmann::ordered_json;
+
+  impl(const profile& p, connection_factory f, axis_page_config c);
+  ~impl();
+
+  // --- the drive --------------------------------------------------------------------------------
+  const profile* table;  // the profile in use; select_profile() changes it with the drive
+  connection_factory connect;
+  axis_page_config config;
+  drive_connection drive;
+  std::unique_ptr<axes::session> session;
+
+  mutable std::mutex mutex;          // guards all here but the board, which has a lock of its own
+  std::condition_variable answered;  // a request's answer came (or the page closed)
+
+  std::uint64_t now_us = 0;
+  std::uint64_t cycles = 0;
+  std::uint64_t next_publish_us = 0;
+
+  // What the drive showed.
+  std::optional<state> observed;  // none: the status word is not known
+  struct transition_seen {
+    std::optional<int> number;
+    state from = state::start;
+    state to = state::start;
+    bool inferred = false;
+  };
+  std::optional<transition_seen> last_transition;
+  bool reset_sent_since_change = false;  // for the inference (a fault-reset edge went out)
+  std::map<std::uint16_t, std::int64_t> objects;  // a bus drive's objects as read at start or written
+  std::uint16_t injected_fault = 0;               // what the page wrote to 0x2001 (a bus node)
+  std::optional<std::uint16_t> last_emergency;    // the newest emergency's error code
+
+  // What the page asked for.
+  std::optional<std::uint16_t> requested_word;  // a word given to the session, not yet sent
+  detail::action_log log;
+  detail::snapshot_board board;
+  detail::recorder recording;
+  std::optional<sim::trace_row> open_row;  // a drive in this process: the cycle under way
+  std::uint64_t open_row_cycle = 0;        // the simulator's cycle count when it began
+  state open_row_state = state::start;     // the drive's state when it began
+
+  // Profile position's handshake (backend::new_setpoint): bit 4 up until status bit 12, then down.
+  struct handshake_run {
+    std::uint16_t word = 0;  // the word bit 4 goes up in
+    bool raised = false;
+    std::uint64_t give_up_us = 0;
+  };
+  std::optional<handshake_run> handshake;
+  // One-click Enable and Stop, and the jog: at most one of each, the session runs them.
+  struct operation {
+    std::uint64_t id = 0;
+    std::string action;
+    std::vector<int> transitions;
+  };
+  std::optional<operation> enabling, stopping;
+  struct jog_run {
+    std::uint64_t id = 0;
+    std::uint64_t session_id = 0;
+    std::string action;
+    std::int64_t velocity_rpm = 0;
+    std::uint64_t time_to_live_us = 0;
+    std::uint64_t started_us = 0;
+    /// The page's own reckoning of the dead-man (the session's counts from when the drive turns, so
+    /// it is never earlier): a keep-alive after it starts the jog anew rather than renew an ending one.
+    std::uint64_t expires_us = 0;
+    std::string why_ended;  // released, Stop, another velocity; empty while it runs
+    bool turning = false;   // the session switched to profile velocity and set 0x60FF
+  };
+  std::optional<jog_run> jogging;
+
+  // --- axis_page.cpp ------------------------------------------------------------------------------
+  void start_session(const profile& p);  // the session over the connection `drive`
+  void advance(std::uint32_t elapsed_us);
+  void on_state(state from, state to, std::uint16_t status_word);
+  void note_transition(std::optional<int> number, state from, state to, bool inferred,
+                       std::uint16_t status_word);
+  void on_cycle();
+  void close_row();
+  void record_bus_row();
+  void run_handshake();
+  void check_enable_walk();
+  bool busy_now() const;
+  std::optional<std::int64_t> value_of(std::uint16_t index) const;
+  std::uint16_t word_shown() const;
+  std::uint16_t word_base() const { return requested_word.value_or(word_shown()); }
+  bool running() const {
+    return session->link().phase() == axes::link_phase::running && session->prepared() && session->link().cyclic();
+  }
+  std::string link_text() const;
+  std::string conditions() const;
+  detail::action_log::standing how_it_stands() const;
+  json capabilities() const;
+  json remote_json() const;
+  json snapshot(bool with_time) const;
+  json bus_snapshot(json j) const;
+
+  // --- axis_page_actions.cpp ----------------------------------------------------------------------
+  std::optional<refused> not_running() const;
+  std::uint64_t change_word(const detail::word_change& w);
+  void send_word(std::uint16_t word, bool reset_edge);
+  std::string enable_blocker(state s) const;
+  void end_operation(std::optional<operation>& op, const axes::result& r, const std::string& done_text);
+  void end_jog(const axes::result& r);
+  /// Runs `start` (a session request whose completion calls the given callback) and waits for its
+  /// result: the session is polled here without time passing first (a drive in this process answers
+  /// at once), then the cycle thread brings it. Nothing when the page closed or the time ran out.
+  std::optional<axes::result> await(std::unique_lock<std::mutex>& lock,
+                                    const std::function<void(axes::completion)>& start);
+  /// The reply to an object write; `tracked`: the action was tracked from before it was sent (a
+  /// plant input whose transitions the page reports), and is refused if the write failed.
+  reply write_reply(const std::optional<axes::result>& r, const std::string& action,
+                    std::optional<std::uint64_t> tracked = std::nullopt);
+  reply change_bus_plant(std::unique_lock<std::mutex>& lock, const plant_change& change);
+};
+
+}  // namespace cia402::page
