@@ -137,9 +137,9 @@ void axis_page::impl::on_state(state from, state to, std::uint16_t status_word) 
 }
 
 void axis_page::impl::note_transition(std::optional<int> number, state from, state to, bool inferred,
-                                      std::uint16_t status_word) {
+                                      std::uint16_t status_word, std::optional<std::uint64_t> at_us) {
   last_transition = transition_seen{number, from, to, inferred};
-  recording.note_transition({0, now_us, number, from, to, word_shown(), status_word, inferred});
+  recording.note_transition({0, at_us.value_or(now_us), number, from, to, word_shown(), status_word, inferred});
   if (!number) return;
   if (auto* a = log.pending()) {
     a->transitions.push_back(*number);
@@ -168,7 +168,8 @@ void axis_page::impl::close_row() {
   sim::complete_row(*open_row, out);
   recording.record(*open_row);
   if (out.transition != no_transition) {
-    note_transition(int{out.transition}, before, out.current, false, out.status_word);
+    // At the time of the cycle whose step took it, as the recording's row for that cycle says.
+    note_transition(int{out.transition}, before, out.current, false, out.status_word, open_row->time_us);
   }
   open_row.reset();
 }

@@ -97,7 +97,8 @@ struct axis_page::impl {
   void advance(std::uint32_t elapsed_us);
   void on_state(state from, state to, std::uint16_t status_word);
   void note_transition(std::optional<int> number, state from, state to, bool inferred,
-                       std::uint16_t status_word);
+                       std::uint16_t status_word,
+                       std::optional<std::uint64_t> at_us = std::nullopt);
   void on_cycle();
   void close_row();
   void record_bus_row();
