@@ -16,10 +16,7 @@
 #include <mutex>
 #include <thread>
 
-#include "virtual_axis_page.hpp"
-#include "cia402/page/runner.hpp"
-#include "cia402/page/server.hpp"
-#include "cia402/profile.hpp"
+#include "page_server_fixture.hpp"
 
 namespace {
 
