@@ -2,257 +2,35 @@
 // against `cia402 serve --port 0` on loopback. What it checks is what seed 003_83442f2f4b0b2bb9.txt
 // asks of the screen page: the present state black, all others gray, the number of the last
 // transition accented; the status word; commands, a fault and its reset; refused commands shown
-// as refused; view-only without the token; phone width. Then the same page for a drive on a CAN
-// bus: `cia402 serve --can` against a `cia402 bus` node over socketcand (inferred transition
-// numbers, the DC-link and STO switches disabled with the reason, the bus going away).
+// as refused; jog, the recorder, the operation modes, phone width; a server stopped under the page.
+// instrument_page_servers.test.mjs goes on with the other servers (token, profiles, axes, --can).
 //
 //   node instrument_page.test.mjs CIA402_BINARY OUTPUT_DIR SCREENSHOT_PNG
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
-import { spawn } from 'node:child_process';
 import fs from 'node:fs';
-import { createRequire } from 'node:module';
-import os from 'node:os';
 import path from 'node:path';
 
-const args = process.argv.slice(2);
-if (args.length !== 3) {
-  console.error('usage: node instrument_page.test.mjs CIA402_BINARY OUTPUT_DIR SCREENSHOT_PNG');
-  process.exit(2);
-}
-const [cia402, outDir, screenshotPath] = args.map((a) => path.resolve(a));
-const modules = path.resolve(process.env.CIA402_NODE_MODULES || 'node_modules');
-const { chromium } = createRequire(path.join(modules, 'resolve-from-here.js'))('playwright-core');
-const executablePath = process.env.CIA402_CHROMIUM || '/usr/bin/chromium';
-fs.mkdirSync(outDir, { recursive: true });
+import {
+  patience,
+  run,
+  startRun,
+  expect,
+  check,
+  launchBrowser,
+  closeBrowser,
+  runChecks,
+  startServer,
+  stopServer,
+  waitResult,
+  expectPresentState,
+  expectAccented,
+  statusWord,
+  click,
+  driveState,
+  untilDrive,
+} from './page_harness.mjs';
 
-const STATES = ['NOT_READY_TO_SWITCH_ON', 'SWITCH_ON_DISABLED', 'READY_TO_SWITCH_ON', 'SWITCHED_ON',
-  'OPERATION_ENABLED', 'QUICK_STOP_ACTIVE', 'FAULT_REACTION_ACTIVE', 'FAULT'];
-
-// How long a wait for the page may take before the check fails, in ms. Generous: on a loaded machine
-// (ctest -j2 beside the model check) chromium may lag by seconds, and a wait ends as soon as its
-// condition holds, so only a failing check pays for it.
-const patience = 20000;
-
-let passed = 0;
-const servers = [];
-let context = null;
-let currentPage = null;
-
-function fail(message) {
-  throw new Error(message);
-}
-
-function expect(condition, message) {
-  if (!condition) fail(message);
-}
-
-async function check(name, fn) {
-  await fn();
-  passed += 1;
-  console.log(`ok ${passed} - ${name}`);
-}
-
-// --- cia402 serve ----------------------------------------------------------------------------
-
-function startServer(extraArgs) {
-  return new Promise((resolve, reject) => {
-    const proc = spawn(cia402, ['serve', '--port', '0', ...extraArgs], {
-      stdio: ['ignore', 'pipe', 'pipe'],
-    });
-    const server = { proc, output: '', url: null, exit: null };
-    servers.push(server);
-    const timer = setTimeout(() => reject(new Error(`no URL from cia402 serve:\n${server.output}`)),
-      15000);
-    proc.stdout.on('data', (d) => {
-      server.output += d;
-      const m = /(http:\/\/\S+)/.exec(server.output);
-      if (m && !server.url) {
-        server.url = m[1];
-        clearTimeout(timer);
-        resolve(server);
-      }
-    });
-    proc.stderr.on('data', (d) => { server.output += d; });
-    proc.on('exit', (code, signal) => {
-      server.exit = { code, signal };
-      if (!server.url) {
-        clearTimeout(timer);
-        reject(new Error(`cia402 serve exited (${code}, ${signal}):\n${server.output}`));
-      }
-    });
-  });
-}
-
-// `cia402 bus --listen 127.0.0.1:0`: resolves with the socketcand port it printed.
-function startBus(extraArgs) {
-  return new Promise((resolve, reject) => {
-    const proc = spawn(cia402, ['bus', '--listen', '127.0.0.1:0', ...extraArgs], {
-      stdio: ['ignore', 'pipe', 'pipe'],
-    });
-    const bus = { proc, output: '', url: null, exit: null };
-    servers.push(bus);
-    const timer = setTimeout(() => reject(new Error(`no port from cia402 bus:\n${bus.output}`)),
-      15000);
-    proc.stdout.on('data', (d) => {
-      bus.output += d;
-      const m = /socketcand on (127\.0\.0\.1:\d+)/.exec(bus.output);
-      if (m && !bus.url) {
-        bus.url = m[1];
-        clearTimeout(timer);
-        resolve(bus);
-      }
-    });
-    proc.stderr.on('data', (d) => { bus.output += d; });
-    proc.on('exit', (code, signal) => {
-      bus.exit = { code, signal };
-      if (!bus.url) {
-        clearTimeout(timer);
-        reject(new Error(`cia402 bus exited (${code}, ${signal}):\n${bus.output}`));
-      }
-    });
-  });
-}
-
-// Ctrl-C: the server must stop cleanly, exit status 0.
-async function stopServer(server) {
-  if (server.exit) return server.exit;
-  const exited = new Promise((resolve) => server.proc.on('exit', (code, signal) => resolve({ code, signal })));
-  server.proc.kill('SIGINT');
-  const timeout = new Promise((resolve) => setTimeout(() => resolve(null), 5000));
-  const result = await Promise.race([exited, timeout]);
-  if (!result) {
-    server.proc.kill('SIGKILL');
-    fail(`cia402 serve did not stop within 5 s of SIGINT:\n${server.output}`);
-  }
-  return result;
-}
-
-// --- reading the page ------------------------------------------------------------------------
-
-async function waitPresent(page, state, timeout = patience) {
-  try {
-    return await page.waitForSelector(`#diagram [id="state.${state}"].present`, { timeout });
-  } catch (e) {
-    // A timeout alone does not tell a slow browser from a drive in another state or a link that
-    // never reported one: say what the page showed and what its server says now.
-    const shown = await page.evaluate(() => ({
-      present: [...document.querySelectorAll('#diagram .present')].map((x) => x.id),
-      remote: document.getElementById('remote')?.dataset.status ?? null,
-      banner: document.getElementById('remote')?.textContent ?? null,
-    })).catch((why) => String(why));
-    let server;
-    try {
-      server = JSON.stringify(await (await fetch(new URL('api/state', page.url()))).json());
-    } catch (why) {
-      server = String(why);
-    }
-    throw new Error(`${e.message}\nthe page showed ${JSON.stringify(shown)}\n` +
-      `its server says ${server.slice(0, 3000)}`);
-  }
-}
-
-function waitResult(page, text, timeout = patience) {
-  return page.waitForFunction((t) => document.getElementById('result').textContent.includes(t),
-    text, { timeout });
-}
-
-// Computed colours of every state box: what a reader actually sees.
-function diagramStyle(page) {
-  return page.evaluate(() => {
-    const rgb = (s) => (s.match(/\d+(\.\d+)?/g) || []).slice(0, 3).map(Number);
-    const states = [...document.querySelectorAll('#diagram .state')]
-      .filter((g) => g.dataset.state !== 'START')
-      .map((g) => {
-        const rect = g.querySelector('rect');
-        const text = g.querySelector('text');
-        return {
-          name: g.dataset.state,
-          label: [...g.querySelectorAll('text')].map((t) => t.textContent).join(' '),
-          present: g.classList.contains('present'),
-          fill: rgb(getComputedStyle(rect).fill),
-          stroke: rgb(getComputedStyle(rect).stroke),
-          text: rgb(getComputedStyle(text).fill),
-        };
-      });
-    const numbers = [...document.querySelectorAll('#diagram .number')].map((g) => {
-      const t = g.querySelector('text');
-      const r = g.querySelector('rect');
-      const cs = getComputedStyle(t);
-      return {
-        number: Number(g.dataset.number),
-        id: g.id,
-        last: g.classList.contains('last'),
-        weight: Number(cs.fontWeight),
-        size: parseFloat(cs.fontSize),
-        underline: cs.textDecorationLine.includes('underline'),
-        boxed: getComputedStyle(r).stroke !== 'none' && parseFloat(getComputedStyle(r).strokeWidth) > 0,
-      };
-    });
-    return { states, numbers };
-  });
-}
-
-const isBlack = ([r, g, b]) => r === 0 && g === 0 && b === 0;
-const isWhite = ([r, g, b]) => r === 255 && g === 255 && b === 255;
-const isGray = ([r, g, b]) => r === g && g === b && r >= 100 && r <= 220;
-
-async function expectPresentState(page, state) {
-  await waitPresent(page, state);
-  const { states } = await diagramStyle(page);
-  const present = states.filter((s) => s.present);
-  expect(present.length === 1 && present[0].name === state,
-    `exactly ${state} should be present, got ${JSON.stringify(present.map((s) => s.name))}`);
-  const p = present[0];
-  expect(p.label === state.replace(/_/g, ' '), `the present box reads "${p.label}"`);
-  expect(isBlack(p.fill), `${state} should be drawn black, fill is rgb(${p.fill})`);
-  for (const s of states.filter((x) => !x.present)) {
-    expect(isWhite(s.fill) && isGray(s.stroke) && isGray(s.text),
-      `${s.name} should be gray (fill ${s.fill}, stroke ${s.stroke}, text ${s.text})`);
-  }
-  expect(states.length === STATES.length, `8 states drawn, got ${states.length}`);
-}
-
-async function expectAccented(page, number) {
-  await page.waitForSelector(`#diagram .number.last[data-number="${number}"]`, { timeout: patience });
-  const { numbers } = await diagramStyle(page);
-  const last = numbers.filter((n) => n.last);
-  expect(last.length === 1 && last[0].number === number,
-    `only transition ${number} should be accented, got ${JSON.stringify(last.map((n) => n.id))}`);
-  const a = last[0];
-  const others = numbers.filter((n) => !n.last);
-  expect(a.weight >= 700 && a.underline && a.boxed,
-    `transition ${number} is accented by shape: weight ${a.weight}, underline ${a.underline}, box ${a.boxed}`);
-  expect(others.every((n) => n.size < a.size && n.weight < 700 && !n.boxed && !n.underline),
-    'the other transition numbers are plain');
-}
-
-async function statusWord(page) {
-  return parseInt(await page.textContent('#sw-hex'), 16);
-}
-
-async function click(page, command) {
-  await page.click(`button[data-command="${command}"]`);
-}
-
-// The drive's snapshot as a script sees it (GET /api/state from here, not from the page).
-async function driveState(baseUrl) {
-  return (await fetch(new URL('/api/state', baseUrl))).json();
-}
-
-// Polls the drive until `holds(snapshot)`; fails naming `what` after `timeout` ms.
-async function untilDrive(baseUrl, holds, what, timeout = patience) {
-  const end = Date.now() + timeout;
-  let s = null;
-  while (Date.now() < end) {
-    s = await driveState(baseUrl);
-    if (holds(s)) return s;
-    await new Promise((r) => setTimeout(r, 25));
-  }
-  fail(`${what}; last 0x60FF ${s && s.target_velocity}, velocity ${s && s.velocity}`);
-  return null;
-}
-
-// --- the test --------------------------------------------------------------------------------
+const [, outDir, screenshotPath] = startRun('instrument_page.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR', 'SCREENSHOT_PNG']);
 
 async function main() {
   const main = await startServer([]);
@@ -260,17 +38,9 @@ async function main() {
     expect(/^http:\/\/127\.0\.0\.1:\d+\/$/.test(main.url), `URL ${main.url}`);
   });
 
-  const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'cia402-chromium-'));
-  context = await chromium.launchPersistentContext(userDataDir, {
-    executablePath,
-    headless: true,
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-    viewport: { width: 1280, height: 800 },
-    acceptDownloads: true,
-  });
+  const context = await launchBrowser();
   const page = context.pages()[0] || await context.newPage();
-  currentPage = page;
+  run.currentPage = page;
   const problems = [];
   page.on('console', (m) => { if (m.type() === 'error') problems.push(m.text()); });
   page.on('pageerror', (e) => problems.push(String(e)));
@@ -630,215 +400,8 @@ async function main() {
   // A page whose server is gone keeps retrying it: closed, so it takes no time from the next pages.
   await page.close();
 
-  // --- a server that requires its token -------------------------------------------------------
-  const guarded = await startServer(['--token-required']);
-  await check('--token-required prints a URL with ?token=', async () => {
-    expect(/\?token=[0-9a-f]{32}$/.test(guarded.url), `URL ${guarded.url}`);
-  });
-  const viewer = await context.newPage();
-  currentPage = viewer;
-  await viewer.setViewportSize({ width: 1280, height: 800 });
-  await check('without the token the page is view-only: banner shown, controls disabled', async () => {
-    await viewer.goto(guarded.url.replace(/\?token=.*$/, ''));
-    await waitPresent(viewer, 'SWITCH_ON_DISABLED');
-    await viewer.waitForSelector('#view-only:not([hidden])', { timeout: patience });
-    // The scope's own tools only look at the samples: they stay usable without the token.
-    const enabled = await viewer.evaluate(() =>
-      [...document.querySelectorAll('button, input, select')]
-        .filter((c) => !c.disabled && !c.closest('.panel-scope')).length);
-    expect(enabled === 0, `${enabled} controls still enabled`);
-  });
-  await viewer.screenshot({ path: path.join(outDir, 'view-only-1280x800.png') });
-  await check('with the token the same server obeys: Shutdown leads to READY TO SWITCH ON', async () => {
-    await viewer.goto(guarded.url);
-    await waitPresent(viewer, 'SWITCH_ON_DISABLED');
-    expect(await viewer.isHidden('#view-only'), 'no view-only banner');
-    await click(viewer, 'shutdown');
-    await expectPresentState(viewer, 'READY_TO_SWITCH_ON');
-    await expectAccented(viewer, 2);
-  });
-  await check('the token leaves the address bar at once and control survives a reload', async () => {
-    const address = await viewer.evaluate(() => location.href);
-    expect(!address.includes('token'), `address bar still shows ${address}`);
-    await viewer.reload();
-    await waitPresent(viewer, 'READY_TO_SWITCH_ON');
-    expect(await viewer.isHidden('#view-only'), 'view-only after a reload');
-    await click(viewer, 'disable_voltage');
-    await expectPresentState(viewer, 'SWITCH_ON_DISABLED');
-  });
-  const r = await stopServer(guarded);
-  expect(r.code === 0, `guarded server exit ${JSON.stringify(r)}`);
-  await viewer.close();
-
-  // --- a PROFIBUS profile: the seed's names, no Halt -------------------------------------------
-  const profibus = await startServer(['--profile', 's300-profibus']);
-  const pb = await context.newPage();
-  currentPage = pb;
-  await pb.setViewportSize({ width: 1280, height: 800 });
-  await check('s300-profibus: no Halt button (bit 8 is Jog there), bits named as STW/ZSW', async () => {
-    await pb.goto(profibus.url);
-    await waitPresent(pb, 'SWITCH_ON_DISABLED');
-    expect(await pb.locator('button[data-command="halt"]').count() === 0, 'a Halt button is offered');
-    const text = await pb.textContent('body');
-    expect(text.includes('Jog'), 'bit 8 is not named Jog');
-    expect(text.includes('Inhibit voltage (active low)'), 'STW bit 1 lacks "(active low)"');
-  });
-
-  await check("s300-profibus: the seed's own words, its meanings and events as hover text, no jargon", async () => {
-    const words = await pb.evaluate(() => ({
-      box: document.getElementById('state.SWITCH_ON_DISABLED').textContent,
-      boxTitle: document.querySelector('[id="state.SWITCH_ON_DISABLED"] title').textContent,
-      quickStop: document.querySelector('button[data-command="quick_stop"]').textContent,
-      disableVoltage: document.querySelector('button[data-command="disable_voltage"]').textContent,
-      faultReset: document.querySelector('button[data-command="fault_reset"]').textContent,
-      t11: document.querySelector('[id^="n11."] title').textContent,
-      summary: document.getElementById('state-name').textContent,
-      header: document.querySelector('header').textContent,
-    }));
-    expect(words.box.includes('SWITCH-ON') && words.box.includes('INHIBITED'), `box '${words.box}'`);
-    expect(words.boxTitle.includes('Parameters can be transferred'), `hover '${words.boxTitle}'`);
-    expect(words.quickStop === 'Fast stop' && words.disableVoltage === 'Inhibit voltage' &&
-      words.faultReset === 'Error reset', `commands ${JSON.stringify(words)}`);
-    expect(words.t11.includes('Event: Bit 2 is canceled') && words.t11.includes('emergency ramp'),
-      `T11 hover '${words.t11}'`);
-    expect(words.summary === 'Switch-on inhibited', `summary '${words.summary}'`);
-    expect(!/\.txt|semantics\.md|S1\.\./.test(words.header), `header '${words.header}'`);
-  });
-  const pr = await stopServer(profibus);
-  expect(pr.code === 0, `profibus server exit ${JSON.stringify(pr)}`);
-  await pb.close();
-
-  // --- several axes, and choosing the profile on the page ----------------------------------------
-  const multi = await startServer(['--nodes', '3']);
-  const mp = await context.newPage();
-  currentPage = mp;
-  await mp.setViewportSize({ width: 1280, height: 800 });
-  const cardState = (k) => mp.textContent(`.axis-card[data-axis="${k}"] .axis-state`);
-  await check('--nodes 3: an overview card per axis, the one shown marked', async () => {
-    await mp.goto(multi.url);
-    await waitPresent(mp, 'SWITCH_ON_DISABLED');
-    await mp.waitForFunction(() => document.querySelectorAll('.axis-card').length === 3, null,
-      { timeout: patience });
-    expect(await mp.getAttribute('.axis-card[data-axis="1"]', 'aria-current') === 'page', 'axis 1 marked');
-    expect((await mp.textContent('h1')).startsWith('axis 1'), 'the heading names the axis');
-  });
-  await check('--nodes 3: axis 2 is a drive of its own: its Shutdown leaves axes 1 and 3 alone', async () => {
-    await mp.click('.axis-card[data-axis="2"]');
-    await mp.waitForURL(/axis=2/);
-    await waitPresent(mp, 'SWITCH_ON_DISABLED');
-    await click(mp, 'shutdown');
-    await waitPresent(mp, 'READY_TO_SWITCH_ON');
-    await mp.waitForFunction(() => document.querySelector('.axis-card[data-axis="2"] .axis-state')
-      .textContent === 'READY TO SWITCH ON', null, { timeout: patience });
-    expect(await cardState(1) === 'SWITCH ON DISABLED' && await cardState(3) === 'SWITCH ON DISABLED',
-      `axes 1 and 3: ${await cardState(1)}, ${await cardState(3)}`);
-    await mp.screenshot({ path: path.join(outDir, 'axes-1280x800.png') });
-  });
-  await check('choosing s300-profibus on the page restarts axis 2 under it, in its own words', async () => {
-    await mp.selectOption('#profile-select', 's300-profibus');
-    await mp.waitForFunction(() => document.getElementById('profile').textContent.includes('s300-profibus'),
-      null, { timeout: patience });
-    await waitPresent(mp, 'SWITCH_ON_DISABLED');
-    expect(await mp.textContent('#state-name') === 'Switch-on inhibited', 'seed 003 state name');
-    expect(await mp.locator('button[data-command="halt"]').count() === 0, 'no Halt on PROFIBUS');
-    const r = await (await fetch(`${multi.url.split('?')[0]}api/state?axis=1`)).json();
-    expect(r.profile === 'cia402', `axis 1 runs ${r.profile}`);
-  });
-  const mr = await stopServer(multi);
-  expect(mr.code === 0, `--nodes server exit ${JSON.stringify(mr)}`);
-  await mp.close();
-
-  // --- a drive on a CAN bus: cia402 serve --can against a cia402 bus node ----------------------
-  const bus = await startBus(['--nodes', '1']);
-  const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
-  const rp = await context.newPage();
-  currentPage = rp;
-  // Its own list: the earlier pages keep retrying their stopped servers.
-  const remoteProblems = [];
-  rp.on('console', (m) => { if (m.type() === 'error') remoteProblems.push(m.text()); });
-  rp.on('pageerror', (e) => remoteProblems.push(String(e)));
-  await rp.setViewportSize({ width: 1280, height: 800 });
-  await check('--can: the page shows node 1 of the bus, its state, and says numbers are inferred', async () => {
-    await rp.goto(remote.url);
-    await rp.waitForSelector('#remote[data-status="running"]', { timeout: patience });
-    const text = await rp.textContent('#remote');
-    expect(text.includes('node 1') && text.includes('inferred'), `banner: "${text}"`);
-    await expectPresentState(rp, 'SWITCH_ON_DISABLED');
-  });
-  await check('--can: DC-link and STO switches disabled with the reason, fault injection offered', async () => {
-    await rp.waitForFunction(() => !document.getElementById('fault-switch').disabled, null,
-      { timeout: patience });
-    const sw = await rp.evaluate(() => ['dc-switch', 'sto-switch'].map((id) => {
-      const e = document.getElementById(id);
-      return { disabled: e.disabled, title: e.title };
-    }));
-    for (const s of sw) {
-      expect(s.disabled && s.title === 'not available on a remote drive', `switch ${JSON.stringify(s)}`);
-    }
-    const note = await rp.textContent('#switches-note');
-    expect(note.includes('not available on a remote drive'), `note: "${note}"`);
-    expect((await rp.textContent('#lamp-sto b')) === 'unknown', 'STO lamp says unknown');
-  });
-  await check('--can: Shutdown, Switch on, Enable operation: T2, T3, T4 accented, inferred', async () => {
-    await click(rp, 'shutdown');
-    await expectPresentState(rp, 'READY_TO_SWITCH_ON');
-    await expectAccented(rp, 2);
-    await click(rp, 'switch_on');
-    await expectPresentState(rp, 'SWITCHED_ON');
-    await expectAccented(rp, 3);
-    await click(rp, 'enable_operation');
-    await expectPresentState(rp, 'OPERATION_ENABLED');
-    await expectAccented(rp, 4);
-    const last = await rp.textContent('#last-transition');
-    expect(last.includes('inferred'), `last transition "${last}"`);
-    expect((await rp.textContent('#cw-hex')) === '0x000F', 'control word 0x000F');
-  });
-  await rp.screenshot({ path: path.join(outDir, 'remote-operation-enabled-1280x800.png') });
-  await check('--can: fault through 0x2001 gives FAULT (T14), reset after clearing gives T15', async () => {
-    await rp.fill('#fault-code', '0x2310');
-    await rp.click('label:has(#fault-switch)');
-    await expectPresentState(rp, 'FAULT');
-    await expectAccented(rp, 14);
-    await rp.waitForFunction(() => document.getElementById('error-code').textContent === '0x2310',
-      null, { timeout: patience });
-    await rp.click('label:has(#fault-switch)');
-    await rp.waitForFunction(() => document.getElementById('lamp-fault').textContent.includes('OFF'),
-      null, { timeout: patience });
-    await click(rp, 'fault_reset');
-    await expectPresentState(rp, 'SWITCH_ON_DISABLED');
-    await expectAccented(rp, 15);
-  });
-  await check('--can: when the bus goes away the page says so and shows no present state', async () => {
-    const b = await stopServer(bus);
-    expect(b.code === 0, `cia402 bus exit ${JSON.stringify(b)}`);
-    await rp.waitForSelector('#remote:not([data-status="running"])', { timeout: patience });
-    const text = await rp.textContent('#remote');
-    expect(text.includes('bus connection failed'), `banner: "${text}"`);
-    await rp.waitForFunction(() => document.querySelectorAll('#diagram .state.present').length === 0,
-      null, { timeout: patience });
-  });
-  await rp.screenshot({ path: path.join(outDir, 'remote-bus-gone-1280x800.png') });
-  await check('--can: no console errors; Ctrl-C stops the server with exit status 0', async () => {
-    expect(remoteProblems.length === 0, `console errors: ${JSON.stringify(remoteProblems)}`);
-    const x = await stopServer(remote);
-    expect(x.code === 0, `exit ${JSON.stringify(x)}:\n${remote.output}`);
-  });
-
-  await context.close();
-  context = null;
-  fs.rmSync(userDataDir, { recursive: true, force: true });
-  console.log(`# ${passed} checks passed; screenshot: ${screenshotPath}`);
+  await closeBrowser();
+  console.log(`# ${run.passed} checks passed; screenshot: ${screenshotPath}`);
 }
 
-main().then(() => process.exit(0), async (e) => {
-  console.error(`not ok ${passed + 1} - ${e.message}`);
-  try {
-    if (currentPage) await currentPage.screenshot({ path: path.join(outDir, 'failure.png'), fullPage: true });
-  } catch { /* the page may be gone */ }
-  for (const s of servers) {
-    if (!s.exit) s.proc.kill('SIGKILL');
-    console.error(`--- cia402 serve output ---\n${s.output}`);
-  }
-  if (context) await context.close().catch(() => {});
-  process.exit(1);
-});
+runChecks(main);
