@@ -239,19 +239,19 @@ TEST_F(modes_test, objects_with_sub_indices_go_through_sdo_to_the_drive) {
   EXPECT_EQ(sdo_write(0x607D, 3, 0, 4), 0x06090011u) << "no sub-index 3";
 }
 
-// The drive master's PDO 3: set up over SDO, a set-point in RPDO3 before every SYNC, the position
-// from TPDO3.
-TEST(modes_master, map_position_streams_rpdo3_and_reads_tpdo3) {
-  virtual_bus bus;
-  apps::virtual_drive_node drive(standard_profile(), bus.attach(), apps::drive_node_config(id));
-  auto ch = bus.attach();
-  drive_master_config mc;
-  mc.cycle_us = 1000;
-  mc.map_position = true;
-  drive_master m(*ch, mc);
-  std::vector<std::int32_t> positions;
-  m.on_position = [&](std::int32_t p) { positions.push_back(p); };
-  const auto run_ms = [&](int ms) {
+// The drive master with PDO 3 mapped and a virtual drive on one in-process bus, SYNC every cycle_us;
+// run_ms() steps both a millisecond at a time, each seeing what the other sent in the same step.
+struct pdo3_bench {
+  explicit pdo3_bench(std::uint32_t cycle_us)
+      : drive(standard_profile(), bus.attach(), apps::drive_node_config(id)), ch(bus.attach()),
+        m(*ch, config(cycle_us)) {}
+  static drive_master_config config(std::uint32_t cycle_us) {
+    drive_master_config mc;
+    mc.cycle_us = cycle_us;
+    mc.map_position = true;
+    return mc;
+  }
+  void run_ms(int ms) {
     for (int i = 0; i < ms; ++i) {
       m.poll(*ch, 1000);
       drive.poll(1000);
@@ -259,28 +259,45 @@ TEST(modes_master, map_position_streams_rpdo3_and_reads_tpdo3) {
       drive.poll(0);
       m.poll(*ch, 0);
     }
-  };
-  run_ms(100);
+  }
+  // Set up, in OPERATION ENABLED in `mode` with the set-point at 0.
+  void enable_in(std::int64_t mode) {
+    run_ms(100);
+    ASSERT_EQ(m.phase(), master_phase::running) << m.failure_text();
+    ASSERT_EQ(drive.drive().write(0x6060, 0, mode), sdo_abort::none);
+    m.set_position_set_point(0);
+    m.set_target(state::operation_enabled);
+    for (int i = 0; i < 300 && m.outcome() != master_outcome::reached; ++i) run_ms(1);
+    ASSERT_EQ(m.outcome(), master_outcome::reached);
+  }
+  virtual_bus bus;
+  apps::virtual_drive_node drive;
+  std::unique_ptr<channel> ch;
+  drive_master m;
+};
+
+// The drive master's PDO 3: set up over SDO, a set-point in RPDO3 before every SYNC, the position
+// from TPDO3.
+TEST(modes_master, map_position_streams_rpdo3_and_reads_tpdo3) {
+  pdo3_bench b(1000);
+  drive_master& m = b.m;
+  b.run_ms(100);
   ASSERT_EQ(m.phase(), master_phase::running) << m.failure_text();
   EXPECT_TRUE(m.position_mapped());
   ASSERT_TRUE(m.position().has_value());
   EXPECT_EQ(*m.position(), 0);
-  std::int64_t v = 0;
-  ASSERT_EQ(drive.drive().write(0x6060, 0, 8), sdo_abort::none);
-  m.set_position_set_point(0);
-  m.set_target(state::operation_enabled);
-  for (int i = 0; i < 300 && m.outcome() != master_outcome::reached; ++i) run_ms(1);
-  ASSERT_EQ(m.outcome(), master_outcome::reached);
-  run_ms(50);
+  ASSERT_NO_FATAL_FAILURE(b.enable_in(8));  // cyclic synchronous position
+  b.run_ms(50);
   std::int32_t sp = 0;
   m.before_sync = [&] {
     if (sp < 5000) sp += 25;
     m.set_position_set_point(sp);
   };
-  run_ms(250);
+  b.run_ms(250);
   EXPECT_EQ(sp, 5000);
   EXPECT_EQ(*m.position(), 5000);
-  ASSERT_EQ(drive.drive().read(0x6064, 0, v), sdo_abort::none);
+  std::int64_t v = 0;
+  ASSERT_EQ(b.drive.drive().read(0x6064, 0, v), sdo_abort::none);
   EXPECT_EQ(v, 5000);
   EXPECT_EQ(m.status_word() & bit13, 0);
 }
@@ -289,39 +306,19 @@ TEST(modes_master, map_position_streams_rpdo3_and_reads_tpdo3) {
 // must not reach the drive before it (by RPDO1, which acts at once) or the drive takes the old target
 // and never moves. Both take effect at one SYNC.
 TEST(modes_master, with_pdo_3_mapped_a_pp_target_and_its_new_set_point_bit_arrive_together) {
-  virtual_bus bus;
-  apps::virtual_drive_node drive(standard_profile(), bus.attach(), apps::drive_node_config(id));
-  auto ch = bus.attach();
-  drive_master_config mc;
-  mc.cycle_us = 10000;  // a SYNC every 10 ms: a word given between two goes out before the next
-  mc.map_position = true;
-  drive_master m(*ch, mc);
-  const auto run_ms = [&](int ms) {
-    for (int i = 0; i < ms; ++i) {
-      m.poll(*ch, 1000);
-      drive.poll(1000);
-      m.poll(*ch, 0);
-      drive.poll(0);
-      m.poll(*ch, 0);
-    }
-  };
-  run_ms(100);
-  ASSERT_EQ(m.phase(), master_phase::running) << m.failure_text();
-  ASSERT_EQ(drive.drive().write(0x6060, 0, 1), sdo_abort::none);  // profile position
-  m.set_position_set_point(0);
-  m.set_target(state::operation_enabled);
-  for (int i = 0; i < 300 && m.outcome() != master_outcome::reached; ++i) run_ms(1);
-  ASSERT_EQ(m.outcome(), master_outcome::reached);
-  run_ms(20);
+  pdo3_bench b(10000);  // a SYNC every 10 ms: a word given between two goes out before the next
+  drive_master& m = b.m;
+  ASSERT_NO_FATAL_FAILURE(b.enable_in(1));  // profile position
+  b.run_ms(20);
   constexpr std::uint16_t enable_operation = 0x000F, new_set_point = 1u << 4;
   m.set_position_set_point(20000);
   m.send_control_word(enable_operation | new_set_point);
-  for (int i = 0; i < 200 && (m.status_word() & bit12) == 0; ++i) run_ms(1);
+  for (int i = 0; i < 200 && (m.status_word() & bit12) == 0; ++i) b.run_ms(1);
   ASSERT_NE(m.status_word() & bit12, 0) << "the set-point was never acknowledged";
   m.send_control_word(enable_operation);
-  for (int i = 0; i < 5000 && (m.status_word() & bit10) == 0; ++i) run_ms(1);
+  for (int i = 0; i < 5000 && (m.status_word() & bit10) == 0; ++i) b.run_ms(1);
   std::int64_t at = 0;
-  ASSERT_EQ(drive.drive().read(0x6064, 0, at), sdo_abort::none);
+  ASSERT_EQ(b.drive.drive().read(0x6064, 0, at), sdo_abort::none);
   EXPECT_EQ(at, 20000) << "the drive took the old target";
   EXPECT_NE(m.status_word() & bit10, 0);
 }
