@@ -29,7 +29,8 @@ constexpr std::uint16_t error_register = 0x1001;          // CiA 301
 constexpr std::uint16_t shown_actuals[] = {
     object_index::modes_of_operation, object_index::modes_of_operation_display, object_index::position_actual_value,
     object_index::torque_actual_value, following_error_actual,
-    object_index::velocity_actual_value, object_index::target_velocity, error_register};
+    object_index::velocity_actual_value, object_index::target_velocity, error_register,
+    object_index::digital_inputs};
 
 }  // namespace
 
@@ -374,6 +375,8 @@ json axis_page::impl::snapshot(bool with_time) const {
     j["position_demand"] = v.position_demand();
     j["following_error"] = v.following_error();
     j["torque_actual"] = v.torque();
+    std::int64_t inputs = 0;
+    j["digital_inputs"] = v.read(object_index::digital_inputs, 0, inputs) == sdo_abort::none ? json(inputs) : json(nullptr);
     json objs = json::object();
     for (const object_name& o : object_names(*table)) {
       std::int64_t value = 0;
@@ -382,6 +385,10 @@ json axis_page::impl::snapshot(bool with_time) const {
     j["objects"] = std::move(objs);
   }
   j["results"] = log.results_json();
+  // "Why can't I enable?": what blocks the way to OPERATION ENABLED now, from the drive's own inputs.
+  const std::string blocker =
+      observed && *observed != state::operation_enabled ? enable_blocker(*observed) : std::string();
+  j["enable_blocker"] = blocker.empty() ? json(nullptr) : json(blocker);
   j["profile"] = table->name;
   if (with_time) {
     j["cycle"] = cycles;
@@ -421,6 +428,7 @@ json axis_page::impl::bus_snapshot(json j) const {
   j["position_demand"] = nullptr;
   j["following_error"] = shown(following_error_actual);
   j["torque_actual"] = shown(object_index::torque_actual_value);
+  j["digital_inputs"] = shown(object_index::digital_inputs);
   json objs = json::object();
   for (const object_name& o : object_names(*table)) {
     if (const auto v = value_of(o.index)) objs[hex(o.index, 4)] = *v;

@@ -54,9 +54,13 @@ std::uint64_t axis_page::impl::change_word(const detail::word_change& w) {
 std::string axis_page::impl::enable_blocker(state s) const {
   if (drive.plant != nullptr) {
     const sim::drive_view v = drive.plant->view();
-    return detail::enable_blocker(s, v.outputs().error_code, v.sto(), v.dc_link());
+    return detail::enable_blocker(s, v.outputs().error_code, v.sto(), v.dc_link(),
+                                  (v.outputs().status_word & status_bit::remote) != 0);
   }
-  return detail::enable_blocker(s, session->error_code(), false, true);
+  // On a bus STO and the DC link are not the drive's objects (bit 4 says voltage enabled, which a
+  // drive may show only once switched on): only what the status word says for certain.
+  const bool remote = !session->status_known() || (session->status_word() & status_bit::remote) != 0;
+  return detail::enable_blocker(s, session->error_code(), false, true, remote);
 }
 
 // Enable or Stop is over: the session's result, with the transitions seen on the way.

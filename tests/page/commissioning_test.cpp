@@ -226,3 +226,24 @@ TEST_F(commissioning, jog_outside_operation_enabled_is_refused_and_sets_nothing)
 }
 
 }  // namespace
+
+#include "commissioning.hpp"
+
+namespace {
+
+// Each blocker of the way to OPERATION ENABLED, in the order they are named: a fault first (the walk
+// never resets one), then STO, the DC link and local control (status word bit 9 off); none of them
+// when all is well.
+TEST(enable_blocker, names_a_fault_sto_no_dc_link_and_local_control_in_that_order) {
+  using cia402::page::detail::enable_blocker;
+  using cia402::state;
+  EXPECT_EQ(enable_blocker(state::switch_on_disabled, 0, false, true, true), "");
+  const std::string fault = enable_blocker(state::fault, 0x3220, true, false, false);
+  EXPECT_NE(fault.find("0x3220"), std::string::npos) << fault;
+  EXPECT_NE(enable_blocker(state::switch_on_disabled, 0, true, false, false).find("STO"), std::string::npos);
+  EXPECT_NE(enable_blocker(state::ready_to_switch_on, 0, false, false, false).find("DC-link"), std::string::npos);
+  const std::string local = enable_blocker(state::switched_on, 0, false, true, false);
+  EXPECT_NE(local.find("bit 9"), std::string::npos) << local;
+}
+
+}  // namespace

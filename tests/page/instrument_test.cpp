@@ -532,3 +532,65 @@ TEST(instrument, info_names_the_mode_specific_bits_per_mode) {
 }
 
 }  // namespace
+
+namespace {
+
+// "Why can't I enable?" (issue 35): the snapshot names what blocks the way to OPERATION ENABLED now,
+// from the drive's own inputs, and nothing once nothing does or the drive is enabled.
+TEST(instrument, the_snapshot_says_what_blocks_enable_and_nothing_once_it_is_gone) {
+  virtual_axis_page inst(cia402::standard_profile());
+  run(inst, 10);
+  EXPECT_TRUE(snapshot(inst)["enable_blocker"].is_null()) << snapshot(inst)["enable_blocker"];
+  plant_change sto;
+  sto.sto = true;
+  inst.change_plant(sto);
+  run(inst, 50);
+  json why = snapshot(inst)["enable_blocker"];
+  ASSERT_TRUE(why.is_string());
+  EXPECT_NE(why.get<std::string>().find("STO"), std::string::npos) << why;
+  sto.sto = false;
+  plant_change no_dc;
+  no_dc.dc_link = false;
+  inst.change_plant(sto);
+  inst.change_plant(no_dc);
+  run(inst, 50);
+  why = snapshot(inst)["enable_blocker"];
+  ASSERT_TRUE(why.is_string());
+  EXPECT_NE(why.get<std::string>().find("DC-link"), std::string::npos) << why;
+  plant_change fault;
+  fault.dc_link = true;
+  fault.fault = true;
+  fault.fault_code = 0x2310;
+  inst.change_plant(fault);
+  run(inst, 300);
+  why = snapshot(inst)["enable_blocker"];
+  ASSERT_TRUE(why.is_string());
+  EXPECT_NE(why.get<std::string>().find("0x2310"), std::string::npos) << why;
+  EXPECT_NE(why.get<std::string>().find("over-current"), std::string::npos) << why;
+  plant_change gone;
+  gone.fault = false;
+  inst.change_plant(gone);
+  inst.command(page_command::fault_reset);
+  run(inst, 300);
+  EXPECT_EQ(snapshot(inst)["state"], "SWITCH_ON_DISABLED");
+  EXPECT_TRUE(snapshot(inst)["enable_blocker"].is_null()) << snapshot(inst)["enable_blocker"];
+}
+
+// 0x60FD digital inputs (CiA 402: bit 0 negative limit, bit 1 positive limit, bit 2 home switch) in
+// the snapshot, for the page's lamps: the home switch lights where the plant has it (from 50,000
+// increments on, its default) and not at 0.
+TEST(instrument, the_snapshot_shows_0x60fd_with_the_home_switch_where_the_plant_has_it) {
+  virtual_axis_page inst(cia402::standard_profile());
+  run(inst, 10);
+  id_of(inst.write_object(0x6060, 1));
+  enable(inst);
+  EXPECT_EQ(snapshot(inst)["digital_inputs"].get<int>() & 0x7, 0);
+  id_of(inst.write_object(0x607A, 60000));
+  id_of(inst.new_setpoint());
+  run(inst, 20);
+  const json s = run_until_status_bit(inst, 10, 40000);
+  ASSERT_EQ(s["position"], 60000);
+  EXPECT_EQ(s["digital_inputs"].get<int>() & 0x7, 0x4) << "home switch on, no limit switch";
+}
+
+}  // namespace

@@ -276,6 +276,16 @@ export function showPlant(s) {
   setLamp('lamp-sto', s.sto);
   const cause = s.fault_cause === null ? null : s.fault_cause !== '0x0000';
   setLamp('lamp-fault', cause, cause ? `ON ${s.fault_cause}` : 'OFF');
+  // 0x60FD digital inputs (CiA 402): bit 0 negative limit, bit 1 positive limit, bit 2 home switch.
+  const inputs = s.digital_inputs;
+  const input = (bit) => (inputs === null || inputs === undefined ? null : (inputs & (1 << bit)) !== 0);
+  setLamp('lamp-neg-limit', input(0));
+  setLamp('lamp-pos-limit', input(1));
+  setLamp('lamp-home', input(2));
+  // "Why can't I enable?": what blocks the way to OPERATION ENABLED, as the server reads the drive.
+  const blocker = el('enable-blocker');
+  blocker.hidden = !s.enable_blocker;
+  blocker.textContent = s.enable_blocker ? `Enable is blocked: ${s.enable_blocker}` : '';
   syncSwitch('fault-switch', cause);
   syncSwitch('dc-switch', !s.dc_link);
   syncSwitch('sto-switch', s.sto);

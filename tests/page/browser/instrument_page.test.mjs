@@ -79,6 +79,20 @@ async function main() {
     await expectPresentState(page, 'SWITCH_ON_DISABLED');
   });
 
+  await check('why Enable is blocked: STO named under Enable while asserted, gone once released; 0x60FD lamps', async () => {
+    expect(await page.isHidden('#enable-blocker'), 'a blocker shown with nothing blocking');
+    await page.click('label:has(#sto-switch)');
+    await page.waitForSelector('#enable-blocker:not([hidden])', { timeout: patience });
+    const text = await page.textContent('#enable-blocker');
+    expect(text.includes('STO'), `blocker "${text}"`);
+    await page.click('label:has(#sto-switch)');
+    await page.waitForSelector('#enable-blocker[hidden]', { state: 'attached', timeout: patience });
+    for (const id of ['lamp-neg-limit', 'lamp-pos-limit', 'lamp-home']) {
+      const lamp = await page.textContent(`#${id} b`);
+      expect(lamp === 'OFF', `${id} reads "${lamp}" at position 0`);
+    }
+  });
+
   await check('Shutdown, Switch on: READY TO SWITCH ON by T2, SWITCHED ON by T3', async () => {
     await click(page, 'shutdown');
     await expectPresentState(page, 'READY_TO_SWITCH_ON');
