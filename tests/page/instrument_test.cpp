@@ -594,3 +594,39 @@ TEST(instrument, the_snapshot_shows_0x60fd_with_the_home_switch_where_the_plant_
 }
 
 }  // namespace
+
+namespace {
+
+// The errors the page saw in 0x603F, newest first, each once per time it came, with the drive's
+// time and the code's text (issue 35's timestamped error history).
+TEST(instrument, the_snapshot_lists_each_error_the_drive_showed_newest_first_with_its_time) {
+  virtual_axis_page inst(cia402::standard_profile());
+  run(inst, 10);
+  EXPECT_TRUE(snapshot(inst)["error_history"].empty());
+  const auto fault = [&inst](std::uint16_t code) {
+    plant_change c;
+    c.fault = true;
+    c.fault_code = code;
+    inst.change_plant(c);
+    run(inst, 100);
+    plant_change gone;
+    gone.fault = false;
+    inst.change_plant(gone);
+    inst.command(page_command::fault_reset);
+    run(inst, 100);
+  };
+  fault(0x2310);
+  fault(0x5530);
+  fault(0x2310);
+  const json h = snapshot(inst)["error_history"];
+  ASSERT_EQ(h.size(), 3u) << h;
+  EXPECT_EQ(h[0]["code"], "0x2310");
+  EXPECT_EQ(h[1]["code"], "0x5530");
+  EXPECT_EQ(h[2]["code"], "0x2310");
+  EXPECT_EQ(h[0]["text"], "continuous over-current");
+  EXPECT_GT(h[0]["time_ms"].get<int>(), h[1]["time_ms"].get<int>());
+  EXPECT_GT(h[1]["time_ms"].get<int>(), h[2]["time_ms"].get<int>());
+  EXPECT_EQ(snapshot(inst)["state"], "SWITCH_ON_DISABLED") << "each fault was reset";
+}
+
+}  // namespace
