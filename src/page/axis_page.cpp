@@ -111,6 +111,9 @@ void axis_page::impl::advance(std::uint32_t elapsed_us) {
     record_bus_row();
   }
   if (elapsed_us > 0) ++cycles;
+  if (observed) {
+    note_error_code(drive.plant != nullptr ? drive.plant->view().outputs().error_code : session->error_code());
+  }
   run_handshake();
   check_enable_walk();
   if (log.pending()) log.settle(now_us, busy_now());
@@ -148,6 +151,14 @@ void axis_page::impl::note_transition(std::optional<int> number, state from, sta
   }
   if (enabling) enabling->transitions.push_back(*number);
   if (stopping) stopping->transitions.push_back(*number);
+}
+
+void axis_page::impl::note_error_code(std::uint16_t code) {
+  if (code == error_shown) return;
+  error_shown = code;
+  if (code == 0) return;
+  errors_seen.push_front({now_us, code});
+  if (errors_seen.size() > errors_kept) errors_seen.pop_back();
 }
 
 // Once per cycle of a drive in this process, before its step: the cycle before is complete.
@@ -385,6 +396,11 @@ json axis_page::impl::snapshot(bool with_time) const {
     j["objects"] = std::move(objs);
   }
   j["results"] = log.results_json();
+  json history = json::array();
+  for (const error_seen& e : errors_seen) {
+    history.push_back({{"time_ms", e.time_us / 1000}, {"code", hex(e.code, 4)}, {"text", error_code_text(e.code)}});
+  }
+  j["error_history"] = std::move(history);
   // "Why can't I enable?": what blocks the way to OPERATION ENABLED now, from the drive's own inputs.
   const std::string blocker =
       observed && *observed != state::operation_enabled ? enable_blocker(*observed) : std::string();

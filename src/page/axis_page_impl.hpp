@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <condition_variable>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -53,6 +54,16 @@ struct axis_page::impl {
   std::map<std::uint16_t, std::int64_t> objects;  // a bus drive's objects as read at start or written
   std::uint16_t injected_fault = 0;               // what the page wrote to 0x2001 (a bus node)
   std::optional<std::uint16_t> last_emergency;    // the newest emergency's error code
+  // Each error code 0x603F took, newest first, with the page's time it was first seen: the history
+  // the page shows (the drive's own is 0x1003, without times).
+  struct error_seen {
+    std::uint64_t time_us = 0;
+    std::uint16_t code = 0;
+  };
+  std::deque<error_seen> errors_seen;
+  std::uint16_t error_shown = 0;
+  static constexpr std::size_t errors_kept = 16;
+  void note_error_code(std::uint16_t code);
 
   // What the page asked for.
   std::optional<std::uint16_t> requested_word;  // a word given to the session, not yet sent

@@ -8,6 +8,7 @@
 
 #include <set>
 
+#include "page_steps.hpp"
 #include "virtual_axis_page.hpp"
 #include "cia402/profile.hpp"
 
@@ -19,6 +20,7 @@ using cia402::page::page_command;
 using cia402::page::plant_change;
 using cia402::page::refused;
 using json = nlohmann::json;
+using namespace cia402::page::testing::steps;
 
 const cia402::profile& by_name(const char* name) {
   const cia402::profile* p = cia402::find_builtin_profile(name);
@@ -26,28 +28,7 @@ const cia402::profile& by_name(const char* name) {
   return p != nullptr ? *p : cia402::standard_profile();
 }
 
-void run(virtual_axis_page& inst, int cycles) {
-  for (int i = 0; i < cycles; ++i) inst.step();
-}
 
-json snapshot(const virtual_axis_page& inst) { return json::parse(inst.snapshot_json()); }
-
-// The newest result, after the drive had time to settle (an action settles 50 quiet cycles after
-// its last transition).
-json settled_result(virtual_axis_page& inst) {
-  run(inst, 300);
-  const json s = snapshot(inst);
-  EXPECT_FALSE(s["results"].empty());
-  return s["results"].empty() ? json::object() : s["results"][0];
-}
-
-std::uint64_t id_of(const cia402::page::reply& r) {
-  const auto* ok = std::get_if<accepted>(&r);
-  EXPECT_NE(ok, nullptr);
-  return ok != nullptr ? ok->id : 0;
-}
-
-int hex_value(const json& v) { return std::stoi(v.get<std::string>(), nullptr, 16); }
 
 TEST(instrument, power_up_reaches_switch_on_disabled_by_t0_t1) {
   virtual_axis_page inst(cia402::standard_profile());
@@ -418,24 +399,6 @@ TEST(instrument, modes_are_a_choice_and_the_snapshot_shows_mode_position_and_tor
 
 namespace {
 
-void enable(virtual_axis_page& inst) {
-  for (const page_command c :
-       {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
-    id_of(inst.command(c));
-    run(inst, 100);
-  }
-}
-
-// Steps until the snapshot shows status bit `bit` set (or `limit` cycles passed).
-json run_until_status_bit(virtual_axis_page& inst, int bit, int limit) {
-  json s = snapshot(inst);
-  for (int i = 0; i < limit && ((hex_value(s["status_word"]) >> bit) & 1) == 0; i += 10) {
-    run(inst, 10);
-    s = snapshot(inst);
-  }
-  return s;
-}
-
 // Profile position from the page: 0x6060 = 1, 0x607A, the new set-point handshake (bit 4 up until
 // status bit 12, then down: CiA 402-2's set-point handshake), the move to the target (bit 10), a
 // relative move adding to it (bit 6).
@@ -533,64 +496,3 @@ TEST(instrument, info_names_the_mode_specific_bits_per_mode) {
 
 }  // namespace
 
-namespace {
-
-// "Why can't I enable?" (issue 35): the snapshot names what blocks the way to OPERATION ENABLED now,
-// from the drive's own inputs, and nothing once nothing does or the drive is enabled.
-TEST(instrument, the_snapshot_says_what_blocks_enable_and_nothing_once_it_is_gone) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
-  EXPECT_TRUE(snapshot(inst)["enable_blocker"].is_null()) << snapshot(inst)["enable_blocker"];
-  plant_change sto;
-  sto.sto = true;
-  inst.change_plant(sto);
-  run(inst, 50);
-  json why = snapshot(inst)["enable_blocker"];
-  ASSERT_TRUE(why.is_string());
-  EXPECT_NE(why.get<std::string>().find("STO"), std::string::npos) << why;
-  sto.sto = false;
-  plant_change no_dc;
-  no_dc.dc_link = false;
-  inst.change_plant(sto);
-  inst.change_plant(no_dc);
-  run(inst, 50);
-  why = snapshot(inst)["enable_blocker"];
-  ASSERT_TRUE(why.is_string());
-  EXPECT_NE(why.get<std::string>().find("DC-link"), std::string::npos) << why;
-  plant_change fault;
-  fault.dc_link = true;
-  fault.fault = true;
-  fault.fault_code = 0x2310;
-  inst.change_plant(fault);
-  run(inst, 300);
-  why = snapshot(inst)["enable_blocker"];
-  ASSERT_TRUE(why.is_string());
-  EXPECT_NE(why.get<std::string>().find("0x2310"), std::string::npos) << why;
-  EXPECT_NE(why.get<std::string>().find("over-current"), std::string::npos) << why;
-  plant_change gone;
-  gone.fault = false;
-  inst.change_plant(gone);
-  inst.command(page_command::fault_reset);
-  run(inst, 300);
-  EXPECT_EQ(snapshot(inst)["state"], "SWITCH_ON_DISABLED");
-  EXPECT_TRUE(snapshot(inst)["enable_blocker"].is_null()) << snapshot(inst)["enable_blocker"];
-}
-
-// 0x60FD digital inputs (CiA 402: bit 0 negative limit, bit 1 positive limit, bit 2 home switch) in
-// the snapshot, for the page's lamps: the home switch lights where the plant has it (from 50,000
-// increments on, its default) and not at 0.
-TEST(instrument, the_snapshot_shows_0x60fd_with_the_home_switch_where_the_plant_has_it) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
-  id_of(inst.write_object(0x6060, 1));
-  enable(inst);
-  EXPECT_EQ(snapshot(inst)["digital_inputs"].get<int>() & 0x7, 0);
-  id_of(inst.write_object(0x607A, 60000));
-  id_of(inst.new_setpoint());
-  run(inst, 20);
-  const json s = run_until_status_bit(inst, 10, 40000);
-  ASSERT_EQ(s["position"], 60000);
-  EXPECT_EQ(s["digital_inputs"].get<int>() & 0x7, 0x4) << "home switch on, no limit switch";
-}
-
-}  // namespace

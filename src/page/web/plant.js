@@ -248,6 +248,23 @@ function setLamp(id, on, text) {
 }
 
 
+// Each error code the drive showed in 0x603F, newest first, with the drive's time it came (the
+// snapshot's error_history); redrawn only when it changed.
+let historyShown = '';
+function showErrorHistory(history) {
+  const key = JSON.stringify(history);
+  if (key === historyShown) return;
+  historyShown = key;
+  const list = el('error-history');
+  list.textContent = '';
+  for (const e of history) {
+    const li = document.createElement('li');
+    li.textContent = `${(e.time_ms / 1000).toFixed(3)} s  ${e.code}${e.text ? ` ${e.text}` : ''}`;
+    list.append(li);
+  }
+  el('error-history-none').hidden = history.length > 0;
+}
+
 // The readouts, lamps, switches, set-points and objects of the newest snapshot.
 export function showPlant(s) {
   showRemote(s);
@@ -270,6 +287,7 @@ export function showPlant(s) {
   // The code's CiA 301 / CiA 402 text (emergency error codes), where the drive reports one.
   el('error-text').textContent = s.error_code !== '0x0000' && s.error_text ? s.error_text : '';
   el('error-register').textContent = s.error_register;
+  showErrorHistory(s.error_history || []);
   setLamp('lamp-torque', s.torque);
   setLamp('lamp-brake', s.brake_engaged, s.brake_engaged ? 'ON (holding)' : 'OFF (released)');
   setLamp('lamp-dc', s.dc_link);

@@ -182,6 +182,10 @@ async function main() {
     expect((await page.textContent('#error-text')) === 'continuous over-current', 'the error code\'s text');
     expect((await page.textContent('#lamp-fault b')).startsWith('ON'), 'fault lamp ON');
     expect((await page.textContent('#lamp-torque b')) === 'OFF', 'torque lamp OFF');
+    const seen = await page.$$eval('#error-history li', (items) => items.map((li) => li.textContent));
+    expect(seen.length === 1 && seen[0].includes('0x2310 continuous over-current'),
+      `the errors seen: ${JSON.stringify(seen)}`);
+    expect(await page.isHidden('#error-history-none'), '"none" shown beside an error');
   });
   await page.screenshot({ path: path.join(outDir, 'fault-1280x800.png') });
 
