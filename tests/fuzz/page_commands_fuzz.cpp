@@ -3,18 +3,28 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <memory>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
-#include "cia402/page/instrument.hpp"
+#include "cia402/apps/local_link.hpp"
+#include "cia402/page/axis_page.hpp"
 #include "cia402/profile.hpp"
 
 using namespace cia402::page;
 
 namespace {
 
+// The page's drive as `cia402 serve` builds it without a bus: an axis session over a local link.
+drive_connection virtual_connection(const cia402::profile& p) {
+  auto link = std::make_unique<cia402::apps::local_link>(p);
+  cia402::sim::virtual_drive* plant = &link->drive();
+  return {std::move(link), plant};
+}
+
 // What an action could change (time and results aside).
-nlohmann::json observable(const instrument& inst) {
+nlohmann::json observable(const axis_page& inst) {
   nlohmann::json s = nlohmann::json::parse(inst.snapshot_json());
   return {s["state"], s["control_word"], s["dc_link"], s["sto"], s["fault_cause"],
           s["target_velocity"], s["objects"], s["profile"]};
@@ -24,7 +34,7 @@ nlohmann::json observable(const instrument& inst) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
-  instrument inst(cia402::builtin_profile(data[0] % cia402::builtin_profile_count()));
+  axis_page inst(cia402::builtin_profile(data[0] % cia402::builtin_profile_count()), virtual_connection);
   for (int k = 0; k < 5; ++k) inst.step();
   for (std::size_t i = 1; i + 1 < size && i < 80; i += 2) {
     const std::uint8_t what = data[i];
