@@ -50,4 +50,5 @@ if [ "${CIA402_UPDATE_SCREENSHOT:-0}" = 1 ]; then
   cp "$work/output/full-1280.png" "$images/instrument-page-full.png"
   cp "$work/output/pp-1280x800.png" "$images/instrument-page-pp.png"
   cp "$work/output/scope-1280.png" "$images/instrument-page-scope.png"
+  node "$here/panel_pictures.mjs" "$cia402" "$work/output" "$images"
 fi
