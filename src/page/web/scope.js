@@ -250,6 +250,7 @@ export function drawScopeFrame() {
 // What the page could not keep up with, said plainly.
 function showHealth() {
   const parts = [];
+  if (store.skipped) parts.push(`browser fell behind: ${store.skipped} samples of the drive's cycles skipped (hatched in the scope)`);
   if (store.missed) parts.push(`${store.missed} snapshots missed from the event stream (the browser or the link could not keep up; hatched in the scope)`);
   if (store.lostRows) parts.push(`${store.lostRows} recording rows lost before the page asked for them`);
   if (store.dropped) parts.push(`the server dropped the oldest ${store.dropped} rows of its recording`);
@@ -257,6 +258,7 @@ function showHealth() {
   h.textContent = parts.length ? `⚠ ${parts.join('; ')}.` : '';
   h.hidden = parts.length === 0;
   h.dataset.missed = String(store.missed);
+  h.dataset.skipped = String(store.skipped);
 }
 
 function showLegend(shown, map) {

@@ -200,15 +200,17 @@ function drawBitLane(c, sig, top) {
 // Over all lanes: the missed snapshots, the transitions, the trigger and the cursors.
 function drawMarks(c) {
   const { g, t0, t1, pw, x, view, bottom } = c;
-  // Missed snapshots: hatched, with how many.
-  for (const [a, b, n] of store.gaps) {
+  // Missed snapshots and skipped cycle samples: hatched, with how many.
+  const gaps = [...store.gaps.map(([a, b, n]) => [a, b, `${n} missed`]),
+    ...store.cycGaps.map(([a, b, n]) => [a, b, `${n} samples skipped`])];
+  for (const [a, b, text] of gaps) {
     if (b < t0 || a > t1) continue;
     const xa = Math.max(LEFT, x(a)), xb = Math.min(LEFT + pw, x(b));
     g.fillStyle = 'rgba(179, 38, 30, 0.12)';
     g.fillRect(xa, TOP, Math.max(2, xb - xa), bottom - TOP);
     g.fillStyle = '#b3261e';
     g.textAlign = 'left';
-    g.fillText(`${n} missed`, xa + 2, bottom - 4);
+    g.fillText(text, xa + 2, bottom - 4);
   }
 
   const vline = (t, colour, width, text, dash) => {
