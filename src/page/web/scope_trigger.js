@@ -1,7 +1,8 @@
 // The scope's trigger: where in the samples a condition first holds, and the acquisition around
 // it (single shot: one capture, then the scope stops; normal: each trigger after the last capture
 // ended gives the next one). Bit edges, states and transitions are found in the recording, exact to
-// the cycle; a level crossing in the signal's samples (the recording where it carries the signal).
+// the cycle; a level crossing in the signal's samples (the drive's cycles, else the recording where
+// it carries the signal, never the snapshots of its live edge).
 import { lowerBound, series, settledUntil, store } from './scope_data.js';
 
 const edgeMatches = (edge, before, after) =>
@@ -14,7 +15,8 @@ const edgeMatches = (edge, before, after) =>
  */
 export function findTrigger(cond, after, until) {
   if (cond.type === 'level') {
-    const points = series(cond.signal, after, until).filter((p) => !cond.signal.rec || p.src === 'rec');
+    // Not from the snapshots of the live edge where the drive's cycles or the recording have it.
+    const points = series(cond.signal, after, until).filter((p) => !cond.signal.rec || p.src !== 'snap');
     for (let i = 1; i < points.length; i++) {
       const p = points[i - 1], q = points[i];
       if (q.t <= after) continue;
@@ -47,7 +49,10 @@ export function findTrigger(cond, after, until) {
 // A signal the recording carries triggers from the recording alone, exact to the cycle, not from
 // the snapshots of the live edge.
 export function triggerSettled(cond) {
-  return cond.type === 'level' && !cond.signal.rec ? settledUntil(cond.signal) : store.recUntil;
+  if (cond.type !== 'level') return store.recUntil;
+  if (!cond.signal.rec) return settledUntil(cond.signal);
+  const lastCyc = cond.signal.cyc && store.cyc.length ? store.cyc[store.cyc.length - 1].t : -Infinity;
+  return Math.max(store.recUntil, lastCyc);
 }
 
 /**

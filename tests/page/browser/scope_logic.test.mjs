@@ -179,6 +179,13 @@ try {
     expect(index === '000010', `index pulse ${index}`);
     expect(data.valueAt(signal('v'), 2003.5) === 7, `interpolated between cycles ${data.valueAt(signal('v'), 2003.5)}`);
   });
+
+  check('a level trigger on a recorded signal fires on the cycle sample, not the later recorded row', () => {
+    // The recording's row at 2002 says 777 (a row 20 ms apart would be later still); the cycles say 5 at 2003.
+    const t = findTrigger({ type: 'level', signal: signal('v'), level: 5, edge: 'rising' }, 1995, 2010);
+    expect(t === 2003, `fired at ${t}`);
+    expect(findTrigger({ type: 'level', signal: signal('v'), level: 9, edge: 'rising' }, 1995, 2010) === 2004, 'over 9 at 2004');
+  });
   console.log(`# ${passed} scope logic checks passed`);
 } catch (e) {
   console.error(`not ok ${passed + 1} - scope logic: ${e.message}`);
