@@ -69,6 +69,7 @@ function buildSignalChoice() {
     ['Objects', (s) => s.key.startsWith('obj')],
     [`${page.info.control_word_name} bits`, (s) => s.kind === 'bit' && s.key.startsWith('cw')],
     [`${page.info.status_word_name} bits`, (s) => s.kind === 'bit' && s.key.startsWith('sw')],
+    ['Inputs 0x60FD', (s) => s.kind === 'bit' && s.key.startsWith('di')],
   ];
   for (const [title, pick] of groups) {
     const fs = document.createElement('fieldset');
@@ -108,7 +109,10 @@ function buildTrigger() {
   const numbers = [...new Set(info.rows.map((r) => r.number))].sort((a, b) => a - b);
   for (const n of numbers) option(el('trig-transition'), n, `transition ${n}`);
   for (const s of info.states.filter((x) => x !== 'START')) option(el('trig-state'), s, stateLabel(s));
-  for (const sig of scope.signals.filter((s) => s.kind === 'bit')) option(el('trig-bit'), sig.key, sig.label);
+  // The word bits (found in the recording, exact to the cycle); 0x60FD's inputs are not recorded.
+  for (const sig of scope.signals.filter((s) => s.kind === 'bit' && !s.key.startsWith('di'))) {
+    option(el('trig-bit'), sig.key, sig.label);
+  }
   for (const sig of scope.signals.filter((s) => s.kind === 'analog' || s.kind === 'step')) {
     option(el('trig-signal'), sig.key, sig.label);
   }
