@@ -109,10 +109,7 @@ function buildTrigger() {
   const numbers = [...new Set(info.rows.map((r) => r.number))].sort((a, b) => a - b);
   for (const n of numbers) option(el('trig-transition'), n, `transition ${n}`);
   for (const s of info.states.filter((x) => x !== 'START')) option(el('trig-state'), s, stateLabel(s));
-  // The word bits (found in the recording, exact to the cycle); 0x60FD's inputs are not recorded.
-  for (const sig of scope.signals.filter((s) => s.kind === 'bit' && !s.key.startsWith('di'))) {
-    option(el('trig-bit'), sig.key, sig.label);
-  }
+  for (const sig of scope.signals.filter((s) => s.kind === 'bit')) option(el('trig-bit'), sig.key, sig.label);
   for (const sig of scope.signals.filter((s) => s.kind === 'analog' || s.kind === 'step')) {
     option(el('trig-signal'), sig.key, sig.label);
   }
@@ -147,7 +144,10 @@ function condition() {
 function arm() {
   const mode = el('trig-mode').value;
   const pre = Math.min(100, Math.max(0, Number(el('trig-pre').value) || 0)) / 100;
-  scope.acq.arm(mode, mode === 'roll' ? null : condition(), pre, serverNow());
+  // From the newest cycle the drive sent (exact, at most a batch old); the page's clock carried on
+  // from a snapshot runs ahead of a drive that runs behind the wall clock.
+  const newest = store.cyc.length ? store.cyc[store.cyc.length - 1].t : serverNow();
+  scope.acq.arm(mode, mode === 'roll' ? null : condition(), pre, newest);
   scope.t0 = null;
   setPaused(false);
 }

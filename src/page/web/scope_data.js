@@ -112,7 +112,7 @@ export function addSamples(batch) {
 // unit: analog signals of one unit share a scale. rec/snap: the value in a recording row or a
 // flattened snapshot (undefined: that source does not carry it). dash: drawn dashed.
 
-const bit = (word, n) => (w) => (w[word] === undefined ? undefined : (w[word] >> n) & 1);
+const bit = (word, n) => (w) => (w[word] === undefined || w[word] === null ? undefined : (w[word] >> n) & 1);
 const inMode = (modes, get) => (s) => (modes.includes(s.mode) ? get(s) : null);
 
 /** Every signal the scope can show, for the present profile (names from /api/info). */

@@ -1,7 +1,7 @@
 // The scope's trigger: where in the samples a condition first holds, and the acquisition around
 // it (single shot: one capture, then the scope stops; normal: each trigger after the last capture
 // ended gives the next one). Bit edges, states and transitions are found in the recording, exact to
-// the cycle; a level crossing in the signal's samples (the drive's cycles, else the recording where
+// the cycle (0x60FD's inputs, the index pulse among them, in the drive's cycles); a level crossing in the signal's samples (the drive's cycles, else the recording where
 // it carries the signal, never the snapshots of its live edge).
 import { lowerBound, series, settledUntil, store } from './scope_data.js';
 
@@ -24,6 +24,7 @@ export function findTrigger(cond, after, until) {
     }
     return null;
   }
+  if (cond.type === 'bit' && cond.word === 'di') return inputEdge(cond, after, until);
   // From the row before `after` (it holds the words and the state an edge is seen against).
   const rec = store.rec;
   let prev = null;
@@ -45,14 +46,25 @@ export function findTrigger(cond, after, until) {
   return null;
 }
 
+// 0x60FD's inputs (the index pulse) are in the drive's cycles only: an edge there, exact to the cycle.
+function inputEdge(cond, after, until) {
+  const cyc = store.cyc;
+  const on = (r) => r.di !== null && r.di !== undefined && ((r.di >> cond.bit) & 1) === 1;
+  for (let i = Math.max(1, lowerBound(cyc, after)); i < cyc.length && cyc[i].t <= until; i++) {
+    if (cyc[i].t > after && edgeMatches(cond.edge, on(cyc[i - 1]), on(cyc[i]))) return cyc[i].t;
+  }
+  return null;
+}
+
 /** How far the samples a condition is looked for in are complete. */
 // A signal the recording carries triggers from the recording alone, exact to the cycle, not from
 // the snapshots of the live edge.
 export function triggerSettled(cond) {
+  const lastCycle = store.cyc.length ? store.cyc[store.cyc.length - 1].t : -Infinity;
+  if (cond.type === 'bit' && cond.word === 'di') return lastCycle;
   if (cond.type !== 'level') return store.recUntil;
   if (!cond.signal.rec) return settledUntil(cond.signal);
-  const lastCyc = cond.signal.cyc && store.cyc.length ? store.cyc[store.cyc.length - 1].t : -Infinity;
-  return Math.max(store.recUntil, lastCyc);
+  return Math.max(store.recUntil, cond.signal.cyc ? lastCycle : -Infinity);
 }
 
 /**

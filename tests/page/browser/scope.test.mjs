@@ -1,12 +1,14 @@
 // The instrument page's scope in a real browser (Debian's chromium, headless, playwright-core)
 // against `cia402 serve --port 0`: a single-shot trigger on a transition captures the samples
 // around it, the cursors snap to the recording's edges and their difference is the recording's to
-// the cycle, zoom changes the span shown, a level trigger fires at the first sample over the level,
-// the CSV export of the view holds the rows the view shows, a status bit's edge triggers on the
-// transition's cycle, the drive's cycles fill a captured window one sample per cycle with the
-// transition in its cycle's sample, homing on the index pulse shows the pulse (0x60FD bit 16), and
-// the first load stays under 300 KB. The expected times come from the
-// server's own recording (/api/recording), never from the page; no wait asserts a duration.
+// the cycle, the drive's cycles fill the captured window one sample per cycle with the transition
+// in its cycle's sample, zoom changes the span shown, a level trigger fires at the drive's first
+// cycle over the level, the CSV export of the view holds the rows the view shows, a status bit's
+// edge triggers on the transition's cycle, homing on the index pulse (method 33: negative, the
+// shaft stands past the positive limit switch by then) triggers the scope on the pulse's cycle
+// (0x60FD bit 16), and the first load stays under 300 KB. The expected times come from the
+// server's own recording (/api/recording) or its cycle samples as the event stream brought them;
+// no wait asserts a duration.
 //
 //   node scope.test.mjs CIA402_BINARY OUTPUT_DIR
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
@@ -276,11 +278,11 @@ async function main() {
     expect(t5 && d.trigger === t5.time_ms, `trigger at ${d.trigger}, T5 (operation enabled bit 2 falls) at ${t5 && t5.time_ms}`);
   });
 
-  await check('homing on the index pulse (method 34) shows the pulse on the scope', async () => {
+  await check("homing on the index pulse (method 33) triggers the scope on the pulse's cycle", async () => {
     const post = (pathName, body) => page.evaluate(async ([u, b]) => (await fetch(u, {
       method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(b) })).status,
     [pathName, body]);
-    expect(await post('/api/object', { index: '0x6098', value: 34 }) === 200, 'method 34 written');
+    expect(await post('/api/object', { index: '0x6098', value: 33 }) === 200, 'method 33 written');
     expect(await post('/api/object', { index: '0x6060', value: 6 }) === 200, 'homing mode written');
     await command('enable_operation');
     await waitState('OPERATION_ENABLED');
@@ -292,13 +294,33 @@ async function main() {
       const { store } = await import('/scope_data.js');
       return store.cyc[store.cyc.length - 1].t;
     });
-    expect(await post('/api/command', { command: 'toggle_bit', bit: 4 }) === 200, 'homing started (bit 4)');
     await page.check('input[data-signal="di16"]');
-    await page.waitForFunction(async (from) => {
+    await arm({ mode: 'single', type: 'bit', bit: 'di16', edge: 'rising', pre: 50, div: 10 });
+    expect(await post('/api/command', { command: 'toggle_bit', bit: 4 }) === 200, 'homing started (bit 4)');
+    try {
+      await page.waitForSelector('#scope-status[data-state="stopped"]', { timeout: patience });
+    } catch (e) {
+      const dump = await page.evaluate(async (from) => {
+        const { store } = await import('/scope_data.js');
+        const runs = [];
+        for (const r of store.cyc.filter((c) => c.t >= from)) {
+          const k = `${r.di}/${r.mode}/${r.cw}/${r.pos}`;
+          if (!runs.length || runs[runs.length - 1][1] !== k) runs.push([r.t, k]);
+        }
+        return { status: document.getElementById('scope-status').textContent,
+          bit: document.getElementById('trig-bit').value, runs: runs.slice(0, 40) };
+      }, startedAt);
+      throw new Error(`${e.message}: ${JSON.stringify(dump)}`);
+    }
+    // The first cycle after the start with the pulse, as the server's cycles say.
+    const pulses = await page.evaluate(async (from) => {
       const { series, catalogue } = await import('/scope_data.js');
       const index = catalogue().find((sig) => sig.key === 'di16');
-      return series(index, from).some((p) => p.v === 1 && p.src === 'cyc');
-    }, startedAt, { timeout: patience, polling: 100 });
+      return series(index, from).filter((p) => p.src === 'cyc').map((p) => [p.t, p.v]);
+    }, startedAt);
+    const first = pulses.find((p, i) => i > 0 && p[1] === 1 && pulses[i - 1][1] === 0);
+    const d = await dataset();
+    expect(first && d.trigger === first[0], `trigger at ${d.trigger}, the first index pulse at ${first && first[0]}`);
   });
 
   await check('no errors in the browser console', async () => {

@@ -186,6 +186,13 @@ try {
     expect(t === 2003, `fired at ${t}`);
     expect(findTrigger({ type: 'level', signal: signal('v'), level: 9, edge: 'rising' }, 1995, 2010) === 2004, 'over 9 at 2004');
   });
+
+  check('a trigger on the index pulse (0x60FD bit 16) fires on its cycle, rising and falling', () => {
+    expect(findTrigger({ type: 'bit', word: 'di', bit: 16, edge: 'rising' }, 1995, 2010) === 2004, 'rises at 2004');
+    expect(findTrigger({ type: 'bit', word: 'di', bit: 16, edge: 'falling' }, 1995, 2010) === 2005, 'falls at 2005');
+    expect(findTrigger({ type: 'bit', word: 'di', bit: 16, edge: 'rising' }, 2004, 2010) === null, 'not again');
+    expect(findTrigger({ type: 'bit', word: 'di', bit: 2, edge: 'either' }, 1995, 2010) === null, 'the home switch stays on');
+  });
   console.log(`# ${passed} scope logic checks passed`);
 } catch (e) {
   console.error(`not ok ${passed + 1} - scope logic: ${e.message}`);
