@@ -300,6 +300,7 @@ async function main() {
     try {
       await page.waitForSelector('#scope-status[data-state="stopped"]', { timeout: patience });
     } catch (e) {
+      // What the page had: a trigger that did not fire told from a homing that did not run.
       const dump = await page.evaluate(async (from) => {
         const { store } = await import('/scope_data.js');
         const runs = [];
