@@ -102,7 +102,8 @@ void axis_page::impl::push_bus_sample() {
   if (!s.has(signal::error_code)) s.set(signal::error_code, session->error_code());
   if (s.has(signal::mode)) {
     if (const std::uint16_t index = set_point_of(s.get(signal::mode)); index != 0) {
-      if (auto v = value_of(index)) s.set(signal::set_point, *v);
+      // What goes out in this cycle where the link carries it, else the value last read or written.
+      if (auto v = session->output(index) ? session->output(index) : value_of(index)) s.set(signal::set_point, *v);
     }
   }
   samples.push(s);
