@@ -3,7 +3,7 @@
 // fraction; two cursors and their difference; export of the view as CSV and PNG; and the spans the
 // page missed, shown rather than hidden.
 import { el, page, serverNow, stateLabel } from './page.js';
-import { catalogue, edges, series, store, valueAt } from './scope_data.js';
+import { DRAWN_CYCLES, catalogue, edges, series, store, valueAt } from './scope_data.js';
 import { COLOURS, DASHES, drawScope, formatSpan } from './scope_draw.js';
 import { acquisition } from './scope_trigger.js';
 
@@ -373,13 +373,16 @@ function showCursors(shown) {
     dt.dataset.ms = '';
   }
   const body = el('cursor-values');
-  const key = `${a}|${b}|${shown.map((s) => s.key).join(',')}|${store.snaps.length}|${store.rec.length}`;
+  const newestCycle = store.cyc.length ? store.cyc[store.cyc.length - 1].n : '';
+  const key = `${a}|${b}|${shown.map((s) => s.key).join(',')}|${store.snaps.length}|${store.rec.length}|${newestCycle}`;
   if (body.dataset.key === key) return;
   body.dataset.key = key;
   body.textContent = '';
   if (a === null && b === null) return;
+  // Around the cursors only (a second either side holds the samples they fall between).
+  const ends = [a, b].filter((t) => t !== null);
   for (const sig of shown) {
-    const pts = series(sig);
+    const pts = series(sig, Math.min(...ends) - 1000, Math.max(...ends) + 1000);
     const va = a === null ? null : valueAt(sig, a, pts);
     const vb = b === null ? null : valueAt(sig, b, pts);
     if (sig.part && va === null && vb === null) continue;  // a set-point of a mode not run there
@@ -401,8 +404,9 @@ function showCursors(shown) {
 function viewRows(shown, withValues = true) {
   const { t0, t1 } = scope.window;
   const times = new Set();
+  // The count shown with the plot is of the samples drawn; the export has every one.
   const all = shown.map((sig) => {
-    const pts = series(sig, t0, t1);
+    const pts = series(sig, t0, t1, withValues ? Infinity : DRAWN_CYCLES);
     for (const p of pts) if (p.t >= t0) times.add(p.t);
     return pts;
   });

@@ -15,6 +15,11 @@ import { hexBits, page } from './page.js';
 import { decodeBatch, skippedBefore } from './scope_samples.js';
 
 const KEEP_MS = 15 * 60 * 1000;  // the longest time base is 10 minutes; a little more is kept
+// The drive's cycles are kept for a minute (60,000 rows at 1 kHz); older spans come from the
+// recording and the snapshots, as before the page had cycles.
+const CYCLES_KEEP_MS = 60 * 1000;
+/** At most this many cycle samples a signal is drawn with; a longer window keeps each bucket's extremes. */
+export const DRAWN_CYCLES = 4000;
 
 export const store = {
   rec: [],          // recording rows {t, cw, sw, state, transition, v, pos, tq}
@@ -44,9 +49,9 @@ function flatten(s) {
   };
 }
 
-function trim(list, newest) {
-  let cut = 0;
-  while (cut + 1 < list.length && list[cut + 1].t < newest - KEEP_MS) cut++;
+function trim(list, newest, keep = KEEP_MS) {
+  // By bisection: the cycles are many.
+  const cut = Math.max(0, lowerBound(list, newest - keep) - 1);
   if (cut) list.splice(0, cut);
 }
 
@@ -103,7 +108,7 @@ export function addSamples(batch) {
   }
   for (const r of rows) store.cyc.push(r);
   const newest = rows[rows.length - 1].t;
-  trim(store.cyc, newest);
+  trim(store.cyc, newest, CYCLES_KEEP_MS);
   while (store.cycGaps.length && store.cycGaps[0][1] < newest - KEEP_MS) store.cycGaps.shift();
 }
 
@@ -165,8 +170,10 @@ const usable = (v) => v !== undefined && v !== null;
 /**
  * The samples of a signal from t0 to t1, with the last one before t0 (so a line starts at the
  * left edge): [{t, v, src}] in time order; src 'cyc' (the drive's cycles), 'rec' or 'snap'.
+ * `drawn`: at most that many cycle samples (the plot's): beyond it each bucket of the window gives
+ * its first, lowest, highest and last value, so no peak (an index pulse of one cycle) is lost.
  */
-export function series(sig, t0 = -Infinity, t1 = Infinity) {
+export function series(sig, t0 = -Infinity, t1 = Infinity, drawn = Infinity) {
   const out = [];
   let before = null;
   const take = (t, v, src) => {
@@ -200,14 +207,34 @@ export function series(sig, t0 = -Infinity, t1 = Infinity) {
   };
   snapsBetween(from, cycFrom);
   if (cyc) {
-    for (let i = Math.max(0, lowerBound(cyc, t0) - 1); i < cyc.length; i++) {
-      if (cyc[i].t > t1) break;
-      take(cyc[i].t, sig.cyc(cyc[i]), 'cyc');
+    const first = Math.max(0, lowerBound(cyc, t0) - 1);
+    const end = Math.min(cyc.length, lowerBound(cyc, t1 + 1e-9));
+    if (end - first <= drawn) {
+      for (let i = first; i < end; i++) take(cyc[i].t, sig.cyc(cyc[i]), 'cyc');
+    } else {
+      takeExtremes(cyc, first, end, Math.ceil((end - first) / (drawn / 4)), sig.cyc, (t, v) => take(t, v, 'cyc'));
     }
     snapsBetween(Math.max(from, cycUntil), Infinity);
   }
   if (before) out.unshift(before);
   return out;
+}
+
+// Rows first..end in buckets of `size`: each bucket's first, lowest, highest and last value, in time order.
+function takeExtremes(rows, first, end, size, get, take) {
+  for (let b = first; b < end; b += size) {
+    const picks = new Set([b, Math.min(end, b + size) - 1]);
+    let lo = null, hi = null;
+    for (let i = b; i < Math.min(end, b + size); i++) {
+      const v = get(rows[i]);
+      if (!usable(v)) continue;
+      if (lo === null || v < get(rows[lo])) lo = i;
+      if (hi === null || v > get(rows[hi])) hi = i;
+    }
+    if (lo !== null) picks.add(lo);
+    if (hi !== null) picks.add(hi);
+    for (const i of [...picks].sort((x, y) => x - y)) take(rows[i].t, get(rows[i]));
+  }
 }
 
 /** The first index in a list sorted by time whose time is at least t. */

@@ -193,6 +193,21 @@ try {
     expect(findTrigger({ type: 'bit', word: 'di', bit: 16, edge: 'rising' }, 2004, 2010) === null, 'not again');
     expect(findTrigger({ type: 'bit', word: 'di', bit: 2, edge: 'either' }, 1995, 2010) === null, 'the home switch stays on');
   });
+  check('a long window is drawn from a bounded number of cycle samples, keeping a one-cycle pulse and a peak', () => {
+    data.clear();
+    const n = 20000;
+    data.addSamples({ from: 100000, n, t0: 10000000, dt: [1000, n - 1], polled: [], columns: {
+      digital_inputs: [4, 12345, 65540, 1, 4, n - 12346], velocity: [0, 10000, 900, 1, 0, n - 10001] } });
+    const t0 = 10000, t1 = 10000 + n;
+    const drawnV = data.series(signal('v'), t0, t1, data.DRAWN_CYCLES);
+    const drawnPulse = data.series(signal('di16'), t0, t1, data.DRAWN_CYCLES);
+    expect(drawnV.length <= data.DRAWN_CYCLES + 8 && drawnPulse.length <= data.DRAWN_CYCLES + 8,
+      `${drawnV.length} and ${drawnPulse.length} points drawn`);
+    expect(drawnV.some((p) => p.v === 900 && p.t === 20000), 'the velocity peak is drawn at its cycle');
+    expect(drawnPulse.some((p) => p.v === 1 && p.t === 22345), 'the index pulse is drawn at its cycle');
+    expect(drawnPulse.every((p, i) => i === 0 || p.t > drawnPulse[i - 1].t), 'in time order');
+    expect(data.series(signal('v'), t0, t1).length === n, 'the export has every cycle');
+  });
   console.log(`# ${passed} scope logic checks passed`);
 } catch (e) {
   console.error(`not ok ${passed + 1} - scope logic: ${e.message}`);
