@@ -143,6 +143,7 @@ void axis_page::impl::on_state(state from, state to, std::uint16_t status_word) 
 void axis_page::impl::note_transition(std::optional<int> number, state from, state to, bool inferred,
                                       std::uint16_t status_word, std::optional<std::uint64_t> at_us) {
   last_transition = transition_seen{number, from, to, inferred};
+  if (inferred && number) transition_for_sample = number;
   recording.note_transition({0, at_us.value_or(now_us), number, from, to, word_shown(), status_word, inferred});
   if (!number) return;
   if (auto* a = log.pending()) {
@@ -163,12 +164,13 @@ void axis_page::impl::note_error_code(std::uint16_t code) {
 
 // Once per cycle of a drive in this process, before its step: the cycle before is complete.
 void axis_page::impl::on_cycle() {
-  if (drive.plant == nullptr) return;
+  if (drive.plant == nullptr) return push_bus_sample();
   close_row();
   const sim::drive_view v = drive.plant->view();
   open_row = sim::begin_row(drive.plant->time_us(), drive.plant->constants(), v.state_of_axis());
   open_row_cycle = drive.plant->cycle();
   open_row_state = v.current();
+  open_plant_sample();
 }
 
 void axis_page::impl::close_row() {
@@ -179,6 +181,7 @@ void axis_page::impl::close_row() {
   const state before = open_row_state;
   sim::complete_row(*open_row, out);
   recording.record(*open_row);
+  push_plant_sample(out);
   if (out.transition != no_transition) {
     // At the time of the cycle whose step took it, as the recording's row for that cycle says.
     note_transition(int{out.transition}, before, out.current, false, out.status_word, open_row->time_us);

@@ -299,6 +299,8 @@ reply axis_page::select_profile(std::string_view name) {
   m.observed.reset();
   m.last_transition.reset();
   m.recording.clear();
+  m.samples.clear();
+  m.transition_for_sample.reset();
   m.session.reset();  // before the link it uses
   m.drive = m.connect(*chosen);
   m.start_session(*chosen);

@@ -16,6 +16,7 @@
 #include "cia402/axis/session.hpp"
 #include "cia402/sim/trace.hpp"
 #include "recorder.hpp"
+#include "sample_ring.hpp"
 #include "snapshot_board.hpp"
 #include "word_change.hpp"
 
@@ -71,6 +72,10 @@ struct axis_page::impl {
   detail::snapshot_board board;
   detail::recorder recording;
   std::optional<sim::trace_row> open_row;  // a drive in this process: the cycle under way
+  // The scope's per-cycle samples (axis_page_samples.cpp): each cycle of the link, once.
+  detail::sample_ring samples;
+  detail::cycle_sample open_sample;                // a drive in this process: the cycle under way
+  std::optional<int> transition_for_sample;        // a bus: noted since the last sample
   std::uint64_t open_row_cycle = 0;        // the simulator's cycle count when it began
   state open_row_state = state::start;     // the drive's state when it began
 
@@ -113,6 +118,11 @@ struct axis_page::impl {
   void on_cycle();
   void close_row();
   void record_bus_row();
+  // --- axis_page_samples.cpp ----------------------------------------------------------------------
+  void open_plant_sample();
+  void push_plant_sample(const drive_outputs& out);
+  void push_bus_sample();
+  std::vector<std::string> polled_signals() const;
   void run_handshake();
   void check_enable_walk();
   bool busy_now() const;

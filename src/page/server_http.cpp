@@ -194,7 +194,9 @@ void serve_events(backend& inst, httplib::Response& res, const server_options& o
   struct stream_state {
     bool started = false;
     std::uint64_t seen = 0;
+    std::uint64_t next_sample = 0;  // the number of the next cycle sample this stream sends
     std::chrono::steady_clock::time_point last_write = std::chrono::steady_clock::now();
+    std::chrono::steady_clock::time_point last_batch = std::chrono::steady_clock::now();
   };
   auto st = std::make_shared<stream_state>();
   res.set_chunked_content_provider(
@@ -214,11 +216,24 @@ void serve_events(backend& inst, httplib::Response& res, const server_options& o
               sink.done();
               return true;
             }
-            // Short waits (at most 200 ms), so a stopping server ends the stream promptly.
-            const auto quiet = std::chrono::duration_cast<std::chrono::milliseconds>(
-                std::chrono::steady_clock::now() - st->last_write);
-            const auto slice = std::clamp(comment_after - quiet, std::chrono::milliseconds(1),
-                                          std::chrono::milliseconds(200));
+            const auto now = std::chrono::steady_clock::now();
+            // The drive's cycles, a batch at most every samples_every (each stream from where it
+            // is; one that fell behind the ring skips ahead, and the numbers show the page the gap).
+            if (inst.samples_end() > st->next_sample && now - st->last_batch >= options.samples_every) {
+              st->last_batch = now;
+              std::uint64_t next = st->next_sample;
+              const std::string batch = inst.samples_json(st->next_sample, options.samples_per_batch, next);
+              if (next > st->next_sample && !batch.empty()) {
+                st->next_sample = next;
+                chunk = "event: samples\ndata: " + batch + "\n\n";
+                break;
+              }
+            }
+            // Short waits (at most 200 ms, one batch's time while the drive has samples), so a
+            // stopping server ends the stream promptly.
+            const auto quiet = std::chrono::duration_cast<std::chrono::milliseconds>(now - st->last_write);
+            const auto longest = inst.samples_end() > 0 ? options.samples_every : std::chrono::milliseconds(200);
+            const auto slice = std::clamp(comment_after - quiet, std::chrono::milliseconds(1), longest);
             if (auto u = inst.wait_for_update(st->seen, slice)) {
               st->seen = u->version;
               chunk = "data: " + u->json + "\n\n";

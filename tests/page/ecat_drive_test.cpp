@@ -145,6 +145,37 @@ TEST(ecat_page, commands_go_in_the_process_data_and_the_states_come_back) {
   EXPECT_GT(b.snapshot()["position"].get<std::int64_t>(), 0) << "0x6064 from the process data";
 }
 
+// The scope's samples over EtherCAT (issue 35): one each LRW (1 ms here), numbered without a gap,
+// the position from the process data in every one of them, not a polled value.
+TEST(ecat_page, each_lrw_gives_one_scope_sample_with_the_process_data_of_that_cycle) {
+  bench b;
+  ASSERT_TRUE(b.run_until([&] { return b.status() == "running"; }));
+  for (page_command c : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
+    ASSERT_TRUE(is_accepted(b.page->command(c)));
+    b.run_ms(30);
+  }
+  plant_change v;
+  v.target_velocity = 300;
+  ASSERT_TRUE(is_accepted(b.blocking([&] { return b.page->change_plant(v); })));
+  ASSERT_TRUE(b.run_until([&] { return b.snapshot()["velocity"] == 300; }));
+  const std::uint64_t from = b.page->samples_end();
+  b.run_ms(100);
+  EXPECT_EQ(b.page->samples_end() - from, 100u);  // 100 ms of a 1 ms LRW
+  std::uint64_t next = 0;
+  const json batch = json::parse(b.page->samples_json(from, 1000, next));
+  EXPECT_EQ(batch["n"], 100);
+  EXPECT_EQ(batch["dt"], json({1000, 99}));
+  // 300 rpm is 50 increments a cycle: a run of one each sample.
+  EXPECT_EQ(batch["columns"]["position"].size(), 200u) << batch["columns"]["position"];
+  EXPECT_EQ(batch["columns"]["set_point"], json({300, 100}));
+  EXPECT_EQ(batch["columns"]["mode"], json({3, 100}));
+  for (const json& name : batch["polled"]) {
+    EXPECT_NE(name, "position");
+    EXPECT_NE(name, "velocity");
+    EXPECT_NE(name, "mode");
+  }
+}
+
 TEST(ecat_page, an_injected_fault_shows_with_its_code_and_a_reset_clears_it) {
   bench b;
   ASSERT_TRUE(b.run_until([&] { return b.status() == "running"; }));

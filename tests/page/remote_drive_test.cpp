@@ -525,3 +525,27 @@ TEST(remote_drive, reads_mode_and_actual_values_and_moves_by_the_setpoint_handsh
 }
 
 }  // namespace
+
+// The scope's samples over CAN (issue 35): one each SYNC (10 ms here), numbered without a gap,
+// the status word the TPDO brought; what the PDOs do not carry is the last polled value, named so.
+TEST(remote_drive, each_sync_gives_one_scope_sample_and_the_batch_names_what_was_polled) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
+  b.run_ms(100);
+  const std::uint64_t from = b.remote().samples_end();
+  b.run_ms(500);
+  EXPECT_EQ(b.remote().samples_end() - from, 50u);  // 500 ms of a 10 ms SYNC
+  std::uint64_t next = 0;
+  const json batch = json::parse(b.remote().samples_json(from, 1000, next));
+  EXPECT_EQ(batch["from"], from);
+  EXPECT_EQ(batch["n"], 50);
+  EXPECT_EQ(batch["dt"], json({10000, 49}));
+  const json& sw = batch["columns"]["status_word"];  // one run: SWITCH ON DISABLED throughout
+  ASSERT_EQ(sw.size(), 2u) << sw;
+  EXPECT_EQ(sw[0].get<int>() & 0x4F, 0x40) << sw;
+  EXPECT_EQ(sw[1], 50);
+  const std::vector<std::string> polled = batch["polled"].get<std::vector<std::string>>();
+  for (const char* name : {"torque", "following_error", "digital_inputs", "mode"}) {
+    EXPECT_NE(std::find(polled.begin(), polled.end(), name), polled.end()) << name << " in " << batch["polled"];
+  }
+}

@@ -6,7 +6,7 @@ import { api, el, page, stateLabel, token } from './page.js';
 import { applyCapabilities, buildObjects, buildPlant, buildSetpoints, showPlant } from './plant.js';
 import { drawTimeline, onRecording, pollRecording } from './recorder.js';
 import { buildScope, drawScopeFrame } from './scope.js';
-import { addRows, addSnapshot } from './scope_data.js';
+import { addRows, addSamples, addSnapshot } from './scope_data.js';
 import { connect, setControl } from './stream.js';
 import { buildBits, buildCommands, buildModes, showWords } from './words.js';
 import './jog.js';
@@ -59,7 +59,7 @@ export async function start() {
   setControl(page.info.control);
   applyCapabilities(page.info.capabilities);
   onRecording(addRows);
-  connect(update);
+  connect(update, addSamples);
   animate();
   pollRecording();
   setInterval(pollRecording, 500);

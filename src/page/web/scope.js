@@ -3,7 +3,7 @@
 // fraction; two cursors and their difference; export of the view as CSV and PNG; and the spans the
 // page missed, shown rather than hidden.
 import { el, page, serverNow, stateLabel } from './page.js';
-import { catalogue, edges, series, store, valueAt } from './scope_data.js';
+import { DRAWN_CYCLES, catalogue, edges, series, store, valueAt } from './scope_data.js';
 import { COLOURS, DASHES, drawScope, formatSpan } from './scope_draw.js';
 import { acquisition } from './scope_trigger.js';
 
@@ -69,6 +69,7 @@ function buildSignalChoice() {
     ['Objects', (s) => s.key.startsWith('obj')],
     [`${page.info.control_word_name} bits`, (s) => s.kind === 'bit' && s.key.startsWith('cw')],
     [`${page.info.status_word_name} bits`, (s) => s.kind === 'bit' && s.key.startsWith('sw')],
+    ['Inputs 0x60FD', (s) => s.kind === 'bit' && s.key.startsWith('di')],
   ];
   for (const [title, pick] of groups) {
     const fs = document.createElement('fieldset');
@@ -143,7 +144,10 @@ function condition() {
 function arm() {
   const mode = el('trig-mode').value;
   const pre = Math.min(100, Math.max(0, Number(el('trig-pre').value) || 0)) / 100;
-  scope.acq.arm(mode, mode === 'roll' ? null : condition(), pre, serverNow());
+  // From the newest cycle the drive sent (exact, at most a batch old); the page's clock carried on
+  // from a snapshot runs ahead of a drive that runs behind the wall clock.
+  const newest = store.cyc.length ? store.cyc[store.cyc.length - 1].t : serverNow();
+  scope.acq.arm(mode, mode === 'roll' ? null : condition(), pre, newest);
   scope.t0 = null;
   setPaused(false);
 }
@@ -250,6 +254,7 @@ export function drawScopeFrame() {
 // What the page could not keep up with, said plainly.
 function showHealth() {
   const parts = [];
+  if (store.skipped) parts.push(`browser fell behind: ${store.skipped} samples of the drive's cycles skipped (hatched in the scope)`);
   if (store.missed) parts.push(`${store.missed} snapshots missed from the event stream (the browser or the link could not keep up; hatched in the scope)`);
   if (store.lostRows) parts.push(`${store.lostRows} recording rows lost before the page asked for them`);
   if (store.dropped) parts.push(`the server dropped the oldest ${store.dropped} rows of its recording`);
@@ -257,6 +262,7 @@ function showHealth() {
   h.textContent = parts.length ? `⚠ ${parts.join('; ')}.` : '';
   h.hidden = parts.length === 0;
   h.dataset.missed = String(store.missed);
+  h.dataset.skipped = String(store.skipped);
 }
 
 function showLegend(shown, map) {
@@ -367,13 +373,16 @@ function showCursors(shown) {
     dt.dataset.ms = '';
   }
   const body = el('cursor-values');
-  const key = `${a}|${b}|${shown.map((s) => s.key).join(',')}|${store.snaps.length}|${store.rec.length}`;
+  const newestCycle = store.cyc.length ? store.cyc[store.cyc.length - 1].n : '';
+  const key = `${a}|${b}|${shown.map((s) => s.key).join(',')}|${store.snaps.length}|${store.rec.length}|${newestCycle}`;
   if (body.dataset.key === key) return;
   body.dataset.key = key;
   body.textContent = '';
   if (a === null && b === null) return;
+  // Around the cursors only (a second either side holds the samples they fall between).
+  const ends = [a, b].filter((t) => t !== null);
   for (const sig of shown) {
-    const pts = series(sig);
+    const pts = series(sig, Math.min(...ends) - 1000, Math.max(...ends) + 1000);
     const va = a === null ? null : valueAt(sig, a, pts);
     const vb = b === null ? null : valueAt(sig, b, pts);
     if (sig.part && va === null && vb === null) continue;  // a set-point of a mode not run there
@@ -395,8 +404,9 @@ function showCursors(shown) {
 function viewRows(shown, withValues = true) {
   const { t0, t1 } = scope.window;
   const times = new Set();
+  // The count shown with the plot is of the samples drawn; the export has every one.
   const all = shown.map((sig) => {
-    const pts = series(sig, t0, t1);
+    const pts = series(sig, t0, t1, withValues ? Infinity : DRAWN_CYCLES);
     for (const p of pts) if (p.t >= t0) times.add(p.t);
     return pts;
   });

@@ -4,7 +4,7 @@
 // Meaning never rests on colour alone: every trace is named in the legend with its line style,
 // set-points are dashed.
 import { fitCanvas, niceStep, stateLabel } from './page.js';
-import { publishMs, series, store, transitions } from './scope_data.js';
+import { DRAWN_CYCLES, publishMs, series, store, transitions } from './scope_data.js';
 
 export const COLOURS = ['#111111', '#b3261e', '#1f5fbf', '#2e7d32', '#8e24aa', '#ef6c00', '#00838f'];
 export const DASHES = [[], [], [2, 2], [8, 3], [1, 3], [10, 3, 2, 3], [4, 4]];
@@ -30,7 +30,7 @@ export function heightFor(shown) {
 function scales(analog, t0, t1) {
   const byUnit = new Map();
   for (const sig of analog) {
-    const pts = series(sig, t0, t1);
+    const pts = series(sig, t0, t1, DRAWN_CYCLES);
     if (!pts.length) continue;  // a set-point of a mode not run in the window takes no scale
     const s = byUnit.get(sig.unit) || { unit: sig.unit, lo: Infinity, hi: -Infinity };
     for (const p of pts) { s.lo = Math.min(s.lo, p.v); s.hi = Math.max(s.hi, p.v); }
@@ -120,7 +120,7 @@ function drawAnalog(c, analog, top) {
   clip(top, ANALOG_H, () => {
     for (const sig of analog) {
       const s = sc.find((u) => u.unit === sig.unit);
-      const pts = series(sig, t0, t1);
+      const pts = series(sig, t0, t1, DRAWN_CYCLES);
       if (!pts.length || !s) continue;
       const k = view.colours.get(sig.key) || 0;
       g.strokeStyle = COLOURS[k % COLOURS.length];
@@ -177,7 +177,7 @@ function drawStateLane(c, stateSig, top) {
 // A word bit as a logic lane.
 function drawBitLane(c, sig, top) {
   const { g, ink, t0, t1, x, view, clip } = c;
-  const pts = series(sig, t0, t1);
+  const pts = series(sig, t0, t1, DRAWN_CYCLES);
   g.fillStyle = ink;
   g.textAlign = 'right';
   g.fillText(sig.label.length > 11 ? `${sig.label.slice(0, 10)}…` : sig.label, LEFT - 4, top + LANE_H - 2);
@@ -200,15 +200,17 @@ function drawBitLane(c, sig, top) {
 // Over all lanes: the missed snapshots, the transitions, the trigger and the cursors.
 function drawMarks(c) {
   const { g, t0, t1, pw, x, view, bottom } = c;
-  // Missed snapshots: hatched, with how many.
-  for (const [a, b, n] of store.gaps) {
+  // Missed snapshots and skipped cycle samples: hatched, with how many.
+  const gaps = [...store.gaps.map(([a, b, n]) => [a, b, `${n} missed`]),
+    ...store.cycGaps.map(([a, b, n]) => [a, b, `${n} samples skipped`])];
+  for (const [a, b, text] of gaps) {
     if (b < t0 || a > t1) continue;
     const xa = Math.max(LEFT, x(a)), xb = Math.min(LEFT + pw, x(b));
     g.fillStyle = 'rgba(179, 38, 30, 0.12)';
     g.fillRect(xa, TOP, Math.max(2, xb - xa), bottom - TOP);
     g.fillStyle = '#b3261e';
     g.textAlign = 'left';
-    g.fillText(`${n} missed`, xa + 2, bottom - 4);
+    g.fillText(text, xa + 2, bottom - 4);
   }
 
   const vline = (t, colour, width, text, dash) => {

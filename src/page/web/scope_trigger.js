@@ -1,7 +1,8 @@
 // The scope's trigger: where in the samples a condition first holds, and the acquisition around
 // it (single shot: one capture, then the scope stops; normal: each trigger after the last capture
 // ended gives the next one). Bit edges, states and transitions are found in the recording, exact to
-// the cycle; a level crossing in the signal's samples (the recording where it carries the signal).
+// the cycle (0x60FD's inputs, the index pulse among them, in the drive's cycles); a level crossing in the signal's samples (the drive's cycles, else the recording where
+// it carries the signal, never the snapshots of its live edge).
 import { lowerBound, series, settledUntil, store } from './scope_data.js';
 
 const edgeMatches = (edge, before, after) =>
@@ -14,7 +15,8 @@ const edgeMatches = (edge, before, after) =>
  */
 export function findTrigger(cond, after, until) {
   if (cond.type === 'level') {
-    const points = series(cond.signal, after, until).filter((p) => !cond.signal.rec || p.src === 'rec');
+    // Not from the snapshots of the live edge where the drive's cycles or the recording have it.
+    const points = series(cond.signal, after, until).filter((p) => !cond.signal.rec || p.src !== 'snap');
     for (let i = 1; i < points.length; i++) {
       const p = points[i - 1], q = points[i];
       if (q.t <= after) continue;
@@ -22,6 +24,7 @@ export function findTrigger(cond, after, until) {
     }
     return null;
   }
+  if (cond.type === 'bit' && cond.word === 'di') return inputEdge(cond, after, until);
   // From the row before `after` (it holds the words and the state an edge is seen against).
   const rec = store.rec;
   let prev = null;
@@ -43,11 +46,25 @@ export function findTrigger(cond, after, until) {
   return null;
 }
 
+// 0x60FD's inputs (the index pulse) are in the drive's cycles only: an edge there, exact to the cycle.
+function inputEdge(cond, after, until) {
+  const cyc = store.cyc;
+  const on = (r) => r.di !== null && r.di !== undefined && ((r.di >> cond.bit) & 1) === 1;
+  for (let i = Math.max(1, lowerBound(cyc, after)); i < cyc.length && cyc[i].t <= until; i++) {
+    if (cyc[i].t > after && edgeMatches(cond.edge, on(cyc[i - 1]), on(cyc[i]))) return cyc[i].t;
+  }
+  return null;
+}
+
 /** How far the samples a condition is looked for in are complete. */
 // A signal the recording carries triggers from the recording alone, exact to the cycle, not from
 // the snapshots of the live edge.
 export function triggerSettled(cond) {
-  return cond.type === 'level' && !cond.signal.rec ? settledUntil(cond.signal) : store.recUntil;
+  const lastCycle = store.cyc.length ? store.cyc[store.cyc.length - 1].t : -Infinity;
+  if (cond.type === 'bit' && cond.word === 'di') return lastCycle;
+  if (cond.type !== 'level') return store.recUntil;
+  if (!cond.signal.rec) return settledUntil(cond.signal);
+  return Math.max(store.recUntil, cond.signal.cyc ? lastCycle : -Infinity);
 }
 
 /**

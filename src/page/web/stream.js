@@ -11,8 +11,9 @@ export function setControl(allowed) {
   }
 }
 
-// `take(snapshot, missed)`: each snapshot and how many versions before it never arrived.
-export function connect(take) {
+// `take(snapshot, missed)`: each snapshot and how many versions before it never arrived;
+// `takeSamples(batch)`: each batch of the drive's cycles (scope_samples.js).
+export function connect(take, takeSamples = null) {
   let version = null;
   const source = new EventSource(api('/api/events'));
   // While the stream is down every value on the page is old: the whole instrument is marked stale
@@ -39,6 +40,11 @@ export function connect(take) {
     el('link').dataset.live = 'false';
     if (!document.body.classList.contains('stale')) stale(true);
   };
+  if (takeSamples) {
+    source.addEventListener('samples', (e) => {
+      try { takeSamples(JSON.parse(e.data)); } catch (err) { console.error(err); }
+    });
+  }
   source.onmessage = (e) => {
     try {
       if (document.body.classList.contains('stale')) stale(false);

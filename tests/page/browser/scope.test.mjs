@@ -1,10 +1,14 @@
 // The instrument page's scope in a real browser (Debian's chromium, headless, playwright-core)
 // against `cia402 serve --port 0`: a single-shot trigger on a transition captures the samples
 // around it, the cursors snap to the recording's edges and their difference is the recording's to
-// the cycle, zoom changes the span shown, a level trigger fires at the first sample over the level,
-// the CSV export of the view holds the rows the view shows, a status bit's edge triggers on the
-// transition's cycle, and the first load stays under 300 KB. The expected times come from the
-// server's own recording (/api/recording), never from the page; no wait asserts a duration.
+// the cycle, the drive's cycles fill the captured window one sample per cycle with the transition
+// in its cycle's sample, zoom changes the span shown, a level trigger fires at the drive's first
+// cycle over the level, the CSV export of the view holds the rows the view shows, a status bit's
+// edge triggers on the transition's cycle, homing on the index pulse (method 33: negative, the
+// shaft stands past the positive limit switch by then) triggers the scope on the pulse's cycle
+// (0x60FD bit 16), and the first load stays under 300 KB. The expected times come from the
+// server's own recording (/api/recording) or its cycle samples as the event stream brought them;
+// no wait asserts a duration.
 //
 //   node scope.test.mjs CIA402_BINARY OUTPUT_DIR
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
@@ -193,6 +197,28 @@ async function main() {
     expect(text.includes(`${(t3 - t4) / cycleMs} cycles`), `Δt in cycles: "${text}"`);
   });
 
+  await check("the drive's cycles fill the captured window: every cycle once, T4 in the sample of its cycle", async () => {
+    // The capture's window (the cursor check may have panned the view since).
+    const d = { t0: t4 - 100, t1: t4 + 100 };
+    const cycleMs = (await page.evaluate(async () => (await fetch('/api/info')).json())).cycle_us / 1000;
+    const got = await page.evaluate(async ([t0, t1]) => {
+      const { store } = await import('/scope_data.js');
+      return { skipped: store.skipped,
+        rows: store.cyc.filter((r) => r.t >= t0 && r.t <= t1).map((r) => [r.n, r.t, r.transition, r.state]) };
+    }, [d.t0, d.t1]);
+    expect(got.skipped === 0, `${got.skipped} samples skipped`);
+    expect(got.rows.length === Math.round((d.t1 - d.t0) / cycleMs) + 1,
+      `${got.rows.length} cycle samples in ${d.t0}..${d.t1}, one per ${cycleMs} ms expected`);
+    expect(got.rows.every((r, i) => i === 0 || (r[0] === got.rows[i - 1][0] + 1 && r[1] === got.rows[i - 1][1] + cycleMs)),
+      'numbered and timed without a gap');
+    const at = got.rows.filter((r) => r[2] === 4);
+    expect(at.length === 1 && at[0][1] === t4 && at[0][3] === 'OPERATION_ENABLED',
+      `T4 in the cycle samples at ${JSON.stringify(at)}, the recording's T4 at ${t4}`);
+    // The cursor difference from T3 to T4 in the cycles equals the recording's, to the cycle.
+    const t3row = got.rows.find((r) => r[2] === 3);
+    if (t3row) expect(t4 - t3row[1] === t4 - t3, `T3 at ${t3row[1]} in the cycles, ${t3} in the recording`);
+  });
+
   await check('zoom changes the time span shown', async () => {
     await page.click('#scope-live');
     await page.selectOption('#scope-div', '100');
@@ -205,16 +231,21 @@ async function main() {
     expect((await page.inputValue('#scope-div')) === '50', 'the time base follows the zoom');
   });
 
-  await check('a level trigger fires at the first recorded sample of the velocity over the level', async () => {
+  await check("a level trigger fires at the drive's first cycle with the velocity over the level", async () => {
     await arm({ mode: 'single', type: 'level', signal: 'v', level: 500, edge: 'rising', pre: 25, div: 200 });
     const armedAt = (await recording()).rows.at(-1)[0];
     await page.fill('#target-input', '1500');
     await page.click('#target-form button[type="submit"]');
     await page.waitForSelector('#scope-status[data-state="stopped"]', { timeout: patience });
+    // The cycles as the server sent them (its sample ring over the event stream); the recording's
+    // rows keep the velocity only every 20 ms, so its first row over the level may come later.
+    const cycles = await page.evaluate(async () => (await import('/scope_data.js')).store.cyc.map((r) => [r.t, r.v]));
+    const first = cycles.find((r, i) => i > 0 && r[0] > armedAt && r[1] >= 500 && cycles[i - 1][1] < 500);
     const rec = await recording();
-    const first = rec.rows.find((r, i) => i > 0 && r[0] > armedAt && r[5] >= 500 && rec.rows[i - 1][5] < 500);
+    const firstRow = rec.rows.find((r, i) => i > 0 && r[0] > armedAt && r[5] >= 500 && rec.rows[i - 1][5] < 500);
     const d = await dataset();
-    expect(first && d.trigger === first[0], `trigger at ${d.trigger}, the first row over 500 rpm: ${JSON.stringify(first)}`);
+    expect(first && d.trigger === first[0], `trigger at ${d.trigger}, the first cycle over 500 rpm: ${JSON.stringify(first)}`);
+    expect(firstRow && firstRow[0] >= first[0] && firstRow[0] - first[0] <= 20, `the recording's first row over it at ${firstRow && firstRow[0]}`);
     expect(d.t0 === first[0] - 500 && d.span === 2000, `25 % of 2 s before the trigger: ${d.t0}..${d.t1}`);
   });
 
@@ -245,6 +276,52 @@ async function main() {
     const t5 = (await recording()).transitions.find((t) => t.number === 5);
     const d = await dataset();
     expect(t5 && d.trigger === t5.time_ms, `trigger at ${d.trigger}, T5 (operation enabled bit 2 falls) at ${t5 && t5.time_ms}`);
+  });
+
+  await check("homing on the index pulse (method 33) triggers the scope on the pulse's cycle", async () => {
+    const post = (pathName, body) => page.evaluate(async ([u, b]) => (await fetch(u, {
+      method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(b) })).status,
+    [pathName, body]);
+    expect(await post('/api/object', { index: '0x6098', value: 33 }) === 200, 'method 33 written');
+    expect(await post('/api/object', { index: '0x6060', value: 6 }) === 200, 'homing mode written');
+    await command('enable_operation');
+    await waitState('OPERATION_ENABLED');
+    await page.waitForFunction(async () => {
+      const { store } = await import('/scope_data.js');
+      return store.cyc.length && store.cyc[store.cyc.length - 1].mode === 6;
+    }, null, { timeout: patience, polling: 100 });
+    const startedAt = await page.evaluate(async () => {
+      const { store } = await import('/scope_data.js');
+      return store.cyc[store.cyc.length - 1].t;
+    });
+    await page.check('input[data-signal="di16"]');
+    await arm({ mode: 'single', type: 'bit', bit: 'di16', edge: 'rising', pre: 50, div: 10 });
+    expect(await post('/api/command', { command: 'toggle_bit', bit: 4 }) === 200, 'homing started (bit 4)');
+    try {
+      await page.waitForSelector('#scope-status[data-state="stopped"]', { timeout: patience });
+    } catch (e) {
+      // What the page had: a trigger that did not fire told from a homing that did not run.
+      const dump = await page.evaluate(async (from) => {
+        const { store } = await import('/scope_data.js');
+        const runs = [];
+        for (const r of store.cyc.filter((c) => c.t >= from)) {
+          const k = `${r.di}/${r.mode}/${r.cw}/${r.pos}`;
+          if (!runs.length || runs[runs.length - 1][1] !== k) runs.push([r.t, k]);
+        }
+        return { status: document.getElementById('scope-status').textContent,
+          bit: document.getElementById('trig-bit').value, runs: runs.slice(0, 40) };
+      }, startedAt);
+      throw new Error(`${e.message}: ${JSON.stringify(dump)}`);
+    }
+    // The first cycle after the start with the pulse, as the server's cycles say.
+    const pulses = await page.evaluate(async (from) => {
+      const { series, catalogue } = await import('/scope_data.js');
+      const index = catalogue().find((sig) => sig.key === 'di16');
+      return series(index, from).filter((p) => p.src === 'cyc').map((p) => [p.t, p.v]);
+    }, startedAt);
+    const first = pulses.find((p, i) => i > 0 && p[1] === 1 && pulses[i - 1][1] === 0);
+    const d = await dataset();
+    expect(first && d.trigger === first[0], `trigger at ${d.trigger}, the first index pulse at ${first && first[0]}`);
   });
 
   await check('no errors in the browser console', async () => {

@@ -24,13 +24,17 @@ globalThis.document = {
   querySelectorAll: () => [],
 };
 const sources = [];
-globalThis.EventSource = class { constructor(url) { this.url = url; sources.push(this); } };
+globalThis.EventSource = class {
+  constructor(url) { this.url = url; this.listeners = {}; sources.push(this); }
+  addEventListener(type, fn) { this.listeners[type] = fn; }
+};
 
 const load = (name) => import(pathToFileURL(path.join(web, name)).href);
 const { page } = await load('page.js');
 const { connect } = await load('stream.js');
 const data = await load('scope_data.js');
 const { acquisition, findTrigger } = await load('scope_trigger.js');
+const { decodeBatch } = await load('scope_samples.js');
 
 let passed = 0;
 function check(name, fn) {
@@ -43,7 +47,9 @@ function expect(condition, message) {
 }
 
 page.info = {
-  publish_ms: 40, cycle_us: 1000, objects: [{ index: '0x607A', name: 'target position' }],
+  publish_ms: 40, cycle_us: 1000, states: ['START', 'NOT_READY_TO_SWITCH_ON', 'SWITCH_ON_DISABLED',
+    'READY_TO_SWITCH_ON', 'SWITCHED_ON', 'OPERATION_ENABLED', 'QUICK_STOP_ACTIVE', 'FAULT_REACTION_ACTIVE', 'FAULT'],
+  objects: [{ index: '0x607A', name: 'target position' }],
   control_bits: [{ bit: 3, name: 'Enable operation' }], status_bits: [{ bit: 2, name: 'Operation enabled' }],
 };
 const snapshot = (version, t, extra = {}) => ({
@@ -118,6 +124,89 @@ try {
   check('rows the server no longer held when asked are counted as lost', () => {
     data.addRows([], { askedAt: 300, lost: 5, dropped: 12 });
     expect(data.store.lostRows === 5 && data.store.dropped === 12, `lost ${data.store.lostRows}, dropped ${data.store.dropped}`);
+  });
+  // A batch of the drive's cycles as sample_ring.cpp writes it: 6 cycles of 1 ms from 2.000 s,
+  // T4 in the fourth, an index pulse in the fifth, the torque never given.
+  const batch = (from, t0Us, extra = {}) => ({
+    from, n: 6, t0: t0Us, dt: [1000, 5], polled: ['torque'],
+    columns: {
+      status_word: [0x233, 3, 0x237, 3], control_word: [7, 2, 15, 4], state: [4, 3, 5, 3],
+      transition: [null, 3, 4, 1, null, 2], velocity: [0, 3, 5, 1, 9, 2], position: [10, 1, 11, 1, 12, 4],
+      torque: [null, 6], following_error: [0, 6], set_point: [100, 6], position_demand: [10, 6],
+      digital_inputs: [4, 4, 65540, 1, 4, 1], mode: [3, 6], error_code: [0, 6],
+    },
+    ...extra,
+  });
+
+  check('a batch of the drive\'s cycles decodes to one row per cycle with its number, time and values', () => {
+    const rows = decodeBatch(batch(40, 2000000), page.info.states);
+    expect(rows.length === 6, `rows ${rows.length}`);
+    expect(rows.map((r) => r.n).join(',') === '40,41,42,43,44,45', 'numbered');
+    expect(rows.map((r) => r.t).join(',') === '2000,2001,2002,2003,2004,2005', `times ${rows.map((r) => r.t)}`);
+    expect(rows.map((r) => r.v).join(',') === '0,0,0,5,9,9', `velocity ${rows.map((r) => r.v)}`);
+    expect(rows[3].transition === 4 && rows[2].transition === null, 'T4 in the fourth only');
+    expect(rows[3].state === 'OPERATION_ENABLED' && rows[2].state === 'SWITCHED_ON', 'state names');
+    expect(rows[0].tq === null, 'a value not given is null');
+    expect(rows.map((r) => (r.di >> 16) & 1).join('') === '000010', 'index pulse in the fifth');
+  });
+
+  check('batches in a row are all kept; a batch after a gap counts the samples skipped and marks the span', () => {
+    data.clear();
+    const source = sources[sources.length - 1];
+    connect(() => {}, data.addSamples);
+    const latest = sources[sources.length - 1];
+    expect(latest !== source && latest.listeners.samples, 'the stream listens for samples');
+    latest.listeners.samples({ data: JSON.stringify(batch(40, 2000000)) });
+    latest.listeners.samples({ data: JSON.stringify(batch(46, 2006000)) });
+    expect(data.store.cyc.length === 12 && data.store.skipped === 0, `kept ${data.store.cyc.length}, skipped ${data.store.skipped}`);
+    latest.listeners.samples({ data: JSON.stringify(batch(100, 2060000)) });  // 52..99 never came
+    expect(data.store.skipped === 48, `skipped ${data.store.skipped}`);
+    expect(JSON.stringify(data.store.cycGaps) === '[[2011,2060,48]]', `gaps ${JSON.stringify(data.store.cycGaps)}`);
+    expect(data.store.polled.join() === 'torque', 'the polled columns named');
+  });
+
+  check('where the drive\'s cycles are, a signal comes from them: the recording before, the snapshots after', () => {
+    data.clear();
+    data.addRows([row(1990, { v: 1 }), row(2002, { v: 777 })], { askedAt: 2010, lost: 0, dropped: 0 });
+    data.addSamples(batch(200, 2000000));
+    data.addSnapshot(snapshot(20, 2040, { velocity: 50 }), 0);
+    const v = data.series(signal('v')).map((p) => `${p.t}:${p.v}:${p.src}`).join(' ');
+    expect(v === '1990:1:rec 2000:0:cyc 2001:0:cyc 2002:0:cyc 2003:5:cyc 2004:9:cyc 2005:9:cyc 2040:50:snap', `velocity ${v}`);
+    // The set-point of pv (mode 3) and the following error every cycle, where snapshots had none.
+    expect(data.series(signal('sp_vel')).filter((p) => p.src === 'cyc').length === 6, 'pv set-point each cycle');
+    expect(data.series(signal('fe')).filter((p) => p.src === 'cyc').length === 6, 'following error each cycle');
+    const index = data.series(signal('di16')).map((p) => p.v).join('');
+    expect(index === '000010', `index pulse ${index}`);
+    expect(data.valueAt(signal('v'), 2003.5) === 7, `interpolated between cycles ${data.valueAt(signal('v'), 2003.5)}`);
+  });
+
+  check('a level trigger on a recorded signal fires on the cycle sample, not the later recorded row', () => {
+    // The recording's row at 2002 says 777 (a row 20 ms apart would be later still); the cycles say 5 at 2003.
+    const t = findTrigger({ type: 'level', signal: signal('v'), level: 5, edge: 'rising' }, 1995, 2010);
+    expect(t === 2003, `fired at ${t}`);
+    expect(findTrigger({ type: 'level', signal: signal('v'), level: 9, edge: 'rising' }, 1995, 2010) === 2004, 'over 9 at 2004');
+  });
+
+  check('a trigger on the index pulse (0x60FD bit 16) fires on its cycle, rising and falling', () => {
+    expect(findTrigger({ type: 'bit', word: 'di', bit: 16, edge: 'rising' }, 1995, 2010) === 2004, 'rises at 2004');
+    expect(findTrigger({ type: 'bit', word: 'di', bit: 16, edge: 'falling' }, 1995, 2010) === 2005, 'falls at 2005');
+    expect(findTrigger({ type: 'bit', word: 'di', bit: 16, edge: 'rising' }, 2004, 2010) === null, 'not again');
+    expect(findTrigger({ type: 'bit', word: 'di', bit: 2, edge: 'either' }, 1995, 2010) === null, 'the home switch stays on');
+  });
+  check('a long window is drawn from a bounded number of cycle samples, keeping a one-cycle pulse and a peak', () => {
+    data.clear();
+    const n = 20000;
+    data.addSamples({ from: 100000, n, t0: 10000000, dt: [1000, n - 1], polled: [], columns: {
+      digital_inputs: [4, 12345, 65540, 1, 4, n - 12346], velocity: [0, 10000, 900, 1, 0, n - 10001] } });
+    const t0 = 10000, t1 = 10000 + n;
+    const drawnV = data.series(signal('v'), t0, t1, data.DRAWN_CYCLES);
+    const drawnPulse = data.series(signal('di16'), t0, t1, data.DRAWN_CYCLES);
+    expect(drawnV.length <= data.DRAWN_CYCLES + 8 && drawnPulse.length <= data.DRAWN_CYCLES + 8,
+      `${drawnV.length} and ${drawnPulse.length} points drawn`);
+    expect(drawnV.some((p) => p.v === 900 && p.t === 20000), 'the velocity peak is drawn at its cycle');
+    expect(drawnPulse.some((p) => p.v === 1 && p.t === 22345), 'the index pulse is drawn at its cycle');
+    expect(drawnPulse.every((p, i) => i === 0 || p.t > drawnPulse[i - 1].t), 'in time order');
+    expect(data.series(signal('v'), t0, t1).length === n, 'the export has every cycle');
   });
   console.log(`# ${passed} scope logic checks passed`);
 } catch (e) {

@@ -94,6 +94,8 @@ class axis_page : public backend {
   std::string snapshot_json() const override;
   std::string recording_json(std::uint64_t rows_seen, std::uint64_t transitions_seen) const override;
   std::string recording_file(recording_format format) const override;
+  std::uint64_t samples_end() const override;
+  std::string samples_json(std::uint64_t from, std::size_t max, std::uint64_t& next) const override;
   std::optional<published> wait_for_update(std::uint64_t seen, std::chrono::milliseconds timeout) override;
   published latest() const override;
   void close() override;

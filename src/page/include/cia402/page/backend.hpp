@@ -6,6 +6,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -133,6 +134,16 @@ class backend {
                                      std::uint64_t transitions_seen) const = 0;
   /// The whole recording as a file.
   virtual std::string recording_file(recording_format format) const = 0;
+
+  /// The drive's cycles for the scope: the number the next sample gets (0: none kept).
+  virtual std::uint64_t samples_end() const { return 0; }
+  /// The samples from number `from` (the oldest kept when it is older) on, at most `max`, as a
+  /// batch (src/page/sample_ring.hpp); `next` is the number after the last one in it.
+  virtual std::string samples_json(std::uint64_t from, std::size_t max, std::uint64_t& next) const {
+    next = from;
+    (void)max;
+    return {};
+  }
 
   /// Waits until a snapshot newer than `seen` is published, or `timeout` passes, or close() is
   /// called. Returns the newest snapshot if it is newer than `seen`, else nothing.

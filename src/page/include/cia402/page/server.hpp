@@ -59,6 +59,10 @@ struct server_options {
   /// The whole head of a request must arrive within this (408), and each later read too.
   std::chrono::milliseconds read_timeout{2000};
   std::chrono::milliseconds keep_alive{15000};  ///< SSE comment line when nothing was published
+  /// The drive's per-cycle samples (the scope's): a batch (SSE event `samples`) at most this often
+  /// per stream, of at most samples_per_batch samples (1 kHz catches up 40 times faster than it comes).
+  std::chrono::milliseconds samples_every{50};
+  std::size_t samples_per_batch = 2000;
   /// An open event stream renews its drive's lease (backend::renew_lease) with each write that goes
   /// out, and writes a comment at least this often so a closed page is noticed (its second write
   /// after the close fails).
