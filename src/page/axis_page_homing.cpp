@@ -6,7 +6,9 @@
 
 #include "cia402/error_codes.hpp"
 #include "cia402/objects.hpp"
+#include "cia402/words.hpp"
 #include "page_json.hpp"
+#include "page_names.hpp"
 
 namespace cia402::page {
 namespace {
@@ -43,9 +45,13 @@ void axis_page::impl::keep_views_read() {
         if (const auto v = integer_of(r); r.ok() && v) (sub == 1 ? switch_speed_read : zero_speed_read) = *v;
       });
     }
-    session->read_object(object_index::homing_acceleration, 0, [this](const axes::result& r) {
-      if (const auto v = integer_of(r); r.ok() && v) objects[object_index::homing_acceleration] = *v;
-    });
+    for (const std::uint16_t index : {object_index::homing_method, object_index::homing_acceleration,
+                                      object_index::home_offset}) {
+      session->read_object(index, 0, [this, index](const axes::result& r) {
+        // A value the page wrote meanwhile stays: it is newer than this read.
+        if (const auto v = integer_of(r); r.ok() && v) objects.emplace(index, *v);
+      });
+    }
   }
   if (error_field.stale && !error_field.reading) {
     error_field.stale = false;
@@ -159,6 +165,9 @@ void axis_page::impl::end_homing(const axes::result& r) {
     log.update({run.id, run.action, "done",
                 "done: homing attained" + (r.position ? ", 0x6064 = " + std::to_string(*r.position) : std::string()),
                 run.transitions});
+  } else if (r.end == axes::outcome::superseded) {
+    log.update({run.id, run.action, "refused", "refused: interrupted by another request before homing was attained",
+                run.transitions});
   } else {
     log.update({run.id, run.action, "refused", "refused: " + failure_text(r), run.transitions});
   }
@@ -170,6 +179,10 @@ reply axis_page::home(const homing_request& request) {
   std::unique_lock lock(impl_->mutex);
   impl& m = *impl_;
   if (auto no = m.not_running()) return *no;
+  if (request.start && *request.start && !left_to_mode(*m.table, true, 4)) {
+    return refused{409, std::string("profile ") + m.table->name + " names control bit 4 \"" +
+                            bit_names_of(*m.table).control[4] + "\": no homing operation start on it"};
+  }
   struct parameter {
     std::uint16_t index;
     std::uint8_t sub;

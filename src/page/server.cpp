@@ -449,6 +449,10 @@ struct server::impl {
       if (may_control(req)) inst->renew_lease();  // a client that polls the state is there
       res.set_content(inst->snapshot_json(), "application/json");
     });
+    http.Get("/api/errors", [this](const httplib::Request& req, httplib::Response& res) {
+      // The drive's 0x1003 as last read (the snapshot's drive_errors); POST /api/errors/read reads anew.
+      if (backend* inst = axis_of(req, res)) send_json(res, 200, json::parse(inst->snapshot_json())["drive_errors"]);
+    });
     http.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
       if (backend* inst = axis_of(req, res)) detail::serve_events(*inst, res, options, streams, stopping);
     });

@@ -73,6 +73,15 @@ TEST_F(homing_page, method_3_at_the_default_speeds_is_attained_within_3_s_with_i
   EXPECT_EQ(s["results"][0]["text"], "done: homing attained, 0x6064 = 0");
 }
 
+TEST_F(homing_page, a_start_where_the_profile_names_bit_4_itself_is_refused) {
+  inst.select_profile("s300-profibus");
+  step(10);
+  const json before = state()["control_word"];
+  expect_refused(post("/api/homing", R"({"start":true})"), 409, "no homing operation start on it");
+  step(3);
+  EXPECT_EQ(state()["control_word"], before);
+}
+
 TEST_F(homing_page, bit_4_toggled_in_homing_mode_says_homing_operation_start) {
   ASSERT_EQ(post("/api/object", R"({"index":"0x6060","value":6})")->status, 200);
   step(5);
@@ -90,6 +99,9 @@ TEST_F(homing_page, a_fault_enters_the_drive_error_field_and_clear_empties_it) {
   ASSERT_EQ(d["count"], 1) << d.dump();
   EXPECT_EQ(d["entries"][0]["code"], "0x2310");
   EXPECT_EQ(d["entries"][0]["text"], "continuous over-current");
+  const auto listed = client->Get("/api/errors");
+  ASSERT_TRUE(listed);
+  EXPECT_EQ(json::parse(listed->body)["entries"][0]["code"], "0x2310") << listed->body;
   const auto read = post("/api/errors/read", "{}");
   ASSERT_EQ(read->status, 200) << read->body;
   EXPECT_EQ(body_of(read)["text"], "0x1003 holds 1 error(s)");
