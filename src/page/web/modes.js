@@ -83,7 +83,7 @@ function showHoming(s) {
   for (const [key, id] of HOMING_INPUTS) {
     const input = el(id);
     if (h[key] === null || h[key] === undefined || document.activeElement === input) continue;
-    if (performance.now() - (touched[id] || 0) < 5000) continue;
+    if (touched[id] !== undefined && performance.now() - touched[id] < 5000) continue;
     input.value = String(h[key]);
   }
 }
@@ -111,8 +111,8 @@ function showDriveErrors(d) {
 
 export function showModePanel(s) {
   const mode = shownMode(s);
-  el('doing-now').textContent = s.doing_now
-    ? `${mode !== null && mode !== undefined ? modeTitle(mode) : 'Mode unknown'}: ${s.doing_now}` : '';
+  el('doing-now').textContent = s.doing_now ? `Now: ${s.doing_now}` : '';
+  el('doing-now').title = mode !== null && mode !== undefined ? `in ${modeTitle(mode)}` : '';
   if (mode !== null && mode !== undefined) showModeBits(s, mode);
   showHoming(s);
   showDriveErrors(s.drive_errors);

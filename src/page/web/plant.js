@@ -106,7 +106,7 @@ function showSetpoints(s) {
   homing.textContent = running ? 'Stop homing' : 'Start homing';
   const method = s.objects && s.objects['0x6098'];
   if (method !== undefined && document.activeElement !== el('homing-method') &&
-      performance.now() - (touched['homing-method'] || 0) > 3000) {
+      (touched['homing-method'] === undefined || performance.now() - touched['homing-method'] > 3000)) {
     el('homing-method').value = String(method);
   }
 }
