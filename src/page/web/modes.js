@@ -22,13 +22,16 @@ export function homingRunning(s) {
   return shownMode(s) === 6 && ((hexBits(s.control_word) >> 4) & 1) === 1;
 }
 
-// The body of POST /api/homing: the method and the parameters typed in, and start or stop.
+// The body of POST /api/homing: start or stop, with the method and each parameter that differs from
+// what the drive holds (a value written elsewhere meanwhile is not overwritten with an old one).
 export function homingBody(method, start) {
   if (!start) return { start: false };
-  const body = { method, start: true };
+  const held = (page.snapshot && page.snapshot.homing) || {};
+  const body = { start: true };
+  if (method !== held.method) body.method = method;
   for (const [key, id] of HOMING_INPUTS) {
     const v = el(id).value.trim();
-    if (/^-?\d+$/.test(v)) body[key] = Number(v);
+    if (/^-?\d+$/.test(v) && Number(v) !== held[key]) body[key] = Number(v);
   }
   return body;
 }
