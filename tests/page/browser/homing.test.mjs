@@ -26,7 +26,7 @@ async function homingChecks(page, where, server) {
     expect(bits.includes('control 4 Homing operation start') && bits.includes('status 13 Homing error'),
       `mode bits: "${bits}"`);
     const doing = await text(page, 'doing-now');
-    expect(doing.startsWith('Homing'), `doing now: "${doing}"`);
+    expect(doing === 'Now: no motion: not OPERATION ENABLED', `doing now: "${doing}"`);
   });
   await check(`${where}: method 3 from the page lights the home switch and is attained`, async () => {
     // The lamp is on only while the shaft stands on the switch: watched from the page's start.
@@ -43,6 +43,8 @@ async function homingChecks(page, where, server) {
     await page.waitForFunction(() => document.getElementById('homing-phase').textContent.includes('homing attained'),
       null, { timeout: patience });
     expect(await page.evaluate(() => window.homeLampSeen), 'the home switch lamp never lit');
+    await page.waitForFunction(() => document.getElementById('doing-now').textContent === 'Now: homing: homing attained',
+      null, { timeout: patience });
     const s = await (await fetch(`${server.url.split('?')[0]}api/state`)).json();
     expect(s.homing.method === 3 && s.homing.fast === 300 && s.homing.slow === 40,
       `homing parameters: ${JSON.stringify(s.homing)}`);
