@@ -71,8 +71,7 @@ void axis_page::impl::read_error_field(std::size_t sub, std::vector<std::uint32_
       if (*v < 0 || static_cast<std::size_t>(*v) > error_field_most) {
         return end_error_field_read("0x1003 sub 0 reports " + std::to_string(*v) + " errors (at most 254)");
       }
-      so_far.reserve(static_cast<std::size_t>(*v));
-      so_far.resize(static_cast<std::size_t>(*v));  // filled below, entry by entry
+      so_far.resize(static_cast<std::size_t>(*v));  // filled entry by entry
       if (*v == 0) {
         error_field.entries.clear();
         return end_error_field_read("");
