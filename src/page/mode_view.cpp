@@ -58,6 +58,10 @@ std::string homing_phase_text(const mode_reading& r) {
       if (method >= 17 && method <= 30) text = "searching the switch edge";
       return text + " at 0x6099:2 = " + value_or_unknown(r.zero_speed_rpm) + " rpm";
     case homing_phase::stopping_past_home: return "in progress: stopping or reversing";
+    case homing_phase::not_started:
+      // CiA 402-2 gives 13 / 12 / 10 = 0 / 0 / 1 both meanings; without bit 10 the shaft still moves.
+      if ((r.status_word & bit10) != 0) return "interrupted or not started";
+      return r.velocity_rpm && *r.velocity_rpm != 0 ? "stopping" : text;
     case homing_phase::moving_to_zero: return "homing attained, still stopping";
     default: return text;
   }

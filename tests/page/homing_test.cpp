@@ -82,6 +82,22 @@ TEST_F(homing_page, a_start_where_the_profile_names_bit_4_itself_is_refused) {
   EXPECT_EQ(state()["control_word"], before);
 }
 
+TEST_F(homing_page, a_run_stopped_from_the_page_ends_superseded_and_stands) {
+  ASSERT_EQ(post("/api/homing", R"({"method":1,"start":true})")->status, 200);  // 100 revolutions away
+  step(500);
+  EXPECT_EQ(state()["homing"]["phase"], "searching limit switch at 0x6099:1 = 1000 rpm");
+  ASSERT_EQ(post("/api/homing", R"({"start":false})")->status, 200);
+  step(100);
+  EXPECT_EQ(state()["homing"]["phase"], "stopping") << "on the profile deceleration 0x6084 (1000 rpm/s)";
+  step(1500);
+  const json s = state();
+  EXPECT_EQ(s["homing"]["phase"], "interrupted or not started");
+  EXPECT_FALSE(s["homing"]["running"].get<bool>());
+  EXPECT_EQ(s["velocity"], 0);
+  EXPECT_EQ(s["results"][0]["text"], "done: stopped");
+  EXPECT_EQ(s["results"][1]["text"], "refused: superseded by another homing request");
+}
+
 TEST_F(homing_page, bit_4_toggled_in_homing_mode_says_homing_operation_start) {
   ASSERT_EQ(post("/api/object", R"({"index":"0x6060","value":6})")->status, 200);
   step(5);
@@ -155,6 +171,11 @@ TEST(homing_phase_inference, the_speed_tells_the_switch_search_from_the_index_se
   r.homing_method = 1;
   r.velocity_rpm = -1000;
   EXPECT_EQ(detail::homing_phase_text(r), "searching limit switch at 0x6099:1 = 1000 rpm");
+  r.control_word = 0x000F;  // bit 4 down: the run was stopped
+  EXPECT_EQ(detail::homing_phase_text(r), "stopping") << "still turning";
+  r.velocity_rpm = 0;
+  r.status_word = 1u << 10;
+  EXPECT_EQ(detail::homing_phase_text(r), "interrupted or not started") << "CiA 402-2's words for 0/0/1";
   r.mode = 3;
   EXPECT_EQ(detail::infer_homing_phase(r), homing_phase::not_started) << "not in homing mode";
 }
