@@ -75,6 +75,8 @@ void axis_page::impl::start_session(const profile& p) {
     } else if (e == axes::link_event::restarted) {
       injected_fault = 0;
       objects.clear();
+      homing_read_asked = false;
+      error_field.stale = true;
     } else if (e == axes::link_event::running) {
       drive.link->start_cyclic();
     }
@@ -114,6 +116,7 @@ void axis_page::impl::advance(std::uint32_t elapsed_us) {
   if (observed) {
     note_error_code(drive.plant != nullptr ? drive.plant->view().outputs().error_code : session->error_code());
   }
+  keep_views_read();
   run_handshake();
   check_enable_walk();
   if (log.pending()) log.settle(now_us, busy_now());
@@ -157,6 +160,7 @@ void axis_page::impl::note_transition(std::optional<int> number, state from, sta
 void axis_page::impl::note_error_code(std::uint16_t code) {
   if (code == error_shown) return;
   error_shown = code;
+  error_field.stale = true;  // the drive's own list 0x1003 changed with it
   if (code == 0) return;
   errors_seen.push_front({now_us, code});
   if (errors_seen.size() > errors_kept) errors_seen.pop_back();
@@ -404,6 +408,9 @@ json axis_page::impl::snapshot(bool with_time) const {
     history.push_back({{"time_ms", e.time_us / 1000}, {"code", hex(e.code, 4)}, {"text", error_code_text(e.code)}});
   }
   j["error_history"] = std::move(history);
+  j["drive_errors"] = drive_errors_json();
+  j["homing"] = homing_json();
+  j["doing_now"] = detail::doing_now(mode_reading_now());
   // "Why can't I enable?": what blocks the way to OPERATION ENABLED now, from the drive's own inputs.
   const std::string blocker =
       observed && *observed != state::operation_enabled ? enable_blocker(*observed) : std::string();

@@ -11,6 +11,7 @@
 #include "cia402/objects.hpp"
 #include "commissioning.hpp"
 #include "page_json.hpp"
+#include "page_names.hpp"
 
 namespace cia402::page {
 namespace {
@@ -139,7 +140,14 @@ reply axis_page::toggle_control_bit(int bit) {
   if (bit < 0 || bit > 15) return refused{400, "bit must be 0..15"};
   std::lock_guard lock(impl_->mutex);
   if (auto no = impl_->not_running()) return *no;
-  return accepted{impl_->change_word(detail::flip_bit(*impl_->table, impl_->word_base(), bit))};
+  detail::word_change w = detail::flip_bit(*impl_->table, impl_->word_base(), bit);
+  // A bit the profile leaves to the mode means what the mode the drive runs makes of it.
+  const auto mode = impl_->value_of(object_index::modes_of_operation_display);
+  const char* name = mode ? mode_bit_name(*impl_->table, true, bit, *mode) : nullptr;
+  if (!w.tracked && name != nullptr) {
+    w.text = "done: " + std::string(name) + " (bit " + std::to_string(bit) + " in mode " + std::to_string(*mode) + ")";
+  }
+  return accepted{impl_->change_word(w)};
 }
 
 reply axis_page::new_setpoint() {

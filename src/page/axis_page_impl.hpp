@@ -15,6 +15,7 @@
 #include "action_log.hpp"
 #include "cia402/axis/session.hpp"
 #include "cia402/sim/trace.hpp"
+#include "mode_view.hpp"
 #include "recorder.hpp"
 #include "sample_ring.hpp"
 #include "snapshot_board.hpp"
@@ -107,6 +108,24 @@ struct axis_page::impl {
     bool turning = false;   // the session switched to profile velocity and set 0x60FF
   };
   std::optional<jog_run> jogging;
+  // A homing run the page started (POST /api/homing with start): the session's home.
+  std::optional<operation> homing_run;
+
+  // What a drive on a bus does not show cyclically and the homing panel needs: 0x6099 sub 1 and 2,
+  // read once the link runs and kept as written (a drive in this process is read directly).
+  std::optional<std::int64_t> switch_speed_read, zero_speed_read;
+  bool homing_read_asked = false;
+  // The drive's own pre-defined error field 0x1003 (CiA 301 §7.5.2.5), read through the session's
+  // object jobs (an SDO on a bus) when the error code changes and on request.
+  struct error_field_read {
+    bool stale = true;     // to be read again
+    bool reading = false;  // a read runs
+    std::optional<std::uint64_t> read_at_us;
+    std::vector<std::uint32_t> entries;  // newest first, as sub 1..n
+    std::string error;                   // why the last read failed (0x1003 absent, no answer, ...)
+    std::vector<std::function<void()>> waiting;  // told when the running read ends
+  };
+  error_field_read error_field;
 
   // --- axis_page.cpp ------------------------------------------------------------------------------
   void start_session(const profile& p);  // the session over the connection `drive`
@@ -157,6 +176,17 @@ struct axis_page::impl {
   reply write_reply(const std::optional<axes::result>& r, const std::string& action,
                     std::optional<std::uint64_t> tracked = std::nullopt);
   reply change_bus_plant(std::unique_lock<std::mutex>& lock, const plant_change& change);
+
+  // --- axis_page_homing.cpp -----------------------------------------------------------------------
+  /// Starts the reads the views need (0x6099 on a bus, 0x1003 once stale); called each cycle.
+  void keep_views_read();
+  void read_error_field(std::size_t sub, std::vector<std::uint32_t> so_far);
+  void end_error_field_read(std::string error);
+  std::optional<std::int64_t> homing_value(std::uint16_t index, std::uint8_t sub) const;
+  detail::mode_reading mode_reading_now() const;
+  json homing_json() const;
+  json drive_errors_json() const;
+  void end_homing(const axes::result& r);
 };
 
 }  // namespace cia402::page

@@ -225,7 +225,11 @@ struct server::impl {
     std::variant<reply, request_error> r = act(*inst, body);
     if (auto* e = std::get_if<request_error>(&r)) return send_error(res, e->status, e->reason);
     const reply& rep = std::get<reply>(r);
-    if (const auto* ok = std::get_if<accepted>(&rep)) return send_json(res, 200, {{"id", ok->id}});
+    if (const auto* ok = std::get_if<accepted>(&rep)) {
+      json j{{"id", ok->id}};
+      if (!ok->text.empty()) j["text"] = ok->text;
+      return send_json(res, 200, j);
+    }
     const refused& no = std::get<refused>(rep);
     json j{{"error", no.reason}};
     if (no.abort != sdo_abort::none) {
@@ -445,6 +449,10 @@ struct server::impl {
       if (may_control(req)) inst->renew_lease();  // a client that polls the state is there
       res.set_content(inst->snapshot_json(), "application/json");
     });
+    http.Get("/api/errors", [this](const httplib::Request& req, httplib::Response& res) {
+      // The drive's 0x1003 as last read (the snapshot's drive_errors); POST /api/errors/read reads anew.
+      if (backend* inst = axis_of(req, res)) send_json(res, 200, json::parse(inst->snapshot_json())["drive_errors"]);
+    });
     http.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
       if (backend* inst = axis_of(req, res)) detail::serve_events(*inst, res, options, streams, stopping);
     });
@@ -496,13 +504,16 @@ struct server::impl {
     // One-click enable and stop, and the jog with its dead-man (commissioning.hpp).
     for (const auto& [path, act] : {std::pair{"/api/enable", &detail::enable_request},
                                     std::pair{"/api/stop", &detail::stop_request},
-                                    std::pair{"/api/jog", &detail::jog_request}}) {
+                                    std::pair{"/api/jog", &detail::jog_request},
+                                    std::pair{"/api/homing", &detail::homing_request_of},
+                                    std::pair{"/api/errors/read", &detail::error_field_read_request},
+                                    std::pair{"/api/errors/clear", &detail::error_field_clear_request}}) {
       http.Post(path, [this, act = act](const httplib::Request& req, httplib::Response& res) {
         post(req, res, act);
       });
     }
     for (const char* path : {"/api/command", "/api/plant", "/api/object", "/api/profile", "/api/enable",
-                             "/api/stop", "/api/jog"}) {
+                             "/api/stop", "/api/jog", "/api/homing", "/api/errors/read", "/api/errors/clear"}) {
       http.Get(path, [](const httplib::Request&, httplib::Response& res) {
         send_error(res, 405, "use POST with a JSON body");
       });

@@ -126,6 +126,40 @@ std::variant<reply, request_error> stop_request(backend& drive, const json& body
   return drive.stop();
 }
 
+std::variant<reply, request_error> homing_request_of(backend& drive, const json& body) {
+  if (auto k = unknown_key(body, {"method", "fast", "slow", "acceleration", "offset", "start"})) {
+    return request_error{400, *k};
+  }
+  homing_request r;
+  for (const auto& [key, field] : {std::pair{"method", &homing_request::method}, std::pair{"fast", &homing_request::switch_speed},
+                                   std::pair{"slow", &homing_request::zero_speed},
+                                   std::pair{"acceleration", &homing_request::acceleration},
+                                   std::pair{"offset", &homing_request::offset}}) {
+    if (!body.contains(key)) continue;
+    const auto v = body[key].is_number_integer() ? integer_of(body[key]) : std::nullopt;
+    if (!v) return request_error{400, std::string("'") + key + "' must be an integer"};
+    r.*field = v;
+  }
+  if (body.contains("start")) {
+    if (!body["start"].is_boolean()) return request_error{400, "'start' must be true (run) or false (stop)"};
+    r.start = body["start"].get<bool>();
+  }
+  if (!r.method && !r.switch_speed && !r.zero_speed && !r.acceleration && !r.offset && !r.start) {
+    return request_error{400, "nothing to do: give a parameter or 'start'"};
+  }
+  return drive.home(r);
+}
+
+std::variant<reply, request_error> error_field_read_request(backend& drive, const json& body) {
+  if (auto k = unknown_key(body, {})) return request_error{400, *k};
+  return drive.read_error_field();
+}
+
+std::variant<reply, request_error> error_field_clear_request(backend& drive, const json& body) {
+  if (auto k = unknown_key(body, {})) return request_error{400, *k};
+  return drive.clear_error_field();
+}
+
 // A refusal written straight to the socket (the request was never parsed).
 void answer_and_close(socket_t sock, int status, const std::string& reason) {
   const char* text = status == 408 ? "Request Timeout"

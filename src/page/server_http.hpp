@@ -51,6 +51,14 @@ std::variant<reply, request_error> jog_request(backend& drive, const nlohmann::j
 std::variant<reply, request_error> enable_request(backend& drive, const nlohmann::json& body);
 std::variant<reply, request_error> stop_request(backend& drive, const nlohmann::json& body);
 
+/// POST /api/homing: {"method", "fast" (0x6099:1, rpm), "slow" (0x6099:2, rpm), "acceleration"
+/// (0x609A, rpm/s), "offset" (0x607C), "start" (true: run, false: stop)}, each optional, integers.
+std::variant<reply, request_error> homing_request_of(backend& drive, const nlohmann::json& body);
+/// POST /api/errors/read and /api/errors/clear take an empty object: the drive's 0x1003 read again,
+/// or emptied (sub 0 = 0).
+std::variant<reply, request_error> error_field_read_request(backend& drive, const nlohmann::json& body);
+std::variant<reply, request_error> error_field_clear_request(backend& drive, const nlohmann::json& body);
+
 /// A refusal written straight to the socket (the request was never parsed); closes it.
 void answer_and_close(socket_t sock, int status, const std::string& reason);
 

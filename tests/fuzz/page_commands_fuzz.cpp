@@ -41,7 +41,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::uint8_t arg = data[i + 1];
     const nlohmann::json before = observable(inst);
     reply r = accepted{};
-    switch (what % 6) {
+    switch (what % 7) {
       case 0: r = inst.command(static_cast<page_command>(arg % 8)); break;
       case 1: r = inst.toggle_control_bit(static_cast<int>(arg) - 8); break;
       case 2: {
@@ -64,6 +64,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 4: {
         const char* names[] = {"cia402", "s300-profibus", "nonesuch", ""};
         r = inst.select_profile(names[arg % 4]);
+        break;
+      }
+      case 5: {
+        // POST /api/homing (parameters, start, stop) and the drive's 0x1003 read and cleared.
+        homing_request h;
+        if (arg & 1) h.method = static_cast<std::int8_t>(arg) % 40;
+        if (arg & 2) h.switch_speed = static_cast<std::int8_t>(arg) * 97;
+        if (arg & 4) h.acceleration = arg % 3;
+        if (arg & 8) h.start = (arg & 16) != 0;
+        r = (arg & 96) == 32 ? inst.read_error_field() : (arg & 96) == 64 ? inst.clear_error_field() : inst.home(h);
         break;
       }
       default:

@@ -191,6 +191,10 @@ TEST(ecat_page, an_injected_fault_shows_with_its_code_and_a_reset_clears_it) {
   EXPECT_TRUE(b.run_until([&] { return b.snapshot()["error_register"] == "0x03"; }, 300))
       << "generic + current, read by SDO";
   EXPECT_EQ(b.snapshot()["remote"]["last_emcy"], "0x2310");
+  // The slave's own pre-defined error field, read over CoE when 0x603F changed (issue 35).
+  EXPECT_TRUE(b.run_until([&] { return b.snapshot()["drive_errors"]["count"] == 1; }, 500))
+      << b.snapshot()["drive_errors"];
+  EXPECT_EQ(b.snapshot()["drive_errors"]["entries"][0]["code"], "0x2310");
   plant_change clear;
   clear.fault = false;
   ASSERT_TRUE(is_accepted(b.blocking([&] { return b.page->change_plant(clear); })));

@@ -549,3 +549,48 @@ TEST(remote_drive, each_sync_gives_one_scope_sample_and_the_batch_names_what_was
     EXPECT_NE(std::find(polled.begin(), polled.end(), name), polled.end()) << name << " in " << batch["polled"];
   }
 }
+
+// Issue 35 on a bus: the homing objects and 0x1003 are read by SDO at start, POST /api/homing's
+// writes and run go by SDO and the drive's status bits, a fault enters the node's 0x1003 and the
+// page reads it again, and 0x1003 sub 0 = 0 empties it.
+TEST(remote_drive, homing_method_3_runs_over_sdo_and_a_fault_enters_the_nodes_0x1003) {
+  remote_bench b;
+  ASSERT_TRUE(b.run_until_running()) << b.remote().link_text();
+  b.run_ms(300);
+  json s = b.snapshot();
+  EXPECT_EQ(s["homing"]["method"], 35) << s["homing"];  // the object table's default
+  EXPECT_EQ(s["homing"]["fast"], 1000);
+  EXPECT_EQ(s["homing"]["slow"], 100);
+  EXPECT_EQ(s["drive_errors"]["count"], 0) << s["drive_errors"];
+  cia402::page::homing_request h;
+  h.method = 3;
+  h.switch_speed = 600;
+  h.zero_speed = 60;
+  h.start = true;
+  const reply started = b.blocking([&] { return b.remote().home(h); });
+  ASSERT_TRUE(is_accepted(started)) << std::get<refused>(started).reason;
+  EXPECT_EQ(std::get<accepted>(started).text, "0x6098 = 3, 0x6099:1 = 600, 0x6099:2 = 60");
+  bool searching_seen = false;
+  for (int ms = 0; ms < 5000 && b.snapshot()["homing"]["phase"] != "homing attained"; ms += 10) {
+    b.run_ms(10);
+    searching_seen = searching_seen || b.snapshot()["homing"]["phase"] == "searching home switch at 0x6099:1 = 600 rpm";
+  }
+  s = b.snapshot();
+  EXPECT_EQ(s["homing"]["phase"], "homing attained") << s["homing"];
+  EXPECT_TRUE(searching_seen);
+  b.run_ms(200);
+  EXPECT_EQ(b.newest_result()["text"], "done: homing attained, 0x6064 = 0") << b.newest_result();
+
+  plant_change fault;
+  fault.fault = true;
+  fault.fault_code = 0x2310;
+  ASSERT_TRUE(is_accepted(b.blocking([&] { return b.remote().change_plant(fault); })));
+  b.run_ms(500);
+  s = b.snapshot();
+  ASSERT_EQ(s["drive_errors"]["count"], 1) << s["drive_errors"];
+  EXPECT_EQ(s["drive_errors"]["entries"][0]["code"], "0x2310");
+  EXPECT_EQ(s["drive_errors"]["entries"][0]["text"], "continuous over-current");
+  ASSERT_TRUE(is_accepted(b.blocking([&] { return b.remote().clear_error_field(); })));
+  b.run_ms(300);
+  EXPECT_EQ(b.snapshot()["drive_errors"]["count"], 0) << b.snapshot()["drive_errors"];
+}

@@ -4,6 +4,7 @@ import { buildAxes, buildProfileChoice } from './axes.js';
 import { drawDiagram, updateDiagram } from './diagram.js';
 import { api, el, page, stateLabel, token } from './page.js';
 import { applyCapabilities, buildObjects, buildPlant, buildSetpoints, showPlant } from './plant.js';
+import { buildModePanel, showModePanel } from './modes.js';
 import { drawTimeline, onRecording, pollRecording } from './recorder.js';
 import { buildScope, drawScopeFrame } from './scope.js';
 import { addRows, addSamples, addSnapshot } from './scope_data.js';
@@ -28,6 +29,7 @@ function update(s, missed) {
   updateDiagram(s);
   showWords(s);
   showPlant(s);
+  showModePanel(s);
   addSnapshot(s, missed);
 }
 
@@ -54,6 +56,7 @@ export async function start() {
   buildObjects();
   buildModes();
   buildSetpoints();
+  buildModePanel();
   buildPlant();
   buildScope();
   setControl(page.info.control);

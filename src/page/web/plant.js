@@ -1,6 +1,7 @@
 // The plant panel: the set-point of the mode the drive runs, the plant's switches (fault, DC link,
 // STO) as far as the backend serves them, the readouts and lamps, the object table and its form.
 import { el, hexBits, label, page, post, showResult } from './page.js';
+import { homingBody, homingRunning } from './modes.js';
 import { modeLabel } from './words.js';
 
 // The set-point inputs of the mode the drive runs: velocity 0x60FF (pv, csv; and when the mode is
@@ -78,17 +79,10 @@ export function buildSetpoints() {
   methods.addEventListener('change', () => { touched['homing-method'] = performance.now(); });
   // Homing operation start is bit 4 held up (CiA 402-2); taking it down interrupts the run.
   el('homing-start').hidden = !handshake;
-  el('homing-form').addEventListener('submit', async (e) => {
+  // POST /api/homing: the parameters, then the run (or its stop); modes.js fills the speeds.
+  el('homing-form').addEventListener('submit', (e) => {
     e.preventDefault();
-    if (controlBit(4)) {
-      post('/api/command', { command: 'toggle_bit', bit: 4 });
-      return;
-    }
-    const method = Number(methods.value);
-    if (page.snapshot && page.snapshot.objects['0x6098'] !== method) {
-      if (!(await post('/api/object', { index: '0x6098', value: method }))) return;
-    }
-    if (handshake) post('/api/command', { command: 'toggle_bit', bit: 4 });
+    post('/api/homing', homingBody(Number(methods.value), !homingRunning(page.snapshot)));
   });
 }
 
@@ -107,12 +101,12 @@ function showSetpoints(s) {
   syncSwitch('pp-relative', ((cw >> 6) & 1) === 1);
   syncSwitch('pp-immediate', ((cw >> 5) & 1) === 1);
   const homing = el('homing-start');
-  const running = mode === 6 && ((cw >> 4) & 1) === 1;
+  const running = homingRunning(s);
   homing.setAttribute('aria-pressed', running ? 'true' : 'false');
   homing.textContent = running ? 'Stop homing' : 'Start homing';
   const method = s.objects && s.objects['0x6098'];
   if (method !== undefined && document.activeElement !== el('homing-method') &&
-      performance.now() - (touched['homing-method'] || 0) > 3000) {
+      (touched['homing-method'] === undefined || performance.now() - touched['homing-method'] > 3000)) {
     el('homing-method').value = String(method);
   }
 }

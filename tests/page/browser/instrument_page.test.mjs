@@ -346,12 +346,11 @@ async function main() {
     await page.click('#homing-start');
     await positionIs('777');
     await statusBitOn(12);
-    await page.waitForFunction(() => document.getElementById('homing-start').textContent === 'Stop homing',
-      null, { timeout: patience });
+    // The run (POST /api/homing) ends once attained: bit 4 down again, the button back to Start.
+    await waitResult(page, 'done: homing attained');
     const method = await page.$eval('#object-values', (t) => [...t.querySelectorAll('tr')]
       .find((r) => r.querySelector('th').textContent.startsWith('0x6098')).querySelector('td').textContent);
     expect(method === '37', `0x6098 reads ${method}`);
-    await page.click('#homing-start');
     await page.waitForFunction(() => document.getElementById('homing-start').textContent === 'Start homing',
       null, { timeout: patience });
     await click(page, 'disable_voltage');

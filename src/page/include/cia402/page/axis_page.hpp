@@ -87,6 +87,9 @@ class axis_page : public backend {
   reply jog(std::int64_t velocity_rpm, std::uint64_t time_to_live_us) override;
   reply write_object(std::uint16_t index, std::int64_t value) override;
   reply change_plant(const plant_change& change) override;
+  reply home(const homing_request& r) override;
+  reply read_error_field() override;
+  reply clear_error_field() override;
   reply select_profile(std::string_view name) override;
   void renew_lease() override;
 

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 
 #include "cia402/sdo_abort.hpp"
@@ -19,7 +20,10 @@ namespace cia402::page {
 
 /// An action the backend took on: its id, reported again in the snapshots' `results`.
 struct accepted {
+  accepted() = default;
+  accepted(std::uint64_t action_id, std::string what = {}) : id(action_id), text(std::move(what)) {}  // NOLINT: implicit from an id
   std::uint64_t id = 0;
+  std::string text;  ///< what was done, where the request answers with it (POST /api/homing)
 };
 
 /// An action refused before anything changed: the HTTP status it maps to and the reason.
@@ -57,6 +61,17 @@ struct plant_change {
   std::uint8_t fault_class = 2;                 ///< with fault = true, 0..4 (profiles with classes)
   std::optional<bool> dc_link;                  ///< DC-link voltage present
   std::optional<bool> sto;                      ///< safe torque off asserted
+};
+
+/// A homing run's parameters and its start (POST /api/homing); each one optional. Written in this
+/// order before the run starts: 0x6098, 0x6099 sub 1, 0x6099 sub 2, 0x609A, 0x607C.
+struct homing_request {
+  std::optional<std::int64_t> method;        ///< 0x6098
+  std::optional<std::int64_t> switch_speed;  ///< 0x6099 sub 1, rpm: searching the switch
+  std::optional<std::int64_t> zero_speed;    ///< 0x6099 sub 2, rpm: the edge and the index pulse
+  std::optional<std::int64_t> acceleration;  ///< 0x609A, rpm/s
+  std::optional<std::int64_t> offset;        ///< 0x607C, increments
+  std::optional<bool> start;  ///< true: run it (homing mode, enabled, bit 4 up); false: stop a run
 };
 
 /// The recorder's export formats: CSV, IEEE 1364 VCD (state as integer codes), GTKWave's VCD.
@@ -106,6 +121,18 @@ class backend {
   /// Writes an object (option codes, ramps, 0x60FF, ...). A write the drive refuses gives its SDO
   /// abort code and changes nothing.
   virtual reply write_object(std::uint16_t index, std::int64_t value) = 0;
+  /// Homing (CiA 402-2 mode 6): writes the parameters the request gives, then starts a run (the
+  /// axis session's home: 0x6060 = 6, OPERATION ENABLED, control bit 4 up until status bits 12 and
+  /// 10) or stops one. A value outside the object table's range is refused (422) before anything is
+  /// sent; a write the drive refuses answers with its SDO abort (422).
+  virtual reply home(const homing_request& r) {
+    (void)r;
+    return refused{409, "homing is not offered on this drive"};
+  }
+  /// The drive's own pre-defined error field 0x1003 (CiA 301 §7.5.2.5): read it again now (the
+  /// snapshots' `drive_errors`), or empty it (0x1003 sub 0 = 0).
+  virtual reply read_error_field() { return refused{409, "this drive has no 0x1003 the page reads"}; }
+  virtual reply clear_error_field() { return refused{409, "this drive has no 0x1003 the page reads"}; }
   /// Plant inputs: target velocity, fault, DC link, STO. A backend that cannot change one refuses
   /// the request (and says so in the `capabilities` of its info).
   virtual reply change_plant(const plant_change& change) = 0;
