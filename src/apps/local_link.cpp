@@ -201,14 +201,7 @@ std::optional<axes::value_format> local_link::describe(std::uint16_t index, std:
 
 void local_link::close() {
   closed_ = true;
-  axes::transfer_result gone;
-  gone.cancelled = true;
-  gone.error = "closed";
-  std::deque<transfer> left;
-  left.swap(transfers_);
-  for (transfer& t : left) {
-    if (t.done) t.done(gone);
-  }
+  axes::cancel_transfers(transfers_, "closed");
   report_.done = true;
 }
 

@@ -99,13 +99,7 @@ class can_link final : public axes::drive_link {
 
  private:
   enum class stage : std::uint8_t { acyclic, recording, setting_up, cyclic, restoring, closed };
-  struct transfer {
-    std::uint16_t index = 0;
-    std::uint8_t sub = 0;
-    bool download = false;
-    std::vector<std::uint8_t> bytes;
-    axes::transfer_done done;
-  };
+  using transfer = axes::pending_transfer;
   struct recorded {
     std::uint16_t index = 0;
     std::uint8_t sub = 0;
