@@ -99,7 +99,7 @@ std::vector<std::uint8_t> initiate_expedited(coe_service s, std::uint8_t cs, std
                                              std::span<const std::uint8_t> value) {
   const std::size_t n = std::clamp<std::size_t>(value.size(), 1, 4);
   std::vector<std::uint8_t> b = coe(s);
-  b.push_back(static_cast<std::uint8_t>((cs << 5) | ((4 - n) << 2) | 0x03));
+  b.push_back(static_cast<std::uint8_t>((std::size_t{cs} << 5) | ((4 - n) << 2) | 0x03));
   put_address(b, index, sub);
   b.insert(b.end(), value.begin(), value.begin() + static_cast<std::ptrdiff_t>(std::min(n, value.size())));
   return padded(std::move(b));
