@@ -7,6 +7,14 @@
 #   the project is configured: canopen and ethercat never link the simulator (nor drive402, which
 #   does), the CoE codec links only the core, the master nothing of the slave side.
 
+# The settings every C++20 library above the core shares: standard C++ without extensions, position
+# independent (the Python package, a shared module, links it), the project's warnings.
+function(cia402_cxx20_library target)
+  set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF POSITION_INDEPENDENT_CODE ON)
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wconversion -Wshadow)
+endfunction()
+
 # Links `include/cia402/<item>` (a folder or a header) for `target` and makes the folder of links the
 # target's public include directory (the installed tree stays CMAKE_INSTALL_INCLUDEDIR).
 function(cia402_export_headers target)

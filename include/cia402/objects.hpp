@@ -9,19 +9,10 @@
 #include <cstdint>
 #include <string_view>
 
+#include "cia402/data_type.hpp"
 #include "cia402/sdo_abort.hpp"
 
 namespace cia402 {
-
-/// CiA 301 data types, by their codes (they are the EDS's DataType values).
-enum class object_type : std::uint8_t {
-  integer8 = 0x02,
-  integer16 = 0x03,
-  integer32 = 0x04,
-  unsigned8 = 0x05,
-  unsigned16 = 0x06,
-  unsigned32 = 0x07,
-};
 
 enum class object_access : std::uint8_t { read_only, write_only, read_write };
 
@@ -30,7 +21,7 @@ enum class object_access : std::uint8_t { read_only, write_only, read_write };
 struct object_description {
   std::uint16_t index;
   std::uint8_t sub;
-  object_type type;
+  data_type type;
   object_access access;
   bool pdo_mappable;
   std::int64_t low;            ///< the lowest value a write may give (within the type)
@@ -39,40 +30,6 @@ struct object_description {
   const char* name;            ///< CiA 402's name, e.g. "Profile acceleration"
   const char* unit;            ///< "rpm", "rpm/s", or "" for none
 };
-
-/// The lowest and highest value of a data type.
-constexpr std::int64_t type_low(object_type t) noexcept {
-  switch (t) {
-    case object_type::integer8: return -128;
-    case object_type::integer16: return -32768;
-    case object_type::integer32: return -2147483647LL - 1;
-    default: return 0;
-  }
-}
-constexpr std::int64_t type_high(object_type t) noexcept {
-  switch (t) {
-    case object_type::integer8: return 127;
-    case object_type::integer16: return 32767;
-    case object_type::integer32: return 2147483647LL;
-    case object_type::unsigned8: return 255;
-    case object_type::unsigned16: return 65535;
-    case object_type::unsigned32: return 4294967295LL;
-  }
-  return 0;
-}
-/// Bytes of a data type on the bus.
-constexpr std::size_t type_size(object_type t) noexcept {
-  switch (t) {
-    case object_type::integer8:
-    case object_type::unsigned8: return 1;
-    case object_type::integer16:
-    case object_type::unsigned16: return 2;
-    default: return 4;
-  }
-}
-constexpr bool type_signed(object_type t) noexcept {
-  return t == object_type::integer8 || t == object_type::integer16 || t == object_type::integer32;
-}
 
 /// The drive profile's objects, in index order.
 std::size_t drive_object_count() noexcept;

@@ -196,19 +196,12 @@ bool local_link::download(std::uint16_t index, std::uint8_t sub, std::vector<std
 std::optional<axes::value_format> local_link::describe(std::uint16_t index, std::uint8_t sub) const {
   const object_dictionary::slot* s = objects_->table().find(index, sub);
   if (s == nullptr) return std::nullopt;
-  return canopen::value_format_of(s->entry->type);
+  return axes::format_of(s->entry->type);
 }
 
 void local_link::close() {
   closed_ = true;
-  axes::transfer_result gone;
-  gone.cancelled = true;
-  gone.error = "closed";
-  std::deque<transfer> left;
-  left.swap(transfers_);
-  for (transfer& t : left) {
-    if (t.done) t.done(gone);
-  }
+  axes::cancel_transfers(transfers_, "closed");
   report_.done = true;
 }
 

@@ -81,8 +81,9 @@ std::string value_format::type_name() const {
   return "unknown";
 }
 
-value_format format_of(object_type t) noexcept {
-  return value_format::integer(static_cast<unsigned>(type_size(t)), type_signed(t));
+value_format format_of(data_type t) noexcept {
+  if (t == data_type::visible_string) return value_format::text();
+  return value_format::integer(type_size(t), type_is_signed(t));
 }
 
 object_value object_value::of_integer(std::int64_t v) {

@@ -18,6 +18,15 @@ std::int64_t window_of(std::int64_t target) noexcept { return std::max<std::int6
 
 }  // namespace
 
+std::function<void()> session::answer_with_state(std::uint64_t id, completion done) {
+  return [this, id, done = std::move(done)] {
+    result r;
+    r.id = id;
+    fill_result(r);
+    if (done) done(r);
+  };
+}
+
 std::uint64_t session::refuse_now(std::string error, completion done, bool bad_input) {
   // Said at once, from the next poll() as every completion; the running operation goes on.
   const std::uint64_t id = next_id_++;
@@ -62,12 +71,7 @@ std::vector<session::step> session::motion_start(std::int8_t m) {
 std::uint64_t session::read_state(completion done) {
   const std::uint64_t id = next_id_++;
   if (status_known()) {
-    deferred_.push_back([this, id, done = std::move(done)] {
-      result r;
-      r.id = id;
-      fill_result(r);
-      if (done) done(r);
-    });
+    deferred_.push_back(answer_with_state(id, std::move(done)));
     return id;
   }
   // No cyclic status yet: over SDO, without setting anything up.
@@ -189,12 +193,7 @@ std::uint64_t session::halt(bool on, completion done) {
     word_changed_us_ = now_us_;
     word_changed_count_ = link_->status_count();
     const std::uint64_t id = next_id_++;
-    after_settled_.push_back([this, id, done = std::move(done)] {
-      result r;
-      r.id = id;
-      fill_result(r);
-      if (done) done(r);
-    });
+    after_settled_.push_back(answer_with_state(id, std::move(done)));
     return id;
   }
   std::vector<step> steps{need_prepared(), need_cyclic(), check(false), step{[this, apply] {

@@ -5,13 +5,13 @@
 namespace cia402 {
 namespace {
 
-using T = object_type;
+using T = data_type;
 using A = object_access;
 
 constexpr object_description var(std::uint16_t index, T type, A access, bool mappable,
                                  const char* name, const char* unit = "",
                                  std::int64_t default_value = 0) noexcept {
-  return {index, 0, type, access, mappable, type_low(type), type_high(type), default_value, name, unit};
+  return {index, 0, type, access, mappable, type_min(type), type_max(type), default_value, name, unit};
 }
 
 // A ramp of 0 rpm/s would never end: 1 is the lowest value.
@@ -47,7 +47,7 @@ constexpr object_description highest_sub(std::uint16_t index, std::uint8_t count
 
 constexpr object_description sub(std::uint16_t index, std::uint8_t sub_index, T type, const char* name,
                                  const char* unit, std::int64_t default_value) noexcept {
-  return {index, sub_index, type, A::read_write, false, type_low(type), type_high(type), default_value,
+  return {index, sub_index, type, A::read_write, false, type_min(type), type_max(type), default_value,
           name, unit};
 }
 

@@ -21,11 +21,11 @@ void add_profile_objects(std::vector<object_entry>& t) {
     const access acc = d.access == cia402::object_access::read_only    ? access::ro
                        : d.access == cia402::object_access::write_only ? access::wo
                                                                        : access::rw;
-    sub_entry e = on_device(variable(d.sub, d.name, static_cast<data_type>(d.type), acc, d.default_value));
+    sub_entry e = on_device(variable(d.sub, d.name, d.type, acc, d.default_value));
     e.pdo_mappable = d.pdo_mappable;
     // The limits a write must keep, where they are narrower than the type (a ramp of 0 would never
     // end): the EDS says so as LowLimit / HighLimit.
-    if (d.low != type_low(d.type) || d.high != type_high(d.type)) e = limited(std::move(e), d.low, d.high);
+    if (d.low != type_min(d.type) || d.high != type_max(d.type)) e = limited(std::move(e), d.low, d.high);
     const bool has_subs = i + 1 < drive_object_count() && drive_object(i + 1).index == d.index;
     if (d.sub != 0 || !has_subs) {
       if (d.sub != 0 && !t.empty() && t.back().index == d.index) {

@@ -63,6 +63,17 @@ class axis_host {
   /// One step of `elapsed_us` of time, the mutex held.
   virtual void step_locked(std::uint32_t elapsed_us) = 0;
 
+  /// Virtual time: `us` of time in steps of at most `period_us` each, then the waiters woken.
+  void advance_in_periods(std::uint64_t us, std::uint32_t period_us) {
+    std::lock_guard lock(mutex_);
+    while (us > 0) {
+      const auto slice = static_cast<std::uint32_t>(std::min<std::uint64_t>(us, period_us));
+      step_locked(slice);
+      us -= slice;
+    }
+    arrived_.notify_all();
+  }
+
   /// The stepping thread of a host on wall time: a step every `period_us` until closed, the mutex
   /// held but while waiting, waiters on arrived_ woken after each step; wake_ ends a wait early.
   void run_on_wall_time(std::uint32_t period_us) {
@@ -115,15 +126,7 @@ class bus_core final : public axis_host {
   }
 
   /// Virtual time: `us` of time for every drive, in periods.
-  void advance(std::uint64_t us) {
-    std::lock_guard lock(mutex_);
-    while (us > 0) {
-      const auto slice = static_cast<std::uint32_t>(std::min<std::uint64_t>(us, period_us_));
-      step(slice);
-      us -= slice;
-    }
-    arrived_.notify_all();
-  }
+  void advance(std::uint64_t us) { advance_in_periods(us, period_us_); }
 
   std::uint32_t step_period_locked() override {
     step(period_us_);

@@ -109,15 +109,7 @@ class line_core final : public axis_host {
     return cycle_us_;
   }
 
-  void advance(std::uint64_t us) {
-    std::lock_guard lock(mutex_);
-    while (us > 0) {
-      const auto slice = static_cast<std::uint32_t>(std::min<std::uint64_t>(us, cycle_us_));
-      step(slice);
-      us -= slice;
-    }
-    arrived_.notify_all();
-  }
+  void advance(std::uint64_t us) { advance_in_periods(us, cycle_us_); }
 
   std::uint64_t now_us() {
     std::lock_guard lock(mutex_);

@@ -66,18 +66,6 @@ py::dict option_specs(const profile& p) {
   return options;
 }
 
-const char* type_name(object_type t) {
-  switch (t) {
-    case object_type::integer8: return "INTEGER8";
-    case object_type::integer16: return "INTEGER16";
-    case object_type::integer32: return "INTEGER32";
-    case object_type::unsigned8: return "UNSIGNED8";
-    case object_type::unsigned16: return "UNSIGNED16";
-    case object_type::unsigned32: return "UNSIGNED32";
-  }
-  return "?";
-}
-
 py::dict describe_object(const object_description& o) {
   py::dict d;
   d["index"] = o.index;

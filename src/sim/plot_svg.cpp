@@ -401,6 +401,14 @@ void write_torque_lane(std::ostream& out, const std::vector<trace_row>& rows, co
   out << "\"/>\n</g>\n";
 }
 
+// A lane's label at its left and its grey background.
+void write_lane_frame(std::ostream& out, double top, const char* label) {
+  out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(top + 11) << "\" text-anchor=\"end\">" << label
+      << "</text>\n";
+  out << "<rect x=\"" << num(left) << "\" y=\"" << num(top) << "\" width=\"" << num(right - left)
+      << "\" height=\"" << num(lane_height) << "\" fill=\"#f4f4f4\" stroke=\"#999\" stroke-width=\"0.5\"/>\n";
+}
+
 // Lanes: torque on; brake released (solid) and changing over (light); inputs from outside.
 void write_lanes(std::ostream& out, const std::vector<trace_row>& rows, const scale& s,
                  const trace_info& info, const layout& places) {
@@ -408,16 +416,8 @@ void write_lanes(std::ostream& out, const std::vector<trace_row>& rows, const sc
   const double brake_top = places.brake_top;
   const double inputs_top = places.inputs_top;
   out << "<g id=\"lanes\">\n";
-  out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(torque_top + 11)
-      << "\" text-anchor=\"end\">torque on</text>\n";
-  out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(brake_top + 11)
-      << "\" text-anchor=\"end\">brake open</text>\n";
-  out << "<rect x=\"" << num(left) << "\" y=\"" << num(torque_top) << "\" width=\""
-      << num(right - left) << "\" height=\"" << num(lane_height)
-      << "\" fill=\"#f4f4f4\" stroke=\"#999\" stroke-width=\"0.5\"/>\n";
-  out << "<rect x=\"" << num(left) << "\" y=\"" << num(brake_top) << "\" width=\""
-      << num(right - left) << "\" height=\"" << num(lane_height)
-      << "\" fill=\"#f4f4f4\" stroke=\"#999\" stroke-width=\"0.5\"/>\n";
+  write_lane_frame(out, torque_top, "torque on");
+  write_lane_frame(out, brake_top, "brake open");
   auto lane = [&](double top, auto level, const char* fill) {
     for (std::size_t i = 0; i < rows.size();) {
       const int v = level(rows[i]);
@@ -447,11 +447,7 @@ void write_lanes(std::ostream& out, const std::vector<trace_row>& rows, const sc
         << "\" fill=\"#666\">no brake fitted</text>\n";
   }
   // Inputs from outside: STO, DC link lost, a fault cause; labelled where there is room.
-  out << "<text x=\"" << num(left - 8) << "\" y=\"" << num(inputs_top + 11)
-      << "\" text-anchor=\"end\">inputs</text>\n";
-  out << "<rect x=\"" << num(left) << "\" y=\"" << num(inputs_top) << "\" width=\""
-      << num(right - left) << "\" height=\"" << num(lane_height)
-      << "\" fill=\"#f4f4f4\" stroke=\"#999\" stroke-width=\"0.5\"/>\n";
+  write_lane_frame(out, inputs_top, "inputs");
   auto input_text = [](const trace_row& r) {
     std::string t;
     if (r.sto) t += "STO";

@@ -14,10 +14,6 @@ using toml_reading::get_bool;
 using toml_reading::get_int;
 using toml_reading::refuse;
 
-std::uint32_t get_u32(const toml::node& n, std::string_view what, std::int64_t lo = 0) {
-  return static_cast<std::uint32_t>(get_int(n, what, lo, std::numeric_limits<std::uint32_t>::max()));
-}
-
 constexpr std::int64_t reach = std::int64_t{1} << 40;
 
 // A place on the shaft (increments within +-2^40), or "none" for a switch that is not fitted.
@@ -75,37 +71,21 @@ void load_plant(const toml::table& t, scenario& s) {
   };
   delay("brake_engage_delay", c.brake_engage_delay_us);
   delay("brake_release_delay", c.brake_release_delay_us);
-  if (const auto* n = t.get("brake_deceleration")) {
-    c.brake_deceleration = get_u32(*n, "brake_deceleration", 1);
-  }
-  if (const auto* n = t.get("coast_deceleration")) {
-    c.coast_deceleration = get_u32(*n, "coast_deceleration");
-  }
-  if (const auto* n = t.get("standstill_window")) {
-    c.standstill_window_rpm =
-        static_cast<std::uint32_t>(get_int(*n, "standstill_window", 0, 1000000));
-  }
-  if (const auto* n = t.get("target_window")) {
-    c.target_window_rpm = static_cast<std::uint32_t>(get_int(*n, "target_window", 0, 65535));
-  }
-  if (const auto* n = t.get("current_limit_percent")) {
-    c.current_limit_percent =
-        static_cast<std::uint32_t>(get_int(*n, "current_limit_percent", 1, 1000));
-  }
-  if (const auto* n = t.get("voltage_limit_percent")) {
-    c.voltage_limit_percent =
-        static_cast<std::uint32_t>(get_int(*n, "voltage_limit_percent", 1, 1000));
-  }
-  if (const auto* n = t.get("max_velocity")) {
-    c.max_velocity_rpm = static_cast<std::uint32_t>(get_int(*n, "max_velocity", 1, 100000));
-  }
-  if (const auto* n = t.get("max_acceleration")) {
-    c.max_acceleration_rpm_s = static_cast<std::uint32_t>(get_int(*n, "max_acceleration", 1, 100000000));
-  }
-  if (const auto* n = t.get("torque_acceleration")) {
-    c.torque_acceleration_rpm_s = static_cast<std::uint32_t>(get_int(*n, "torque_acceleration", 1, 100000000));
-  }
-  if (const auto* n = t.get("friction")) c.friction_permille = static_cast<std::uint32_t>(get_int(*n, "friction", 0, 1000));
+  // A constant in rpm, rpm/s, percent or permille, within lo..hi.
+  auto number = [&](const char* key, std::uint32_t& out, std::int64_t lo, std::int64_t hi) {
+    if (const auto* n = t.get(key)) out = static_cast<std::uint32_t>(get_int(*n, key, lo, hi));
+  };
+  constexpr std::int64_t u32_max = std::numeric_limits<std::uint32_t>::max();
+  number("brake_deceleration", c.brake_deceleration, 1, u32_max);
+  number("coast_deceleration", c.coast_deceleration, 0, u32_max);
+  number("standstill_window", c.standstill_window_rpm, 0, 1000000);
+  number("target_window", c.target_window_rpm, 0, 65535);
+  number("current_limit_percent", c.current_limit_percent, 1, 1000);
+  number("voltage_limit_percent", c.voltage_limit_percent, 1, 1000);
+  number("max_velocity", c.max_velocity_rpm, 1, 100000);
+  number("max_acceleration", c.max_acceleration_rpm_s, 1, 100000000);
+  number("torque_acceleration", c.torque_acceleration_rpm_s, 1, 100000000);
+  number("friction", c.friction_permille, 0, 1000);
   if (const auto* n = t.get("load")) c.load_permille = static_cast<std::int32_t>(get_int(*n, "load", -1000, 1000));
   if (const auto* n = t.get("home_switch")) load_home_switch(*n, c);
   if (const auto* n = t.get("index_position")) c.index_position = get_int(*n, "index_position", -reach, reach);

@@ -9,6 +9,15 @@
 namespace cia402::axes::test {
 namespace {
 
+TEST(object_value, every_cia301_data_type_travels_as_text_or_an_integer_of_its_size_and_sign) {
+  EXPECT_EQ(format_of(data_type::visible_string), value_format::text());
+  EXPECT_EQ(format_of(data_type::boolean), value_format::integer(1, false));
+  EXPECT_EQ(format_of(data_type::integer8), value_format::integer(1, true));
+  EXPECT_EQ(format_of(data_type::unsigned16), value_format::integer(2, false));
+  EXPECT_EQ(format_of(data_type::integer32), value_format::integer(4, true));
+  EXPECT_EQ(format_of(data_type::unsigned64), value_format::integer(8, false));
+}
+
 TEST(object_value, command_line_text_is_read_as_its_type_says) {
   std::string why;
   EXPECT_EQ(parse_value("100", std::nullopt, why), object_value::of_integer(100));

@@ -203,7 +203,7 @@ class sim_link final : public drive_link {
           std::uint64_t u = 0;
           for (std::size_t i = 0; i < size; ++i) u |= std::uint64_t{t.bytes[i]} << (8 * i);
           std::int64_t v = static_cast<std::int64_t>(u);
-          if (type_signed(o->type) && size < 8 && (t.bytes.back() & 0x80)) v = static_cast<std::int64_t>(u | (~std::uint64_t{0} << (8 * size)));
+          if (type_is_signed(o->type) && size < 8 && (t.bytes.back() & 0x80)) v = static_cast<std::int64_t>(u | (~std::uint64_t{0} << (8 * size)));
           r.abort = drive.write(t.index, t.sub, v);
           r.ok = r.abort == sdo_abort::none;
           if (r.ok) downloads.push_back({t.index, t.sub, t.bytes});

@@ -180,8 +180,8 @@ TEST(eds, the_dictionary_holds_every_object_of_the_one_table_as_it_describes_it)
       EXPECT_EQ(e.low, d.low);
       EXPECT_EQ(e.high, d.high);
     } else {
-      EXPECT_EQ(d.low, cia402::type_low(d.type));
-      EXPECT_EQ(d.high, cia402::type_high(d.type));
+      EXPECT_EQ(d.low, cia402::type_min(d.type));
+      EXPECT_EQ(d.high, cia402::type_max(d.type));
     }
   }
 }

@@ -5,17 +5,43 @@
 #include "cia402/objects.hpp"
 #include "cia402/profile.hpp"
 
+#include <limits>
 #include <vector>
 
 namespace cia402 {
 namespace {
+
+// CiA 301 §7.1.6: an integer type's range is all its size and sign allow (UNSIGNED64 up to what an
+// int64 holds); BOOLEAN is 0..1 in one byte; VISIBLE_STRING has no fixed size.
+TEST(data_types, each_integer_type_ranges_over_what_its_size_and_sign_allow) {
+  for (const data_type t : {data_type::integer8, data_type::integer16, data_type::integer32, data_type::unsigned8,
+                            data_type::unsigned16, data_type::unsigned32}) {
+    const unsigned bits = 8 * type_size(t);
+    if (type_is_signed(t)) {
+      EXPECT_EQ(type_min(t), -(std::int64_t{1} << (bits - 1))) << type_name(t);
+      EXPECT_EQ(type_max(t), (std::int64_t{1} << (bits - 1)) - 1) << type_name(t);
+    } else {
+      EXPECT_EQ(type_min(t), 0) << type_name(t);
+      EXPECT_EQ(type_max(t), (std::int64_t{1} << bits) - 1) << type_name(t);
+    }
+  }
+  EXPECT_EQ(type_size(data_type::integer64), 8u);
+  EXPECT_EQ(type_min(data_type::integer64), std::numeric_limits<std::int64_t>::min());
+  EXPECT_EQ(type_max(data_type::unsigned64), std::numeric_limits<std::int64_t>::max());
+  EXPECT_FALSE(type_is_signed(data_type::unsigned64));
+  EXPECT_EQ(type_size(data_type::boolean), 1u);
+  EXPECT_EQ(type_max(data_type::boolean), 1);
+  EXPECT_EQ(type_size(data_type::visible_string), 0u);
+  EXPECT_STREQ(type_name(data_type::unsigned16), "UNSIGNED16");
+  EXPECT_STREQ(type_name(data_type::visible_string), "VISIBLE_STRING");
+}
 
 TEST(objects, every_option_code_is_an_integer16_the_profile_decides_the_values_of) {
   for (int i = 0; i < option_count; ++i) {
     const std::uint16_t index = option_index(static_cast<option>(i));
     const object_description* o = find_drive_object(index);
     ASSERT_NE(o, nullptr) << std::hex << index;
-    EXPECT_EQ(o->type, object_type::integer16);
+    EXPECT_EQ(o->type, data_type::integer16);
     EXPECT_EQ(o->access, object_access::read_write);
     EXPECT_FALSE(o->pdo_mappable);
   }
@@ -24,50 +50,50 @@ TEST(objects, every_option_code_is_an_integer16_the_profile_decides_the_values_o
 TEST(objects, the_table_holds_the_drive_objects_with_their_types_and_access) {
   struct expected {
     std::uint16_t index;
-    object_type type;
+    data_type type;
     object_access access;
   };
   // CiA 402-2: controlword UNSIGNED16 rw, statusword UNSIGNED16 ro, error code UNSIGNED16 ro,
   // modes INTEGER8, velocity actual and target velocity INTEGER32, ramps UNSIGNED32.
   const expected table[] = {
-      {0x603F, object_type::unsigned16, object_access::read_only},
-      {0x6040, object_type::unsigned16, object_access::read_write},
-      {0x6041, object_type::unsigned16, object_access::read_only},
-      {0x6060, object_type::integer8, object_access::read_write},
-      {0x6061, object_type::integer8, object_access::read_only},
-      {0x606C, object_type::integer32, object_access::read_only},
-      {0x6083, object_type::unsigned32, object_access::read_write},
-      {0x6084, object_type::unsigned32, object_access::read_write},
-      {0x6085, object_type::unsigned32, object_access::read_write},
-      {0x60FF, object_type::integer32, object_access::read_write},
-      {0x6502, object_type::unsigned32, object_access::read_only},
-      {0x6062, object_type::integer32, object_access::read_only},
-      {0x6064, object_type::integer32, object_access::read_only},
-      {0x6065, object_type::unsigned32, object_access::read_write},
-      {0x6066, object_type::unsigned16, object_access::read_write},
-      {0x6067, object_type::unsigned32, object_access::read_write},
-      {0x6068, object_type::unsigned16, object_access::read_write},
-      {0x6071, object_type::integer16, object_access::read_write},
-      {0x6077, object_type::integer16, object_access::read_only},
-      {0x607A, object_type::integer32, object_access::read_write},
-      {0x607C, object_type::integer32, object_access::read_write},
-      {0x6081, object_type::unsigned32, object_access::read_write},
-      {0x6082, object_type::unsigned32, object_access::read_write},
-      {0x6087, object_type::unsigned32, object_access::read_write},
-      {0x6098, object_type::integer8, object_access::read_write},
-      {0x609A, object_type::unsigned32, object_access::read_write},
-      {0x60B0, object_type::integer32, object_access::read_write},
-      {0x60B1, object_type::integer32, object_access::read_write},
-      {0x60B2, object_type::integer16, object_access::read_write},
-      {0x60F4, object_type::integer32, object_access::read_only},
+      {0x603F, data_type::unsigned16, object_access::read_only},
+      {0x6040, data_type::unsigned16, object_access::read_write},
+      {0x6041, data_type::unsigned16, object_access::read_only},
+      {0x6060, data_type::integer8, object_access::read_write},
+      {0x6061, data_type::integer8, object_access::read_only},
+      {0x606C, data_type::integer32, object_access::read_only},
+      {0x6083, data_type::unsigned32, object_access::read_write},
+      {0x6084, data_type::unsigned32, object_access::read_write},
+      {0x6085, data_type::unsigned32, object_access::read_write},
+      {0x60FF, data_type::integer32, object_access::read_write},
+      {0x6502, data_type::unsigned32, object_access::read_only},
+      {0x6062, data_type::integer32, object_access::read_only},
+      {0x6064, data_type::integer32, object_access::read_only},
+      {0x6065, data_type::unsigned32, object_access::read_write},
+      {0x6066, data_type::unsigned16, object_access::read_write},
+      {0x6067, data_type::unsigned32, object_access::read_write},
+      {0x6068, data_type::unsigned16, object_access::read_write},
+      {0x6071, data_type::integer16, object_access::read_write},
+      {0x6077, data_type::integer16, object_access::read_only},
+      {0x607A, data_type::integer32, object_access::read_write},
+      {0x607C, data_type::integer32, object_access::read_write},
+      {0x6081, data_type::unsigned32, object_access::read_write},
+      {0x6082, data_type::unsigned32, object_access::read_write},
+      {0x6087, data_type::unsigned32, object_access::read_write},
+      {0x6098, data_type::integer8, object_access::read_write},
+      {0x609A, data_type::unsigned32, object_access::read_write},
+      {0x60B0, data_type::integer32, object_access::read_write},
+      {0x60B1, data_type::integer32, object_access::read_write},
+      {0x60B2, data_type::integer16, object_access::read_write},
+      {0x60F4, data_type::integer32, object_access::read_only},
   };
   for (const expected& e : table) {
     const object_description* o = find_drive_object(e.index);
     ASSERT_NE(o, nullptr) << std::hex << e.index;
     EXPECT_EQ(o->type, e.type) << std::hex << e.index;
     EXPECT_EQ(o->access, e.access) << std::hex << e.index;
-    EXPECT_GE(o->low, type_low(o->type));
-    EXPECT_LE(o->high, type_high(o->type));
+    EXPECT_GE(o->low, type_min(o->type));
+    EXPECT_LE(o->high, type_max(o->type));
     EXPECT_GE(o->default_value, o->low);
     EXPECT_LE(o->default_value, o->high);
     EXPECT_NE(o->name[0], '\0');

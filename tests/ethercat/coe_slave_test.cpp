@@ -19,7 +19,7 @@ namespace cia402::ethercat {
 namespace {
 
 using canopen::access;
-using canopen::data_type;
+using cia402::data_type;
 using canopen::object_category;
 using canopen::object_code;
 

@@ -14,7 +14,7 @@ namespace cia402::ethercat {
 namespace {
 
 using canopen::access;
-using canopen::data_type;
+using cia402::data_type;
 using canopen::object_code;
 using canopen::object_entry;
 using canopen::sub_entry;

@@ -181,8 +181,8 @@ TEST(objects, the_virtual_drive_answers_every_object_of_the_one_table) {
     SCOPED_TRACE(o.name);
     std::int64_t value = 0;
     ASSERT_EQ(d.read(o.index, o.sub, value), sdo_abort::none);
-    EXPECT_GE(value, cia402::type_low(o.type));
-    EXPECT_LE(value, cia402::type_high(o.type));
+    EXPECT_GE(value, cia402::type_min(o.type));
+    EXPECT_LE(value, cia402::type_max(o.type));
     if (o.access == cia402::object_access::read_only) {
       EXPECT_EQ(d.write(o.index, o.sub, value), sdo_abort::read_only_object);
       continue;

@@ -27,10 +27,10 @@ bool one_of(const std::array<std::string_view, N>& list, std::string_view s) {
 bool number_for(std::string_view text, std::uint16_t index, std::int64_t& out, std::string& why) {
   const auto v = axes::parse_integer(text);
   const object_description* o = find_drive_object(index);
-  if (!v || o == nullptr || *v < type_low(o->type) || *v > type_high(o->type)) {
+  if (!v || o == nullptr || *v < type_min(o->type) || *v > type_max(o->type)) {
     why = "'" + std::string(text) + "' is not a value for " + hex(index, 4) +
-          (o != nullptr ? std::string(" (") + o->name + "): an integer from " + std::to_string(type_low(o->type)) + " to " +
-                              std::to_string(type_high(o->type))
+          (o != nullptr ? std::string(" (") + o->name + "): an integer from " + std::to_string(type_min(o->type)) + " to " +
+                              std::to_string(type_max(o->type))
                         : std::string());
     return false;
   }

@@ -76,13 +76,7 @@ class local_link final : public axes::drive_link {
 
  private:
   class objects;
-  struct transfer {
-    std::uint16_t index = 0;
-    std::uint8_t sub = 0;
-    bool download = false;
-    std::vector<std::uint8_t> bytes;
-    axes::transfer_done done;
-  };
+  using transfer = axes::pending_transfer;
 
   void one_cycle();
   void note_error(std::uint16_t code, std::uint8_t reg);

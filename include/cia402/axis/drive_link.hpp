@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <optional>
 #include <span>
@@ -43,6 +44,19 @@ struct transfer_result {
   std::vector<std::uint8_t> data;      ///< an upload's bytes
 };
 using transfer_done = std::function<void(const transfer_result&)>;
+
+/// One acyclic transfer a link holds until its turn: what upload() or download() was given.
+struct pending_transfer {
+  std::uint16_t index = 0;
+  std::uint8_t sub = 0;
+  bool download = false;
+  std::vector<std::uint8_t> bytes;
+  transfer_done done;
+};
+
+/// Ends every transfer of `queue` as cancelled with `why` (the link was lost or closed) and leaves
+/// it empty before the first `done` runs, so a `done` that queues again finds a clean queue.
+void cancel_transfers(std::deque<pending_transfer>& queue, const std::string& why);
 
 /// An object in the cyclic data (CANopen PDOs, EtherCAT process data).
 struct cyclic_object {

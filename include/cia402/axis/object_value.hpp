@@ -33,8 +33,8 @@ struct value_format {
   bool operator==(const value_format&) const = default;
 };
 
-/// The format of a type of the core's object table.
-value_format format_of(object_type t) noexcept;
+/// The format a value of a CiA 301 data type travels in (BOOLEAN: one unsigned byte).
+value_format format_of(data_type t) noexcept;
 
 /// A value: which of the three it is, and that one.
 struct object_value {

@@ -260,6 +260,8 @@ class session {
   std::uint64_t begin(std::string name, std::vector<step> steps, completion done, bool motion);
   void fill_result(result& r) const;
   std::uint64_t refuse_now(std::string error, completion done, bool bad_input = false);
+  // A job that ends operation `id` done: `done` gets the state as it stands when the job runs.
+  std::function<void()> answer_with_state(std::uint64_t id, completion done);
   // session_jobs.cpp
   void queue_upload(std::uint16_t index, std::uint8_t sub, transfer_done done, bool front = false);
   void queue_download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes, transfer_done done);

@@ -1,59 +1,10 @@
 #include "cia402/canopen/301/object_dictionary.hpp"
 
 #include <algorithm>
-#include <limits>
 
 #include "cia402/canopen/can/frame.hpp"
 
 namespace cia402::canopen {
-
-unsigned type_size(data_type t) noexcept {
-  switch (t) {
-    case data_type::boolean:
-    case data_type::integer8:
-    case data_type::unsigned8: return 1;
-    case data_type::integer16:
-    case data_type::unsigned16: return 2;
-    case data_type::integer32:
-    case data_type::unsigned32: return 4;
-    case data_type::integer64:
-    case data_type::unsigned64: return 8;
-    case data_type::visible_string: return 0;
-  }
-  return 0;
-}
-
-bool type_is_signed(data_type t) noexcept {
-  return t == data_type::integer8 || t == data_type::integer16 || t == data_type::integer32 ||
-         t == data_type::integer64;
-}
-
-std::int64_t type_min(data_type t) noexcept {
-  switch (t) {
-    case data_type::integer8: return std::numeric_limits<std::int8_t>::min();
-    case data_type::integer16: return std::numeric_limits<std::int16_t>::min();
-    case data_type::integer32: return std::numeric_limits<std::int32_t>::min();
-    case data_type::integer64: return std::numeric_limits<std::int64_t>::min();
-    default: return 0;
-  }
-}
-
-std::int64_t type_max(data_type t) noexcept {
-  switch (t) {
-    case data_type::boolean: return 1;
-    case data_type::integer8: return std::numeric_limits<std::int8_t>::max();
-    case data_type::unsigned8: return std::numeric_limits<std::uint8_t>::max();
-    case data_type::integer16: return std::numeric_limits<std::int16_t>::max();
-    case data_type::unsigned16: return std::numeric_limits<std::uint16_t>::max();
-    case data_type::integer32: return std::numeric_limits<std::int32_t>::max();
-    case data_type::unsigned32: return std::numeric_limits<std::uint32_t>::max();
-    // UNSIGNED64 above 2^63-1 does not fit the int64 every value travels in; no object uses it.
-    case data_type::integer64:
-    case data_type::unsigned64: return std::numeric_limits<std::int64_t>::max();
-    case data_type::visible_string: return 0;
-  }
-  return 0;
-}
 
 const char* access_name(access a) noexcept {
   switch (a) {

@@ -43,6 +43,19 @@ void sdo_server::abort(std::uint16_t index, std::uint8_t sub, sdo_abort code) {
   mode_ = mode::idle;
 }
 
+bool sdo_server::segment_continues(mode open, std::uint8_t command) {
+  if (mode_ != open) {
+    // No transfer of this direction is open: the abort names no object unless another one is.
+    abort(mode_ == mode::idle ? 0 : index_, mode_ == mode::idle ? 0 : sub_, sdo_abort::command_specifier_invalid);
+    return false;
+  }
+  if (((command >> 4) & 1u) != toggle_) {
+    abort(index_, sub_, sdo_abort::toggle_bit_not_alternated);
+    return false;
+  }
+  return true;
+}
+
 void sdo_server::on_request(const frame& request) {
   if (request.len != 8 || request.rtr) return;
   const std::uint8_t* d = request.data.data();
@@ -82,12 +95,8 @@ void sdo_server::on_request(const frame& request) {
       return respond(0x60, mux);
     }
     case ccs_download_segment: {
-      if (mode_ != mode::downloading) {
-        return abort(mode_ == mode::idle ? 0 : index_, mode_ == mode::idle ? 0 : sub_,
-                     sdo_abort::command_specifier_invalid);
-      }
-      const std::uint8_t t = (d[0] >> 4) & 1;
-      if (t != toggle_) return abort(index_, sub_, sdo_abort::toggle_bit_not_alternated);
+      if (!segment_continues(mode::downloading, d[0])) return;
+      const std::uint8_t t = toggle_;
       const std::size_t n = 7 - ((d[0] >> 1) & 0x07);
       buffer_.insert(buffer_.end(), d + 1, d + 1 + n);
       if (buffer_.size() > max_download || (size_known_ && buffer_.size() > size_)) {
@@ -127,12 +136,8 @@ void sdo_server::on_request(const frame& request) {
       return respond(0x41, payload);
     }
     case ccs_upload_segment: {
-      if (mode_ != mode::uploading) {
-        return abort(mode_ == mode::idle ? 0 : index_, mode_ == mode::idle ? 0 : sub_,
-                     sdo_abort::command_specifier_invalid);
-      }
-      const std::uint8_t t = (d[0] >> 4) & 1;
-      if (t != toggle_) return abort(index_, sub_, sdo_abort::toggle_bit_not_alternated);
+      if (!segment_continues(mode::uploading, d[0])) return;
+      const std::uint8_t t = toggle_;
       const std::size_t n = std::min<std::size_t>(7, buffer_.size() - offset_);
       const bool last = offset_ + n == buffer_.size();
       const std::span<const std::uint8_t> part(buffer_.data() + offset_, n);

@@ -17,7 +17,7 @@ constexpr std::uint16_t option_indices[] = {0x605A, 0x605B, 0x605C, 0x605D, 0x60
 
 bool is_signed_object(std::uint16_t index) {
   const object_description* o = find_drive_object(index);
-  return o != nullptr && type_signed(o->type);
+  return o != nullptr && type_is_signed(o->type);
 }
 
 }  // namespace

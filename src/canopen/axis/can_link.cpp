@@ -36,24 +36,13 @@ std::optional<axes::value_format> find_format(const std::vector<object_entry>& t
   for (const object_entry& o : table) {
     if (o.index != index) continue;
     for (const sub_entry& e : o.subs) {
-      if (e.sub == sub) return value_format_of(e.type);
+      if (e.sub == sub) return axes::format_of(e.type);
     }
   }
   return std::nullopt;
 }
 
 }  // namespace
-
-std::optional<axes::value_format> value_format_of(data_type t) {
-  switch (t) {
-    case data_type::visible_string: return axes::value_format::text();
-    case data_type::boolean: return axes::value_format::integer(1, false);
-    default: break;
-  }
-  const unsigned size = type_size(t);
-  if (size == 0) return std::nullopt;
-  return axes::value_format::integer(size, type_is_signed(t));
-}
 
 can_link::can_link(channel& bus, can_link_config config)
     : bus_(&bus), config_(std::move(config)), sdo_(bus, config_.node_id, config_.sdo_timeout_us) {}

@@ -84,10 +84,19 @@ class sdo_step {
   std::string announced_size() const {
     return t_.size_indicated ? size_text(t_.size) : std::string("size not indicated");
   }
-  void start_segments(phase p) {
+  // An initiate that opens a segmented transfer of `what` ("download", "upload"): followed from here.
+  void start_segments(phase p, const std::string& what) {
     t_.restart(p, s_.index(), s_.sub());
     t_.size_indicated = s_.size_indicated();
     t_.size = s_.size_indicated() ? static_cast<std::size_t>(get_le(s_.d + 4, 4)) : 0;
+    d_.event = what + "-start";
+    d_.text = "SDO " + what + " " + named(s_.index(), s_.sub()) + ", " + announced_size() + " in segments";
+  }
+  // Command specifier 7: CiA 301 gives it no meaning in either direction.
+  void unknown_specifier(const char* side) {
+    d_.kind = frame_kind::unknown;
+    d_.event.clear();
+    d_.text = std::string("SDO ") + side + " with command specifier 7, none of CiA 301's";
   }
   void block(const char* side) {
     t_.restart(phase::idle, 0, 0);
@@ -114,9 +123,7 @@ void sdo_step::request() {
         d_.text = "SDO download " + value(s_.index(), s_.sub(), {s_.d + 4, s_.expedited_size()});
         return;
       }
-      start_segments(phase::download_initiated);
-      d_.event = "download-start";
-      d_.text = "SDO download " + named(s_.index(), s_.sub()) + ", " + announced_size() + " in segments";
+      start_segments(phase::download_initiated, "download");
       return;
     case ccs_download_segment:
       d_.event = "download-segment";
@@ -149,11 +156,7 @@ void sdo_step::request() {
     case ccs_block_download:
       object(s_.index(), s_.sub());
       return block(s_.cs() == ccs_block_upload ? "upload request" : "download request");
-    default:
-      d_.kind = frame_kind::unknown;
-      d_.event.clear();
-      d_.text = "SDO request with command specifier 7, none of CiA 301's";
-      return;
+    default: return unknown_specifier("request");
   }
 }
 
@@ -200,9 +203,7 @@ void sdo_step::response() {
         t_.restart(phase::idle, 0, 0);
         return;
       }
-      start_segments(phase::upload_segments);
-      d_.event = "upload-start";
-      d_.text = "SDO upload " + named(s_.index(), s_.sub()) + ", " + announced_size() + " in segments";
+      start_segments(phase::upload_segments, "upload");
       return;
     case scs_upload_segment:
       d_.event = "upload-segment";
@@ -223,11 +224,7 @@ void sdo_step::response() {
     case scs_block_download:
     case scs_block_upload:
       return block(s_.cs() == scs_block_upload ? "upload response" : "download response");
-    default:
-      d_.kind = frame_kind::unknown;
-      d_.event.clear();
-      d_.text = "SDO response with command specifier 7, none of CiA 301's";
-      return;
+    default: return unknown_specifier("response");
   }
 }
 

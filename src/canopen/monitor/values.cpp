@@ -22,7 +22,7 @@ object_info info_of(const object_table* table, std::uint16_t index, std::uint8_t
   if (d != nullptr) {
     info.name = d->name;
     info.typed = true;
-    info.type = static_cast<data_type>(d->type);  // the codes are CiA 301's in both
+    info.type = d->type;
     info.unit = d->unit;
   }
   if (table == nullptr) return info;

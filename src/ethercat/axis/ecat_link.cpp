@@ -211,14 +211,7 @@ void ecat_link::restart() {
 void ecat_link::fail(std::string why) {
   if (!failure_.empty()) return;
   failure_ = std::move(why);
-  axes::transfer_result r;
-  r.cancelled = true;
-  r.error = failure_;
-  std::deque<transfer> gone;
-  gone.swap(transfers_);
-  for (transfer& t : gone) {
-    if (t.done) t.done(r);
-  }
+  axes::cancel_transfers(transfers_, failure_);
   if (on_event) on_event(axes::link_event::failed, failure_);
 }
 
@@ -283,14 +276,7 @@ std::optional<axes::value_format> ecat_link::describe(std::uint16_t index, std::
 void ecat_link::close() {
   if (closed_) return;
   closed_ = true;
-  axes::transfer_result r;
-  r.cancelled = true;
-  r.error = "closed";
-  std::deque<transfer> gone;
-  gone.swap(transfers_);
-  for (transfer& t : gone) {
-    if (t.done) t.done(r);
-  }
+  axes::cancel_transfers(transfers_, "closed");
   line_->detach_closed();
   if (!line_->left_op_) report_.done = true;  // the line leaves OP with its last drive
 }

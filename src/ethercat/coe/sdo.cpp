@@ -48,6 +48,13 @@ std::span<const std::uint8_t> segment_data(std::span<const std::uint8_t> body) n
   return body.subspan(1, std::min(n, available));
 }
 
+// A segment that carries data (download request, upload response): the toggle, the last flag, the data.
+void read_segment(std::span<const std::uint8_t> body, sdo_frame& f) noexcept {
+  f.toggle = (body[0] & toggle_bit) != 0;
+  f.last = (body[0] & 0x01) != 0;
+  f.data = segment_data(body);
+}
+
 // The value part of an initiate frame (download request, upload response): expedited in the four data
 // bytes (4 - n of them when the size is indicated), else the size and what of the value follows.
 void read_initiate(std::span<const std::uint8_t> body, sdo_frame& f) noexcept {
@@ -83,6 +90,57 @@ std::uint8_t unused_of(std::size_t n) noexcept {
   return static_cast<std::uint8_t>(n < segment_data_in_ten_bytes ? segment_data_in_ten_bytes - n : 0);
 }
 
+// A client's request and the server's response of the other direction are alike but for the service
+// and the command specifier (CiA 301 §7.2.4.3.3 ff., ETG.1000.6 §5.6.2): the frames that carry a
+// value (download request, upload response) and those that ask for or confirm one (upload request,
+// download response).
+// Initiate, expedited: 1..4 bytes in the frame, the size indicated (bits 2..3: 4 - n unused).
+std::vector<std::uint8_t> initiate_expedited(coe_service s, std::uint8_t cs, std::uint16_t index, std::uint8_t sub,
+                                             std::span<const std::uint8_t> value) {
+  const std::size_t n = std::clamp<std::size_t>(value.size(), 1, 4);
+  std::vector<std::uint8_t> b = coe(s);
+  b.push_back(static_cast<std::uint8_t>((std::size_t{cs} << 5) | ((4 - n) << 2) | 0x03));
+  put_address(b, index, sub);
+  b.insert(b.end(), value.begin(), value.begin() + static_cast<std::ptrdiff_t>(std::min(n, value.size())));
+  return padded(std::move(b));
+}
+
+// Initiate, normal: the complete size, then as much of the value as the mailbox takes.
+std::vector<std::uint8_t> initiate_normal(coe_service s, std::uint8_t cs, std::uint16_t index, std::uint8_t sub,
+                                          bool complete_access, std::uint32_t size, std::span<const std::uint8_t> first) {
+  std::vector<std::uint8_t> b = coe(s);
+  b.push_back(static_cast<std::uint8_t>((cs << 5) | (complete_access ? complete_access_bit : 0) | 0x01));
+  put_address(b, index, sub);
+  put32(b, size);
+  b.insert(b.end(), first.begin(), first.end());
+  return b;
+}
+
+// A segment: the toggle, the unused count of a short one, the last flag, the data.
+std::vector<std::uint8_t> segment(coe_service s, std::uint8_t cs, bool toggle, bool last, std::span<const std::uint8_t> data) {
+  std::vector<std::uint8_t> b = coe(s);
+  b.push_back(static_cast<std::uint8_t>((cs << 5) | (toggle ? toggle_bit : 0) | (unused_of(data.size()) << 1) |
+                                        (last ? 1 : 0)));
+  b.insert(b.end(), data.begin(), data.end());
+  return padded(std::move(b));
+}
+
+// Initiate without a value: the object and the complete access bit.
+std::vector<std::uint8_t> initiate_without_value(coe_service s, std::uint8_t cs, std::uint16_t index, std::uint8_t sub,
+                                                 bool complete_access) {
+  std::vector<std::uint8_t> b = coe(s);
+  b.push_back(static_cast<std::uint8_t>((cs << 5) | (complete_access ? complete_access_bit : 0)));
+  put_address(b, index, sub);
+  return padded(std::move(b));
+}
+
+// A segment without data: the toggle alone.
+std::vector<std::uint8_t> segment_without_data(coe_service s, std::uint8_t cs, bool toggle) {
+  std::vector<std::uint8_t> b = coe(s);
+  b.push_back(static_cast<std::uint8_t>((cs << 5) | (toggle ? toggle_bit : 0)));
+  return padded(std::move(b));
+}
+
 }  // namespace
 
 std::optional<coe_view> parse_coe(std::span<const std::uint8_t> data) noexcept {
@@ -102,9 +160,7 @@ std::optional<sdo_frame> parse_sdo_request(std::span<const std::uint8_t> body) n
   switch (cmd >> 5) {
     case ccs_download_segment:
       f.command = sdo_command::download_segment;
-      f.toggle = (cmd & toggle_bit) != 0;
-      f.last = (cmd & 0x01) != 0;
-      f.data = segment_data(body);
+      read_segment(body, f);
       return f;
     case ccs_upload_segment:
       f.command = sdo_command::upload_segment;
@@ -143,9 +199,7 @@ std::optional<sdo_frame> parse_sdo_response(coe_service service, std::span<const
   switch (cmd >> 5) {
     case scs_upload_segment:
       f.command = sdo_command::upload_segment;
-      f.toggle = (cmd & toggle_bit) != 0;
-      f.last = (cmd & 0x01) != 0;
-      f.data = segment_data(body);
+      read_segment(body, f);
       return f;
     case scs_download_segment:
       f.command = sdo_command::download_segment;
@@ -168,43 +222,24 @@ std::optional<sdo_frame> parse_sdo_response(coe_service service, std::span<const
 }
 
 std::vector<std::uint8_t> sdo_upload_request(std::uint16_t index, std::uint8_t sub, bool complete_access) {
-  std::vector<std::uint8_t> b = coe(coe_service::sdo_request);
-  b.push_back(static_cast<std::uint8_t>((ccs_initiate_upload << 5) | (complete_access ? complete_access_bit : 0)));
-  put_address(b, index, sub);
-  return padded(std::move(b));
+  return initiate_without_value(coe_service::sdo_request, ccs_initiate_upload, index, sub, complete_access);
 }
 
 std::vector<std::uint8_t> sdo_upload_segment_request(bool toggle) {
-  std::vector<std::uint8_t> b = coe(coe_service::sdo_request);
-  b.push_back(static_cast<std::uint8_t>((ccs_upload_segment << 5) | (toggle ? toggle_bit : 0)));
-  return padded(std::move(b));
+  return segment_without_data(coe_service::sdo_request, ccs_upload_segment, toggle);
 }
 
 std::vector<std::uint8_t> sdo_download_expedited(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> value) {
-  const std::size_t n = std::clamp<std::size_t>(value.size(), 1, 4);
-  std::vector<std::uint8_t> b = coe(coe_service::sdo_request);
-  b.push_back(static_cast<std::uint8_t>((ccs_initiate_download << 5) | ((4 - n) << 2) | 0x03));
-  put_address(b, index, sub);
-  b.insert(b.end(), value.begin(), value.begin() + static_cast<std::ptrdiff_t>(std::min(n, value.size())));
-  return padded(std::move(b));
+  return initiate_expedited(coe_service::sdo_request, ccs_initiate_download, index, sub, value);
 }
 
 std::vector<std::uint8_t> sdo_download_normal(std::uint16_t index, std::uint8_t sub, bool complete_access,
                                               std::uint32_t size, std::span<const std::uint8_t> first) {
-  std::vector<std::uint8_t> b = coe(coe_service::sdo_request);
-  b.push_back(static_cast<std::uint8_t>((ccs_initiate_download << 5) | (complete_access ? complete_access_bit : 0) | 0x01));
-  put_address(b, index, sub);
-  put32(b, size);
-  b.insert(b.end(), first.begin(), first.end());
-  return b;
+  return initiate_normal(coe_service::sdo_request, ccs_initiate_download, index, sub, complete_access, size, first);
 }
 
 std::vector<std::uint8_t> sdo_download_segment(bool toggle, bool last, std::span<const std::uint8_t> data) {
-  std::vector<std::uint8_t> b = coe(coe_service::sdo_request);
-  b.push_back(static_cast<std::uint8_t>((ccs_download_segment << 5) | (toggle ? toggle_bit : 0) |
-                                        (unused_of(data.size()) << 1) | (last ? 1 : 0)));
-  b.insert(b.end(), data.begin(), data.end());
-  return padded(std::move(b));
+  return segment(coe_service::sdo_request, ccs_download_segment, toggle, last, data);
 }
 
 std::vector<std::uint8_t> sdo_abort_request(std::uint16_t index, std::uint8_t sub, std::uint32_t code) {
@@ -217,43 +252,24 @@ std::vector<std::uint8_t> sdo_abort_request(std::uint16_t index, std::uint8_t su
 
 std::vector<std::uint8_t> sdo_upload_expedited_response(std::uint16_t index, std::uint8_t sub,
                                                         std::span<const std::uint8_t> value) {
-  const std::size_t n = std::clamp<std::size_t>(value.size(), 1, 4);
-  std::vector<std::uint8_t> b = coe(coe_service::sdo_response);
-  b.push_back(static_cast<std::uint8_t>((scs_initiate_upload << 5) | ((4 - n) << 2) | 0x03));
-  put_address(b, index, sub);
-  b.insert(b.end(), value.begin(), value.begin() + static_cast<std::ptrdiff_t>(std::min(n, value.size())));
-  return padded(std::move(b));
+  return initiate_expedited(coe_service::sdo_response, scs_initiate_upload, index, sub, value);
 }
 
 std::vector<std::uint8_t> sdo_upload_normal_response(std::uint16_t index, std::uint8_t sub, bool complete_access,
                                                      std::uint32_t size, std::span<const std::uint8_t> first) {
-  std::vector<std::uint8_t> b = coe(coe_service::sdo_response);
-  b.push_back(static_cast<std::uint8_t>((scs_initiate_upload << 5) | (complete_access ? complete_access_bit : 0) | 0x01));
-  put_address(b, index, sub);
-  put32(b, size);
-  b.insert(b.end(), first.begin(), first.end());
-  return b;
+  return initiate_normal(coe_service::sdo_response, scs_initiate_upload, index, sub, complete_access, size, first);
 }
 
 std::vector<std::uint8_t> sdo_upload_segment_response(bool toggle, bool last, std::span<const std::uint8_t> data) {
-  std::vector<std::uint8_t> b = coe(coe_service::sdo_response);
-  b.push_back(static_cast<std::uint8_t>((scs_upload_segment << 5) | (toggle ? toggle_bit : 0) |
-                                        (unused_of(data.size()) << 1) | (last ? 1 : 0)));
-  b.insert(b.end(), data.begin(), data.end());
-  return padded(std::move(b));
+  return segment(coe_service::sdo_response, scs_upload_segment, toggle, last, data);
 }
 
 std::vector<std::uint8_t> sdo_download_response(std::uint16_t index, std::uint8_t sub, bool complete_access) {
-  std::vector<std::uint8_t> b = coe(coe_service::sdo_response);
-  b.push_back(static_cast<std::uint8_t>((scs_initiate_download << 5) | (complete_access ? complete_access_bit : 0)));
-  put_address(b, index, sub);
-  return padded(std::move(b));
+  return initiate_without_value(coe_service::sdo_response, scs_initiate_download, index, sub, complete_access);
 }
 
 std::vector<std::uint8_t> sdo_download_segment_response(bool toggle) {
-  std::vector<std::uint8_t> b = coe(coe_service::sdo_response);
-  b.push_back(static_cast<std::uint8_t>((scs_download_segment << 5) | (toggle ? toggle_bit : 0)));
-  return padded(std::move(b));
+  return segment_without_data(coe_service::sdo_response, scs_download_segment, toggle);
 }
 
 std::vector<std::uint8_t> emergency_request(const emergency_message& e) {

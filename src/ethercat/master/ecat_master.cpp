@@ -438,7 +438,7 @@ std::optional<std::int64_t> ecat_master::input(std::size_t i, std::uint16_t inde
     if (o.index != index || o.sub != sub || o.bits == 0 || o.bits > 32) continue;
     const std::uint64_t raw = get_bits(image_, (s.logical_inputs - logical_base) * 8u + o.bit_offset, o.bits);
     const object_description* d = find_drive_object(index, sub);
-    const bool is_signed = d != nullptr && type_signed(d->type);
+    const bool is_signed = d != nullptr && type_is_signed(d->type);
     if (is_signed && o.bits < 64 && ((raw >> (o.bits - 1)) & 1u)) {
       return static_cast<std::int64_t>(raw | (~std::uint64_t{0} << o.bits));
     }

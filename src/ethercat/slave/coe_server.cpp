@@ -28,7 +28,7 @@ std::uint16_t access_bits(std::uint16_t index, const sub_entry& e) noexcept {
 }
 
 std::uint16_t bit_length(const sub_entry& e) noexcept {
-  const unsigned size = canopen::type_size(e.type);
+  const unsigned size = type_size(e.type);
   if (size != 0) return static_cast<std::uint16_t>(size * 8);
   const std::size_t text = std::max(e.capacity, e.default_text.size());
   return static_cast<std::uint16_t>(std::min<std::size_t>(text, 8191) * 8);
@@ -212,7 +212,7 @@ sdo_abort coe_server::download_complete(std::uint16_t index, std::uint8_t sub, s
   std::size_t at = 0;
   for (const sub_entry& e : o->subs) {
     if (e.sub < sub) continue;
-    const unsigned size = canopen::type_size(e.type);
+    const unsigned size = type_size(e.type);
     if (size == 0) return sdo_abort::unsupported_access;
     if (at + size > data.size()) break;  // a shorter download sets the first entries only
     pieces.push_back({e.sub, data.subspan(at, size)});

@@ -53,7 +53,7 @@ bool coe_slave::entry_mappable(std::uint16_t mapping, std::uint32_t m) const {
   const bool rx = mapping < 0x1A00;
   return target != nullptr && target->entry->pdo_mappable &&
          (rx ? canopen::writable(target->entry->acc) : !canopen::writable(target->entry->acc)) &&
-         canopen::type_size(target->entry->type) * 8 == (m & 0xFFu) && (m & 0xFFu) != 0;
+         type_size(target->entry->type) * 8 == (m & 0xFFu) && (m & 0xFFu) != 0;
 }
 
 sdo_abort coe_slave::write_pdo_configuration(canopen::object_dictionary::slot& s, std::int64_t v) {

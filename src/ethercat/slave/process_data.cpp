@@ -59,7 +59,7 @@ bool coe_slave::bind(std::uint16_t assignment, std::vector<bound_entry>& out, un
       const auto length = static_cast<std::uint8_t>(m);
       // An entry cleared after its count was written names nothing: the mapping cannot run.
       if (s == nullptr || length == 0 || length > 64 || length % 8 != 0) return false;
-      out.push_back({s, static_cast<std::uint16_t>(bits), length, canopen::type_is_signed(s->entry->type)});
+      out.push_back({s, static_cast<std::uint16_t>(bits), length, type_is_signed(s->entry->type)});
       bits += length;
     }
   }

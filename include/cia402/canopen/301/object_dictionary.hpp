@@ -9,30 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "cia402/data_type.hpp"
 #include "cia402/sdo_abort.hpp"
 
 namespace cia402::canopen {
-
-/// Static data types of CiA 301 §7.1.6 (the values are the data type indices 0x0001..).
-enum class data_type : std::uint16_t {
-  boolean = 0x0001,
-  integer8 = 0x0002,
-  integer16 = 0x0003,
-  integer32 = 0x0004,
-  unsigned8 = 0x0005,
-  unsigned16 = 0x0006,
-  unsigned32 = 0x0007,
-  visible_string = 0x0009,
-  integer64 = 0x0015,
-  unsigned64 = 0x001B,
-};
-
-/// Bytes a value of the type takes on the bus; 0 for strings (their length varies).
-unsigned type_size(data_type t) noexcept;
-bool type_is_signed(data_type t) noexcept;
-/// The smallest and largest value of a numeric type.
-std::int64_t type_min(data_type t) noexcept;
-std::int64_t type_max(data_type t) noexcept;
 
 /// Access types as the EDS spells them (CiA 306 §4.6.3): ro, wo, rw, const.
 enum class access : std::uint8_t { ro, wo, rw, constant };

@@ -51,6 +51,9 @@ class sdo_server {
   enum class mode : std::uint8_t { idle, downloading, uploading };
   void respond(std::uint8_t command, std::span<const std::uint8_t> data = {});
   void abort(std::uint16_t index, std::uint8_t sub, sdo_abort code);
+  // A segment continues the transfer open in direction `open` and alternates the toggle (CiA 301
+  // §7.2.4.3.4); otherwise the transfer ends with the abort, and false.
+  bool segment_continues(mode open, std::uint8_t command);
 
   object_access* od_;
   channel* out_;

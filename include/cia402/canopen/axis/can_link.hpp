@@ -36,10 +36,6 @@
 
 namespace cia402::canopen {
 
-/// How the axis layer reads and writes a value of a CiA 301 data type: text, or an integer of the
-/// type's size and sign; nothing for a type it has no value format for (a domain).
-std::optional<axes::value_format> value_format_of(data_type t);
-
 struct can_link_config {
   std::uint8_t node_id = 1;
   std::string bus_name;                    ///< what() names it: "socketcand://127.0.0.1:29536/can0"
@@ -103,13 +99,7 @@ class can_link final : public axes::drive_link {
 
  private:
   enum class stage : std::uint8_t { acyclic, recording, setting_up, cyclic, restoring, closed };
-  struct transfer {
-    std::uint16_t index = 0;
-    std::uint8_t sub = 0;
-    bool download = false;
-    std::vector<std::uint8_t> bytes;
-    axes::transfer_done done;
-  };
+  using transfer = axes::pending_transfer;
   struct recorded {
     std::uint16_t index = 0;
     std::uint8_t sub = 0;

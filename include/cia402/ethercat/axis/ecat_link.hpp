@@ -115,13 +115,7 @@ class ecat_link final : public axes::drive_link {
 
  private:
   friend class ecat_line;
-  struct transfer {
-    std::uint16_t index = 0;
-    std::uint8_t sub = 0;
-    bool download = false;
-    std::vector<std::uint8_t> bytes;
-    axes::transfer_done done;
-  };
+  using transfer = axes::pending_transfer;
   const ecat_slave& slave() const { return line_->master().slaves()[position_]; }
   void after_cycle(bool ok);
   void fail(std::string why);
