@@ -147,6 +147,16 @@ struct axis_page::impl {
   reply write_reply(const std::optional<axes::result>& r, const std::string& action,
                     std::optional<std::uint64_t> tracked = std::nullopt);
   reply change_bus_plant(std::unique_lock<std::mutex>& lock, const plant_change& change);
+
+  // --- axis_page_parameters.cpp -------------------------------------------------------------------
+  struct entry_values {
+    std::vector<parameter_entry> entries;
+    std::vector<std::optional<axes::result>> results;  // none: not read (write-only, or no answer)
+  };
+  std::vector<std::optional<axes::result>> read_entries(std::unique_lock<std::mutex>& lock,
+                                                        const std::vector<parameter_entry>& entries);
+  entry_values entries_read(std::unique_lock<std::mutex>& lock);
+  std::string not_loaded(const parameter_entry& e) const;
 };
 
 }  // namespace cia402::page

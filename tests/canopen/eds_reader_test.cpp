@@ -176,7 +176,9 @@ TEST(eds_reader, a_dcf_written_from_entries_reads_back_with_its_parameter_values
   ASSERT_NE(s, nullptr);
   EXPECT_EQ(a->subs.front().default_value, 4321);
   EXPECT_EQ(s->subs[1].default_value, 777);
+  EXPECT_TRUE(a->subs.front().parameter_value);
   EXPECT_EQ(s->subs[2].default_value, speeds->subs[2].default_value);  // no ParameterValue: the default
+  EXPECT_FALSE(s->subs[2].parameter_value);
   EXPECT_EQ(dcf.objects.size(), objects.size());
 }
 

@@ -18,6 +18,7 @@
 #include "cia402/page/runner.hpp"
 #include "cia402/page/server.hpp"
 #include "cli/common.hpp"
+#include "cli/parameter_file.hpp"
 
 namespace cia402::cli {
 namespace {
@@ -126,6 +127,7 @@ int open_can(const serve_args& args, const profile& p, page::axis_page_config pc
     canopen::channel* bus = d.channels.back().get();
     pc.node = node;
     pc.bus = args.can;
+    pc.parameters = parameter_entries(c.known_objects, node);
     d.drives.push_back(std::make_unique<page::axis_page>(
         p,
         [bus, c](const profile&) {
@@ -210,6 +212,7 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   served_drives served;
   page::axis_page_config pc;
   pc.lease_us = static_cast<std::uint64_t>(args.lease_ms) * 1000;
+  pc.parameter_file = dcf_parameter_file();
   if (!args.ecat.empty()) {
     if (const int status = open_ecat(args, choice.get(), pc, served, err)) return status;
   } else if (!args.can.empty()) {
