@@ -110,7 +110,9 @@ std::vector<std::optional<axes::result>> axis_page::impl::read_entries(std::uniq
       if (--*left == 0) answered.notify_all();
     });
   }
-  for (int k = 0; k < 8 && *left > 0; ++k) session->poll(0);
+  // A drive in this process answers each at once (a few polls apiece); on a bus the cycle thread's
+  // polls bring them.
+  for (std::size_t k = 0; k < 8 + 4 * entries.size() && *left > 0; ++k) session->poll(0);
   answered.wait_for(lock, config.request_timeout, [&] { return *left == 0 || board.closed(); });
   return *results;
 }
