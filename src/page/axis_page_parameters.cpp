@@ -112,7 +112,8 @@ std::vector<std::optional<axes::result>> axis_page::impl::read_entries(std::uniq
   }
   // A drive in this process answers each at once (a few polls apiece); on a bus the cycle thread's
   // polls bring them.
-  for (std::size_t k = 0; k < 8 + 4 * entries.size() && *left > 0; ++k) session->poll(0);
+  const std::size_t polls = drive.plant != nullptr ? 8 + 4 * entries.size() : 8;
+  for (std::size_t k = 0; k < polls && *left > 0; ++k) session->poll(0);
   answered.wait_for(lock, config.request_timeout, [&] { return *left == 0 || board.closed(); });
   return *results;
 }

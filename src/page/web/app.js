@@ -10,6 +10,7 @@ import { addRows, addSnapshot } from './scope_data.js';
 import { connect, setControl } from './stream.js';
 import { buildBits, buildCommands, buildModes, showWords } from './words.js';
 import './jog.js';
+import { buildParameters } from './parameters.js';
 
 function update(s, missed) {
   if (s.profile && page.info && s.profile !== page.info.profile.name) {
@@ -56,6 +57,7 @@ export async function start() {
   buildSetpoints();
   buildPlant();
   buildScope();
+  buildParameters();
   setControl(page.info.control);
   applyCapabilities(page.info.capabilities);
   onRecording(addRows);
