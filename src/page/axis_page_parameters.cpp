@@ -234,6 +234,9 @@ document axis_page::load_parameter_file(std::string_view text) {
     return {400, j.dump()};
   }
   const std::vector<parameter_entry> all = catalog(impl_->config.parameters);
+  std::unique_lock lock(impl_->mutex);
+  impl& m = *impl_;
+  if (auto no = m.not_running()) return error_document(no->http_status, no->reason);
   // Every value is checked before the first goes out: a file with one that its entry cannot take
   // changes nothing.
   struct planned {
@@ -245,7 +248,7 @@ document axis_page::load_parameter_file(std::string_view text) {
   for (const parameter_value& v : std::get<std::vector<parameter_value>>(parsed)) {
     const auto e = std::find_if(all.begin(), all.end(),
                                 [&v](const parameter_entry& x) { return x.index == v.index && x.sub == v.sub; });
-    const std::string why = e == all.end() ? "not an entry the page knows" : impl_->not_loaded(*e);
+    const std::string why = e == all.end() ? "not an entry the page knows" : m.not_loaded(*e);
     if (!why.empty()) {
       skipped.push_back(json{{"key", key_of(v.index, v.sub)}, {"value", v.value}, {"reason", why}});
       continue;
@@ -255,9 +258,6 @@ document axis_page::load_parameter_file(std::string_view text) {
     if (!value) return error_document(400, key_of(v.index, v.sub) + " = " + v.value + ": " + bad);
     writes.push_back({&v, std::move(*value)});
   }
-  std::unique_lock lock(impl_->mutex);
-  impl& m = *impl_;
-  if (auto no = m.not_running()) return error_document(no->http_status, no->reason);
   json written = json::array(), refused_list = json::array();
   for (const planned& w : writes) {
     const std::uint16_t index = w.given->index;

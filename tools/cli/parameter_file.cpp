@@ -1,5 +1,6 @@
 #include "cli/parameter_file.hpp"
 
+#include <charconv>
 #include <ctime>
 #include <map>
 #include <sstream>
@@ -10,6 +11,15 @@
 
 namespace cia402::cli {
 namespace {
+
+// A text as one line of the file: a drive's text (its device name, 0x1008) is a peer's and may hold
+// anything; a line break in it would start a line of its own.
+std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r' || c == '\0') c = ' ';
+  }
+  return text;
+}
 
 canopen::access access_of(const std::string& a) {
   if (a == "rw") return canopen::access::rw;
@@ -27,18 +37,18 @@ std::vector<canopen::object_entry> objects_of(const std::vector<page::parameter_
   for (const auto& [index, subs] : by_index) {
     canopen::object_entry o;
     o.index = index;
-    o.name = subs.front()->name;
+    o.name = one_line(subs.front()->name);
     const bool var = subs.size() == 1 && subs.front()->sub == 0;
     o.code = var ? canopen::object_code::var : canopen::object_code::record;
     for (const page::parameter_entry* e : subs) {
       canopen::sub_entry s;
       s.sub = e->sub;
-      s.name = !var && e->sub == 0 ? "Highest sub-index supported" : e->name;
+      s.name = !var && e->sub == 0 ? "Highest sub-index supported" : one_line(e->name);
       s.type = static_cast<canopen::data_type>(e->data_type);
       s.acc = access_of(e->access);
       s.pdo_mappable = e->pdo_mappable;
       s.default_value = e->default_number.value_or(0);
-      s.default_text = e->default_text;
+      s.default_text = one_line(e->default_text);
       if (e->low || e->high) {
         s.has_limits = true;
         s.low = e->low.value_or(canopen::type_min(s.type));
@@ -76,12 +86,16 @@ std::string write_file(const std::vector<page::parameter_entry>& entries,
     if (!values[i]) continue;
     const page::parameter_entry& e = entries[i];
     if (e.data_type == static_cast<std::uint16_t>(canopen::data_type::visible_string)) {
-      given[{e.index, e.sub}] = *values[i];
+      given[{e.index, e.sub}] = one_line(*values[i]);
       continue;
     }
+    std::int64_t number = 0;
+    const std::string& text = *values[i];
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), number);
+    if (ec != std::errc() || end != text.data() + text.size()) continue;  // not a number: no value
     canopen::sub_entry s;
     s.type = static_cast<canopen::data_type>(e.data_type);
-    given[{e.index, e.sub}] = canopen::dcf_value_text(s, std::stoll(*values[i]));
+    given[{e.index, e.sub}] = canopen::dcf_value_text(s, number);
   }
   std::ostringstream out;
   canopen::write_dcf(objects, given, file_info(node), out);
