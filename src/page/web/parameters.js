@@ -55,6 +55,8 @@ function writeCell(row, e) {
     button.type = 'submit';
     button.className = 'control';
     button.textContent = 'Write';
+    // Drawn after the page learnt whether it may control (stream.js setControl): off when not.
+    input.disabled = button.disabled = document.body.classList.contains('view-only');
     form.append(input, button);
     form.addEventListener('submit', async (ev) => {
       ev.preventDefault();
@@ -115,6 +117,8 @@ export async function readList() {
     const reply = await res.json().catch(() => ({}));
     if (!res.ok) {
       el('param-count').textContent = `not read: ${reply.error || `HTTP ${res.status}`}`;
+      // A drive not reachable yet (503): read again while the panel stays open.
+      if (res.status === 503) setTimeout(() => { if (el('param-details').open) readList(); }, 1000);
       return;
     }
     state.entries = reply.entries || [];
@@ -168,9 +172,11 @@ export function buildParameters() {
   el('param-read').addEventListener('click', readList);
   // Read when first opened: the list is a read of every entry (an SDO each on a bus), not part of
   // the page's first load.
-  el('param-details').addEventListener('toggle', () => {
+  const opened = () => {
     if (el('param-details').open && !state.entries.length) readList();
-  });
+  };
+  el('param-details').addEventListener('toggle', opened);
+  opened();  // opened before the page had started
   el('param-save').addEventListener('click', () => {
     const a = document.createElement('a');
     a.href = api('/api/parameters.dcf');
