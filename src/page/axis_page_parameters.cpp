@@ -259,9 +259,17 @@ document axis_page::load_parameter_file(std::string_view text) {
     writes.push_back({&v, std::move(*value)});
   }
   json written = json::array(), refused_list = json::array();
+  std::string stopped;  // why the writes stopped: no answer in time, or the drive went away
   for (const planned& w : writes) {
     const std::uint16_t index = w.given->index;
     const std::uint8_t sub = w.given->sub;
+    if (stopped.empty()) {
+      if (auto no = m.not_running()) stopped = no->reason;
+    }
+    if (!stopped.empty()) {
+      skipped.push_back(json{{"key", key_of(index, sub)}, {"value", w.given->value}, {"reason", "not sent: " + stopped}});
+      continue;
+    }
     const auto r = m.await(lock, [&m, &w, index, sub](axes::completion done) {
       m.session->write_object(index, sub, w.value, std::move(done));
     });
@@ -271,6 +279,7 @@ document axis_page::load_parameter_file(std::string_view text) {
       written.push_back(std::move(item));
       continue;
     }
+    if (!r) stopped = "no answer from " + m.session->link().short_name() + " in time";
     if (r && r->abort != sdo_abort::none) item.update(abort_json(r->abort));
     item["error"] = !r ? "no answer from " + m.session->link().short_name() + " in time"
                        : r->abort != sdo_abort::none ? abort_text(r->abort) : r->error;
