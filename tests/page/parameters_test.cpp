@@ -11,6 +11,8 @@
 #include <regex>
 #include <string>
 
+#include "cia402/apps/virtual_drive_node.hpp"
+#include "cia402/canopen/301/slave.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/page/server.hpp"
 #include "cli/parameter_file.hpp"
@@ -193,6 +195,51 @@ TEST_F(parameters, a_file_bigger_than_a_command_body_is_taken) {
   auto r = load(file);
   ASSERT_TRUE(r);
   EXPECT_EQ(r->status, 200) << r->body;
+}
+
+// The entries `serve --can` gives the page beyond the table: a node's dictionary, each sub-index
+// with its type, access and its node-dependent default resolved ($NODEID+0x180 for node 5).
+TEST(parameter_entries, a_nodes_dictionary_gives_its_communication_objects_with_resolved_defaults) {
+  const auto entries = cli::parameter_entries(canopen::node_objects(apps::drive_node_config(5)), 5);
+  const auto find = [&](std::uint16_t index, std::uint8_t sub) -> const parameter_entry* {
+    for (const parameter_entry& e : entries) {
+      if (e.index == index && e.sub == sub) return &e;
+    }
+    return nullptr;
+  };
+  const parameter_entry* device_type = find(0x1000, 0);
+  ASSERT_NE(device_type, nullptr);
+  EXPECT_EQ(device_type->data_type, 0x0007);
+  EXPECT_EQ(device_type->access, "ro");
+  const parameter_entry* name = find(0x1008, 0);
+  ASSERT_NE(name, nullptr);
+  EXPECT_EQ(name->data_type, 0x0009);
+  const parameter_entry* tpdo1 = find(0x1800, 1);
+  ASSERT_NE(tpdo1, nullptr);
+  EXPECT_EQ(tpdo1->default_number.value_or(0) & 0x7FF, 0x180 + 5);
+}
+
+// A drive's text is a peer's: a line break in it stays inside its value in the file and cannot add
+// an entry of its own.
+TEST(dcf_parameter_file, a_text_with_line_breaks_cannot_add_an_entry_to_the_file) {
+  parameter_entry name;
+  name.index = 0x1008;
+  name.name = "Manufacturer device name";
+  name.data_type = 0x0009;
+  name.access = "const";
+  parameter_entry accel;
+  accel.index = 0x6083;
+  accel.name = "Profile acceleration";
+  accel.data_type = 0x0007;
+  const auto format = cli::dcf_parameter_file();
+  const std::string file =
+      format.write({name, accel}, {std::string("drive\n[6083]\nParameterValue=1"), std::nullopt}, 1);
+  auto read = format.read(file);
+  ASSERT_TRUE(std::holds_alternative<std::vector<parameter_value>>(read)) << file;
+  const auto& values = std::get<std::vector<parameter_value>>(read);
+  ASSERT_EQ(values.size(), 1u) << file;
+  EXPECT_EQ(values[0].index, 0x1008);
+  EXPECT_EQ(values[0].value, "drive [6083] ParameterValue=1");
 }
 
 }  // namespace
