@@ -4,20 +4,9 @@
 // drive's refusal shown (the SDO abort code and its text), and the whole set saved to a file and
 // loaded back with what was written, refused and skipped. Every value is the server's: the list is
 // read again after each write.
-import { api, el, token } from './page.js';
+import { api, el, send } from './page.js';
 
 const state = { entries: [], loading: false };
-
-async function send(path, body) {
-  const headers = { 'Content-Type': 'application/json' };
-  if (token) headers['X-Cia402-Token'] = token;
-  try {
-    const res = await fetch(api(path), { method: 'POST', headers, body: JSON.stringify(body) });
-    return { ok: res.ok, status: res.status, reply: await res.json().catch(() => ({})) };
-  } catch (e) {
-    return { ok: false, status: 0, reply: { error: `no connection to the server (${e.message})` } };
-  }
-}
 
 function cell(row, text, cls) {
   const td = document.createElement('td');
