@@ -187,6 +187,15 @@ struct axis_page::impl {
   json homing_json() const;
   json drive_errors_json() const;
   void end_homing(const axes::result& r);
+  // --- axis_page_parameters.cpp -------------------------------------------------------------------
+  struct entry_values {
+    std::vector<parameter_entry> entries;
+    std::vector<std::optional<axes::result>> results;  // none: not read (write-only, or no answer)
+  };
+  std::vector<std::optional<axes::result>> read_entries(std::unique_lock<std::mutex>& lock,
+                                                        const std::vector<parameter_entry>& entries);
+  entry_values entries_read(std::unique_lock<std::mutex>& lock);
+  std::string not_loaded(const parameter_entry& e) const;
 };
 
 }  // namespace cia402::page

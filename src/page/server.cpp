@@ -162,7 +162,7 @@ struct server::impl {
   }
 
   // The checks every POST passes before its body is read as JSON.
-  std::optional<request_error> check_post(const httplib::Request& req) const {
+  std::optional<request_error> check_post(const httplib::Request& req, std::size_t max_body) const {
     if (options.token_required) {
       if (!has_token(req)) {
         return request_error{403,
@@ -190,24 +190,27 @@ struct server::impl {
     if (bare != "application/json") {
       return request_error{415, "Content-Type must be application/json"};
     }
-    if (req.body.size() > options.max_body) {
-      return request_error{413, "body larger than " + std::to_string(options.max_body) + " bytes"};
+    if (req.body.size() > max_body) {
+      return request_error{413, "body larger than " + std::to_string(max_body) + " bytes"};
     }
     return std::nullopt;
   }
 
-  // Checks, parses and hands a POST body to `act`, which returns the instrument's reply or a
-  // request error of its own.
-  template <typename Act>
-  void post(const httplib::Request& req, httplib::Response& res, Act act) {
-    if (const auto e = check_post(req)) return send_error(res, e->status, e->reason);
+  // Checks and parses a POST body (at most `max_body` bytes): the drive it names and its JSON
+  // object, or nothing with the refusal sent.
+  std::optional<std::pair<backend*, json>> post_body(const httplib::Request& req, httplib::Response& res,
+                                                     std::size_t max_body) {
+    if (const auto e = check_post(req, max_body)) {
+      send_error(res, e->status, e->reason);
+      return std::nullopt;
+    }
     backend* inst = axis_of(req, res);
-    if (inst == nullptr) return;
+    if (inst == nullptr) return std::nullopt;
     inst->renew_lease();  // a client that controls is there
     // A key given twice is refused: "last wins" would act on a value the sender may not have meant.
     std::vector<std::set<std::string>> keys;
     bool duplicate = false;
-    const json body = json::parse(
+    json body = json::parse(
         req.body,
         [&](int, json::parse_event_t event, json& parsed) {
           if (event == json::parse_event_t::object_start) keys.emplace_back();
@@ -219,10 +222,24 @@ struct server::impl {
           return true;
         },
         false);
-    if (body.is_discarded()) return send_error(res, 400, "body is not valid JSON");
-    if (duplicate) return send_error(res, 400, "a key is given twice in the body");
-    if (!body.is_object()) return send_error(res, 400, "body must be a JSON object");
-    std::variant<reply, request_error> r = act(*inst, body);
+    const char* why = body.is_discarded() ? "body is not valid JSON"
+                      : duplicate         ? "a key is given twice in the body"
+                      : !body.is_object() ? "body must be a JSON object"
+                                          : nullptr;
+    if (why != nullptr) {
+      send_error(res, 400, why);
+      return std::nullopt;
+    }
+    return std::pair{inst, std::move(body)};
+  }
+
+  // Checks, parses and hands a POST body to `act`, which returns the instrument's reply or a
+  // request error of its own.
+  template <typename Act>
+  void post(const httplib::Request& req, httplib::Response& res, Act act) {
+    auto body = post_body(req, res, options.max_body);
+    if (!body) return;
+    std::variant<reply, request_error> r = act(*body->first, body->second);
     if (auto* e = std::get_if<request_error>(&r)) return send_error(res, e->status, e->reason);
     const reply& rep = std::get<reply>(r);
     if (const auto* ok = std::get_if<accepted>(&rep)) {
@@ -230,14 +247,7 @@ struct server::impl {
       if (!ok->text.empty()) j["text"] = ok->text;
       return send_json(res, 200, j);
     }
-    const refused& no = std::get<refused>(rep);
-    json j{{"error", no.reason}};
-    if (no.abort != sdo_abort::none) {
-      char buf[16];
-      std::snprintf(buf, sizeof buf, "0x%08X", static_cast<unsigned>(no.abort));
-      j["abort"] = buf;
-    }
-    send_json(res, no.http_status, j);
+    detail::send_refusal(res, std::get<refused>(rep));
   }
 
   // The drive a request names with ?axis=K (1..N; the first without it), or nullptr with the
@@ -332,20 +342,6 @@ struct server::impl {
     return inst.select_profile(body["profile"].get_ref<const std::string&>());
   }
 
-  std::variant<reply, request_error> on_object(backend& inst, const json& body) {
-    if (auto k = unknown_key(body, {"index", "value"})) return request_error{400, *k};
-    if (!body.contains("index") || !body.contains("value")) {
-      return request_error{400, "'index' and 'value' are required"};
-    }
-    const auto index = integer_of(body["index"]);
-    if (!index || *index < 0 || *index > 0xFFFF) {
-      return request_error{400, "'index' must be an object index 0x0000..0xFFFF"};
-    }
-    const auto value = integer_of(body["value"]);
-    if (!value) return request_error{400, "'value' must be an integer"};
-    return inst.write_object(static_cast<std::uint16_t>(*index), *value);
-  }
-
   void routes() {
     // cpp-httplib's default sets SO_REUSEPORT, so a second `cia402 serve` on the same port would
     // listen too and the two would answer in turn. SO_REUSEADDR alone still allows a restart while
@@ -356,7 +352,7 @@ struct server::impl {
       ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
       listen_fd = sock;
     });
-    http.set_payload_max_length(options.max_body);
+    http.set_payload_max_length(std::max(options.max_body, options.max_file_body));
     // A client that sends its request slowly holds a worker only this long per read.
     http.set_read_timeout(options.read_timeout);
     http.set_write_timeout(std::chrono::seconds(5));
@@ -367,9 +363,10 @@ struct server::impl {
       std::optional<request_error> e;
       if (req.has_header("Transfer-Encoding")) {
         e = request_error{411, "chunked bodies are not accepted: send Content-Length"};
-      } else if (req.has_header("Content-Length") &&
-                 !length_within(req.get_header_value("Content-Length"), options.max_body)) {
-        e = request_error{413, "body larger than " + std::to_string(options.max_body) + " bytes"};
+      } else if (const std::size_t most = req.path == detail::parameter_file_path ? options.max_file_body
+                                                                                 : options.max_body;
+                 req.has_header("Content-Length") && !length_within(req.get_header_value("Content-Length"), most)) {
+        e = request_error{413, "body larger than " + std::to_string(most) + " bytes"};
       }
       if (!e) return httplib::Server::HandlerResponse::Unhandled;
       // The unread body must not be taken for the next request: this connection ends here.
@@ -496,7 +493,7 @@ struct server::impl {
       post(req, res, [this](backend& d, const json& b) { return on_plant(d, b); });
     });
     http.Post("/api/object", [this](const httplib::Request& req, httplib::Response& res) {
-      post(req, res, [this](backend& d, const json& b) { return on_object(d, b); });
+      post(req, res, &detail::object_request);
     });
     http.Post("/api/profile", [this](const httplib::Request& req, httplib::Response& res) {
       post(req, res, [this](backend& d, const json& b) { return on_profile(d, b); });
@@ -512,8 +509,14 @@ struct server::impl {
         post(req, res, act);
       });
     }
-    for (const char* path : {"/api/command", "/api/plant", "/api/object", "/api/profile", "/api/enable",
-                             "/api/stop", "/api/jog", "/api/homing", "/api/errors/read", "/api/errors/clear"}) {
+    detail::add_parameter_routes(
+        http, {[this](const httplib::Request& req, httplib::Response& res) { return axis_of(req, res); },
+               [this](const httplib::Request& req, httplib::Response& res) {
+                 return post_body(req, res, options.max_file_body);
+               }});
+    for (const char* path : {"/api/command", "/api/plant", "/api/profile", "/api/enable",
+                             "/api/stop", "/api/jog", "/api/homing", "/api/errors/read",
+                             "/api/errors/clear"}) {
       http.Get(path, [](const httplib::Request&, httplib::Response& res) {
         send_error(res, 405, "use POST with a JSON body");
       });

@@ -11,6 +11,8 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <utility>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -58,6 +60,24 @@ std::variant<reply, request_error> homing_request_of(backend& drive, const nlohm
 /// or emptied (sub 0 = 0).
 std::variant<reply, request_error> error_field_read_request(backend& drive, const nlohmann::json& body);
 std::variant<reply, request_error> error_field_clear_request(backend& drive, const nlohmann::json& body);
+/// A refusal of the drive's: its status, {"error": reason} and, where the drive's object interface
+/// refused, "abort" (0x%08X) and "abort_text".
+void send_refusal(httplib::Response& res, const refused& no);
+
+/// POST /api/object: {"index": 0x6099 or "0x6099:1" (INDEX:SUB), "value": a number, or a string
+/// (a number's text, or a string entry's value)}.
+std::variant<reply, request_error> object_request(backend& drive, const nlohmann::json& body);
+
+/// The parameter list's routes (server_parameters.cpp): GET /api/parameters, GET and POST
+/// /api/parameters.dcf. What they need of the server: the drive a request names, and a checked POST
+/// body (the drive and the JSON object; nothing with the refusal sent).
+inline constexpr const char* parameter_file_path = "/api/parameters.dcf";
+struct parameter_route_hooks {
+  std::function<backend*(const httplib::Request&, httplib::Response&)> axis_of;
+  std::function<std::optional<std::pair<backend*, nlohmann::json>>(const httplib::Request&, httplib::Response&)>
+      post_body;
+};
+void add_parameter_routes(httplib::Server& http, parameter_route_hooks hooks);
 
 /// A refusal written straight to the socket (the request was never parsed); closes it.
 void answer_and_close(socket_t sock, int status, const std::string& reason);

@@ -151,5 +151,36 @@ TEST(eds_reader, a_file_that_does_not_parse_is_refused_with_its_line) {
   }
 }
 
+// A DCF (write_dcf): each entry given a value carries it as ParameterValue beside its DefaultValue,
+// and reads back with it; an entry without one reads back as its default.
+TEST(eds_reader, a_dcf_written_from_entries_reads_back_with_its_parameter_values) {
+  std::vector<object_entry> objects = node_objects(apps::drive_node_config(1));
+  dcf_values values;
+  const object_entry* accel = find(objects, 0x6083);
+  const object_entry* speeds = find(objects, 0x6099);
+  ASSERT_NE(accel, nullptr);
+  ASSERT_NE(speeds, nullptr);
+  ASSERT_GE(speeds->subs.size(), 3u);
+  values[{0x6083, 0}] = dcf_value_text(accel->subs.front(), 4321);
+  values[{0x6099, 1}] = dcf_value_text(speeds->subs[1], 777);
+  eds_info info;
+  info.node_id = 5;
+  std::ostringstream out;
+  write_dcf(objects, values, info, out);
+  EXPECT_NE(out.str().find("ParameterValue=0x000010E1"), std::string::npos) << out.str();
+  const eds_contents dcf = read_ok(out.str());
+  EXPECT_EQ(dcf.node_id, 5);
+  const object_entry* a = find(dcf.objects, 0x6083);
+  const object_entry* s = find(dcf.objects, 0x6099);
+  ASSERT_NE(a, nullptr);
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(a->subs.front().default_value, 4321);
+  EXPECT_EQ(s->subs[1].default_value, 777);
+  EXPECT_TRUE(a->subs.front().parameter_value);
+  EXPECT_EQ(s->subs[2].default_value, speeds->subs[2].default_value);  // no ParameterValue: the default
+  EXPECT_FALSE(s->subs[2].parameter_value);
+  EXPECT_EQ(dcf.objects.size(), objects.size());
+}
+
 }  // namespace
 }  // namespace cia402::canopen

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
+#include <string>
 #include <utility>
 
 #include <nlohmann/json.hpp>
@@ -47,6 +48,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 2: {
         constexpr std::uint16_t indices[] = {0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007,
                                              0x6083, 0x6040, 0x60FF, 0x1234};
+        if (arg & 0x80) {  // by index and sub-index, from text (the parameter list's writes)
+          const std::uint8_t sub = static_cast<std::uint8_t>(arg % 4);
+          r = inst.write_entry(arg & 0x40 ? 0x6099 : 0x607D, sub, std::to_string((arg % 7) * 9999 - 20000));
+          break;
+        }
         r = inst.write_object(indices[arg % 10], static_cast<std::int8_t>(arg) * 37);
         break;
       }

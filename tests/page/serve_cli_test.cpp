@@ -2,6 +2,8 @@
 // (exit status 2, or 1 for a bus that cannot be reached), with a reason.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -51,6 +53,23 @@ TEST(cli_serve_can, a_bus_nobody_listens_on_fails_with_status_1_and_says_why) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("cannot reach the bus socketcand://127.0.0.1:1/can0"), std::string::npos)
       << r.err;
+}
+
+TEST(cli_serve_can, an_eds_that_does_not_parse_or_cannot_be_read_is_refused_before_the_bus_is_reached) {
+  const std::string path = ::testing::TempDir() + "cia402-serve-bad.eds";
+  {
+    std::ofstream f(path);
+    f << "[1000]\nDataType=0x0007\nno key here\n";
+  }
+  // Port 1: were the file taken, the bus would be tried and refused with status 1.
+  result r = run_tool({"serve", "--can", "socketcand://127.0.0.1:1/can0", "--eds", path, "--port", "0"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find(path + ":3: "), std::string::npos) << r.err;
+  std::remove(path.c_str());
+  r = run_tool({"serve", "--can", "socketcand://127.0.0.1:1/can0", "--eds", path, "--port", "0"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("cannot read the file"), std::string::npos) << r.err;
+  EXPECT_NE(run_tool({"serve", "--eds", path, "--port", "0"}).status, 0);  // --eds needs --can
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <csignal>
+#include <fstream>
+#include <sstream>
 #include <memory>
 #include <vector>
 #include <ostream>
@@ -11,6 +13,7 @@
 #include "cia402/apps/ethercat_link.hpp"
 #include "cia402/apps/local_link.hpp"
 #include "cia402/apps/virtual_drive_node.hpp"
+#include "cia402/canopen/306/eds_reader.hpp"
 #include "cia402/canopen/axis/can_link.hpp"
 #include "cia402/canopen/transport/channel_url.hpp"
 #include "cia402/ethercat/axis/ecat_link.hpp"
@@ -18,6 +21,7 @@
 #include "cia402/page/runner.hpp"
 #include "cia402/page/server.hpp"
 #include "cli/common.hpp"
+#include "cli/parameter_file.hpp"
 
 namespace cia402::cli {
 namespace {
@@ -95,6 +99,23 @@ int open_can(const serve_args& args, const profile& p, page::axis_page_config pc
            "on a CAN bus start `cia402 bus` and give its socketcand:// URL\n";
     return refused;
   }
+  // The nodes' EDS or DCF: what their objects are, for the link and the page's parameter list.
+  std::vector<canopen::object_entry> eds;
+  if (!args.eds.empty()) {
+    std::ifstream in(args.eds);
+    if (!in) {
+      err << "cia402 serve: --eds " << args.eds << ": cannot read the file\n";
+      return refused;
+    }
+    std::stringstream text;
+    text << in.rdbuf();
+    auto parsed = canopen::read_eds(text.str());
+    if (const auto* e = std::get_if<canopen::eds_error>(&parsed)) {
+      err << "cia402 serve: --eds " << args.eds << ":" << e->line << ": " << e->reason << "\n";
+      return refused;
+    }
+    eds = std::move(std::get<canopen::eds_contents>(parsed).objects);
+  }
   pc.reset_pulse_us = 20000;
   pc.settle_quiet_us = 150000;
   for (const int node : args.nodes) {
@@ -126,6 +147,8 @@ int open_can(const serve_args& args, const profile& p, page::axis_page_config pc
     canopen::channel* bus = d.channels.back().get();
     pc.node = node;
     pc.bus = args.can;
+    c.eds = eds;
+    pc.parameters = parameter_entries(eds.empty() ? c.known_objects : eds, node);
     d.drives.push_back(std::make_unique<page::axis_page>(
         p,
         [bus, c](const profile&) {
@@ -170,6 +193,11 @@ CLI::App* add_serve_subcommand(CLI::App& app, serve_args& args) {
                    ->check(CLI::Range(1, 127))
                    ->default_str("1")
                    ->needs(can);
+  cmd->add_option("--eds", args.eds,
+                  "with --can: the nodes' EDS or DCF (CiA 306): their objects' types for the link, "
+                  "and the entries of the page's parameter list beyond the CiA 402 table")
+      ->type_name("FILE")
+      ->needs(can);
   cmd->add_option("--nodes", args.virtual_axes,
                   "without --can: run this many virtual drives, one axis of the page each")
       ->type_name("N")
@@ -210,6 +238,7 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   served_drives served;
   page::axis_page_config pc;
   pc.lease_us = static_cast<std::uint64_t>(args.lease_ms) * 1000;
+  pc.parameter_file = dcf_parameter_file();
   if (!args.ecat.empty()) {
     if (const int status = open_ecat(args, choice.get(), pc, served, err)) return status;
   } else if (!args.can.empty()) {

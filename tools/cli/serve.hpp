@@ -23,6 +23,7 @@ struct serve_args {
   bool token_required = false;  ///< also on for any --bind address that is not loopback
   std::string can;              ///< socketcand://HOST:PORT/BUS or socketcan://IFACE; "" = virtual drive
   std::vector<int> nodes{1};    ///< with --can: the drives' node-IDs, one axis each
+  std::string eds;              ///< with --can: the nodes' EDS or DCF (CiA 306), "" for none
   int virtual_axes = 1;         ///< without --can: how many virtual drives (--nodes N)
   std::string ecat;             ///< a network interface: the drive on that EtherCAT line instead
   int position = 0;             ///< with --ecat: the drive's position on the line, 0 first

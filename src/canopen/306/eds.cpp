@@ -1,6 +1,8 @@
 #include "cia402/canopen/306/eds.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <ostream>
 #include <vector>
 
@@ -26,6 +28,8 @@ std::string section_name(std::uint16_t index) {
   return buf;
 }
 
+std::string number_text(data_type type, std::int64_t v);
+
 // The value at power-up as the EDS writes it; false if the device lacks the object.
 bool default_text(slave& node, const object_entry& o, const sub_entry& e, std::string& out) {
   if (e.type == data_type::visible_string) {
@@ -44,22 +48,20 @@ bool default_text(slave& node, const object_entry& o, const sub_entry& e, std::s
     if (a == sdo_abort::object_does_not_exist) return false;
     if (a != sdo_abort::none) v = 0;
   }
-  if (type_is_signed(e.type)) {
-    out = std::to_string(v);
-  } else {
-    out = hex(static_cast<std::uint64_t>(v), static_cast<int>(type_size(e.type) * 2));
-  }
+  out = number_text(e.type, v);
   return true;
 }
 
-void write_sub(std::ostream& out, const std::string& section, const object_entry& o,
-               const sub_entry& e, const std::string& value) {
+// One entry's section; `parameter` (a DCF's) is the value the node has now (CiA 306 §4.6.4).
+void write_sub(std::ostream& out, const std::string& section, const object_entry& o, const sub_entry& e,
+               const std::string& value, const std::string* parameter = nullptr) {
   out << "[" << section << "]\n"
       << "ParameterName=" << (o.subs.size() == 1 && o.code == object_code::var ? o.name : e.name) << "\n"
       << "ObjectType=0x7\n"
       << "DataType=" << hex(static_cast<std::uint16_t>(e.type), 4) << "\n"
       << "AccessType=" << access_name(e.acc) << "\n"
       << "DefaultValue=" << value << "\n";
+  if (parameter != nullptr) out << "ParameterValue=" << *parameter << "\n";
   if (e.has_limits) {
     const bool sign = type_is_signed(e.type);
     out << "LowLimit=" << (sign ? std::to_string(e.low) : hex(static_cast<std::uint64_t>(e.low), 0)) << "\n"
@@ -67,6 +69,62 @@ void write_sub(std::ostream& out, const std::string& section, const object_entry
         << "\n";
   }
   out << "PDOMapping=" << (e.pdo_mappable ? 1 : 0) << "\n\n";
+}
+
+void write_file_info(std::ostream& out, const eds_info& info) {
+  out << "[FileInfo]\n"
+      << "FileName=" << info.file_name << "\n"
+      << "FileVersion=1\nFileRevision=0\nEDSVersion=4.0\n"
+      << "Description=" << info.description << "\n"
+      << "CreationTime=" << info.time << "\nCreationDate=" << info.date << "\n"
+      << "CreatedBy=" << info.created_by << "\n"
+      << "ModificationTime=" << info.time << "\nModificationDate=" << info.date << "\n"
+      << "ModifiedBy=" << info.created_by << "\n\n";
+}
+
+void write_commissioning(std::ostream& out, const eds_info& info) {
+  if (info.node_id == 0) return;
+  // CiA 306's commissioning section (as a DCF has it): the node this file was written for.
+  out << "[DeviceComissioning]\nNodeID=" << int{info.node_id} << "\nNodeName=" << info.product_name
+      << " " << int{info.node_id} << "\nBaudrate=1000\n\n";
+}
+
+// The three object lists (CiA 306 §4.6.2) and each object's sections; `value_of` gives an entry's
+// DefaultValue text, `parameter_of` its ParameterValue (nullptr: none).
+void write_objects(std::ostream& out, const std::vector<const object_entry*>& present,
+                   const std::function<std::string(const object_entry&, const sub_entry&)>& value_of,
+                   const std::function<const std::string*(const object_entry&, const sub_entry&)>& parameter_of) {
+  const char* list_names[3] = {"MandatoryObjects", "OptionalObjects", "ManufacturerObjects"};
+  for (int c = 0; c < 3; ++c) {
+    std::vector<const object_entry*> in;
+    for (const object_entry* o : present) {
+      if (eds_list_of(o->index) == c) in.push_back(o);
+    }
+    out << "[" << list_names[c] << "]\nSupportedObjects=" << in.size() << "\n";
+    for (std::size_t i = 0; i < in.size(); ++i) out << i + 1 << "=" << hex(in[i]->index, 4) << "\n";
+    out << "\n";
+    for (const object_entry* o : in) {
+      const std::string name = section_name(o->index);
+      if (o->code == object_code::var) {
+        const sub_entry& e = o->subs.front();
+        write_sub(out, name, *o, e, value_of(*o, e), parameter_of(*o, e));
+        continue;
+      }
+      out << "[" << name << "]\n"
+          << "ParameterName=" << o->name << "\n"
+          << "ObjectType=" << hex(static_cast<unsigned>(o->code), 0) << "\n"
+          << "SubNumber=" << hex(o->subs.size(), 0) << "\n\n";
+      for (const sub_entry& e : o->subs) {
+        write_sub(out, name + "sub" + hex(e.sub, 0).substr(2), *o, e, value_of(*o, e), parameter_of(*o, e));
+      }
+    }
+  }
+}
+
+// An entry's value as CiA 306 writes it: decimal when signed, hexadecimal when not.
+std::string number_text(data_type type, std::int64_t v) {
+  if (type_is_signed(type)) return std::to_string(v);
+  return hex(static_cast<std::uint64_t>(v), static_cast<int>(type_size(type) * 2));
 }
 
 }  // namespace
@@ -91,14 +149,7 @@ void write_eds(slave& node, const eds_info& info, std::ostream& out) {
   (void)node.read(0x1018, 2, product);
   (void)node.read(0x1018, 3, revision);
 
-  out << "[FileInfo]\n"
-      << "FileName=" << info.file_name << "\n"
-      << "FileVersion=1\nFileRevision=0\nEDSVersion=4.0\n"
-      << "Description=" << info.description << "\n"
-      << "CreationTime=" << info.time << "\nCreationDate=" << info.date << "\n"
-      << "CreatedBy=" << info.created_by << "\n"
-      << "ModificationTime=" << info.time << "\nModificationDate=" << info.date << "\n"
-      << "ModifiedBy=" << info.created_by << "\n\n";
+  write_file_info(out, info);
   out << "[DeviceInfo]\n"
       << "VendorName=" << info.vendor_name << "\n"
       << "VendorNumber=" << hex(static_cast<std::uint64_t>(vendor), 8) << "\n"
@@ -113,40 +164,41 @@ void write_eds(slave& node, const eds_info& info, std::ostream& out) {
   out << "[DummyUsage]\n";
   for (int i = 1; i <= 7; ++i) out << "Dummy000" << i << "=0\n";
   out << "\n[Comments]\nLines=1\nLine1=Generated from the node's object dictionary (cia402 eds).\n\n";
-  if (info.node_id != 0) {
-    // CiA 306's commissioning section (as a DCF has it): the node this file was written for.
-    out << "[DeviceComissioning]\nNodeID=" << int{info.node_id} << "\nNodeName=" << info.product_name
-        << " " << int{info.node_id} << "\nBaudrate=1000\n\n";
-  }
+  write_commissioning(out, info);
+  write_objects(
+      out, present,
+      [&node](const object_entry& o, const sub_entry& e) {
+        std::string value;
+        default_text(node, o, e, value);
+        return value;
+      },
+      [](const object_entry&, const sub_entry&) -> const std::string* { return nullptr; });
+}
 
-  const char* list_names[3] = {"MandatoryObjects", "OptionalObjects", "ManufacturerObjects"};
-  for (int c = 0; c < 3; ++c) {
-    std::vector<const object_entry*> in;
-    for (const object_entry* o : present) {
-      if (eds_list_of(o->index) == c) in.push_back(o);
-    }
-    out << "[" << list_names[c] << "]\nSupportedObjects=" << in.size() << "\n";
-    for (std::size_t i = 0; i < in.size(); ++i) out << i + 1 << "=" << hex(in[i]->index, 4) << "\n";
-    out << "\n";
-    for (const object_entry* o : in) {
-      const std::string name = section_name(o->index);
-      if (o->code == object_code::var) {
-        std::string value;
-        default_text(node, *o, o->subs.front(), value);
-        write_sub(out, name, *o, o->subs.front(), value);
-        continue;
-      }
-      out << "[" << name << "]\n"
-          << "ParameterName=" << o->name << "\n"
-          << "ObjectType=" << hex(static_cast<unsigned>(o->code), 0) << "\n"
-          << "SubNumber=" << hex(o->subs.size(), 0) << "\n\n";
-      for (const sub_entry& e : o->subs) {
-        std::string value;
-        default_text(node, *o, e, value);
-        write_sub(out, name + "sub" + hex(e.sub, 0).substr(2), *o, e, value);
-      }
-    }
+std::string dcf_value_text(const sub_entry& e, std::int64_t value) { return number_text(e.type, value); }
+
+void write_dcf(const std::vector<object_entry>& objects, const dcf_values& values, const eds_info& info,
+               std::ostream& out) {
+  write_file_info(out, info);
+  out << "[DeviceInfo]\nVendorName=" << info.vendor_name << "\nProductName=" << info.product_name << "\n\n";
+  write_commissioning(out, info);
+  std::vector<const object_entry*> present;
+  for (const object_entry& o : objects) {
+    if (!o.subs.empty()) present.push_back(&o);
   }
+  std::sort(present.begin(), present.end(),
+            [](const object_entry* a, const object_entry* b) { return a->index < b->index; });
+  write_objects(
+      out, present,
+      [](const object_entry&, const sub_entry& e) {
+        if (e.type == data_type::visible_string) return e.default_text;
+        if (e.plus_node_id) return "$NODEID+" + hex(static_cast<std::uint64_t>(e.default_value), 0);
+        return number_text(e.type, e.default_value);
+      },
+      [&values](const object_entry& o, const sub_entry& e) -> const std::string* {
+        const auto it = values.find({o.index, e.sub});
+        return it == values.end() ? nullptr : &it->second;
+      });
 }
 
 }  // namespace cia402::canopen

@@ -180,7 +180,8 @@ class reader {
       e.high = high.value_or(type_max(e.type));
     }
     const value_line* value = find(s, "ParameterValue");
-    if (value == nullptr || value->text.empty()) value = find(s, "DefaultValue");
+    e.parameter_value = value != nullptr && !value->text.empty();
+    if (!e.parameter_value) value = find(s, "DefaultValue");
     if (value == nullptr) return true;
     return default_value(*value, e);
   }

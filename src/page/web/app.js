@@ -11,6 +11,7 @@ import { addRows, addSamples, addSnapshot } from './scope_data.js';
 import { connect, setControl } from './stream.js';
 import { buildBits, buildCommands, buildModes, showWords } from './words.js';
 import './jog.js';
+import { buildParameters } from './parameters.js';
 
 function update(s, missed) {
   if (s.profile && page.info && s.profile !== page.info.profile.name) {
@@ -59,6 +60,7 @@ export async function start() {
   buildModePanel();
   buildPlant();
   buildScope();
+  buildParameters();
   setControl(page.info.control);
   applyCapabilities(page.info.capabilities);
   onRecording(addRows);

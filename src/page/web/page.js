@@ -35,22 +35,24 @@ export function serverNow() {
   return page.snapshot ? page.snapshot.time_ms + (performance.now() - page.received) : 0;
 }
 
-export async function post(path, body) {
+// A POST with the token: `{ ok, status, reply }` (the reply's JSON, `{ error }` without a connection).
+export async function send(path, body) {
   const headers = { 'Content-Type': 'application/json' };
   if (token) headers['X-Cia402-Token'] = token;
-  let reply;
   try {
     const res = await fetch(api(path), { method: 'POST', headers, body: JSON.stringify(body) });
-    reply = await res.json().catch(() => ({}));
-    if (!res.ok) {
-      showResult('refused', reply.error || `HTTP ${res.status}`);
-      return null;
-    }
+    return { ok: res.ok, status: res.status, reply: await res.json().catch(() => ({})) };
   } catch (e) {
-    showResult('refused', `no connection to the server (${e.message})`);
-    return null;
+    return { ok: false, status: 0, reply: { error: `no connection to the server (${e.message})` } };
   }
-  return reply;
+}
+
+// A POST whose refusal is shown as the page's result: the reply, or null when refused.
+export async function post(path, body) {
+  const { ok, status, reply } = await send(path, body);
+  if (ok) return reply;
+  showResult('refused', reply.error || `HTTP ${status}`);
+  return null;
 }
 
 export function showResult(outcome, text) {

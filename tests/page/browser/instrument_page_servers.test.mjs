@@ -43,10 +43,11 @@ async function main() {
     await viewer.goto(guarded.url.replace(/\?token=.*$/, ''));
     await waitPresent(viewer, 'SWITCH_ON_DISABLED');
     await viewer.waitForSelector('#view-only:not([hidden])', { timeout: patience });
-    // The scope's own tools only look at the samples: they stay usable without the token.
+    // The scope's own tools only look at the samples, and the parameter list's search, filter, read
+    // and save only read: they stay usable without the token.
     const enabled = await viewer.evaluate(() =>
       [...document.querySelectorAll('button, input, select')]
-        .filter((c) => !c.disabled && !c.closest('.panel-scope')).length);
+        .filter((c) => !c.disabled && !c.closest('.panel-scope, .param-view')).length);
     expect(enabled === 0, `${enabled} controls still enabled`);
   });
   await viewer.screenshot({ path: path.join(outDir, 'view-only-1280x800.png') });

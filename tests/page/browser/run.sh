@@ -42,6 +42,7 @@ node "$here/instrument_page.test.mjs" "$cia402" "$work/output" "$screenshot"
 node "$here/instrument_page_servers.test.mjs" "$cia402" "$work/output"
 node "$here/scope.test.mjs" "$cia402" "$work/output"
 node "$here/homing.test.mjs" "$cia402" "$work/output"
+node "$here/parameters.test.mjs" "$cia402" "$work/output"
 # With CIA402_UPDATE_SCREENSHOT=1 the docs' other pictures follow: phone width, several axes, the
 # recorder (the whole page at 1280 px), profile position after a move.
 if [ "${CIA402_UPDATE_SCREENSHOT:-0}" = 1 ]; then

@@ -45,6 +45,9 @@ struct sub_entry {
   std::int64_t low = 0;        ///< value limits (inclusive) when has_limits
   std::int64_t high = 0;
   bool has_limits = false;
+  /// The value came from a DCF's ParameterValue (CiA 306 §4.6.4: what the node is configured with),
+  /// not from its DefaultValue (eds_reader.hpp).
+  bool parameter_value = false;
 };
 
 struct object_entry {

@@ -8,8 +8,12 @@
 
 #include <cstdint>
 #include <iosfwd>
+#include <map>
+#include <utility>
+#include <vector>
 #include <string>
 
+#include "cia402/canopen/301/object_dictionary.hpp"
 #include "cia402/canopen/301/slave.hpp"
 
 namespace cia402::canopen {
@@ -28,5 +32,18 @@ struct eds_info {
 
 /// Writes the EDS of `node` (a freshly started node: its values are the defaults).
 void write_eds(slave& node, const eds_info& info, std::ostream& out);
+
+/// A DCF's present values (CiA 306 §4.6.4, ParameterValue), by index and sub-index, as the file
+/// writes them (dcf_value_text for a number).
+using dcf_values = std::map<std::pair<std::uint16_t, std::uint8_t>, std::string>;
+
+/// A number as a DCF writes an entry of its type: decimal when signed, 0x-hexadecimal when not.
+std::string dcf_value_text(const sub_entry& e, std::int64_t value);
+
+/// Writes a device configuration file (CiA 306 DCF): `objects` as an EDS describes them, each entry
+/// with a value in `values` with its ParameterValue too; read_eds (eds_reader.hpp) reads it back,
+/// ParameterValue over DefaultValue. Objects without entries are left out.
+void write_dcf(const std::vector<object_entry>& objects, const dcf_values& values, const eds_info& info,
+               std::ostream& out);
 
 }  // namespace cia402::canopen

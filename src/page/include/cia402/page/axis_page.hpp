@@ -25,6 +25,7 @@
 
 #include "cia402/axis/drive_link.hpp"
 #include "cia402/page/backend.hpp"
+#include "cia402/page/parameters.hpp"
 #include "cia402/profile.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 
@@ -64,6 +65,11 @@ struct axis_page_config {
   int node = 0;
   std::string bus;
   std::string where;
+  /// Entries the composition knows beyond the CiA 402 object table (a CAN node's communication and
+  /// identity objects from its dictionary or EDS); the table's entry wins where both have one.
+  std::vector<parameter_entry> parameters;
+  /// The parameter files (CiA 306 DCF from `cia402 serve`); empty: none offered.
+  parameter_file_format parameter_file;
 };
 
 class axis_page : public backend {
@@ -86,6 +92,10 @@ class axis_page : public backend {
   reply stop() override;
   reply jog(std::int64_t velocity_rpm, std::uint64_t time_to_live_us) override;
   reply write_object(std::uint16_t index, std::int64_t value) override;
+  reply write_entry(std::uint16_t index, std::uint8_t sub, std::string_view value) override;
+  document parameters() override;
+  document parameter_file() override;
+  document load_parameter_file(std::string_view text) override;
   reply change_plant(const plant_change& change) override;
   reply home(const homing_request& r) override;
   reply read_error_field() override;

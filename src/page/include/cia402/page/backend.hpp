@@ -35,6 +35,13 @@ struct refused {
 
 using reply = std::variant<accepted, refused>;
 
+/// An answer with a body of its own: the HTTP status and the body (JSON; a parameter file's text
+/// with status 200 where the request asked for the file).
+struct document {
+  int http_status = 200;
+  std::string body;
+};
+
 /// The page's command buttons. `disable_operation` sends the same word as `switch_on` (the state
 /// tells them apart); `fault_reset` is an edge of bit 7; `halt` toggles bit 8.
 enum class page_command : std::uint8_t {
@@ -133,6 +140,26 @@ class backend {
   /// snapshots' `drive_errors`), or empty it (0x1003 sub 0 = 0).
   virtual reply read_error_field() { return refused{409, "this drive has no 0x1003 the page reads"}; }
   virtual reply clear_error_field() { return refused{409, "this drive has no 0x1003 the page reads"}; }
+  /// Writes one entry (index and sub-index) from text: a number (decimal or 0x-hexadecimal) or,
+  /// for a string entry, the string. A refusal gives the SDO abort code (CiA 301 §7.2.4.3.17).
+  virtual reply write_entry(std::uint16_t index, std::uint8_t sub, std::string_view value) {
+    (void)index;
+    (void)sub;
+    (void)value;
+    return refused{409, "this drive offers no parameter list"};
+  }
+  /// The parameter list (docs/instrument-page.md, "Parameter list and parameter files"): every
+  /// entry with its description and present value, read in one pass, as JSON.
+  virtual document parameters() { return {409, R"({"error":"this drive offers no parameter list"})"}; }
+  /// The parameter set as a file (200 and the file's text, or an error as JSON).
+  virtual document parameter_file() { return parameters(); }
+  /// Writes every writable value a parameter file gives, in file order: JSON with what was written,
+  /// refused (with its abort code and text) and skipped. A file that does not parse changes nothing
+  /// (400, with its line and reason).
+  virtual document load_parameter_file(std::string_view text) {
+    (void)text;
+    return parameters();
+  }
   /// Plant inputs: target velocity, fault, DC link, STO. A backend that cannot change one refuses
   /// the request (and says so in the `capabilities` of its info).
   virtual reply change_plant(const plant_change& change) = 0;

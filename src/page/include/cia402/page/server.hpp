@@ -48,6 +48,8 @@ struct server_options {
   bool token_required = false;
   std::string token;  ///< the token; make_token() when empty and required
   std::size_t max_body = 4096;
+  /// A parameter file's body (POST /api/parameters.dcf): a DCF of a whole drive is tens of KB.
+  std::size_t max_file_body = 1 << 20;
   std::size_t max_headers = 64;  ///< header lines a request may have (431 beyond)
   std::size_t max_head = 16384;  ///< bytes of a request's head (431 beyond)
   /// Open connections one client address may hold (beyond loopback; 503 beyond).

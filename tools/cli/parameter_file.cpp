@@ -1,0 +1,162 @@
+#include "cli/parameter_file.hpp"
+
+#include <charconv>
+#include <ctime>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include "cia402/canopen/306/eds.hpp"
+#include "cia402/canopen/306/eds_reader.hpp"
+
+namespace cia402::cli {
+namespace {
+
+// A text as one line of the file: a drive's text (its device name, 0x1008) is a peer's and may hold
+// anything; a line break in it would start a line of its own.
+std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r' || c == '\0') c = ' ';
+  }
+  return text;
+}
+
+canopen::access access_of(const std::string& a) {
+  if (a == "rw") return canopen::access::rw;
+  if (a == "wo") return canopen::access::wo;
+  if (a == "const") return canopen::access::constant;
+  return canopen::access::ro;
+}
+
+// The page's entries as the dictionary's objects: one VAR where an index has only sub-index 0, else
+// a RECORD named by its sub-index 0 (CiA 301 §7.4.3).
+std::vector<canopen::object_entry> objects_of(const std::vector<page::parameter_entry>& entries) {
+  std::map<std::uint16_t, std::vector<const page::parameter_entry*>> by_index;
+  for (const page::parameter_entry& e : entries) by_index[e.index].push_back(&e);
+  std::vector<canopen::object_entry> out;
+  for (const auto& [index, subs] : by_index) {
+    canopen::object_entry o;
+    o.index = index;
+    o.name = one_line(subs.front()->name);
+    const bool var = subs.size() == 1 && subs.front()->sub == 0;
+    o.code = var ? canopen::object_code::var : canopen::object_code::record;
+    for (const page::parameter_entry* e : subs) {
+      canopen::sub_entry s;
+      s.sub = e->sub;
+      s.name = !var && e->sub == 0 ? "Highest sub-index supported" : one_line(e->name);
+      s.type = static_cast<canopen::data_type>(e->data_type);
+      s.acc = access_of(e->access);
+      s.pdo_mappable = e->pdo_mappable;
+      s.default_value = e->default_number.value_or(0);
+      s.default_text = one_line(e->default_text);
+      if (e->low || e->high) {
+        s.has_limits = true;
+        s.low = e->low.value_or(canopen::type_min(s.type));
+        s.high = e->high.value_or(canopen::type_max(s.type));
+      }
+      o.subs.push_back(std::move(s));
+    }
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+canopen::eds_info file_info(int node) {
+  canopen::eds_info info;
+  info.file_name = "cia402-parameters.dcf";
+  info.description = "parameter set saved by cia402 serve";
+  info.created_by = "cia402 serve";
+  const std::time_t now = std::time(nullptr);
+  std::tm t{};
+  gmtime_r(&now, &t);
+  char date[16], time[16];
+  std::strftime(date, sizeof date, "%m-%d-%Y", &t);
+  std::strftime(time, sizeof time, "%I:%M%p", &t);
+  info.date = date;
+  info.time = time;
+  info.node_id = node >= 1 && node <= 127 ? static_cast<std::uint8_t>(node) : 0;
+  return info;
+}
+
+std::string write_file(const std::vector<page::parameter_entry>& entries,
+                       const std::vector<std::optional<std::string>>& values, int node) {
+  const std::vector<canopen::object_entry> objects = objects_of(entries);
+  canopen::dcf_values given;
+  for (std::size_t i = 0; i < entries.size() && i < values.size(); ++i) {
+    if (!values[i]) continue;
+    const page::parameter_entry& e = entries[i];
+    if (e.data_type == static_cast<std::uint16_t>(canopen::data_type::visible_string)) {
+      given[{e.index, e.sub}] = one_line(*values[i]);
+      continue;
+    }
+    std::int64_t number = 0;
+    const std::string& text = *values[i];
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), number);
+    if (ec != std::errc() || end != text.data() + text.size()) continue;  // not a number: no value
+    canopen::sub_entry s;
+    s.type = static_cast<canopen::data_type>(e.data_type);
+    given[{e.index, e.sub}] = canopen::dcf_value_text(s, number);
+  }
+  std::ostringstream out;
+  canopen::write_dcf(objects, given, file_info(node), out);
+  return out.str();
+}
+
+std::variant<std::vector<page::parameter_value>, page::parameter_file_error> read_file(std::string_view text) {
+  auto parsed = canopen::read_eds(text);
+  if (const auto* bad = std::get_if<canopen::eds_error>(&parsed)) {
+    return page::parameter_file_error{bad->line, bad->reason};
+  }
+  const canopen::eds_contents& dcf = std::get<canopen::eds_contents>(parsed);
+  std::vector<page::parameter_value> out;
+  for (const canopen::object_entry& o : dcf.objects) {
+    for (const canopen::sub_entry& s : o.subs) {
+      if (!s.parameter_value) continue;
+      std::string value = s.type == canopen::data_type::visible_string
+                              ? s.default_text
+                              : std::to_string(s.default_value + (s.plus_node_id ? dcf.node_id : 0));
+      out.push_back({o.index, s.sub, std::move(value)});
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+page::parameter_file_format dcf_parameter_file() {
+  page::parameter_file_format f;
+  f.extension = "dcf";
+  f.media_type = "text/plain";
+  f.write = write_file;
+  f.read = read_file;
+  return f;
+}
+
+std::vector<page::parameter_entry> parameter_entries(const std::vector<canopen::object_entry>& objects,
+                                                     int node_id) {
+  std::vector<page::parameter_entry> out;
+  for (const canopen::object_entry& o : objects) {
+    for (const canopen::sub_entry& s : o.subs) {
+      page::parameter_entry e;
+      e.index = o.index;
+      e.sub = s.sub;
+      e.name = o.code == canopen::object_code::var || s.sub == 0 ? o.name : s.name;
+      e.data_type = static_cast<std::uint16_t>(s.type);
+      e.access = canopen::access_name(s.acc);
+      e.pdo_mappable = s.pdo_mappable;
+      if (s.has_limits) {
+        e.low = s.low;
+        e.high = s.high;
+      }
+      if (s.type == canopen::data_type::visible_string) {
+        e.default_text = s.default_text;
+      } else {
+        e.default_number = s.default_value + (s.plus_node_id ? node_id : 0);
+      }
+      out.push_back(std::move(e));
+    }
+  }
+  return out;
+}
+
+}  // namespace cia402::cli
