@@ -44,15 +44,15 @@ std::vector<canopen::object_entry> objects_of(const std::vector<page::parameter_
       canopen::sub_entry s;
       s.sub = e->sub;
       s.name = !var && e->sub == 0 ? "Highest sub-index supported" : one_line(e->name);
-      s.type = static_cast<canopen::data_type>(e->data_type);
+      s.type = static_cast<data_type>(e->data_type);
       s.acc = access_of(e->access);
       s.pdo_mappable = e->pdo_mappable;
       s.default_value = e->default_number.value_or(0);
       s.default_text = one_line(e->default_text);
       if (e->low || e->high) {
         s.has_limits = true;
-        s.low = e->low.value_or(canopen::type_min(s.type));
-        s.high = e->high.value_or(canopen::type_max(s.type));
+        s.low = e->low.value_or(type_min(s.type));
+        s.high = e->high.value_or(type_max(s.type));
       }
       o.subs.push_back(std::move(s));
     }
@@ -85,7 +85,7 @@ std::string write_file(const std::vector<page::parameter_entry>& entries,
   for (std::size_t i = 0; i < entries.size() && i < values.size(); ++i) {
     if (!values[i]) continue;
     const page::parameter_entry& e = entries[i];
-    if (e.data_type == static_cast<std::uint16_t>(canopen::data_type::visible_string)) {
+    if (e.data_type == static_cast<std::uint16_t>(data_type::visible_string)) {
       given[{e.index, e.sub}] = one_line(*values[i]);
       continue;
     }
@@ -94,7 +94,7 @@ std::string write_file(const std::vector<page::parameter_entry>& entries,
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), number);
     if (ec != std::errc() || end != text.data() + text.size()) continue;  // not a number: no value
     canopen::sub_entry s;
-    s.type = static_cast<canopen::data_type>(e.data_type);
+    s.type = static_cast<data_type>(e.data_type);
     given[{e.index, e.sub}] = canopen::dcf_value_text(s, number);
   }
   std::ostringstream out;
@@ -112,7 +112,7 @@ std::variant<std::vector<page::parameter_value>, page::parameter_file_error> rea
   for (const canopen::object_entry& o : dcf.objects) {
     for (const canopen::sub_entry& s : o.subs) {
       if (!s.parameter_value) continue;
-      std::string value = s.type == canopen::data_type::visible_string
+      std::string value = s.type == data_type::visible_string
                               ? s.default_text
                               : std::to_string(s.default_value + (s.plus_node_id ? dcf.node_id : 0));
       out.push_back({o.index, s.sub, std::move(value)});
@@ -148,7 +148,7 @@ std::vector<page::parameter_entry> parameter_entries(const std::vector<canopen::
         e.low = s.low;
         e.high = s.high;
       }
-      if (s.type == canopen::data_type::visible_string) {
+      if (s.type == data_type::visible_string) {
         e.default_text = s.default_text;
       } else {
         e.default_number = s.default_value + (s.plus_node_id ? node_id : 0);
