@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "bytes.hpp"
+#include "cia402/sdo_command.hpp"
 
 namespace cia402::ethercat {
 namespace {
@@ -12,17 +13,7 @@ using detail::le32;
 using detail::put16;
 using detail::put32;
 
-// Command specifiers (the top three bits), CiA 301 §7.2.4.3, as a client sends them ...
-constexpr std::uint8_t ccs_download_segment = 0;
-constexpr std::uint8_t ccs_initiate_download = 1;
-constexpr std::uint8_t ccs_initiate_upload = 2;
-constexpr std::uint8_t ccs_upload_segment = 3;
-constexpr std::uint8_t cs_abort = 4;
-// ... and as a server answers.
-constexpr std::uint8_t scs_upload_segment = 0;
-constexpr std::uint8_t scs_download_segment = 1;
-constexpr std::uint8_t scs_initiate_upload = 2;
-constexpr std::uint8_t scs_initiate_download = 3;
+using namespace sdo_command_specifier;  // ccs_*, scs_*, cs_abort: CiA 301's, the top three bits
 constexpr std::uint8_t complete_access_bit = 0x10;
 constexpr std::uint8_t toggle_bit = 0x10;
 constexpr std::size_t segment_data_in_ten_bytes = 7;
