@@ -20,20 +20,13 @@ constexpr int portable_set_bits(std::uint32_t v) noexcept {
   return n;
 }
 
-inline int lowest_bit(std::uint32_t v) noexcept {
+// One choice of implementation for both: the builtins where the compiler has them.
 #if defined(__GNUC__) || defined(__clang__)
-  return __builtin_ctz(v);
+inline int lowest_bit(std::uint32_t v) noexcept { return __builtin_ctz(v); }
+inline int set_bits(std::uint32_t v) noexcept { return __builtin_popcount(v); }
 #else
-  return portable_lowest_bit(v);
+inline int lowest_bit(std::uint32_t v) noexcept { return portable_lowest_bit(v); }
+inline int set_bits(std::uint32_t v) noexcept { return portable_set_bits(v); }
 #endif
-}
-
-inline int set_bits(std::uint32_t v) noexcept {
-#if defined(__GNUC__) || defined(__clang__)
-  return __builtin_popcount(v);
-#else
-  return portable_set_bits(v);
-#endif
-}
 
 }  // namespace cia402::detail

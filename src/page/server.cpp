@@ -499,12 +499,12 @@ struct server::impl {
       post(req, res, [this](backend& d, const json& b) { return on_profile(d, b); });
     });
     // One-click enable and stop, and the jog with its dead-man (commissioning.hpp).
-    for (const auto& [path, act] : {std::pair{"/api/enable", &detail::enable_request},
-                                    std::pair{"/api/stop", &detail::stop_request},
+    for (const auto& [path, act] : {std::pair{"/api/enable", &detail::bare_request<&backend::enable>},
+                                    std::pair{"/api/stop", &detail::bare_request<&backend::stop>},
                                     std::pair{"/api/jog", &detail::jog_request},
                                     std::pair{"/api/homing", &detail::homing_request_of},
-                                    std::pair{"/api/errors/read", &detail::error_field_read_request},
-                                    std::pair{"/api/errors/clear", &detail::error_field_clear_request}}) {
+                                    std::pair{"/api/errors/read", &detail::bare_request<&backend::read_error_field>},
+                                    std::pair{"/api/errors/clear", &detail::bare_request<&backend::clear_error_field>}}) {
       http.Post(path, [this, act = act](const httplib::Request& req, httplib::Response& res) {
         post(req, res, act);
       });

@@ -116,16 +116,6 @@ std::variant<reply, request_error> jog_request(backend& drive, const json& body)
   return drive.jog(*velocity, ttl_ms * 1000);
 }
 
-std::variant<reply, request_error> enable_request(backend& drive, const json& body) {
-  if (auto k = unknown_key(body, {})) return request_error{400, *k};
-  return drive.enable();
-}
-
-std::variant<reply, request_error> stop_request(backend& drive, const json& body) {
-  if (auto k = unknown_key(body, {})) return request_error{400, *k};
-  return drive.stop();
-}
-
 std::variant<reply, request_error> homing_request_of(backend& drive, const json& body) {
   if (auto k = unknown_key(body, {"method", "fast", "slow", "acceleration", "offset", "start"})) {
     return request_error{400, *k};
@@ -148,16 +138,6 @@ std::variant<reply, request_error> homing_request_of(backend& drive, const json&
     return request_error{400, "nothing to do: give a parameter or 'start'"};
   }
   return drive.home(r);
-}
-
-std::variant<reply, request_error> error_field_read_request(backend& drive, const json& body) {
-  if (auto k = unknown_key(body, {})) return request_error{400, *k};
-  return drive.read_error_field();
-}
-
-std::variant<reply, request_error> error_field_clear_request(backend& drive, const json& body) {
-  if (auto k = unknown_key(body, {})) return request_error{400, *k};
-  return drive.clear_error_field();
 }
 
 // A refusal written straight to the socket (the request was never parsed).

@@ -49,17 +49,18 @@ struct request_error {
 
 /// POST /api/jog: {"velocity": rpm (signed; 0 releases), "ttl_ms": 20..1000, 300 if not given}.
 std::variant<reply, request_error> jog_request(backend& drive, const nlohmann::json& body);
-/// POST /api/enable and /api/stop take an empty object.
-std::variant<reply, request_error> enable_request(backend& drive, const nlohmann::json& body);
-std::variant<reply, request_error> stop_request(backend& drive, const nlohmann::json& body);
+/// A request with an empty object for its body, which asks `action` of the drive: POST /api/enable
+/// and /api/stop, /api/errors/read (the drive's 0x1003 read again) and /api/errors/clear (emptied,
+/// sub 0 = 0). Any key in the body is refused.
+template <reply (backend::*action)()>
+std::variant<reply, request_error> bare_request(backend& drive, const nlohmann::json& body) {
+  if (auto k = unknown_key(body, {})) return request_error{400, *k};
+  return (drive.*action)();
+}
 
 /// POST /api/homing: {"method", "fast" (0x6099:1, rpm), "slow" (0x6099:2, rpm), "acceleration"
 /// (0x609A, rpm/s), "offset" (0x607C), "start" (true: run, false: stop)}, each optional, integers.
 std::variant<reply, request_error> homing_request_of(backend& drive, const nlohmann::json& body);
-/// POST /api/errors/read and /api/errors/clear take an empty object: the drive's 0x1003 read again,
-/// or emptied (sub 0 = 0).
-std::variant<reply, request_error> error_field_read_request(backend& drive, const nlohmann::json& body);
-std::variant<reply, request_error> error_field_clear_request(backend& drive, const nlohmann::json& body);
 /// A refusal of the drive's: its status, {"error": reason} and, where the drive's object interface
 /// refused, "abort" (0x%08X) and "abort_text".
 void send_refusal(httplib::Response& res, const refused& no);

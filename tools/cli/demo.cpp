@@ -58,14 +58,18 @@ class demo_run {
     }
   }
 
-  void command_word(command c) {
+  /// The profile's control word for `c`, then the cycles it brings under `label`.
+  void command_word(command c, const std::string& label) {
     std::uint16_t word = 0;
     encode_command(p_, c, 0, word);
     set_word(word);
+    event(label);
   }
-  /// 0x60FF. Enabling clears the set-points (T4), so a target is given once the drive runs.
+  /// 0x60FF, then the cycles it brings. Enabling clears the set-points (T4), so a target is given
+  /// once the drive runs.
   void set_target_rpm(std::int32_t rpm) {
     (void)drive_.view().write(object_index::target_velocity, 0, rpm);
+    event("target velocity " + std::to_string(rpm) + " rpm");
   }
   void set_word(std::uint16_t word) { (void)drive_.view().write(object_index::control_word, 0, word); }
   std::uint16_t word() { return drive_.view().control_word(); }
@@ -94,24 +98,15 @@ class demo_run {
 void run_demo(const profile& p, std::ostream& out) {
   demo_run d(p, out);
   d.event("power-up");
-  d.command_word(command::shutdown);
-  d.event("shutdown");
-  d.command_word(command::switch_on);
-  d.event("switch on");
-  d.command_word(command::enable_operation);
-  d.event("enable operation");
+  d.command_word(command::shutdown, "shutdown");
+  d.command_word(command::switch_on, "switch on");
+  d.command_word(command::enable_operation, "enable operation");
   d.set_target_rpm(300);
-  d.event("target velocity 300 rpm");
-  d.command_word(command::quick_stop);
-  d.event("quick stop");
-  d.command_word(command::disable_voltage);
-  d.event("disable voltage");
-  d.command_word(command::shutdown);
-  d.event("shutdown");
-  d.command_word(command::enable_operation);
-  d.event("enable operation (T3, then T4)");
+  d.command_word(command::quick_stop, "quick stop");
+  d.command_word(command::disable_voltage, "disable voltage");
+  d.command_word(command::shutdown, "shutdown");
+  d.command_word(command::enable_operation, "enable operation (T3, then T4)");
   d.set_target_rpm(300);
-  d.event("target velocity 300 rpm");
   (void)d.view().inject_fault(0x2310);
   d.event("fault: continuous over-current");
   d.set_word(static_cast<std::uint16_t>(d.word() | control_bit::fault_reset));

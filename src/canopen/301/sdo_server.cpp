@@ -3,16 +3,12 @@
 #include <algorithm>
 
 #include "cia402/canopen/can/frame.hpp"
+#include "cia402/sdo_command.hpp"
 
 namespace cia402::canopen {
 namespace {
 
-// Command specifiers, bits 5..7 of byte 0 (CiA 301 §7.2.4.3).
-constexpr unsigned ccs_download_segment = 0;
-constexpr unsigned ccs_initiate_download = 1;
-constexpr unsigned ccs_initiate_upload = 2;
-constexpr unsigned ccs_upload_segment = 3;
-constexpr unsigned ccs_abort = 4;
+using namespace sdo_command_specifier;  // ccs_*, cs_abort: bits 5..7 of byte 0
 
 }  // namespace
 
@@ -146,7 +142,7 @@ void sdo_server::on_request(const frame& request) {
       if (last) mode_ = mode::idle;
       return respond(static_cast<std::uint8_t>((t << 4) | ((7 - n) << 1) | (last ? 1 : 0)), part);
     }
-    case ccs_abort:
+    case cs_abort:
       mode_ = mode::idle;
       return;
     default:  // block upload (5), block download (6), and 7

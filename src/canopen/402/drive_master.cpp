@@ -123,8 +123,12 @@ void drive_master::drop_requests() {
   for (auto& done : cancelled) done(r);
 }
 
-bool drive_master::queue_request(sdo_job j) {
+bool drive_master::queue_request(std::uint16_t index, std::uint8_t sub, sdo_job j,
+                                 std::function<void(const sdo_result&)> done) {
   if (phase_ != master_phase::running) return false;
+  j.index = index;
+  j.sub = sub;
+  j.done = std::move(done);
   requests_.push_back(std::move(j));
   return true;
 }
@@ -132,11 +136,8 @@ bool drive_master::queue_request(sdo_job j) {
 bool drive_master::read(std::uint16_t index, std::uint8_t sub, bool is_signed,
                         std::function<void(const sdo_result&)> done) {
   sdo_job j;
-  j.index = index;
-  j.sub = sub;
   j.is_signed = is_signed;
-  j.done = std::move(done);
-  return queue_request(std::move(j));
+  return queue_request(index, sub, std::move(j), std::move(done));
 }
 
 bool drive_master::write(std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes,
@@ -154,11 +155,8 @@ bool drive_master::download(std::uint16_t index, std::uint8_t sub, std::vector<s
                             std::function<void(const sdo_result&)> done) {
   sdo_job j;
   j.write = true;
-  j.index = index;
-  j.sub = sub;
   j.raw = std::move(bytes);
-  j.done = std::move(done);
-  return queue_request(std::move(j));
+  return queue_request(index, sub, std::move(j), std::move(done));
 }
 
 std::vector<std::pair<std::uint16_t, std::uint8_t>> drive_master::objects_written() const {

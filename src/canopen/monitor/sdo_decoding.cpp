@@ -3,16 +3,13 @@
 // transfer shows once its last segment went. What a server confirmed (a download) or reported (an
 // upload) is handed to the PDO maps.
 #include "cia402/sdo_abort.hpp"
+#include "cia402/sdo_command.hpp"
 #include "node_state.hpp"
 
 namespace cia402::canopen::monitor {
 namespace {
 
-// Command specifiers, bits 5..7 of byte 0: the client's (ccs) and the server's (scs).
-constexpr unsigned ccs_download_segment = 0, ccs_initiate_download = 1, ccs_initiate_upload = 2,
-                   ccs_upload_segment = 3, cs_abort = 4, ccs_block_upload = 5, ccs_block_download = 6;
-constexpr unsigned scs_upload_segment = 0, scs_download_segment = 1, scs_initiate_upload = 2,
-                   scs_initiate_download = 3, scs_block_download = 5, scs_block_upload = 6;
+using namespace sdo_command_specifier;  // ccs_*, scs_*, cs_abort: bits 5..7 of byte 0
 
 using phase = sdo_follow::phase;
 

@@ -98,14 +98,26 @@ std::string format_send(const frame& f) {
   return buf;
 }
 
-bool parse_send(std::string_view element, frame& out, std::string& why) {
-  const auto w = words(element);
-  if (w.size() < 3 || w[0] != "send") {
-    why = "expected < send ID LEN DATA... >";
+namespace {
+
+// The words of an element that names a frame, `< KEYWORD ID more... >` with at least one word after
+// the identifier, and the frame's identifier; false with the reason when it is anything else.
+bool frame_element(std::string_view element, std::string_view keyword, const char* expected,
+                   std::vector<std::string_view>& w, frame& f, std::string& why) {
+  w = words(element);
+  if (w.size() < 3 || w[0] != keyword) {
+    why = expected;
     return false;
   }
+  return identifier(w[1], f, why);
+}
+
+}  // namespace
+
+bool parse_send(std::string_view element, frame& out, std::string& why) {
+  std::vector<std::string_view> w;
   frame f;
-  if (!identifier(w[1], f, why)) return false;
+  if (!frame_element(element, "send", "expected < send ID LEN DATA... >", w, f, why)) return false;
   unsigned len = 0;
   const auto [end, ec] = std::from_chars(w[2].data(), w[2].data() + w[2].size(), len, 10);
   if (ec != std::errc{} || end != w[2].data() + w[2].size() || len > 8) {
@@ -130,13 +142,9 @@ bool parse_send(std::string_view element, frame& out, std::string& why) {
 }
 
 bool parse_frame(std::string_view element, frame& out, std::string& why) {
-  const auto w = words(element);
-  if (w.size() < 3 || w[0] != "frame") {
-    why = "expected < frame ID SECS.USECS DATA >";
-    return false;
-  }
+  std::vector<std::string_view> w;
   frame f;
-  if (!identifier(w[1], f, why)) return false;
+  if (!frame_element(element, "frame", "expected < frame ID SECS.USECS DATA >", w, f, why)) return false;
   std::string hex;
   for (std::size_t i = 3; i < w.size(); ++i) hex.append(w[i]);
   if (hex.size() % 2 != 0 || hex.size() > 16) {

@@ -26,16 +26,7 @@ constexpr fact_set facts(F first, More... more) noexcept {
 constexpr transition_row row(std::uint8_t number, std::uint16_t from_states, S to, fact_set any,
                              fact_set all = {}, fact_set none = {},
                              row_stop stop = row_stop::immediate, std::uint8_t flags = 0) noexcept {
-  transition_row r;
-  r.number = number;
-  r.from = from_states;
-  r.to = to;
-  r.any = any;
-  r.all = all;
-  r.none = none;
-  r.stop = stop;
-  r.flags = flags;
-  return r;
+  return transition_row{number, to, from_states, any, all, none, stop, flags};  // the fields' order
 }
 
 inline constexpr std::uint8_t interrupts = row_flag::interrupts_stop;

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "bytes.hpp"
+#include "cia402/sdo_command.hpp"
 
 namespace cia402::ethercat {
 namespace {
@@ -12,17 +13,7 @@ using detail::le32;
 using detail::put16;
 using detail::put32;
 
-// Command specifiers (the top three bits), CiA 301 §7.2.4.3, as a client sends them ...
-constexpr std::uint8_t ccs_download_segment = 0;
-constexpr std::uint8_t ccs_initiate_download = 1;
-constexpr std::uint8_t ccs_initiate_upload = 2;
-constexpr std::uint8_t ccs_upload_segment = 3;
-constexpr std::uint8_t cs_abort = 4;
-// ... and as a server answers.
-constexpr std::uint8_t scs_upload_segment = 0;
-constexpr std::uint8_t scs_download_segment = 1;
-constexpr std::uint8_t scs_initiate_upload = 2;
-constexpr std::uint8_t scs_initiate_download = 3;
+using namespace sdo_command_specifier;  // ccs_*, scs_*, cs_abort: CiA 301's, the top three bits
 constexpr std::uint8_t complete_access_bit = 0x10;
 constexpr std::uint8_t toggle_bit = 0x10;
 constexpr std::size_t segment_data_in_ten_bytes = 7;
@@ -49,19 +40,35 @@ std::span<const std::uint8_t> segment_data(std::span<const std::uint8_t> body) n
 }
 
 // A segment that carries data (download request, upload response): the toggle, the last flag, the data.
-void read_segment(std::span<const std::uint8_t> body, sdo_frame& f) noexcept {
+sdo_frame data_segment(sdo_command command, std::span<const std::uint8_t> body) noexcept {
+  sdo_frame f;
+  f.command = command;
   f.toggle = (body[0] & toggle_bit) != 0;
   f.last = (body[0] & 0x01) != 0;
   f.data = segment_data(body);
+  return f;
+}
+
+// A segment without data (upload request, download response): only the toggle.
+sdo_frame empty_segment(sdo_command command, std::uint8_t cmd) noexcept {
+  sdo_frame f;
+  f.command = command;
+  f.toggle = (cmd & toggle_bit) != 0;
+  return f;
+}
+
+// The object an initiate frame names, and whether it is CoE's complete access.
+void read_object(std::span<const std::uint8_t> body, sdo_frame& f) noexcept {
+  f.index = le16(body.data() + 1);
+  f.sub = body[3];
+  f.complete_access = (body[0] & complete_access_bit) != 0;
 }
 
 // The value part of an initiate frame (download request, upload response): expedited in the four data
 // bytes (4 - n of them when the size is indicated), else the size and what of the value follows.
 void read_initiate(std::span<const std::uint8_t> body, sdo_frame& f) noexcept {
   const std::uint8_t cmd = body[0];
-  f.index = le16(body.data() + 1);
-  f.sub = body[3];
-  f.complete_access = (cmd & complete_access_bit) != 0;
+  read_object(body, f);
   f.expedited = (cmd & 0x02) != 0;
   f.size_indicated = (cmd & 0x01) != 0;
   if (f.expedited) {
@@ -158,14 +165,8 @@ std::optional<sdo_frame> parse_sdo_request(std::span<const std::uint8_t> body) n
   sdo_frame f;
   const std::uint8_t cmd = body[0];
   switch (cmd >> 5) {
-    case ccs_download_segment:
-      f.command = sdo_command::download_segment;
-      read_segment(body, f);
-      return f;
-    case ccs_upload_segment:
-      f.command = sdo_command::upload_segment;
-      f.toggle = (cmd & toggle_bit) != 0;
-      return f;
+    case ccs_download_segment: return data_segment(sdo_command::download_segment, body);
+    case ccs_upload_segment: return empty_segment(sdo_command::upload_segment, cmd);
     case cs_abort:
       // The master gives up: whatever it names, the transfer ends.
       f.command = sdo_command::abort;
@@ -179,9 +180,7 @@ std::optional<sdo_frame> parse_sdo_request(std::span<const std::uint8_t> body) n
     read_initiate(body, f);
     return f;
   }
-  f.index = le16(body.data() + 1);
-  f.sub = body[3];
-  f.complete_access = (cmd & complete_access_bit) != 0;
+  read_object(body, f);
   f.command = (cmd >> 5) == ccs_initiate_upload ? sdo_command::initiate_upload : sdo_command::other;
   return f;
 }
@@ -197,14 +196,8 @@ std::optional<sdo_frame> parse_sdo_response(coe_service service, std::span<const
   }
   if (service != coe_service::sdo_response) return std::nullopt;
   switch (cmd >> 5) {
-    case scs_upload_segment:
-      f.command = sdo_command::upload_segment;
-      read_segment(body, f);
-      return f;
-    case scs_download_segment:
-      f.command = sdo_command::download_segment;
-      f.toggle = (cmd & toggle_bit) != 0;
-      return f;
+    case scs_upload_segment: return data_segment(sdo_command::upload_segment, body);
+    case scs_download_segment: return empty_segment(sdo_command::download_segment, cmd);
     case scs_initiate_upload:
       if (body.size() < sdo_header_size) return std::nullopt;
       f.command = sdo_command::initiate_upload;
@@ -213,9 +206,7 @@ std::optional<sdo_frame> parse_sdo_response(coe_service service, std::span<const
     case scs_initiate_download:
       if (body.size() < sdo_header_size) return std::nullopt;
       f.command = sdo_command::initiate_download;
-      f.index = le16(body.data() + 1);
-      f.sub = body[3];
-      f.complete_access = (cmd & complete_access_bit) != 0;
+      read_object(body, f);
       return f;
     default: return std::nullopt;
   }

@@ -2,7 +2,7 @@
 // server from what any drive shows), the mode's handshake bits by the names the mode gives them
 // (info.mode_bits), the homing parameters and phase (snapshot.homing, POST /api/homing), and the
 // drive's own error list 0x1003 (snapshot.drive_errors, POST /api/errors/read and /clear).
-import { el, hexBits, page, post } from './page.js';
+import { el, errorText, hexBits, page, post, showList } from './page.js';
 import { modeTitle } from './words.js';
 
 // Control bits 4, 5, 6, 8 (halt), 9 and status bits 10, 11, 12, 13: the ones a mode's handshake uses.
@@ -91,19 +91,11 @@ function showHoming(s) {
   }
 }
 
-let errorsShown = '';
 function showDriveErrors(d) {
-  const key = JSON.stringify(d);
-  if (key === errorsShown) return;
-  errorsShown = key;
-  const list = el('drive-errors');
-  list.textContent = '';
-  for (const e of d ? d.entries : []) {
-    const li = document.createElement('li');
-    li.textContent = `sub ${e.sub}: ${e.code}${e.text ? ` ${e.text}` : ''}`;
+  showList('drive-errors', d ? d.entries : [], (li, e) => {
+    li.textContent = `sub ${e.sub}: ${errorText(e)}`;
     li.title = `0x1003 sub ${e.sub} = ${e.value}`;
-    list.append(li);
-  }
+  });
   let note = 'not read';
   if (d && d.error) note = `not read: ${d.error}`;
   else if (d && d.count === 0) note = 'empty';

@@ -71,6 +71,27 @@ export function stateLabel(name) {
   return (info && info.state_names && info.state_names[name]) || label(name);
 }
 
+// Fills the list `id` with one <li> an entry, each written by fill(li, entry), only when the entries
+// changed since the list was last filled: one redrawn with every snapshot would lose a hover.
+const listsShown = new Map();
+export function showList(id, entries, fill) {
+  const key = JSON.stringify(entries);
+  if (listsShown.get(id) === key) return;
+  listsShown.set(id, key);
+  const list = el(id);
+  list.textContent = '';
+  for (const e of entries) {
+    const li = document.createElement('li');
+    fill(li, e);
+    list.append(li);
+  }
+}
+
+// An error code as the server sends it, then its text where the server knows one.
+export function errorText(e) {
+  return `${e.code}${e.text ? ` ${e.text}` : ''}`;
+}
+
 export function hexBits(hex) {
   return parseInt(hex, 16);
 }

@@ -1,6 +1,6 @@
 // The plant panel: the set-point of the mode the drive runs, the plant's switches (fault, DC link,
 // STO) as far as the backend serves them, the readouts and lamps, the object table and its form.
-import { el, hexBits, label, page, post, showResult } from './page.js';
+import { el, errorText, hexBits, label, page, post, showList, showResult } from './page.js';
 import { homingBody, homingRunning } from './modes.js';
 import { modeLabel } from './words.js';
 
@@ -244,18 +244,10 @@ function setLamp(id, on, text) {
 
 // Each error code the drive showed in 0x603F, newest first, with the drive's time it came (the
 // snapshot's error_history); redrawn only when it changed.
-let historyShown = '';
 function showErrorHistory(history) {
-  const key = JSON.stringify(history);
-  if (key === historyShown) return;
-  historyShown = key;
-  const list = el('error-history');
-  list.textContent = '';
-  for (const e of history) {
-    const li = document.createElement('li');
-    li.textContent = `${(e.time_ms / 1000).toFixed(3)} s  ${e.code}${e.text ? ` ${e.text}` : ''}`;
-    list.append(li);
-  }
+  showList('error-history', history, (li, e) => {
+    li.textContent = `${(e.time_ms / 1000).toFixed(3)} s  ${errorText(e)}`;
+  });
   el('error-history-none').hidden = history.length > 0;
 }
 

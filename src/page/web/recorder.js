@@ -119,6 +119,16 @@ export function drawTimeline() {
   // Segments: [t_start, t_end, row] for each kept row.
   const segments = rows.map((r, i) => [r.t, i + 1 < rows.length ? rows[i + 1].t : now, r]);
   const visible = segments.filter(([a, b]) => b >= t0);
+  // One value of the rows at height y(row): samples are points of a ramp, so straight lines between
+  // them, held after the last.
+  const strokeRamp = (y) => {
+    g.beginPath();
+    visible.forEach(([a, b, r], i) => {
+      if (i === 0) g.moveTo(x(a), y(r)); else g.lineTo(x(a), y(r));
+      if (i === visible.length - 1) g.lineTo(x(b), y(r));
+    });
+    g.stroke();
+  };
 
   g.fillStyle = ink;
   g.textAlign = 'right';
@@ -154,13 +164,7 @@ export function drawTimeline() {
   g.strokeRect(left, velTop, pw, velH);
   g.strokeStyle = ink;
   g.lineWidth = 2;
-  g.beginPath();
-  visible.forEach(([a, b, r], i) => {
-    // Samples are points of a ramp: straight lines between them, held after the last.
-    if (i === 0) g.moveTo(x(a), vy(r.v)); else g.lineTo(x(a), vy(r.v));
-    if (i === visible.length - 1) g.lineTo(x(b), vy(r.v));
-  });
-  g.stroke();
+  strokeRamp((r) => vy(r.v));
 
   // The position 0x6064, dashed on a scale of its own, where it moved in the window.
   const positions = visible.map(([, , r]) => r.pos).filter((p) => p !== undefined && p !== null);
@@ -171,12 +175,7 @@ export function drawTimeline() {
       g.save();
       g.setLineDash([5, 3]);
       g.lineWidth = 1.5;
-      g.beginPath();
-      visible.forEach(([a, b, r], i) => {
-        if (i === 0) g.moveTo(x(a), py(r.pos)); else g.lineTo(x(a), py(r.pos));
-        if (i === visible.length - 1) g.lineTo(x(b), py(r.pos));
-      });
-      g.stroke();
+      strokeRamp((r) => py(r.pos));
       g.restore();
       g.fillStyle = ink;
       g.textAlign = 'right';

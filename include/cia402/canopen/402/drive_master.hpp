@@ -248,7 +248,10 @@ class drive_master {
   void go_running();
   void fail(master_failure f, sdo_abort a, std::uint16_t index, std::uint8_t sub, std::string text);
   void drop_requests();
-  bool queue_request(sdo_job j);
+  /// A request for object `index`:`sub` whose result goes to `done`; `j` says the rest (a read, or
+  /// a download of its bytes). False, nothing queued, unless running.
+  bool queue_request(std::uint16_t index, std::uint8_t sub, sdo_job j,
+                     std::function<void(const sdo_result&)> done);
   void start_transfer(const sdo_job& j);
   bool start_next_job();
   void complete_current();
