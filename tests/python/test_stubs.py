@@ -40,6 +40,8 @@ def members(node):
             names.add(item.name)
         elif isinstance(item, ast.AnnAssign) and isinstance(item.target, ast.Name):
             names.add(item.target.id)
+        elif isinstance(item, ast.Assign):  # a method declared as another's alias (settle = step)
+            names.update(t.id for t in item.targets if isinstance(t, ast.Name))
     return names
 
 
