@@ -41,6 +41,12 @@ async function main() {
   await post(server.url, 'api/plant', { target_velocity: 1000 });
   await page.waitForTimeout(2500);
 
+  // The parameter list opened, narrowed to the homing objects (the whole list is 200 rows).
+  await page.click('#param-details summary');
+  await page.waitForSelector('#param-rows tr', { timeout: patience });
+  await page.fill('#param-search', '609');
+  await page.waitForTimeout(300);
+
   const names = await page.$$eval('section.panel', (sections) => sections.map((s) =>
     [...s.classList].find((c) => c.startsWith('panel-')) ?? null));
   let taken = 0;
@@ -54,6 +60,16 @@ async function main() {
     console.log(`${name}.png`);
   }
   if (taken === 0) throw new Error('no panel was visible');
+
+  // The plant panel in homing mode, method 3 under way: the homing form, its phase line and the
+  // mode panel's bits by their homing names.
+  await page.selectOption('#mode-select', '6');
+  await page.waitForFunction(() => !document.getElementById('homing-form').hidden, null, { timeout: patience });
+  await page.selectOption('#homing-method', '3');
+  await page.click('#homing-start');
+  await page.waitForTimeout(500);
+  await page.locator('section.panel-plant').screenshot({ path: path.join(imagesDir, 'panel-plant-homing.png') });
+  console.log('panel-plant-homing.png');
   fs.writeFileSync(path.join(run.outDir, 'panel-pictures.txt'), `${taken} panels\n`);
   await closeBrowser();
   await stopServer(server);
