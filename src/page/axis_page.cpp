@@ -146,7 +146,7 @@ void axis_page::impl::on_state(state from, state to, std::uint16_t status_word) 
 void axis_page::impl::note_transition(std::optional<int> number, state from, state to, bool inferred,
                                       std::uint16_t status_word, std::optional<std::uint64_t> at_us) {
   last_transition = transition_seen{number, from, to, inferred};
-  if (inferred && number) transition_for_sample = number;
+  if (inferred && number) transition_for_sample = transition_for_row = number;
   recording.note_transition({0, at_us.value_or(now_us), number, from, to, word_shown(), status_word, inferred});
   if (!number) return;
   if (auto* a = log.pending()) {
@@ -205,7 +205,10 @@ void axis_page::impl::record_bus_row() {
   row.status_word = session->status_word();
   row.error_code = session->error_code();
   row.current = *observed;
-  row.transition = no_transition;
+  // The inferred transition in the row of the cycle it was seen in (the scope's trigger reads rows);
+  // of a chain seen in one cycle (3 then 4) the row holds the last, as the sample does.
+  row.transition = transition_for_row ? static_cast<std::uint8_t>(*transition_for_row) : no_transition;
+  transition_for_row.reset();
   row.torque = table->info(*observed).activity != state_activity::idle;
   row.brake_released = row.torque;
   row.brake_engaged = !row.torque;
@@ -525,7 +528,9 @@ std::string axis_page::info_json(bool control, bool token_required) const {
   }
   j["control"] = control;
   j["token_required"] = token_required;
-  j["cycle_us"] = m.config.cycle_us;
+  // The period of the drive's cycles, one scope sample each: a step here, the link's cycle on a bus
+  // (the SYNC period over CANopen, the LRW's over EtherCAT), not the page's own step.
+  j["cycle_us"] = m.drive.plant != nullptr ? m.config.cycle_us : m.session->link().cycle_us();
   j["lease_ms"] = m.session->lease_us() / 1000;
   // Snapshots come at most this often (the plot holds a value across a gap between them).
   j["publish_ms"] = m.config.publish_us / 1000.0;

@@ -309,6 +309,7 @@ reply axis_page::select_profile(std::string_view name) {
   m.recording.clear();
   m.samples.clear();
   m.transition_for_sample.reset();
+  m.transition_for_row.reset();
   m.session.reset();  // before the link it uses
   m.drive = m.connect(*chosen);
   m.start_session(*chosen);

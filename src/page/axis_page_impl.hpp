@@ -77,6 +77,7 @@ struct axis_page::impl {
   detail::sample_ring samples;
   detail::cycle_sample open_sample;                // a drive in this process: the cycle under way
   std::optional<int> transition_for_sample;        // a bus: noted since the last sample
+  std::optional<int> transition_for_row;           // a bus: noted in this cycle, for its row
   std::uint64_t open_row_cycle = 0;        // the simulator's cycle count when it began
   state open_row_state = state::start;     // the drive's state when it began
 

@@ -4,6 +4,8 @@
 #                                                  it, are written with CIA402_UPDATE_SCREENSHOT=1)
 # Then scope.test.mjs, the scope's checks, on a server of its own; homing, parameters and the jog's
 # dead-man (jog.test.mjs) after it.
+# Then scope.test.mjs, the scope's checks, on a server of its own, and scope_can.test.mjs, the same
+# on a drive behind `cia402 serve --can`.
 # Installs playwright-core with `npm ci` from this folder's package-lock.json into WORK_DIR (no
 # browser download: Debian's /usr/bin/chromium is used), then runs instrument_page.test.mjs.
 # Exit 77 (CTest: skipped) with the reason printed when node, npm or chromium is missing, or when
@@ -42,6 +44,7 @@ export CIA402_CHROMIUM="$chromium"
 node "$here/instrument_page.test.mjs" "$cia402" "$work/output" "$screenshot"
 node "$here/instrument_page_servers.test.mjs" "$cia402" "$work/output"
 node "$here/scope.test.mjs" "$cia402" "$work/output"
+node "$here/scope_can.test.mjs" "$cia402" "$work/output"
 node "$here/homing.test.mjs" "$cia402" "$work/output"
 node "$here/parameters.test.mjs" "$cia402" "$work/output"
 node "$here/jog.test.mjs" "$cia402" "$work/output"

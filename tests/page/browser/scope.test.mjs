@@ -17,6 +17,8 @@ import fs from 'node:fs';
 import { createRequire } from 'node:module';
 import os from 'node:os';
 import path from 'node:path';
+import { arm as armOn, cursorMs as cursorOf, cursorsFromTrigger, cyclesFilling, cycleMs as cycleOf, dataset as datasetOf,
+  recording as recordingOf } from './scope_harness.mjs';
 
 const [cia402, outDir] = process.argv.slice(2).map((a) => path.resolve(a));
 if (!cia402 || !outDir) {
@@ -63,21 +65,11 @@ function startServer() {
   });
 }
 
-// The server's recording, as the page could fetch it.
-function recording() {
-  return page.evaluate(async () => (await fetch('/api/recording')).json());
-}
-
-const dataset = () => page.evaluate(() => {
-  const d = document.getElementById('plot').dataset;
-  return { t0: Number(d.t0), t1: Number(d.t1), span: Number(d.span), samples: Number(d.samples),
-    trigger: d.trigger === '' ? null : Number(d.trigger), left: Number(d.left), width: Number(d.width) };
-});
-
-const cursorMs = (id) => page.evaluate((i) => {
-  const v = document.getElementById(i).dataset.ms;
-  return v === '' ? null : Number(v);
-}, id);
+// The helpers of scope_harness.mjs on this script's page.
+const recording = () => recordingOf(page);
+const dataset = () => datasetOf(page);
+const cursorMs = (id) => cursorOf(page, id);
+const arm = (settings) => armOn(page, settings);
 
 async function command(key) {
   await page.click(`button[data-command="${key}"]`);
@@ -85,21 +77,6 @@ async function command(key) {
 
 async function waitState(state) {
   await page.waitForSelector(`#diagram [id="state.${state}"].present`, { timeout: patience });
-}
-
-async function arm(settings) {
-  await page.selectOption('#trig-mode', settings.mode);
-  await page.selectOption('#trig-type', settings.type);
-  if (settings.transition !== undefined) await page.selectOption('#trig-transition', String(settings.transition));
-  if (settings.signal) await page.selectOption('#trig-signal', settings.signal);
-  if (settings.bit) await page.selectOption('#trig-bit', settings.bit);
-  if (settings.level !== undefined) await page.fill('#trig-level', String(settings.level));
-  if (settings.edge) await page.selectOption('#trig-edge', settings.edge);
-  await page.fill('#trig-pre', String(settings.pre));
-  await page.selectOption('#scope-div', String(settings.div));
-  await page.click('#trig-arm');
-  await page.waitForFunction(() => document.getElementById('scope-status').textContent.includes('armed'),
-    null, { timeout: patience });
 }
 
 async function download(id) {
@@ -174,25 +151,14 @@ async function main() {
 
   let t3 = null;
   await check('cursors snap to the transitions and read their difference to the cycle', async () => {
-    const d = await dataset();
-    // A click on the trigger's line puts cursor A on the transition's cycle.
-    const x = d.left + ((t4 - d.t0) / (d.t1 - d.t0)) * d.width;
-    await page.click('#plot', { position: { x: Math.round(x), y: 60 } });
-    await page.waitForFunction(() => document.getElementById('cursor-a-time').dataset.ms !== '', null, { timeout: patience });
-    expect(await cursorMs('cursor-a-time') === t4, `cursor A at ${await cursorMs('cursor-a-time')}, T4 at ${t4}`);
-    // B steps back edge by edge (transitions and word changes) to transition 3.
-    const rec = await recording();
-    t3 = rec.transitions.find((t) => t.number === 3).time_ms;
-    for (let i = 0; i < 40; i++) {
-      const b = await cursorMs('cursor-b-time');
-      if (b !== null && b <= t3) break;
-      await page.click('#cur-b-prev');
-      await page.waitForFunction((old) => document.getElementById('cursor-b-time').dataset.ms !== String(old ?? ''),
-        b, { timeout: patience });
-    }
+    // A click on the trigger's line puts cursor A on the transition's cycle; B steps back edge by
+    // edge (transitions and word changes) to transition 3.
+    t3 = (await recording()).transitions.find((t) => t.number === 3).time_ms;
+    const at = await cursorsFromTrigger(page, t4, t3);
+    expect(at.a === t4, `cursor A at ${at.a}, T4 at ${t4}`);
     expect(await cursorMs('cursor-b-time') === t3, `cursor B at ${await cursorMs('cursor-b-time')}, T3 at ${t3}`);
     expect(await cursorMs('cursor-dt') === t3 - t4, `Δt ${await cursorMs('cursor-dt')}, the recording says ${t3 - t4}`);
-    const cycleMs = (await page.evaluate(async () => (await fetch('/api/info')).json())).cycle_us / 1000;
+    const cycleMs = await cycleOf(page);
     const text = await page.textContent('#cursor-dt');
     expect(text.includes(`${(t3 - t4) / cycleMs} cycles`), `Δt in cycles: "${text}"`);
   });
@@ -200,22 +166,12 @@ async function main() {
   await check("the drive's cycles fill the captured window: every cycle once, T4 in the sample of its cycle", async () => {
     // The capture's window (the cursor check may have panned the view since).
     const d = { t0: t4 - 100, t1: t4 + 100 };
-    const cycleMs = (await page.evaluate(async () => (await fetch('/api/info')).json())).cycle_us / 1000;
-    const got = await page.evaluate(async ([t0, t1]) => {
-      const { store } = await import('/scope_data.js');
-      return { skipped: store.skipped,
-        rows: store.cyc.filter((r) => r.t >= t0 && r.t <= t1).map((r) => [r.n, r.t, r.transition, r.state]) };
-    }, [d.t0, d.t1]);
-    expect(got.skipped === 0, `${got.skipped} samples skipped`);
-    expect(got.rows.length === Math.round((d.t1 - d.t0) / cycleMs) + 1,
-      `${got.rows.length} cycle samples in ${d.t0}..${d.t1}, one per ${cycleMs} ms expected`);
-    expect(got.rows.every((r, i) => i === 0 || (r[0] === got.rows[i - 1][0] + 1 && r[1] === got.rows[i - 1][1] + cycleMs)),
-      'numbered and timed without a gap');
-    const at = got.rows.filter((r) => r[2] === 4);
+    const rows = await cyclesFilling(page, d.t0, d.t1, await cycleOf(page));
+    const at = rows.filter((r) => r[2] === 4);
     expect(at.length === 1 && at[0][1] === t4 && at[0][3] === 'OPERATION_ENABLED',
       `T4 in the cycle samples at ${JSON.stringify(at)}, the recording's T4 at ${t4}`);
     // The cursor difference from T3 to T4 in the cycles equals the recording's, to the cycle.
-    const t3row = got.rows.find((r) => r[2] === 3);
+    const t3row = rows.find((r) => r[2] === 3);
     if (t3row) expect(t4 - t3row[1] === t4 - t3, `T3 at ${t3row[1]} in the cycles, ${t3} in the recording`);
   });
 
