@@ -50,6 +50,9 @@ async function checks(context, name, server) {
   page.on('pageerror', (e) => problems.push(String(e)));
   await check(`${name}: the Parameters panel lists the drive's entries with type, unit, limits and default`, async () => {
     await page.goto(server.url);
+    // The page's modules run and have the drive (a state drawn) before the panel is opened: a page
+    // that boot.js reloads for a module lost in flight would come back with the panel closed.
+    await page.waitForSelector('#diagram .present', { timeout: patience });
     await page.click('#param-details summary');
     await page.waitForSelector('#param-rows tr[data-key="0x6099:1"]', { timeout: patience });
     const cells = await page.$$eval('#param-rows tr[data-key="0x6099:1"] td', (tds) => tds.map((t) => t.textContent));
