@@ -6,10 +6,6 @@
 namespace cia402::page::detail {
 namespace {
 
-constexpr std::uint16_t bit10 = status_bit::target_reached;
-constexpr std::uint16_t bit12 = 1u << 12;
-constexpr std::uint16_t bit13 = 1u << 13;
-
 std::int64_t magnitude(std::int64_t v) noexcept { return v < 0 ? -v : v; }
 
 bool limit_switch_method(std::int64_t m) noexcept { return m == 1 || m == 2 || m == 17 || m == 18; }
@@ -25,9 +21,11 @@ motion::homing_phase infer_homing_phase(const mode_reading& r) noexcept {
   if (r.mode != mode::homing) return homing_phase::not_started;
   const std::uint16_t sw = r.status_word;
   const bool start = (r.control_word & control_bit::homing_operation_start) != 0;
-  if ((sw & bit13) != 0) return homing_phase::error;
-  if ((sw & bit12) != 0) return (sw & bit10) != 0 ? homing_phase::attained : homing_phase::moving_to_zero;
-  if ((sw & bit10) != 0) return start ? homing_phase::interrupted : homing_phase::not_started;
+  if ((sw & status_bit::homing_error) != 0) return homing_phase::error;
+  if ((sw & status_bit::homing_attained) != 0) {
+    return (sw & status_bit::target_reached) != 0 ? homing_phase::attained : homing_phase::moving_to_zero;
+  }
+  if ((sw & status_bit::target_reached) != 0) return start ? homing_phase::interrupted : homing_phase::not_started;
   if (!start || !r.enabled) return homing_phase::not_started;
   // In progress (13 / 12 / 10 all 0): the speed says which search runs.
   if (!r.velocity_rpm || *r.velocity_rpm == 0) return homing_phase::stopping_past_home;
@@ -60,7 +58,7 @@ std::string homing_phase_text(const mode_reading& r) {
     case homing_phase::stopping_past_home: return "in progress: stopping or reversing";
     case homing_phase::not_started:
       // CiA 402-2 gives 13 / 12 / 10 = 0 / 0 / 1 both meanings; without bit 10 the shaft still moves.
-      if ((r.status_word & bit10) != 0) return "interrupted or not started";
+      if ((r.status_word & status_bit::target_reached) != 0) return "interrupted or not started";
       return r.velocity_rpm && *r.velocity_rpm != 0 ? "stopping" : text;
     case homing_phase::moving_to_zero: return "homing attained, still stopping";
     default: return text;
@@ -72,30 +70,30 @@ std::string doing_now(const mode_reading& r) {
   if (!r.mode) return "mode not known yet (0x6061 not read)";
   const std::uint16_t sw = r.status_word;
   if ((r.control_word & control_bit::halt) != 0 && *r.mode != mode::homing) {
-    return (sw & bit10) != 0 ? "halted (control bit 8), standing" : "halting (control bit 8)";
+    return (sw & status_bit::target_reached) != 0 ? "halted (control bit 8), standing" : "halting (control bit 8)";
   }
   switch (*r.mode) {
     case mode::profile_position: {
       const std::string to = value_or_unknown(r.target_position);
-      if ((sw & bit13) != 0) return "following error (status bit 13)";
-      if ((sw & bit10) != 0) return "target reached (0x607A = " + to + ")";
-      if ((sw & bit12) != 0) return "moving to " + to + " (set-point acknowledged)";
+      if ((sw & status_bit::following_error) != 0) return "following error (status bit 13)";
+      if ((sw & status_bit::target_reached) != 0) return "target reached (0x607A = " + to + ")";
+      if ((sw & status_bit::set_point_acknowledge) != 0) return "moving to " + to + " (set-point acknowledged)";
       return "moving to " + to;
     }
     case mode::profile_velocity: {
       const std::string to = value_or_unknown(r.target_velocity);
-      if ((sw & bit10) != 0) return "at 0x60FF = " + to + " rpm (target reached)";
-      if ((sw & bit12) != 0) return "standing (speed = 0), 0x60FF = " + to + " rpm";
+      if ((sw & status_bit::target_reached) != 0) return "at 0x60FF = " + to + " rpm (target reached)";
+      if ((sw & status_bit::speed_zero) != 0) return "standing (speed = 0), 0x60FF = " + to + " rpm";
       return "accelerating to 0x60FF = " + to + " rpm";
     }
     case mode::profile_torque:
       return std::string("torque 0x6071 = ") + value_or_unknown(r.target_torque) + " permille" +
-             ((sw & bit10) != 0 ? " (target reached)" : "");
+             ((sw & status_bit::target_reached) != 0 ? " (target reached)" : "");
     case mode::homing: return "homing: " + homing_phase_text(r);
     case mode::cyclic_synchronous_position:
     case mode::cyclic_synchronous_velocity:
     case mode::cyclic_synchronous_torque: {
-      if ((sw & bit12) == 0) return "ignoring the command value (status bit 12 = 0)";
+      if ((sw & status_bit::drive_follows_command) == 0) return "ignoring the command value (status bit 12 = 0)";
       const char* what = *r.mode == mode::cyclic_synchronous_position   ? "0x607A = "
                          : *r.mode == mode::cyclic_synchronous_velocity ? "0x60FF = "
                                                                          : "0x6071 = ";
