@@ -220,7 +220,13 @@ void session::drive_control_word() {
       break;
     }
     case control::words:
-      while (words_.size() > 1 && words_.front().second <= now_us_) words_.pop_front();
+      // The next word only once this one went out, was held its time and the drive answered it:
+      // a master whose poll comes late would otherwise send both words of an edge between two
+      // cycles of the drive, which then sees no edge at all.
+      if (words_.size() > 1 && sent_ == words_.front().first && now_us_ - word_changed_us_ >= words_.front().second &&
+          word_taken()) {
+        words_.pop_front();
+      }
       if (!words_.empty()) word = words_.front().first;
       break;
   }
@@ -365,7 +371,9 @@ std::uint32_t session::next_deadline() const {
   std::uint64_t next = 0xFFFFFFFFu;  // none
   const auto until = [&](std::uint64_t at) { next = std::min(next, at > now_us_ ? at - now_us_ : 0); };
   if (lease_us_ != 0 && !lapsed_) until(lease_renewed_us_ + lease_us_);
-  if (control_ == control::words && words_.size() > 1) until(words_.front().second);
+  if (control_ == control::words && words_.size() > 1 && word_changed_us_ + words_.front().second > now_us_) {
+    until(word_changed_us_ + words_.front().second);  // after that, the drive's status words wake the poll
+  }
   if (jog_until_us_ != 0) until(jog_until_us_);
   for (const auto& [index, p] : polled_) {
     if (p.wanted > 0 && !p.absent) until(p.next_us);

@@ -162,10 +162,10 @@ std::uint64_t session::reset(completion done) {
     (void)encode_command(*profile_, command::disable_voltage, 0, off);
     const fault_reset_words edge = fault_reset_edge(sent_.value_or(0), off);
     for (std::uint8_t i = 0; i < edge.count; ++i) {
-      words_.emplace_back(edge.words[i], now_us_ + std::uint64_t{i + 1u} * config_.reset_pulse_us);
+      words_.emplace_back(edge.words[i], config_.reset_pulse_us);
     }
   }));
-  steps.push_back(wait_step([this] { return words_.size() <= 1 && settled(); }, 0, [] { return std::string(); }));
+  steps.push_back(edge_sent());
   steps.push_back(wait_step([this] { return settled() && observed_ != state::fault; }, config_.reset_timeout_us, [this] {
     return "still in FAULT after the fault-reset edge: error code " + error_code_words(error_code()) +
            "; is the fault cause still present?";
@@ -373,15 +373,15 @@ std::uint64_t session::send_word(std::uint16_t word, bool reset_edge, completion
                             word_changed_us_ = now_us_;
                             word_changed_count_ = link_->status_count();
                             if (!reset_edge) {
-                              words_.emplace_back(word, now_us_);
+                              words_.emplace_back(word, 0);
                               return;
                             }
                             const fault_reset_words edge = fault_reset_edge(sent_.value_or(0), word);
                             for (std::uint8_t i = 0; i < edge.count; ++i) {
-                              words_.emplace_back(edge.words[i], now_us_ + std::uint64_t{i + 1u} * config_.reset_pulse_us);
+                              words_.emplace_back(edge.words[i], config_.reset_pulse_us);
                             }
                           }),
-                          wait_step([this] { return words_.size() <= 1 && settled(); }, 0, [] { return std::string(); })};
+                          edge_sent()};
   const std::uint64_t id = begin(reset_edge ? "fault-reset edge" : "control word", std::move(steps), std::move(done), false);
   op_->fault_ok = true;
   return id;

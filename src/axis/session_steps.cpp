@@ -23,6 +23,10 @@ bool session::settled() const {
   return link_->status_count() >= word_changed_count_ + 2 || now_us_ - word_changed_us_ >= config_.settle_us;
 }
 
+bool session::word_taken() const {
+  return link_->cyclic() ? link_->status_count() >= word_changed_count_ + 2 : settled();
+}
+
 std::optional<std::int64_t> session::fresh(std::uint16_t index, moment m) const {
   if (link_->cyclic()) {
     if (const auto v = link_->cyclic_input(index, 0)) {
@@ -115,6 +119,14 @@ session::step session::wait_step(std::function<bool()> done, std::uint64_t timeo
 
 session::step session::wait_settled() {
   return {nullptr, [this] { return settled() ? step_state::done : step_state::running; }};
+}
+
+session::step session::edge_sent() {
+  return wait_step([this] { return words_.size() <= 1 && settled(); }, config_.reset_timeout_us, [this] {
+    return "the drive did not answer the control words sent (" + std::to_string(words_.size()) +
+           " not yet sent, " + std::to_string(link_->status_count() - word_changed_count_) +
+           " status words since the last)";
+  });
 }
 
 void session::write_integer(std::uint16_t index, std::uint8_t sub, std::int64_t value,

@@ -199,6 +199,34 @@ TEST(session, reset_clears_a_fault_with_an_edge_and_leaves_a_healthy_drive_alone
   EXPECT_TRUE(b.sent(control_bit::fault_reset, control_bit::fault_reset)) << "bit 7 rose";
 }
 
+// A master polled far more often than the drive steps (its own cycle much shorter than the
+// drive's): each word of the edge waits for the drive's answer, so the drive sees bit 7 rise.
+TEST(session, a_fault_reset_edge_reaches_a_drive_that_steps_slower_than_the_pulse) {
+  session_config c;
+  c.reset_pulse_us = 1000;
+  bench b(c);
+  b.link.cycle = 40'000;
+  ASSERT_TRUE(b.enable().ok());
+  b.link.drive.view().inject_fault(0x2310);
+  ASSERT_TRUE(b.run_until([&] { return b.s->observed() == state::fault; }, 2000));
+  b.link.drive.view().clear_faults();
+  const result r = b.finish([&](completion d) { return b.s->reset(std::move(d)); });
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.shown, state::switch_on_disabled);
+}
+
+TEST(session, a_fault_reset_edge_to_a_drive_that_stopped_answering_ends_and_says_so) {
+  bench b;
+  ASSERT_TRUE(b.enable().ok());
+  b.link.drive.view().inject_fault(0x2310);
+  ASSERT_TRUE(b.run_until([&] { return b.s->observed() == state::fault; }, 1000));
+  b.link.drive.view().clear_faults();
+  b.link.cycle = 100'000'000;  // no status word for 100 s
+  const result r = b.finish([&](completion d) { return b.s->reset(std::move(d)); }, 5000);
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.error.find("the drive did not answer the control words sent"), std::string::npos) << r.error;
+}
+
 TEST(session, a_reset_whose_cause_persists_says_so) {
   bench b;
   ASSERT_TRUE(b.enable().ok());

@@ -8,7 +8,8 @@
 //   0x1008 (the device name) where present;
 // - state targets through the core's `cia402::master` (the planner: S17, never through OPERATION
 //   ENABLED to reach another state), and the fault-reset edge (`cia402::fault_reset_edge`, each word
-//   held `reset_pulse_us`);
+//   held `reset_pulse_us` and until the drive has answered it: a drive that steps once between two
+//   words of the edge would never see bit 7 rise);
 // - the object job queue: FIFO, one transfer at a time; an object the link carries in its cyclic
 //   outputs is written there instead (an SDO would be undone by the next cycle);
 // - polling of what the cyclic data does not carry (0x6061, 0x6064, 0x606C, 0x6077, 0x603F, ...),
@@ -49,7 +50,8 @@ struct session_config {
   std::uint64_t acknowledge_timeout_us = 1'000'000;  ///< pp: status bit 12 after control bit 4
   std::uint64_t reset_timeout_us = 1'000'000;        ///< FAULT left after a fault-reset edge
   std::uint32_t poll_us = 20'000;                    ///< each polled object at most this often
-  std::uint32_t reset_pulse_us = 20'000;             ///< each word of a fault-reset edge held this long
+  /// Each word of a fault-reset edge held at least this long, and until two status words came after it.
+  std::uint32_t reset_pulse_us = 20'000;
   /// A status word counts as the answer to a control word once the link brought two after it, or
   /// this long after it (a link that sends on change only).
   std::uint32_t settle_us = 50'000;
@@ -285,11 +287,16 @@ class session {
   step wait_step(std::function<bool()> done, std::uint64_t timeout_us, std::function<std::string()> why);
   step call_step(std::function<void()> f);
   step wait_settled();
+  /// Waits for the words of control::words to have gone out and been answered (reset_timeout_us at most).
+  step edge_sent();
   step wait_stopped(bool halted);
   std::optional<std::string> cannot_command(bool motion) const;
   std::string fault_text() const;
   std::string state_text() const;
   bool settled() const;
+  /// The drive has had the control word last sent: two status words after it on a cyclic link,
+  /// settled() on one that sends on change only.
+  bool word_taken() const;
   void set_target(state target);
   void set_command(command c);
   void set_mode_bits(std::uint16_t bits);
@@ -338,7 +345,7 @@ class session {
   master_policy policy_{};
   cia402::master master_;
   command command_ = command::disable_voltage;
-  std::deque<std::pair<std::uint16_t, std::uint64_t>> words_;  // word, held until (us)
+  std::deque<std::pair<std::uint16_t, std::uint32_t>> words_;  // word, held at least (us) once sent
   std::uint16_t mode_bits_ = 0;
   bool halt_by_user_ = false;
   bool halt_by_stop_ = false;
