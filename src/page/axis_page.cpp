@@ -414,6 +414,7 @@ json axis_page::impl::snapshot(bool with_time) const {
   j["drive_errors"] = drive_errors_json();
   j["homing"] = homing_json();
   j["doing_now"] = detail::doing_now(mode_reading_now());
+  j["set_point"] = set_point_json();
   // "Why can't I enable?": what blocks the way to OPERATION ENABLED now, from the drive's own inputs.
   const std::string blocker =
       observed && *observed != state::operation_enabled ? enable_blocker(*observed) : std::string();

@@ -143,6 +143,7 @@ struct axis_page::impl {
   void push_plant_sample(const drive_outputs& out);
   void push_bus_sample();
   std::vector<std::string> polled_signals() const;
+  json set_point_json() const;
   void run_handshake();
   void check_enable_walk();
   bool busy_now() const;

@@ -9,10 +9,12 @@
 #include "axis_page_impl.hpp"
 #include "cia402/master.hpp"
 #include "cia402/objects.hpp"
+#include "page_json.hpp"
 
 namespace cia402::page {
 namespace {
 
+using detail::hex;
 using detail::signal;
 
 // The object each object column shows (the set-point's depends on the mode).
@@ -47,6 +49,29 @@ bool carried(const std::vector<axes::cyclic_object>& objects, std::uint16_t inde
 }
 
 }  // namespace
+
+// The mode panel's set-point: the object of the mode the drive shows and its value now, the local
+// drive's own, else what goes out in this cycle (a csp, csv or cst stream's value) or the last read
+// or written. `cyclic`: it travels in every cycle.
+axis_page::impl::json axis_page::impl::set_point_json() const {
+  std::optional<std::int64_t> mode = value_of(object_index::modes_of_operation_display);
+  if (drive.plant != nullptr) mode = drive.plant->view().operation_mode();
+  const std::uint16_t index = mode ? set_point_of(*mode) : 0;
+  if (index == 0) return nullptr;
+  std::optional<std::int64_t> value;
+  if (drive.plant != nullptr) {
+    std::int64_t v = 0;
+    if (drive.plant->view().read(index, 0, v) == sdo_abort::none) value = v;
+  } else {
+    value = value_of(index);
+  }
+  const object_description* d = find_drive_object(index);
+  return {{"index", hex(index, 4)},
+          {"name", d != nullptr ? d->name : ""},
+          {"unit", d != nullptr ? d->unit : ""},
+          {"value", value ? json(*value) : json(nullptr)},
+          {"cyclic", drive.plant != nullptr || carried(session->link().cyclic_outputs(), index)}};
+}
 
 // The values the drive reads as its cycle begins, as the recording's row has them.
 void axis_page::impl::open_plant_sample() {

@@ -50,6 +50,21 @@ TEST_F(homing_page, a_value_outside_the_object_table_is_refused_and_nothing_is_w
 
 // Method 3 at the table's default speeds on the default plant (home switch 5 revolutions up):
 // the phases in order, the home switch bit of 0x60FD on the way, attained within 3 s of drive time.
+// The mode panel's set-point follows the mode the drive shows: pv's 0x60FF, then pp's 0x607A.
+TEST_F(homing_page, the_set_point_shown_is_the_one_of_the_mode_the_drive_shows) {
+  const json pv = state()["set_point"];
+  EXPECT_EQ(pv["index"], "0x60FF") << pv;
+  EXPECT_EQ(pv["name"], "Target velocity") << pv;
+  EXPECT_EQ(pv["cyclic"], true) << "the local drive's own value, each cycle";
+  ASSERT_TRUE(post("/api/object", R"({"index":"0x60FF","value":250})"));
+  ASSERT_TRUE(post("/api/object", R"({"index":"0x607A","value":-1234})"));
+  ASSERT_TRUE(post("/api/object", R"({"index":"0x6060","value":1})"));
+  step(20);
+  const json pp = state()["set_point"];
+  EXPECT_EQ(pp["index"], "0x607A") << pp;
+  EXPECT_EQ(pp["value"], -1234) << pp;
+}
+
 TEST_F(homing_page, method_3_at_the_default_speeds_is_attained_within_3_s_with_its_phases) {
   const auto r = post("/api/homing", R"({"method":3,"start":true})");
   ASSERT_TRUE(r);
@@ -70,6 +85,7 @@ TEST_F(homing_page, method_3_at_the_default_speeds_is_attained_within_3_s_with_i
   EXPECT_TRUE(phases.count("searching home switch at 0x6099:1 = 1000 rpm")) << json(phases).dump();
   EXPECT_TRUE(phases.count("searching index pulse at 0x6099:2 = 100 rpm")) << json(phases).dump();
   EXPECT_EQ(s["doing_now"], "homing: homing attained");
+  EXPECT_TRUE(s["set_point"].is_null()) << "homing has no set-point of its own: " << s["set_point"];
   EXPECT_EQ(s["results"][0]["text"], "done: homing attained, 0x6064 = 0");
 }
 

@@ -158,6 +158,10 @@ TEST(remote_drive, target_velocity_goes_out_by_sdo_and_actual_velocity_comes_bac
   EXPECT_EQ(s["target_velocity"], 300);
   EXPECT_EQ(s["velocity"], 300);
   EXPECT_EQ(b.drive().view().target_velocity(), 300);
+  // The mode panel's set-point: pv's 0x60FF, written by SDO here (not in the PDOs the page maps).
+  EXPECT_EQ(s["set_point"]["index"], "0x60FF") << s["set_point"];
+  EXPECT_EQ(s["set_point"]["value"], 300) << s["set_point"];
+  EXPECT_EQ(s["set_point"]["unit"], "rpm") << s["set_point"];
 }
 
 TEST(remote_drive, dc_link_and_sto_are_refused_and_the_capabilities_say_why) {

@@ -1,7 +1,8 @@
 // The active mode's panel: what the drive does now (the snapshot's doing_now, inferred by the
-// server from what any drive shows), the mode's handshake bits by the names the mode gives them
-// (info.mode_bits), the homing parameters and phase (snapshot.homing, POST /api/homing), and the
-// drive's own error list 0x1003 (snapshot.drive_errors, POST /api/errors/read and /clear).
+// server from what any drive shows), the mode's set-point (snapshot.set_point), its handshake bits
+// by the names the mode gives them (info.mode_bits), the homing parameters and phase
+// (snapshot.homing, POST /api/homing), and the drive's own error list 0x1003 (snapshot.drive_errors,
+// POST /api/errors/read and /clear).
 import { el, errorText, hexBits, page, post, showList } from './page.js';
 import { modeTitle } from './words.js';
 
@@ -104,9 +105,22 @@ function showDriveErrors(d) {
   el('drive-errors-note').textContent = note;
 }
 
+// The set-point of the mode the drive shows (snapshot.set_point): a stream's value as it goes out.
+function showSetpoint(sp) {
+  const p = el('mode-setpoint');
+  if (!sp) {
+    p.textContent = '';
+    return;
+  }
+  const value = sp.value === null ? 'not read' : `${sp.value}${sp.unit ? ` ${sp.unit}` : ''}`;
+  p.textContent = `Set-point ${sp.index} ${sp.name}: ${value}${sp.cyclic ? ' (sent every cycle)' : ''}`;
+  p.dataset.index = sp.index;
+}
+
 export function showModePanel(s) {
   const mode = shownMode(s);
   el('doing-now').textContent = s.doing_now ? `Now: ${s.doing_now}` : '';
+  showSetpoint(s.set_point);
   el('doing-now').title = mode !== null && mode !== undefined ? `in ${modeTitle(mode)}` : '';
   if (mode !== null && mode !== undefined) showModeBits(s, mode);
   showHoming(s);

@@ -1,9 +1,10 @@
 // Homing made visible and the drive's own error list, in a real browser (issue 35), on the local
 // virtual drive and on a drive behind `cia402 serve --can` (a `cia402 bus` node over socketcand):
 // the homing panel writes its parameters (0x6098, 0x6099:1/2) and runs method 3, the home-switch
-// lamp lights on the way and the phase line says "homing attained"; the mode panel names the
-// handshake bits as homing mode names them and says what the drive does; a fault shows its text,
-// enters the page's history and the drive's 0x1003 list, and Clear empties that list.
+// lamp lights on the way and the phase line says "homing attained"; the mode panel shows the mode's
+// set-point (none in homing), names the handshake bits as homing mode names them and says what the
+// drive does; a fault shows its text, enters the page's history and the drive's 0x1003 list, and
+// Clear empties that list.
 //
 //   node homing.test.mjs CIA402_BINARY OUTPUT_DIR
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
@@ -17,6 +18,13 @@ startRun('homing.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
 const text = (page, id) => page.evaluate((i) => document.getElementById(i).textContent, id);
 
 async function homingChecks(page, where, server) {
+  await check(`${where}: the mode panel shows the set-point of the mode: pv's 0x60FF, none in homing`, async () => {
+    await page.waitForFunction(() => document.getElementById('mode-setpoint').textContent
+      .startsWith('Set-point 0x60FF Target velocity: '), null, { timeout: patience });
+    await page.selectOption('#mode-select', '6');
+    await page.waitForFunction(() => document.getElementById('mode-setpoint').textContent === '',
+      null, { timeout: patience });
+  });
   await check(`${where}: homing mode names its bits and says what the drive does`, async () => {
     await page.selectOption('#mode-select', '6');
     await page.waitForFunction(() => !document.getElementById('homing-form').hidden, null, { timeout: patience });
