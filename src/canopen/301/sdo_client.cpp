@@ -4,8 +4,11 @@
 
 #include "cia402/canopen/can/frame.hpp"
 #include "cia402/canopen/301/sdo_server.hpp"
+#include "cia402/sdo_command.hpp"
 
 namespace cia402::canopen {
+
+using namespace sdo_command_specifier;  // ccs_*, scs_*, cs_abort: bits 5..7 of byte 0
 
 void sdo_client::send(const std::uint8_t (&bytes)[8]) {
   frame f;
@@ -31,7 +34,7 @@ bool sdo_client::start_upload(std::uint16_t index, std::uint8_t sub) {
   data_.clear();
   status_ = status::busy;
   step_ = step::upload_initiate;
-  const std::uint8_t b[8] = {0x40, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8),
+  const std::uint8_t b[8] = {ccs_initiate_upload << 5, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8),
                              sub, 0, 0, 0, 0};
   send(b);
   return true;
@@ -49,12 +52,13 @@ bool sdo_client::start_download(std::uint16_t index, std::uint8_t sub, std::vect
   std::uint8_t b[8] = {0, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8), sub,
                        0, 0, 0, 0};
   if (!segmented && !data_.empty() && data_.size() <= 4) {
-    b[0] = static_cast<std::uint8_t>(0x23 | ((4 - data_.size()) << 2));
+    // expedited (bit 1) with its size indicated (bit 0): n = 4 - size in bits 2..3
+    b[0] = static_cast<std::uint8_t>((ccs_initiate_download << 5) | 0x03 | ((4 - data_.size()) << 2));
     std::copy(data_.begin(), data_.end(), b + 4);
     offset_ = data_.size();
     expedited_ = true;
   } else {
-    b[0] = 0x21;
+    b[0] = (ccs_initiate_download << 5) | 0x01;  // segmented, its size in bytes 4..7
     put_le(b + 4, data_.size(), 4);
     offset_ = 0;
     expedited_ = false;
@@ -87,7 +91,7 @@ bool sdo_client::on_frame(const frame& f) {
   if (f.extended || f.rtr || f.id != cob::sdo_tx + node_id_ || f.len != 8) return false;
   if (status_ != status::busy) return true;
   const std::uint8_t* d = f.data.data();
-  if (d[0] == 0x80) {
+  if (d[0] == cs_abort << 5) {
     abort_ = static_cast<sdo_abort>(get_le(d + 4, 4));
     status_ = status::aborted;
     step_ = step::none;
@@ -97,7 +101,7 @@ bool sdo_client::on_frame(const frame& f) {
   const bool same_object = get_le(d + 1, 2) == index_ && d[3] == sub_;
   switch (step_) {
     case step::upload_initiate: {
-      if (scs != 2 || !same_object) {
+      if (scs != scs_initiate_upload || !same_object) {
         fail(sdo_abort::command_specifier_invalid, true);
         break;
       }
@@ -112,12 +116,12 @@ bool sdo_client::on_frame(const frame& f) {
       expected_ = size_known_ ? static_cast<std::size_t>(get_le(d + 4, 4)) : 0;
       toggle_ = 0;
       step_ = step::upload_segment;
-      const std::uint8_t b[8] = {0x60, 0, 0, 0, 0, 0, 0, 0};
+      const std::uint8_t b[8] = {ccs_upload_segment << 5, 0, 0, 0, 0, 0, 0, 0};
       send(b);
       break;
     }
     case step::upload_segment: {
-      if (scs != 0) {
+      if (scs != scs_upload_segment) {
         fail(sdo_abort::command_specifier_invalid, true);
         break;
       }
@@ -137,12 +141,12 @@ bool sdo_client::on_frame(const frame& f) {
         }
         break;
       }
-      const std::uint8_t b[8] = {static_cast<std::uint8_t>(0x60 | (toggle_ << 4)), 0, 0, 0, 0, 0, 0, 0};
+      const std::uint8_t b[8] = {static_cast<std::uint8_t>((ccs_upload_segment << 5) | (toggle_ << 4)), 0, 0, 0, 0, 0, 0, 0};
       send(b);
       break;
     }
     case step::download_initiate:
-      if (scs != 3 || !same_object) {
+      if (scs != scs_initiate_download || !same_object) {
         fail(sdo_abort::command_specifier_invalid, true);
       } else if (expedited_) {
         status_ = status::done;  // expedited: the whole value went with the initiate
@@ -152,8 +156,8 @@ bool sdo_client::on_frame(const frame& f) {
       }
       break;
     case step::download_segment:
-      if (scs != 1 || ((d[0] >> 4) & 1) != toggle_) {
-        fail(scs != 1 ? sdo_abort::command_specifier_invalid : sdo_abort::toggle_bit_not_alternated,
+      if (scs != scs_download_segment || ((d[0] >> 4) & 1) != toggle_) {
+        fail(scs != scs_download_segment ? sdo_abort::command_specifier_invalid : sdo_abort::toggle_bit_not_alternated,
              true);
         break;
       }

@@ -179,7 +179,8 @@ export function buildPlant() {
 const touched = {};
 function syncSwitch(id, value) {
   if (value === null || value === undefined) return;
-  if (performance.now() - (touched[id] || 0) > 800) el(id).checked = value;
+  // Never touched is not "touched at time 0": the first 0.8 s after a load follow the drive too.
+  if (touched[id] === undefined || performance.now() - touched[id] > 800) el(id).checked = value;
 }
 
 // The plant switches a backend cannot serve (DC link and STO on a remote drive; fault injection on
