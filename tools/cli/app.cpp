@@ -2,8 +2,10 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <functional>
 #include <istream>
 #include <ostream>
+#include <utility>
 #include <variant>
 
 #include "cia402/profile_file.hpp"
@@ -102,25 +104,27 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
       ->check(CLI::IsMember({"dot", "mermaid", "svg"}))
       ->default_str("dot");
 
+  // The commands with a file of their own: each entry adds the command's options and runs it once
+  // parsed, so a new command is one entry here.
   simulate_args simulate_options;
-  auto* simulate = add_simulate_subcommand(app, simulate_options);
-
   serve_args serve_options;
-  auto* serve = add_serve_subcommand(app, serve_options);
-
   bus_args bus_options;
-  auto* bus = add_bus_subcommand(app, bus_options);
   master_args master_options;
   master_options.raw = args;  // its steps and their options are read in order from here
-  auto* master = add_master_subcommand(app, master_options);
   monitor_args monitor_options;
-  auto* monitor = add_monitor_subcommand(app, monitor_options);
   eds_args eds_options;
-  auto* eds = add_eds_subcommand(app, eds_options);
   esi_args esi_options;
-  auto* esi = add_esi_subcommand(app, esi_options);
   ecat_slave_args ecat_slave_options;
-  auto* ecat_slave = add_ecat_slave_subcommand(app, ecat_slave_options);
+  const std::pair<CLI::App*, std::function<int()>> own_file_commands[] = {
+      {add_simulate_subcommand(app, simulate_options), [&] { return run_simulate(simulate_options, out, err); }},
+      {add_serve_subcommand(app, serve_options), [&] { return run_serve(serve_options, out, err); }},
+      {add_bus_subcommand(app, bus_options), [&] { return run_bus(bus_options, out, err); }},
+      {add_master_subcommand(app, master_options), [&] { return run_master(master_options, out, err); }},
+      {add_monitor_subcommand(app, monitor_options), [&] { return run_monitor(monitor_options, in, out, err); }},
+      {add_eds_subcommand(app, eds_options), [&] { return run_eds(eds_options, out, err); }},
+      {add_esi_subcommand(app, esi_options), [&] { return run_esi(esi_options, out, err); }},
+      {add_ecat_slave_subcommand(app, ecat_slave_options), [&] { return run_ecat_slave(ecat_slave_options, out, err); }},
+  };
 
   // A word that is not a command gets the list of commands, not CLI11's "subcommand required".
   const std::string first = args.empty() ? std::string() : args.front();
@@ -141,14 +145,9 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
     return usage_error;
   }
 
-  if (simulate->parsed()) return run_simulate(simulate_options, out, err);
-  if (serve->parsed()) return run_serve(serve_options, out, err);
-  if (bus->parsed()) return run_bus(bus_options, out, err);
-  if (master->parsed()) return run_master(master_options, out, err);
-  if (monitor->parsed()) return run_monitor(monitor_options, in, out, err);
-  if (eds->parsed()) return run_eds(eds_options, out, err);
-  if (esi->parsed()) return run_esi(esi_options, out, err);
-  if (ecat_slave->parsed()) return run_ecat_slave(ecat_slave_options, out, err);
+  for (const auto& [command, run] : own_file_commands) {
+    if (command->parsed()) return run();
+  }
   if (profiles->parsed()) {
     if (dump_name.empty()) return list_profiles(out);
     const profile* p = find_builtin_profile(dump_name);

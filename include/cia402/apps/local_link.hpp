@@ -33,7 +33,7 @@ namespace cia402::apps {
 /// 0x1003 (CiA 301): the pre-defined error field.
 inline constexpr std::uint16_t error_history_index = 0x1003;
 
-class local_link final : public axes::drive_link {
+class local_link final : public axes::link_base {
  public:
   /// The profile must outlive the link. `error_history`: entries 0x1003 keeps (1..254).
   explicit local_link(const profile& p, const sim::plant_config& plant = {}, std::uint8_t error_history = 8);
@@ -52,12 +52,9 @@ class local_link final : public axes::drive_link {
   std::uint32_t cycle_us() const override;
   bool status_known() const override { return status_count_ > 0; }
   std::uint16_t status_word() const override;
-  std::uint64_t status_count() const override { return status_count_; }
   std::optional<std::uint16_t> error_code() const override;
   void set_control_word(std::uint16_t word) override;
 
-  const std::vector<axes::cyclic_object>& cyclic_inputs() const override { return inputs_; }
-  const std::vector<axes::cyclic_object>& cyclic_outputs() const override { return outputs_; }
   std::optional<std::int64_t> cyclic_input(std::uint16_t index, std::uint8_t sub) const override;
   bool set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) override;
 
@@ -66,7 +63,6 @@ class local_link final : public axes::drive_link {
   std::optional<axes::value_format> describe(std::uint16_t index, std::uint8_t sub) const override;
 
   void close() override;
-  const axes::close_report& closing() const override { return report_; }
 
   /// The simulated drive: its views set the plant's inputs (STO, DC link, fault causes).
   sim::virtual_drive& drive() noexcept { return device_->drive(); }
@@ -83,16 +79,13 @@ class local_link final : public axes::drive_link {
 
   std::unique_ptr<drive402::sim_device> device_;
   std::unique_ptr<objects> objects_;
-  std::vector<axes::cyclic_object> inputs_, outputs_;
   std::optional<std::uint16_t> word_;
   std::uint32_t pending_us_ = 0;
-  std::uint64_t status_count_ = 0;
   std::uint16_t last_error_ = 0;
   std::uint8_t history_size_;
   std::deque<std::uint32_t> history_;
   std::deque<transfer> transfers_;
   bool closed_ = false;
-  axes::close_report report_;
 };
 
 }  // namespace cia402::apps

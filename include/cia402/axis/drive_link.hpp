@@ -145,4 +145,19 @@ class drive_link {
   std::function<void()> before_cycle;
 };
 
+/// What every bus's link keeps alike, held once: the status words counted, the objects of the cyclic
+/// exchange (each link fills them as its bus maps them) and the report of its close.
+class link_base : public drive_link {
+ public:
+  std::uint64_t status_count() const override { return status_count_; }
+  const std::vector<cyclic_object>& cyclic_inputs() const override { return inputs_; }
+  const std::vector<cyclic_object>& cyclic_outputs() const override { return outputs_; }
+  const close_report& closing() const override { return report_; }
+
+ protected:
+  std::uint64_t status_count_ = 0;
+  std::vector<cyclic_object> inputs_, outputs_;
+  close_report report_;
+};
+
 }  // namespace cia402::axes

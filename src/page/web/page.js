@@ -29,6 +29,8 @@ export function api(path) {
   return `${path}${path.includes('?') ? '&' : '?'}axis=${encodeURIComponent(axisParam)}`;
 }
 export const el = (id) => document.getElementById(id);
+// A new element with its properties set (textContent, className, title, type, ...).
+export const make = (tag, props = {}) => Object.assign(document.createElement(tag), props);
 
 // The drive's time now in ms: the newest snapshot's, carried on by the time since it came.
 export function serverNow() {

@@ -1,6 +1,6 @@
 // The plant panel: the set-point of the mode the drive runs, the plant's switches (fault, DC link,
 // STO) as far as the backend serves them, the readouts and lamps, the object table and its form.
-import { el, errorText, hexBits, label, page, post, showList, showResult } from './page.js';
+import { el, errorText, hexBits, label, make, page, post, showList, showResult } from './page.js';
 import { homingBody, homingRunning } from './modes.js';
 import { modeLabel } from './words.js';
 
@@ -298,14 +298,9 @@ export function showPlant(s) {
   const rows = el('object-values');
   rows.textContent = '';
   for (const o of page.info.objects) {
-    const tr = document.createElement('tr');
-    const a = document.createElement('th');
-    a.scope = 'row';
-    a.textContent = `${o.index} ${o.name}`;
-    const b = document.createElement('td');
-    b.textContent = s.objects[o.index] !== undefined ? s.objects[o.index] : '–';
-    tr.append(a, b);
-    rows.appendChild(tr);
+    const value = s.objects[o.index] !== undefined ? s.objects[o.index] : '–';
+    rows.appendChild(make('tr')).append(make('th', { scope: 'row', textContent: `${o.index} ${o.name}` }),
+      make('td', { textContent: value }));
   }
   if (document.activeElement !== el('object-value') && el('object-value').value === '') {
     fillObjectValue();

@@ -1,6 +1,6 @@
 // The command buttons and their results, the control word (a button per bit) and the status word,
 // and the operation modes: the mode-specific bits by the names CiA 402-2 gives them in each mode.
-import { el, hexBits, label, page, post, showResult } from './page.js';
+import { el, hexBits, label, make, page, post, showResult } from './page.js';
 
 // The server says which bits the profile leaves to the mode and their names per mode (info.mode_bits); a
 // DRIVECOM profile keeps the names it gives its bits.
@@ -36,40 +36,32 @@ export function nameModeBits(mode) {
 
 // The control and status words bit by bit, and the command buttons.
 
+// A bit's number, value and name, filled in as each bit is built.
+const BIT_CELLS = '<span class="n"></span><span class="v">0</span><span class="name"></span>';
+
 export function buildBits() {
   el('h-control').textContent = page.info.control_word_name.replace(/^./, (c) => c.toUpperCase());
   el('h-status').textContent = page.info.status_word_name.replace(/^./, (c) => c.toUpperCase());
   const cw = el('control-bits');
   cw.textContent = '';
   for (const b of page.info.control_bits) {
-    const li = document.createElement('li');
-    const btn = document.createElement('button');
-    btn.type = 'button';
-    btn.className = 'bit control';
+    const btn = make('button', { type: 'button', className: 'bit control', innerHTML: BIT_CELLS });
     btn.setAttribute('role', 'switch');
     btn.setAttribute('aria-checked', 'false');
     btn.dataset.bit = b.bit;
-    btn.innerHTML = '<span class="n"></span><span class="v">0</span><span class="name"></span>';
     btn.querySelector('.n').textContent = b.bit;
     btn.querySelector('.name').textContent = b.name;
     if (b.owned) {
-      const sm = document.createElement('span');
-      sm.className = 'sm';
-      sm.title = "read by the profile's state machine";
-      sm.textContent = 'SM';
-      btn.appendChild(sm);
+      btn.appendChild(make('span', { className: 'sm', title: "read by the profile's state machine", textContent: 'SM' }));
     }
     btn.addEventListener('click', () => post('/api/command', { command: 'toggle_bit', bit: b.bit }));
-    li.appendChild(btn);
-    cw.appendChild(li);
+    cw.appendChild(make('li')).appendChild(btn);
   }
   const sw = el('status-bits');
   sw.textContent = '';
   for (const b of page.info.status_bits) {
-    const li = document.createElement('li');
-    li.className = 'bit';
+    const li = make('li', { className: 'bit', innerHTML: BIT_CELLS });
     li.dataset.bit = b.bit;
-    li.innerHTML = '<span class="n"></span><span class="v">0</span><span class="name"></span>';
     li.querySelector('.n').textContent = b.bit;
     li.querySelector('.name').textContent = b.name;
     sw.appendChild(li);

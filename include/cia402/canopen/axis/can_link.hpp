@@ -59,7 +59,7 @@ struct can_link_config {
   std::function<std::uint64_t()> heartbeat_clock_us;
 };
 
-class can_link final : public axes::drive_link {
+class can_link final : public axes::link_base {
  public:
   /// `bus` must outlive the link; the link reads every frame it receives.
   can_link(channel& bus, can_link_config config);
@@ -76,12 +76,9 @@ class can_link final : public axes::drive_link {
   std::uint32_t cycle_us() const override { return config_.cycle_us; }
   bool status_known() const override;
   std::uint16_t status_word() const override;
-  std::uint64_t status_count() const override { return status_count_; }
   std::optional<std::uint16_t> error_code() const override;
   void set_control_word(std::uint16_t word) override;
 
-  const std::vector<axes::cyclic_object>& cyclic_inputs() const override { return inputs_; }
-  const std::vector<axes::cyclic_object>& cyclic_outputs() const override { return outputs_; }
   std::optional<std::int64_t> cyclic_input(std::uint16_t index, std::uint8_t sub) const override;
   bool set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) override;
 
@@ -90,7 +87,6 @@ class can_link final : public axes::drive_link {
   std::optional<axes::value_format> describe(std::uint16_t index, std::uint8_t sub) const override;
 
   void close() override;
-  const axes::close_report& closing() const override { return report_; }
 
   /// CAN only: one NMT command to the node.
   std::error_code send_nmt(nmt_command c);
@@ -131,15 +127,12 @@ class can_link final : public axes::drive_link {
   std::vector<transfer> finished_;  // transfers done, said at the next poll
   std::vector<std::pair<transfer, axes::transfer_result>> results_;
 
-  std::vector<axes::cyclic_object> inputs_, outputs_;
   std::optional<std::uint16_t> word_;
-  std::uint64_t status_count_ = 0;
   std::string device_name_;
 
   std::vector<recorded> restoring_;
   std::size_t restore_at_ = 0;
   bool restore_busy_ = false;
-  axes::close_report report_;
 };
 
 }  // namespace cia402::canopen

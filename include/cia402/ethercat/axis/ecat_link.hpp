@@ -78,7 +78,7 @@ class ecat_line {
   std::vector<ecat_link*> drives_;
 };
 
-class ecat_link final : public axes::drive_link {
+class ecat_link final : public axes::link_base {
  public:
   /// Drive `position` on `line` (which must outlive the link and be in OP for it to run).
   ecat_link(ecat_line& line, std::size_t position);
@@ -95,12 +95,9 @@ class ecat_link final : public axes::drive_link {
   std::uint32_t cycle_us() const override { return line_->master().cycle_us(); }
   bool status_known() const override { return cyclic() && status_count_ > 0; }
   std::uint16_t status_word() const override;
-  std::uint64_t status_count() const override { return status_count_; }
   std::optional<std::uint16_t> error_code() const override;
   void set_control_word(std::uint16_t word) override;
 
-  const std::vector<axes::cyclic_object>& cyclic_inputs() const override { return inputs_; }
-  const std::vector<axes::cyclic_object>& cyclic_outputs() const override { return outputs_; }
   std::optional<std::int64_t> cyclic_input(std::uint16_t index, std::uint8_t sub) const override;
   bool set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) override;
 
@@ -109,7 +106,6 @@ class ecat_link final : public axes::drive_link {
   std::optional<axes::value_format> describe(std::uint16_t index, std::uint8_t sub) const override;
 
   void close() override;
-  const axes::close_report& closing() const override { return report_; }
 
   std::size_t position() const noexcept { return position_; }
 
@@ -126,12 +122,9 @@ class ecat_link final : public axes::drive_link {
   std::size_t position_;
   bool started_ = false;
   std::string failure_;
-  std::vector<axes::cyclic_object> inputs_, outputs_;
-  std::uint64_t status_count_ = 0;
   std::size_t emergencies_seen_ = 0;
   std::deque<transfer> transfers_;
   bool closed_ = false;
-  axes::close_report report_;
 };
 
 }  // namespace cia402::ethercat
