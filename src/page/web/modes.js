@@ -114,14 +114,13 @@ function showSetpoint(sp) {
   }
   const value = sp.value === null ? 'not read' : `${sp.value}${sp.unit ? ` ${sp.unit}` : ''}`;
   p.textContent = `Set-point ${sp.index} ${sp.name}: ${value}${sp.cyclic ? ' (sent every cycle)' : ''}`;
-  p.dataset.index = sp.index;
 }
 
 export function showModePanel(s) {
   const mode = shownMode(s);
   el('doing-now').textContent = s.doing_now ? `Now: ${s.doing_now}` : '';
-  showSetpoint(s.set_point);
   el('doing-now').title = mode !== null && mode !== undefined ? `in ${modeTitle(mode)}` : '';
+  showSetpoint(s.set_point);
   if (mode !== null && mode !== undefined) showModeBits(s, mode);
   showHoming(s);
   showDriveErrors(s.drive_errors);
