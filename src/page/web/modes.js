@@ -108,6 +108,7 @@ function showDriveErrors(d) {
 // The set-point of the mode the drive shows (snapshot.set_point): a stream's value as it goes out.
 function showSetpoint(sp) {
   const p = el('mode-setpoint');
+  p.hidden = !sp;
   if (!sp) {
     p.textContent = '';
     return;
