@@ -10,6 +10,7 @@
 #include <chrono>
 #include <future>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -50,6 +51,27 @@ inline remote_config test_config(std::uint8_t node = 1) {
   return c;
 }
 
+// The virtual bus belongs to one thread, but a request made with blocking() polls the page's link
+// on its own thread while the bench's thread runs the node. The page's channel takes the bench's
+// lock for each frame and the node runs under it, so the two never touch the bus at once.
+class locked_channel final : public co::channel {
+ public:
+  locked_channel(std::unique_ptr<co::virtual_channel> inner, std::mutex& bus_lock)
+      : inner_(std::move(inner)), bus_lock_(&bus_lock) {}
+  std::error_code send(const co::frame& f) noexcept override {
+    std::lock_guard lock(*bus_lock_);
+    return inner_->send(f);
+  }
+  bool receive(co::frame& f) noexcept override {
+    std::lock_guard lock(*bus_lock_);
+    return inner_->receive(f);
+  }
+
+ private:
+  std::unique_ptr<co::virtual_channel> inner_;
+  std::mutex* bus_lock_;
+};
+
 // One virtual drive as node 1 and the page's backend on the same in-process bus. Each virtual
 // millisecond: the backend runs, the node answers and steps its drive, the backend reads the
 // answers. `silence()` stops the node (it neither answers nor sends heartbeats).
@@ -59,7 +81,7 @@ class remote_bench {
                         const cia402::profile& p = cia402::standard_profile())
       : node_(std::make_unique<apps::virtual_drive_node>(p, bus_.attach(), apps::drive_node_config(1))) {
     for (int i = 0; i < 10; ++i) node_->poll(1000);  // power-up: T0, T1
-    page_ch_ = bus_.attach();
+    page_ch_ = std::make_unique<locked_channel>(bus_.attach(), bus_lock_);
     config.link.drive_profile = &p;
     co::channel* ch = page_ch_.get();
     remote_ = std::make_unique<axis_page>(
@@ -78,14 +100,10 @@ class remote_bench {
   /// machine, whose runner skips the cycles it lost, when drive_us is above cycle_us.
   void cycle(std::uint32_t drive_us) {
     remote_->step();
-    if (alive_) node_->poll(drive_us);
+    run_node(drive_us);
     remote_->advance(0);
-    if (alive_) node_->poll(0);
+    run_node(0);
     remote_->advance(0);
-    if (!alive_) {
-      co::frame f;
-      while (node_->bus_channel().receive(f)) {}
-    }
   }
 
   bool run_until_running(int ms = 2000) {
@@ -112,7 +130,10 @@ class remote_bench {
   /// The node alone, as when the page's process is gone: what it sends is dropped unread.
   void run_drive_only_ms(int ms) {
     for (int i = 0; i < ms; ++i) {
-      node_->poll(1000);
+      {
+        std::lock_guard lock(bus_lock_);
+        node_->poll(1000);
+      }
       co::frame f;
       while (page_ch_->receive(f)) {}
     }
@@ -132,9 +153,21 @@ class remote_bench {
   cia402::sim::virtual_drive& drive() { return node_->drive(); }
 
  private:
+  // The node's turn on the bus; a silenced node's frames are taken off unread.
+  void run_node(std::uint32_t drive_us) {
+    std::lock_guard lock(bus_lock_);
+    if (alive_) {
+      node_->poll(drive_us);
+      return;
+    }
+    co::frame f;
+    while (node_->bus_channel().receive(f)) {}
+  }
+
+  std::mutex bus_lock_;
   co::virtual_bus bus_;
   std::unique_ptr<apps::virtual_drive_node> node_;
-  std::unique_ptr<co::virtual_channel> page_ch_;
+  std::unique_ptr<locked_channel> page_ch_;
   std::unique_ptr<axis_page> remote_;
   bool alive_ = true;
 };
