@@ -10,6 +10,7 @@
 #include <chrono>
 #include <future>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "cia402/apps/virtual_drive_slave.hpp"
@@ -34,15 +35,23 @@ class wire final : public ethercat::master_link {
       line.add(slaves.back()->controller());
     }
   }
+  // A request made with blocking() polls the page's link on its own thread while the bench's thread
+  // steps the slaves: the wire is one lock, as a cable carries one frame at a time.
   bool exchange(std::vector<std::uint8_t>& frame) override {
+    std::lock_guard lock(mutex);
     if (cut) return false;
     return line.pass(frame) == ethercat::frame_error::none;
   }
-  std::uint64_t now_us() override { return now; }
+  std::uint64_t now_us() override {
+    std::lock_guard lock(mutex);
+    return now;
+  }
   void wait_us(std::uint32_t us) override {
+    std::lock_guard lock(mutex);
     now += us;
     for (auto& s : slaves) s->step(us);
   }
+  std::mutex mutex;
   std::vector<std::unique_ptr<apps::virtual_drive_slave>> slaves;
   ethercat::chain line;
   std::uint64_t now = 0;
