@@ -13,6 +13,7 @@
 #include <mutex>
 #include <vector>
 
+#include "blocking_request.hpp"
 #include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/axis/ecat_link.hpp"
 #include "cia402/page/axis_page.hpp"
@@ -100,15 +101,10 @@ struct bench {
     }
     return false;
   }
+  // A request that waits for a transfer: made on another thread while this one runs the bus.
   template <typename Request>
   reply blocking(Request request) {
-    auto result = std::async(std::launch::async, request);
-    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-    while (result.wait_for(std::chrono::microseconds(50)) != std::future_status::ready &&
-           std::chrono::steady_clock::now() < give_up) {
-      run_ms(1);
-    }
-    return result.get();
+    return cia402::page::testing::blocking_request(request, [this] { run_ms(1); });
   }
   json snapshot() const { return json::parse(page->snapshot_json()); }
   std::string state() const { return snapshot()["state"]; }

@@ -14,6 +14,7 @@
 #include <string>
 #include <thread>
 
+#include "blocking_request.hpp"
 #include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/axis/can_link.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
@@ -114,16 +115,10 @@ class remote_bench {
     return false;
   }
 
-  // A request that waits for an SDO transfer: made on another thread while this one runs the bus.
+  // A request that waits for a transfer: made on another thread while this one runs the bus.
   template <typename Request>
   reply blocking(Request request) {
-    auto result = std::async(std::launch::async, request);
-    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-    while (result.wait_for(std::chrono::microseconds(50)) != std::future_status::ready &&
-           std::chrono::steady_clock::now() < give_up) {
-      run_ms(1);
-    }
-    return result.get();
+    return cia402::page::testing::blocking_request(request, [this] { run_ms(1); });
   }
 
   void silence() { alive_ = false; }
