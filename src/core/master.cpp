@@ -209,25 +209,33 @@ command_path plan_path(const profile& p, const axis* from, std::size_t count, st
   constexpr command order[command_count] = {command::enable_operation, command::switch_on,
                                             command::shutdown,         command::quick_stop,
                                             command::disable_voltage,  command::stop_and_inhibit};
-  std::array<std::uint16_t, 2 * command_count> words{};
-  std::size_t word_count = 0;
-  for (const command c : order) {
-    std::uint16_t w = 0;
-    if (encode_command(p, c, 0, w)) words[word_count++] = w;
-  }
   constexpr command reset_order[command_count] = {command::disable_voltage,  command::shutdown,
                                                   command::switch_on,        command::enable_operation,
                                                   command::quick_stop,       command::stop_and_inhibit};
-  for (const command c : reset_order) {
-    std::uint16_t w = 0;
-    if (encode_command(p, c, 0, w)) words[word_count++] = static_cast<std::uint16_t>(w | control_bit::fault_reset);
+  // A master asked for any other state never sends Enable operation, not even where the drive moves
+  // on by itself whatever it gets (NOT READY TO SWITCH ON, a fault reaction): a drive in QUICK STOP
+  // ACTIVE would take it as T16. Only a profile that cannot do without it (none built in) gets it.
+  for (const bool with_enable : {target == state::operation_enabled, true}) {
+    std::array<std::uint16_t, 2 * command_count> words{};
+    std::size_t word_count = 0;
+    for (const command c : order) {
+      std::uint16_t w = 0;
+      if ((with_enable || c != command::enable_operation) && encode_command(p, c, 0, w)) words[word_count++] = w;
+    }
+    for (const command c : reset_order) {
+      std::uint16_t w = 0;
+      if ((with_enable || c != command::enable_operation) && encode_command(p, c, 0, w)) {
+        words[word_count++] = static_cast<std::uint16_t>(w | control_bit::fault_reset);
+      }
+    }
+    // A target the drive leaves by itself (QUICK STOP ACTIVE with 0x605A = 1..4) has no word that
+    // holds it: then arriving is enough.
+    const command_path held = search(p, start, target, words.data(), word_count, true);
+    if (held.reachable) return held;
+    const command_path arrived = search(p, start, target, words.data(), word_count, false);
+    if (arrived.reachable || with_enable) return arrived;
   }
-
-  // A target the drive leaves by itself (QUICK STOP ACTIVE with 0x605A = 1..4) has no word that
-  // holds it: then arriving is enough.
-  const command_path held = search(p, start, target, words.data(), word_count, true);
-  if (held.reachable) return held;
-  return search(p, start, target, words.data(), word_count, false);
+  return {};
 }
 
 namespace {
@@ -283,17 +291,51 @@ master_policy master_policy::make(const profile& p, const axis& options_from, st
       }
     }
   }
-  // The holding word at the target: the last command of any path into it, else a harmless one.
+  // The holding word at the target keeps the drive there and asks nothing more of it: of the
+  // commands that hold every way the drive may stand there, the one that asks least. The last word
+  // of a path into the target is no such word: from START every word leads to SWITCH ON DISABLED,
+  // and Enable operation, first in the search order, would then be held there, and would bring a
+  // drive in QUICK STOP ACTIVE with 0x605A = 5..8 back to OPERATION ENABLED (T16).
+  constexpr command least_first[command_count] = {command::disable_voltage, command::quick_stop,
+                                                  command::stop_and_inhibit, command::shutdown,
+                                                  command::switch_on,        command::enable_operation};
+  for (int bit = 0; bit < 2; ++bit) {
+    entry& hold = policy.first[static_cast<int>(target)][bit];
+    if (hold.control_word != 0xFFFF) continue;
+    std::array<axis, max_beliefs> at{};
+    at[0] = axis_at_rest(p, options_from, target, bit != 0);
+    std::size_t count = 1;
+    if (reads_entered_by_fault(p)) {
+      at[1] = at[0];
+      at[1].flags |= axis_flag::entered_by_fault;
+      count = 2;
+    }
+    for (const command c : least_first) {
+      std::uint16_t w = 0;
+      if (!encode_command(p, c, 0, w)) continue;
+      bool holds = true;
+      for (std::size_t i = 0; i < count && holds; ++i) holds = word_holds(p, at[i], w);
+      if (holds) {
+        hold.control_word = w;
+        break;
+      }
+    }
+  }
+  // A target the drive leaves by itself (QUICK STOP ACTIVE with 0x605A = 1..4) has no holding word:
+  // keep the last word of a path into it, so arriving is enough, but never Enable operation on the
+  // way to another target (S17).
+  std::uint16_t enable = 0xFFFF;
+  (void)encode_command(p, command::enable_operation, 0, enable);
   for (int s = 0; s < state_count; ++s) {
     for (int bit = 0; bit < 2; ++bit) {
       entry& hold = policy.first[static_cast<int>(target)][bit];
       if (hold.control_word != 0xFFFF) continue;
       const command_path path =
           plan_path_from_status(p, options_from, static_cast<state>(s), bit != 0, target);
-      if (path.reachable && path.length > 0) {
-        hold.control_word = static_cast<std::uint16_t>(path.steps[path.length - 1].control_word &
-                                                       ~control_bit::fault_reset);
-      }
+      if (!path.reachable || path.length == 0) continue;
+      const auto last = static_cast<std::uint16_t>(path.steps[path.length - 1].control_word &
+                                                   ~control_bit::fault_reset);
+      if (last != enable || target == state::operation_enabled) hold.control_word = last;
     }
   }
   for (int bit = 0; bit < 2; ++bit) {
