@@ -3,6 +3,7 @@
 // a file that does not parse is refused with its line and gives nothing.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <sstream>
 #include <string>
 #include <variant>
@@ -141,6 +142,7 @@ TEST(eds_reader, a_file_that_does_not_parse_is_refused_with_its_line) {
       {"[2000]\nObjectType=0x8\nDataType=0x0005\nCompactSubObj=300\n", 1, "CompactSubObj above 254"},
       {"[DeviceComissioning]\nNodeID=128\n", 2, "NodeID '128' is not 1..127"},
       {"[1A00sub1]\nDataType=0x0007\n", 1, "[1A00sub1] has no object section [1A00]"},
+      {"[1000]\nDataType=0x0007\n[1000]\n", 3, "(lines 1 and 3)"},
   };
   for (const auto& b : bad) {
     const auto r = read_eds(b.text);
@@ -148,6 +150,157 @@ TEST(eds_reader, a_file_that_does_not_parse_is_refused_with_its_line) {
     const eds_error& e = std::get<eds_error>(r);
     EXPECT_EQ(e.line, b.line) << b.text;
     EXPECT_NE(e.reason.find(b.reason), std::string::npos) << b.text << " -> " << e.reason;
+  }
+}
+
+// Issue 42, a hostile or faulty peer's file. "$NODEID+X" is X plus the node-ID, and that sum must
+// fit the entry's type: INTEGER64's largest + 5 overflowed (UBSan) and, wrapped, was a large negative
+// default the page listed and loaded. Limits and both values are checked against the type as the
+// default was: an UNSIGNED32 LowLimit=-6 was taken and written back as 0xFFFFFFFFFFFFFFFA, which the
+// reader then refused. Two spellings of one sub-index were two sections, written back as one twice.
+TEST(eds_reader, a_value_outside_its_type_or_an_entry_given_twice_is_refused_with_its_lines) {
+  const struct {
+    const char* text;
+    std::size_t line;
+    const char* reason;
+  } bad[] = {
+      {"[DeviceComissioning]\nNodeID=5\n[2000]\nDataType=0x0015\nDefaultValue=$NODEID+0x7FFFFFFFFFFFFFFF\n", 5,
+       "outside its data type INTEGER64 (-9223372036854775808..9223372036854775807) for node 5"},
+      {"[2000]\nDataType=0x0015\nParameterValue=$NODEID+0x7FFFFFFFFFFFFFFF\n[DeviceComissioning]\nNodeID=5\n", 3,
+       "for node 5"},
+      {"[2000]\nDataType=0x0015\nDefaultValue=0x7FFFFFFFFFFFFFFF+$NODEID\n", 3, "for a node-ID of 1..127"},
+      {"[2000]\nDataType=0x0005\nDefaultValue=$NODEID+0x81\n", 3, "UNSIGNED8 (0..255) for a node-ID of 1..127"},
+      {"[2000]\nDataType=0x0002\nDefaultValue=$NODEID+-129\n", 3, "outside its data type INTEGER8"},
+      {"[2000]\nDataType=0x0007\nLowLimit=-6\n", 3, "LowLimit '-6' is outside its data type UNSIGNED32 (0..4294967295)"},
+      {"[2000]\nDataType=0x0007\nHighLimit=0x100000000\n", 3, "HighLimit '0x100000000' is outside"},
+      {"[2000]\nDataType=0x0003\nLowLimit=-32769\nHighLimit=5\n", 3, "INTEGER16"},
+      {"[2000]\nDataType=0x0001\nHighLimit=2\n", 3, "BOOLEAN (0..1)"},
+      {"[2000]\nDataType=0x0009\nLowLimit=1\n", 3, "a VISIBLE_STRING has no limits"},
+      {"[2000]\nDataType=0x0007\nDefaultValue=-1\nParameterValue=5\n", 3, "value '-1' is outside"},
+      {"[2000]\nDataType=0x0006\nDefaultValue=5\nParameterValue=0x10000\n", 4, "value '0x10000' is outside"},
+      {"[60E3]\nObjectType=0x8\n[60E3sub2]\nDataType=0x0008\n[60E3sub02]\nDataType=0x0008\n", 5,
+       "[60E3sub02] names the entry of [60E3sub2] (line 3) again"},
+      {"[60E3]\nObjectType=0x8\n[60e3sub02]\nDataType=0x0008\n[60E3SUB2]\nDataType=0x0008\n", 5,
+       "[60E3SUB2] names the entry of [60e3sub02] (line 3) again"},
+  };
+  for (const auto& b : bad) {
+    const auto r = read_eds(b.text);
+    ASSERT_TRUE(std::holds_alternative<eds_error>(r)) << b.text;
+    const eds_error& e = std::get<eds_error>(r);
+    EXPECT_EQ(e.line, b.line) << b.text;
+    EXPECT_NE(e.reason.find(b.reason), std::string::npos) << b.text << " -> " << e.reason;
+  }
+  // At the edge: the largest X that fits with the file's node, and with any node.
+  EXPECT_EQ(read_ok("[DeviceComissioning]\nNodeID=5\n[2000]\nDataType=0x0015\n"
+                    "DefaultValue=$NODEID+0x7FFFFFFFFFFFFFFA\n").objects.size(), 1u);
+  EXPECT_EQ(read_ok("[2000]\nDataType=0x0005\nDefaultValue=$NODEID+0x80\n").objects.size(), 1u);
+}
+
+TEST(eds_reader, value_for_node_adds_the_node_checked_against_the_type) {
+  sub_entry e;
+  e.type = data_type::integer64;
+  e.plus_node_id = true;
+  e.default_value = std::numeric_limits<std::int64_t>::max();
+  EXPECT_EQ(value_for_node(e, 0), e.default_value);
+  EXPECT_EQ(value_for_node(e, 5), std::nullopt);
+  e.type = data_type::unsigned32;
+  e.default_value = 0x180;
+  EXPECT_EQ(value_for_node(e, 5), 0x185);
+  e.default_value = 0xFFFFFFF0;
+  EXPECT_EQ(value_for_node(e, 0x20), std::nullopt);
+  e.plus_node_id = false;
+  EXPECT_EQ(value_for_node(e, 0x20), 0xFFFFFFF0);
+}
+
+// Every field of every entry, one line each, so two readings compare as texts (and a mismatch shows).
+std::string fields(const eds_contents& c) {
+  std::ostringstream out;
+  out << "node " << int{c.node_id} << "\n";
+  for (const object_entry& o : c.objects) {
+    out << std::hex << o.index << std::dec << " '" << o.name << "' code " << int(o.code) << " category "
+        << int(o.category) << "\n";
+    for (const sub_entry& e : o.subs) {
+      out << "  sub " << int{e.sub} << " '" << e.name << "' type " << int(e.type) << " acc " << int(e.acc)
+          << " pdo " << e.pdo_mappable << " where " << int(e.where) << " value " << e.default_value
+          << " node+ " << e.plus_node_id << " text '" << e.default_text << "' capacity " << e.capacity
+          << " limits " << e.has_limits << " " << e.low << ".." << e.high << " parameter "
+          << e.parameter_value << "\n";
+    }
+  }
+  return out.str();
+}
+
+// What write_dcf writes of a file read_eds gave: its entries, each ParameterValue again as one.
+std::string dcf_of(const eds_contents& c) {
+  dcf_values values;
+  for (const object_entry& o : c.objects) {
+    for (const sub_entry& e : o.subs) {
+      if (e.parameter_value) values[{o.index, e.sub}] = dcf_entry_text(e);
+    }
+  }
+  eds_info info;
+  info.node_id = c.node_id;
+  std::ostringstream out;
+  write_dcf(c.objects, values, info, out);
+  return out.str();
+}
+
+// Entries of every integer type at its ends, with limits, as ParameterValue and in each $NODEID
+// form; a string, a compact array and a record beside them. `node`: the file's NodeID, 0 for none.
+std::string generated_entries(int node) {
+  std::ostringstream out;
+  if (node != 0) out << "[DeviceComissioning]\nNodeID=" << node << "\n";
+  unsigned index = 0x2000;
+  const auto var = [&](data_type t, const std::string& keys) {
+    out << "[" << std::hex << index++ << std::dec << "]\nParameterName=entry " << index << "\nDataType="
+        << int(t) << "\nAccessType=rw\nPDOMapping=" << (index % 2) << "\n" << keys;
+  };
+  const int room = node != 0 ? node : 127;  // the largest node X must leave room for
+  for (const data_type t : {data_type::boolean, data_type::integer8, data_type::integer16, data_type::integer32,
+                            data_type::integer64, data_type::unsigned8, data_type::unsigned16,
+                            data_type::unsigned32, data_type::unsigned64}) {
+    const std::string min = std::to_string(type_min(t)), max = std::to_string(type_max(t));
+    std::ostringstream max_hex;
+    max_hex << "0x" << std::hex << std::uppercase << type_max(t);
+    var(t, "DefaultValue=" + min + "\n");
+    var(t, "DefaultValue=" + max + "\n");
+    var(t, "DefaultValue=" + max_hex.str() + "\n");
+    var(t, "LowLimit=" + min + "\nHighLimit=" + max + "\nDefaultValue=" + max + "\n");
+    var(t, "LowLimit=" + max + "\n");
+    var(t, "HighLimit=" + min + "\n");
+    var(t, "DefaultValue=" + min + "\nParameterValue=" + max + "\n");
+    var(t, "DefaultValue=\n");
+    if (t == data_type::boolean) continue;  // 1 has no room for a node-ID
+    const std::string largest = std::to_string(type_max(t) - room);
+    var(t, "DefaultValue=$NODEID\n");
+    var(t, "DefaultValue=$NODEID+" + largest + "\n");
+    var(t, "DefaultValue=" + largest + "+$NODEID\nParameterValue=0x0+$NODEID\n");
+    var(t, "ParameterValue=$NODEID+" + largest + "\n");
+    if (type_is_signed(t)) var(t, "DefaultValue=$NODEID+" + min + "\n");
+    if (type_is_signed(t)) var(t, "DefaultValue=$NODEID+-5\nLowLimit=-7\nHighLimit=-6\n");
+  }
+  var(data_type::visible_string, "DefaultValue=a text\nParameterValue=another\n");
+  out << "[3000]\nParameterName=Compact\nObjectType=0x8\nDataType=0x0004\nCompactSubObj=3\nDefaultValue=-5\n"
+      << "LowLimit=-10\n"
+      << "[3001]\nParameterName=Record\nObjectType=0x9\n"
+      << "[3001sub0]\nParameterName=Highest\nDataType=0x0005\nDefaultValue=0x0C\n"
+      << "[3001sub0C]\nParameterName=Twelve\nDataType=0x0007\nDefaultValue=$NODEID+0x80000180\n"
+      << "[3001sub3]\nParameterName=Three\nDataType=0x0003\nParameterValue=-32768\n";
+  return out.str();
+}
+
+// The property (issue 42): for a file read_eds accepts, what write_dcf writes reads back to the same
+// entries, and writes again to the same text. Today's writer failed it on a signed $NODEID+X with X
+// below 0 ("$NODEID+0xFFFFFFFFFFFFFFFB", which no reader takes).
+TEST(eds_reader, what_write_dcf_writes_of_an_accepted_file_reads_back_to_the_same_entries) {
+  for (const int node : {0, 5, 127}) {
+    SCOPED_TRACE(testing::Message() << "NodeID " << node);
+    const eds_contents first = read_ok(generated_entries(node));
+    ASSERT_GT(first.objects.size(), 100u);
+    const std::string dcf = dcf_of(first);
+    const eds_contents second = read_ok(dcf);
+    EXPECT_EQ(fields(second), fields(first)) << dcf;
+    EXPECT_EQ(dcf_of(second), dcf);
   }
 }
 

@@ -30,6 +30,13 @@ std::string section_name(std::uint16_t index) {
 
 std::string number_text(data_type type, std::int64_t v);
 
+// "$NODEID+X" with X as number_text writes it, so a signed type's negative X reads back (its hex
+// two's complement, 0xFFFFFFFFFFFFFFFB, is no INTEGER the reader takes).
+std::string node_text(const sub_entry& e) {
+  return "$NODEID+" + (type_is_signed(e.type) ? std::to_string(e.default_value)
+                                               : hex(static_cast<std::uint64_t>(e.default_value), 0));
+}
+
 // The value at power-up as the EDS writes it; false if the device lacks the object.
 bool default_text(slave& node, const object_entry& o, const sub_entry& e, std::string& out) {
   if (e.type == data_type::visible_string) {
@@ -39,7 +46,7 @@ bool default_text(slave& node, const object_entry& o, const sub_entry& e, std::s
     return true;
   }
   if (e.plus_node_id) {
-    out = "$NODEID+" + hex(static_cast<std::uint64_t>(e.default_value), 0);
+    out = node_text(e);
     return true;
   }
   std::int64_t v = e.default_value;
@@ -177,6 +184,12 @@ void write_eds(slave& node, const eds_info& info, std::ostream& out) {
 
 std::string dcf_value_text(const sub_entry& e, std::int64_t value) { return number_text(e.type, value); }
 
+std::string dcf_entry_text(const sub_entry& e) {
+  if (e.type == data_type::visible_string) return e.default_text;
+  if (e.plus_node_id) return node_text(e);
+  return number_text(e.type, e.default_value);
+}
+
 void write_dcf(const std::vector<object_entry>& objects, const dcf_values& values, const eds_info& info,
                std::ostream& out) {
   write_file_info(out, info);
@@ -190,11 +203,7 @@ void write_dcf(const std::vector<object_entry>& objects, const dcf_values& value
             [](const object_entry* a, const object_entry* b) { return a->index < b->index; });
   write_objects(
       out, present,
-      [](const object_entry&, const sub_entry& e) {
-        if (e.type == data_type::visible_string) return e.default_text;
-        if (e.plus_node_id) return "$NODEID+" + hex(static_cast<std::uint64_t>(e.default_value), 0);
-        return number_text(e.type, e.default_value);
-      },
+      [](const object_entry&, const sub_entry& e) { return dcf_entry_text(e); },
       [&values](const object_entry& o, const sub_entry& e) -> const std::string* {
         const auto it = values.find({o.index, e.sub});
         return it == values.end() ? nullptr : &it->second;

@@ -68,11 +68,33 @@ class reader {
   std::variant<eds_contents, eds_error> run() {
     if (!split()) return error_;
     eds_contents out;
+    // The node first: a "$NODEID+X" value must fit its type for the node the file names.
+    const auto commissioning = sections_.find("devicecomissioning");
+    if (commissioning != sections_.end()) {
+      if (const value_line* v = find(commissioning->second, "NodeID")) {
+        const auto id = integer(v->text);
+        if (!id || *id < 1 || *id > 127) {
+          return eds_error{v->line, "NodeID '" + v->text + "' is not 1..127"};
+        }
+        out.node_id = static_cast<std::uint8_t>(*id);
+      }
+    }
+    node_id_ = out.node_id;
+    std::map<std::uint32_t, const section*> entries;  // (index << 8 | sub) of each sub section
     for (const auto& [name, s] : sections_) {
-      const bool sub_section = name.size() > 7 && name.compare(4, 3, "sub") == 0 && hex_number(name.substr(0, 4), 4) &&
-                               hex_number(std::string_view(name).substr(7), 2);
-      if (sub_section && sections_.count(name.substr(0, 4)) == 0) {
+      const auto index = name.size() > 7 && name.compare(4, 3, "sub") == 0 ? hex_number(name.substr(0, 4), 4) : std::nullopt;
+      const auto sub = index ? hex_number(std::string_view(name).substr(7), 2) : std::nullopt;
+      if (!sub) continue;
+      if (sections_.count(name.substr(0, 4)) == 0) {
         return eds_error{s.line, "[" + s.written + "] has no object section [" + s.written.substr(0, 4) + "]"};
+      }
+      // "[60E3sub2]" and "[60E3sub02]" name one entry: a file that gives it twice is ambiguous.
+      const auto [it, fresh] = entries.try_emplace(*index << 8 | *sub, &s);
+      if (!fresh) {
+        const section& a = it->second->line < s.line ? *it->second : s;
+        const section& b = it->second->line < s.line ? s : *it->second;
+        return eds_error{b.line, "[" + b.written + "] names the entry of [" + a.written + "] (line " +
+                                     std::to_string(a.line) + ") again"};
       }
     }
     for (const auto& [name, s] : sections_) {
@@ -85,16 +107,6 @@ class reader {
     }
     std::sort(out.objects.begin(), out.objects.end(),
               [](const object_entry& a, const object_entry& b) { return a.index < b.index; });
-    const auto commissioning = sections_.find("devicecomissioning");
-    if (commissioning != sections_.end()) {
-      if (const value_line* v = find(commissioning->second, "NodeID")) {
-        const auto id = integer(v->text);
-        if (!id || *id < 1 || *id > 127) {
-          return eds_error{v->line, "NodeID '" + v->text + "' is not 1..127"};
-        }
-        out.node_id = static_cast<std::uint8_t>(*id);
-      }
-    }
     return out;
   }
 
@@ -123,7 +135,10 @@ class reader {
         if (line.back() != ']' || line.size() < 3) return fail(number, "a section name needs [ and ]");
         const std::string name = lower(trim(line.substr(1, line.size() - 2)));
         auto [it, fresh] = sections_.try_emplace(name);
-        if (!fresh) return fail(number, "section [" + std::string(line.substr(1, line.size() - 2)) + "] appears twice");
+        if (!fresh) {
+          return fail(number, "section [" + std::string(line.substr(1, line.size() - 2)) + "] appears twice (lines " +
+                                  std::to_string(it->second.line) + " and " + std::to_string(number) + ")");
+        }
         it->second.line = number;
         it->second.written = std::string(trim(line.substr(1, line.size() - 2)));
         current = &it->second;
@@ -173,17 +188,40 @@ class reader {
     if (!number_key(s, "PDOMapping", mapping)) return false;
     e.pdo_mappable = mapping.value_or(0) != 0;
     std::optional<std::int64_t> low, high;
-    if (!number_key(s, "LowLimit", low) || !number_key(s, "HighLimit", high)) return false;
+    if (!limit_key(s, "LowLimit", e.type, low) || !limit_key(s, "HighLimit", e.type, high)) return false;
     if (low || high) {
       e.has_limits = true;
       e.low = low.value_or(type_min(e.type));
       e.high = high.value_or(type_max(e.type));
     }
-    const value_line* value = find(s, "ParameterValue");
-    e.parameter_value = value != nullptr && !value->text.empty();
-    if (!e.parameter_value) value = find(s, "DefaultValue");
+    // Both values are checked, the one taken and the one left: a file with a value its type cannot
+    // hold is at fault, whichever a reader takes.
+    const value_line* parameter = find(s, "ParameterValue");
+    const value_line* standard = find(s, "DefaultValue");
+    e.parameter_value = parameter != nullptr && !parameter->text.empty();
+    if (e.parameter_value && standard != nullptr) {
+      sub_entry left = e;
+      if (!default_value(*standard, left)) return false;
+    }
+    const value_line* value = e.parameter_value ? parameter : standard;
     if (value == nullptr) return true;
     return default_value(*value, e);
+  }
+
+  // LowLimit or HighLimit: a number its entry's type can hold (CiA 306 §4.6.3).
+  bool limit_key(const section& s, const char* key, data_type type, std::optional<std::int64_t>& out) {
+    if (!number_key(s, key, out)) return false;
+    if (!out) return true;
+    const value_line& v = *find(s, key);
+    if (type == data_type::visible_string) return fail(v.line, std::string(key) + " '" + v.text + "': a VISIBLE_STRING has no limits");
+    if (*out < type_min(type) || *out > type_max(type)) {
+      return fail(v.line, std::string(key) + " '" + v.text + "' is outside its data type " + type_range(type));
+    }
+    return true;
+  }
+
+  static std::string type_range(data_type t) {
+    return std::string(type_name(t)) + " (" + std::to_string(type_min(t)) + ".." + std::to_string(type_max(t)) + ")";
   }
 
   bool default_value(const value_line& v, sub_entry& e) {
@@ -202,13 +240,23 @@ class reader {
       else if (!text.empty() && text.back() == '+') text.pop_back();
       else if (!text.empty()) return fail(v.line, "value '" + v.text + "' is not $NODEID+X or X+$NODEID");
     }
-    if (text.empty()) return true;
-    const auto n = integer(text);
-    if (!n) return fail(v.line, "value '" + v.text + "' is not a number");
-    if (*n < type_min(e.type) || *n > type_max(e.type)) {
-      return fail(v.line, "value '" + v.text + "' is outside its data type");
+    std::int64_t n = 0;
+    if (!text.empty()) {
+      const auto parsed = integer(text);
+      if (!parsed) return fail(v.line, "value '" + v.text + "' is not a number");
+      n = *parsed;
     }
-    e.default_value = *n;
+    if (n < type_min(e.type) || n > type_max(e.type)) {
+      return fail(v.line, "value '" + v.text + "' is outside its data type " + type_range(e.type));
+    }
+    e.default_value = n;
+    if (!e.plus_node_id) return true;
+    // $NODEID+X: X + the node-ID must fit too, for the file's node, or for any node 1..127 when the
+    // file names none. Checked, so no sum overflows (X may be INTEGER64's largest).
+    if (node_id_ != 0 ? !value_for_node(e, node_id_) : !value_for_node(e, 1) || !value_for_node(e, 127)) {
+      return fail(v.line, "value '" + v.text + "' is outside its data type " + type_range(e.type) +
+                              (node_id_ != 0 ? " for node " + std::to_string(node_id_) : " for a node-ID of 1..127"));
+    }
     return true;
   }
 
@@ -275,6 +323,7 @@ class reader {
   }
 
   std::string_view text_;
+  std::uint8_t node_id_ = 0;  // [DeviceComissioning] NodeID, 0: none
   std::map<std::string, section> sections_;
   eds_error error_;
 };
@@ -282,5 +331,12 @@ class reader {
 }  // namespace
 
 std::variant<eds_contents, eds_error> read_eds(std::string_view text) { return reader(text).run(); }
+
+std::optional<std::int64_t> value_for_node(const sub_entry& e, int node_id) {
+  std::int64_t v = e.default_value;
+  if (e.plus_node_id && __builtin_add_overflow(v, std::int64_t{node_id}, &v)) return std::nullopt;
+  if (v < type_min(e.type) || v > type_max(e.type)) return std::nullopt;
+  return v;
+}
 
 }  // namespace cia402::canopen

@@ -40,6 +40,10 @@ using dcf_values = std::map<std::pair<std::uint16_t, std::uint8_t>, std::string>
 /// A number as a DCF writes an entry of its type: decimal when signed, 0x-hexadecimal when not.
 std::string dcf_value_text(const sub_entry& e, std::int64_t value);
 
+/// The entry's default value as write_dcf writes it (DefaultValue): a string's text, "$NODEID+X",
+/// or dcf_value_text of the number. As a ParameterValue it reads back as the entry's value.
+std::string dcf_entry_text(const sub_entry& e);
+
 /// Writes a device configuration file (CiA 306 DCF): `objects` as an EDS describes them, each entry
 /// with a value in `values` with its ParameterValue too; read_eds (eds_reader.hpp) reads it back,
 /// ParameterValue over DefaultValue. Objects without entries are left out.

@@ -10,10 +10,17 @@
 // dictionary has no type for (REAL32, OCTET_STRING, DOMAIN, ...) and DOMAIN / DEFTYPE / DEFSTRUCT
 // objects are left out. A file that does not parse is refused with its line and reason, and gives
 // nothing.
+//
+// A peer's file is not trusted. Every LowLimit, HighLimit, DefaultValue and ParameterValue (the one
+// taken and the one left) must be a value of its entry's data type; a "$NODEID+X" one must be so with
+// the file's NodeID added, or with any node-ID 1..127 when the file names none. A section named
+// twice, in any spelling ("[60E3sub2]" and "[60E3sub02]"), is refused with both lines. So what
+// write_dcf writes of what read_eds gave, read_eds reads back to the same entries.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -34,5 +41,10 @@ struct eds_error {
 };
 
 std::variant<eds_contents, eds_error> read_eds(std::string_view text);
+
+/// An entry's number on node `node_id`: its default value, plus the node-ID when it is "$NODEID+X";
+/// nothing when that is not a value of the entry's data type (a file read for one node and used for
+/// another may not fit). The sum is checked: it never overflows.
+std::optional<std::int64_t> value_for_node(const sub_entry& e, int node_id);
 
 }  // namespace cia402::canopen
