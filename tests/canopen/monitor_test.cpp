@@ -4,6 +4,7 @@
 // CiA 402's terms, written out here.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <string>
 #include <variant>
@@ -297,6 +298,32 @@ TEST(monitor, a_node_described_by_its_eds_decodes_by_the_files_mapping) {
   EXPECT_EQ(d.node, 9);
   EXPECT_EQ(d.text, "TPDO1 0x2100:1 = -2 (Temperatures: Temperatures 1), "
                     "0x6064:0 = 10000 inc (Position actual value)");
+}
+
+// A description is a peer's: "$NODEID+X" for a node it was not written for may leave the COB-ID's
+// type, and X may be INTEGER64's largest. The sum is checked (no signed overflow); a COB-ID that does
+// not fit its type is no COB-ID, not one cut to 32 bits (0x100000010 taken as 0x010).
+TEST(monitor, a_cob_id_that_does_not_fit_its_type_on_the_node_is_no_pdo) {
+  const auto eds = read_eds(
+      "[DeviceComissioning]\nNodeID=1\n"
+      "[1800]\nParameterName=TPDO1 communication parameter\nObjectType=0x9\n"
+      "[1800sub1]\nParameterName=COB-ID\nDataType=0x0007\nDefaultValue=$NODEID+0xFFFFFFF0\n"
+      "[1A00]\nParameterName=TPDO1 mapping parameter\nObjectType=0x9\n"
+      "[1A00sub0]\nParameterName=Count\nDataType=0x0005\nDefaultValue=1\n"
+      "[1A00sub1]\nParameterName=Entry 1\nDataType=0x0007\nDefaultValue=0x60410010\n");
+  ASSERT_TRUE(std::holds_alternative<eds_contents>(eds));  // 0xFFFFFFF0 + node 1 fits UNSIGNED32
+  decoder dec;
+  dec.describe_node(0x20, std::get<eds_contents>(eds).objects);  // + 0x20: 0x100000010
+  EXPECT_EQ(dec.decode(make_frame(0x010, {0x37, 0x02}), 0).kind, frame_kind::unknown);
+
+  std::vector<object_entry> hostile = std::get<eds_contents>(eds).objects;
+  sub_entry& cob_id = hostile.front().subs.front();
+  ASSERT_EQ(cob_id.sub, 1);
+  cob_id.type = data_type::integer64;
+  cob_id.default_value = std::numeric_limits<std::int64_t>::max();  // + 9 overflows int64
+  decoder other;
+  other.describe_node(9, hostile);
+  EXPECT_EQ(other.decode(make_frame(0x008, {0x37, 0x02}), 0).kind, frame_kind::unknown);
 }
 
 TEST(monitor, frames_that_are_not_what_their_cob_id_says_decode_as_unknown_with_the_reason) {

@@ -1,6 +1,7 @@
 // PDOs: the maps of each node (from its description, then from the SDO traffic), and a PDO frame
 // read by the map of the PDO whose COB-ID it carries (CiA 301 §7.2.2).
 #include <algorithm>
+#include <optional>
 
 #include "node_state.hpp"
 
@@ -35,6 +36,16 @@ const sub_entry* sub_of(const object_entry& o, std::uint8_t sub) {
   return nullptr;
 }
 
+// A COB-ID entry's value on node `node_id`: "$NODEID+X" summed with the overflow checked; nothing
+// when the sum overflows or leaves the entry's type (a description written for another node, or a
+// hostile one), so no PDO is taken to be on an identifier its description never meant.
+std::optional<std::uint32_t> cob_id_of(const sub_entry& e, std::uint8_t node_id) {
+  std::int64_t v = e.default_value;
+  if (e.plus_node_id && __builtin_add_overflow(v, std::int64_t{node_id}, &v)) return std::nullopt;
+  if (v < type_min(e.type) || v > type_max(e.type) || v < 0 || v > 0xFFFFFFFF) return std::nullopt;
+  return static_cast<std::uint32_t>(v);
+}
+
 std::string pdo_name(std::uint16_t communication) {
   return std::string(transmit(communication) ? "TPDO" : "RPDO") +
          std::to_string((communication & 0x1FFu) + 1);
@@ -48,9 +59,7 @@ void load_pdos(decoder::node_state& n, std::uint8_t node_id) {
   for (const object_entry& o : *n.table) {
     if (!communication_index(o.index)) continue;
     pdo_map m;
-    if (const sub_entry* e = sub_of(o, 1)) {
-      m.cob_id = static_cast<std::uint32_t>(e->default_value + (e->plus_node_id ? node_id : 0));
-    }
+    if (const sub_entry* e = sub_of(o, 1)) m.cob_id = cob_id_of(*e, node_id).value_or(pdo_cob_invalid);
     for (const object_entry& map : *n.table) {
       if (map.index != o.index + 0x200) continue;
       if (const sub_entry* count = sub_of(map, 0)) {
