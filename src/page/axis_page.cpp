@@ -12,6 +12,7 @@
 #include "cia402/page/transition_inference.hpp"
 #include "cia402/words.hpp"
 #include "page_json.hpp"
+#include "json_text.hpp"
 #include "page_names.hpp"
 
 namespace cia402::page {
@@ -351,7 +352,8 @@ json axis_page::impl::remote_json() const {
                                                         : "configuring";
   r["text"] = link_text();
   r["nmt"] = nullptr;
-  r["device_name"] = session->device_name();
+  // A drive's name may be bytes that are not UTF-8 (Latin-1 "Servoverst\xe4rker"): shown as Latin-1.
+  r["device_name"] = detail::display_text(session->device_name());
   r["cyclic"] = l.cyclic();
   r["lease_lapsed"] = session->lease_lapsed();
   r["last_emcy"] = last_emergency ? json(hex(*last_emergency, 4)) : json(nullptr);
@@ -547,7 +549,7 @@ std::string axis_page::info_json(bool control, bool token_required) const {
       o["values"] = std::move(values);
     }
   }
-  return j.dump();
+  return detail::json_text(j);
 }
 
 std::string axis_page::snapshot_json() const {
@@ -557,7 +559,7 @@ std::string axis_page::snapshot_json() const {
 
 std::string axis_page::recording_json(std::uint64_t rows_seen, std::uint64_t transitions_seen) const {
   std::lock_guard lock(impl_->mutex);
-  return impl_->recording.since_json(rows_seen, transitions_seen).dump();
+  return detail::json_text(impl_->recording.since_json(rows_seen, transitions_seen));
 }
 
 std::string axis_page::recording_file(recording_format format) const {

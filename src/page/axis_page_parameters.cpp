@@ -10,6 +10,7 @@
 
 #include "cia402/objects.hpp"
 #include "page_json.hpp"
+#include "json_text.hpp"
 
 namespace cia402::page {
 namespace {
@@ -88,7 +89,7 @@ bool differs(const axes::object_value& v, const parameter_entry& e) {
   return false;
 }
 
-document error_document(int status, const std::string& why) { return {status, json{{"error", why}}.dump()}; }
+document error_document(int status, const std::string& why) { return {status, detail::json_text(json{{"error", why}})}; }
 
 json abort_json(sdo_abort a) {
   return json{{"abort", hex(static_cast<std::uint32_t>(a), 8)}, {"abort_text", sdo_abort_text(a)}};
@@ -190,7 +191,7 @@ document axis_page::parameters() {
   }
   json out{{"axis", m.session->link().short_name()}, {"entries", std::move(list)}};
   out["file"] = m.config.parameter_file.write ? json(m.config.parameter_file.extension) : json(nullptr);
-  return {200, out.dump()};
+  return {200, detail::json_text(out)};
 }
 
 document axis_page::parameter_file() {
@@ -231,7 +232,7 @@ document axis_page::load_parameter_file(std::string_view text) {
   if (const auto* bad = std::get_if<parameter_file_error>(&parsed)) {
     json j{{"error", "line " + std::to_string(bad->line) + ": " + bad->reason}, {"line", bad->line},
            {"reason", bad->reason}};
-    return {400, j.dump()};
+    return {400, detail::json_text(j)};
   }
   const std::vector<parameter_entry> all = catalog(impl_->config.parameters);
   std::unique_lock lock(impl_->mutex);
@@ -289,7 +290,7 @@ document axis_page::load_parameter_file(std::string_view text) {
                    std::to_string(written.size()) + " written, " + std::to_string(refused_list.size()) +
                        " refused, " + std::to_string(skipped.size()) + " skipped");
   json out{{"written", std::move(written)}, {"refused", std::move(refused_list)}, {"skipped", std::move(skipped)}};
-  return {200, out.dump()};
+  return {200, detail::json_text(out)};
 }
 
 }  // namespace cia402::page

@@ -24,6 +24,7 @@
 #include <thread>
 
 #include "server_http.hpp"
+#include "json_text.hpp"
 #include "web_assets.hpp"
 
 namespace cia402::page {
@@ -423,7 +424,7 @@ struct server::impl {
       j["axis"] = static_cast<std::size_t>(a - axes.data()) + 1;
       j["axis_label"] = a->label;
       j["axes"] = axes.size();
-      res.set_content(j.dump(), "application/json");
+      res.set_content(detail::json_text(j), "application/json");
     });
     http.Get("/api/axes", [this](const httplib::Request&, httplib::Response& res) {
       // The overview: each axis's present state in a few values.

@@ -1,6 +1,7 @@
 #include "server_http.hpp"
 
 #include "commissioning.hpp"
+#include "json_text.hpp"
 
 #include <arpa/inet.h>
 #include <poll.h>
@@ -22,7 +23,7 @@ using json = nlohmann::json;
 
 void send_json(httplib::Response& res, int status, const json& body) {
   res.status = status;
-  res.set_content(body.dump(), "application/json");
+  res.set_content(json_text(body), "application/json");
 }
 
 void send_error(httplib::Response& res, int status, const std::string& reason) {
@@ -145,7 +146,7 @@ void answer_and_close(socket_t sock, int status, const std::string& reason) {
   const char* text = status == 408 ? "Request Timeout"
                      : status == 431 ? "Request Header Fields Too Large"
                                      : "Service Unavailable";
-  const std::string body = json{{"error", reason}}.dump();
+  const std::string body = json_text(json{{"error", reason}});
   const std::string head = "HTTP/1.1 " + std::to_string(status) + " " + text +
                            "\r\nContent-Type: application/json\r\nContent-Length: " +
                            std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n";

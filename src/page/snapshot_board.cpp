@@ -1,9 +1,11 @@
 #include "snapshot_board.hpp"
 
+#include "json_text.hpp"
+
 namespace cia402::page::detail {
 
 void snapshot_board::publish(const std::function<json(bool with_time)>& snapshot) {
-  std::string body = snapshot(false).dump();
+  std::string body = json_text(snapshot(false));
   {
     std::lock_guard lock(mutex_);
     if (body == published_body_ && newest_.version != 0) return;
@@ -11,7 +13,7 @@ void snapshot_board::publish(const std::function<json(bool with_time)>& snapshot
     json j = snapshot(true);
     j["version"] = newest_.version + 1;
     newest_.version += 1;
-    newest_.json = j.dump();
+    newest_.json = json_text(j);
   }
   updated_.notify_all();
 }
@@ -19,7 +21,7 @@ void snapshot_board::publish(const std::function<json(bool with_time)>& snapshot
 std::string snapshot_board::present_json(json snapshot) const {
   std::lock_guard lock(mutex_);
   snapshot["version"] = newest_.version;
-  return snapshot.dump();
+  return json_text(snapshot);
 }
 
 std::optional<published> snapshot_board::wait_for_update(std::uint64_t seen,
