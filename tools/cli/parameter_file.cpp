@@ -8,6 +8,7 @@
 
 #include "cia402/canopen/306/eds.hpp"
 #include "cia402/canopen/306/eds_reader.hpp"
+#include "cia402/support/text.hpp"
 
 namespace cia402::cli {
 namespace {
@@ -95,6 +96,8 @@ std::string write_file(const std::vector<page::parameter_entry>& entries,
     if (ec != std::errc() || end != text.data() + text.size()) continue;  // not a number: no value
     canopen::sub_entry s;
     s.type = static_cast<data_type>(e.data_type);
+    // A value its type cannot hold (a peer's answer) would make a file the reader refuses: no value.
+    if (number < type_min(s.type) || number > type_max(s.type)) continue;
     given[{e.index, e.sub}] = canopen::dcf_value_text(s, number);
   }
   std::ostringstream out;
@@ -112,10 +115,19 @@ std::variant<std::vector<page::parameter_value>, page::parameter_file_error> rea
   for (const canopen::object_entry& o : dcf.objects) {
     for (const canopen::sub_entry& s : o.subs) {
       if (!s.parameter_value) continue;
-      std::string value = s.type == data_type::visible_string
-                              ? s.default_text
-                              : std::to_string(s.default_value + (s.plus_node_id ? dcf.node_id : 0));
-      out.push_back({o.index, s.sub, std::move(value)});
+      if (s.type == data_type::visible_string) {
+        out.push_back({o.index, s.sub, s.default_text});
+        continue;
+      }
+      // read_eds has checked $NODEID+X against the type for the file's node; checked again here,
+      // so no sum can overflow whatever the reader lets through.
+      const auto number = canopen::value_for_node(s, dcf.node_id);
+      if (!number) {
+        return page::parameter_file_error{0, support::hex(o.index, 4) + ":" + std::to_string(s.sub) +
+                                                 ": its value is outside its data type for node " +
+                                                 std::to_string(dcf.node_id)};
+      }
+      out.push_back({o.index, s.sub, std::to_string(*number)});
     }
   }
   return out;
@@ -151,7 +163,8 @@ std::vector<page::parameter_entry> parameter_entries(const std::vector<canopen::
       if (s.type == data_type::visible_string) {
         e.default_text = s.default_text;
       } else {
-        e.default_number = s.default_value + (s.plus_node_id ? node_id : 0);
+        // Nothing when "$NODEID+X" does not fit its type on this node (an EDS written for another).
+        e.default_number = canopen::value_for_node(s, node_id);
       }
       out.push_back(std::move(e));
     }
