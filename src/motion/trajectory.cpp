@@ -90,10 +90,11 @@ void profile_position::reset(std::int64_t position) noexcept {
   target_ = position;
 }
 
-void profile_position::reset(const shaft& s) noexcept {
+void profile_position::reset(const shaft& s, bool new_setpoint_now) noexcept {
   *this = profile_position{};
   shaft_ = s;
   target_ = s.position;
+  last_new_setpoint_ = new_setpoint_now;
 }
 
 pp_status profile_position::step(const pp_command& cmd, const pp_parameters& par,

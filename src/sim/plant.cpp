@@ -23,12 +23,17 @@ void restart_cyclic(axis_state& a) noexcept {
                                                                                           : a.position);
 }
 
-// A mode change takes effect at the start of the next cycle's motion: the new mode takes the shaft
-// over as it is (pp with no set-point brakes it, homing waits for its start), and 0x6061 shows it.
+// Control bit 4 (new set-point in pp, homing operation start in hm) as the control word has it now.
+bool bit_4(const axis_state& a) noexcept { return (a.control_word & control_bit::new_set_point) != 0; }
+
+// A mode change takes effect at the start of the next cycle, before the core's decision: the new
+// mode takes the shaft over as it is (pp with no set-point brakes it, homing waits for its start),
+// 0x6061 shows it, and that cycle's status word shows none of the old mode's bits (10..13). Bit 4 acts on its 0->1 edge seen while the mode is active: its value now counts as the previous
+// one, so entering a mode with bit 4 already 1 starts nothing (and bit 12 is 0); the next edge acts.
 [[gnu::noinline]] void enter_mode(axis_state& a) noexcept {
   a.operation_mode = a.requested_mode;
-  a.pp.reset(motion::shaft{a.position, a.position_fraction, a.velocity});
-  a.homing.reset();
+  a.pp.reset(motion::shaft{a.position, a.position_fraction, a.velocity}, bit_4(a));
+  a.homing.reset(bit_4(a));
   a.demand = a.position;
   a.torque_demand = a.torque;
   a.following_error_us = 0;
@@ -113,7 +118,6 @@ void shaft_follow(const profile& p, const plant_constants& k, axis_state& a, con
 void follow(const profile& p, const plant_constants& k, axis_state& a,
             const drive_outputs& out) noexcept {
   a.previous_position = a.position;
-  if (a.requested_mode != a.operation_mode) enter_mode(a);  // out of line
   const std::int64_t v_old = a.velocity;
   const bool brake_holds = k.brake_fitted && (a.flags & sim_flag::brake_closed);
   const bool run = out.torque && !brake_holds && p.info(out.current).activity == state_activity::run;
@@ -143,8 +147,9 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
     status = move_in_mode(k, a, out, s, torque_set);
   } else {
     status = velocity_follow(p, k, a, out, s, brake_holds);
-    if (a.operation_mode == cia402::mode::profile_position) a.pp.reset(s);  // no set-point survives a stop
-    if (a.operation_mode == cia402::mode::homing) a.homing.interrupt();
+    // No set-point survives a stop, and no run; bit 4 is still seen, so only an edge after it acts.
+    if (a.operation_mode == cia402::mode::profile_position) a.pp.reset(s, bit_4(a));
+    if (a.operation_mode == cia402::mode::homing) a.homing.stand_by(bit_4(a));
     a.demand = s.position;
     a.torque_demand = 0;
     a.following_error_us = 0;
@@ -315,7 +320,8 @@ namespace {
 [[gnu::noinline]] void after_decision(axis_state& a) noexcept {
   if (a.last.clear_setpoints) {
     a.flags |= sim_flag::setpoints_cleared;
-    a.pp.reset(motion::shaft{a.position, a.position_fraction, a.velocity});
+    // Bit 4 as last seen: an edge in this very cycle (Enable operation with bit 4) still offers one.
+    a.pp.reset(motion::shaft{a.position, a.position_fraction, a.velocity}, a.pp.new_setpoint_seen());
   }
   // A following error is an event: once the drive has reacted (FAULT), its cause is gone and a
   // fault reset can clear 0x603F.
@@ -385,6 +391,10 @@ namespace {
 // motion, then the plant in whatever mode and state.
 [[gnu::noinline]] const drive_outputs& full_cycle(const profile& p, const plant_constants& k,
                                                   axis_state& a, bool settled) noexcept {
+  if (a.requested_mode != a.operation_mode) {
+    enter_mode(a);  // out of line; the core decides again, on the new mode's (empty) status bits
+    settled = false;
+  }
   if (!settled) decide(p, k, a);
   if (a.last.clear_setpoints | ((a.flags & sim_flag::following_error_raised) != 0)) after_decision(a);
   follow(p, k, a, a.last);

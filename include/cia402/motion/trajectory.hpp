@@ -87,8 +87,10 @@ class profile_position {
   /// Starts at rest at `position` with no set-point (as when the mode is entered).
   void reset(std::int64_t position) noexcept;
   /// Takes over a shaft in whatever motion it is (a mode change while moving): no set-point, so the
-  /// profile brakes it to rest on the deceleration ramp.
-  void reset(const shaft& s) noexcept;
+  /// profile brakes it to rest on the deceleration ramp, and bit 12 is 0. `new_setpoint_now` is
+  /// control bit 4 as it is now: it counts as the previous value, so only a 0->1 edge after it offers
+  /// a set-point (entering the mode with bit 4 already 1 is no edge).
+  void reset(const shaft& s, bool new_setpoint_now = false) noexcept;
 
   pp_status step(const pp_command& cmd, const pp_parameters& par, std::uint32_t dt_us) noexcept;
 
@@ -97,6 +99,8 @@ class profile_position {
   /// The set-point the profile runs to now, if any.
   bool has_target() const noexcept { return active_; }
   std::int64_t target() const noexcept { return target_; }
+  /// Control bit 4 as the last step (or reset) saw it: the value its next edge is judged against.
+  bool new_setpoint_seen() const noexcept { return last_new_setpoint_; }
 
  private:
   shaft shaft_;
