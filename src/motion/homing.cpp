@@ -170,8 +170,8 @@ void homing::start(const homing_parameters& par, const homing_machine& m, shaft&
   }
   if (method_ == 33 || method_ == 34) {
     final_direction_ = method_ == 34 ? 1 : -1;
-    index_after_edge_ = true;
-    edge_found(m, par.increments_per_rev ? par.increments_per_rev : 1, s.position);
+    home_at_ = first_pulse_ahead(m, par.increments_per_rev ? par.increments_per_rev : 1, s);
+    stage_ = stage::index;
     return;
   }
   if (!supports(method_)) {
@@ -182,7 +182,18 @@ void homing::start(const homing_parameters& par, const homing_machine& m, shaft&
   follow_plan(method_, m, s.position, false);
 }
 
-// Home is measured from `home_at_` (the edge, or for 33 / 34 the start): the edge itself, or the
+// Methods 33 / 34: the first index pulse the shaft reaches in the final direction. A pulse is
+// latched on its edge as the shaft moves across it: one exactly under the standing shaft was passed
+// before the run and is not taken (the search goes on to the next, a revolution on); a shaft a
+// fraction above a pulse still crosses it going down.
+std::int64_t homing::first_pulse_ahead(const homing_machine& m, std::int64_t resolution,
+                                       const shaft& s) const noexcept {
+  const std::int64_t below = m.index_at + floor_div(s.position - m.index_at, resolution) * resolution;
+  if (final_direction_ > 0) return below + resolution;
+  return below == s.position && s.fraction == 0 ? below - resolution : below;
+}
+
+// Home is measured from `home_at_` (the edge of methods 1..14): the edge itself, or the
 // first index pulse at or beyond it in the final direction, which the search then runs to unless the
 // shaft is there already (or past it).
 void homing::edge_found(const homing_machine& m, std::int64_t resolution, std::int64_t here) noexcept {
@@ -276,7 +287,8 @@ homing_status homing::step(bool start_bit, const homing_parameters& par, const h
 
   if (stage_ == stage::searching) search(par, m, s);
   if (stage_ == stage::index) {
-    if (final_direction_ > 0 ? after >= home_at_ : after <= home_at_) {
+    // Reached: at or past the pulse (a shaft a fraction above it has not yet reached it going down).
+    if (final_direction_ > 0 ? after >= home_at_ : after < home_at_ || (after == home_at_ && s.fraction == 0)) {
       stage_ = stage::stopping;
     } else if (limit_met(m, s, final_direction_)) {
       stage_ = stage::failed;

@@ -1,8 +1,9 @@
 // Homing on a machine whose switches and index pulses are places on the shaft: every method of
 // 0x60E3 ends at the home CiA 402-2's figure for it names (the edge it measures from, the side of it
 // the home lies on), from every kind of starting place, and a second run from that home ends where
-// the first did. The expected homes are worked out here from the figures, never by the code under
-// test.
+// the first did (33 and 34: on the next pulse, since the one under the standing shaft is not
+// latched, docs/semantics.md S19). The expected homes are worked out here from the figures, never
+// by the code under test.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -38,13 +39,15 @@ const homing_machine positive_home_switch = with_home_switch(50000, homing_machi
 const homing_machine negative_home_switch = with_home_switch(homing_machine::none_below, 50000);
 const homing_machine cam = with_home_switch(50000, 80000);  // an edge either side
 
-// The first index pulse at or above / at or below a position.
+// The first index pulse at or above / at or below a position, and strictly above / below it.
 std::int64_t pulse_at_or_above(const homing_machine& m, std::int64_t at) {
   return m.index_at + (floor_div(at - m.index_at - 1, revolution) + 1) * revolution;
 }
 std::int64_t pulse_at_or_below(const homing_machine& m, std::int64_t at) {
   return m.index_at + floor_div(at - m.index_at, revolution) * revolution;
 }
+std::int64_t pulse_above(const homing_machine& m, std::int64_t at) { return pulse_at_or_above(m, at + 1); }
+std::int64_t pulse_below(const homing_machine& m, std::int64_t at) { return pulse_at_or_below(m, at - 1); }
 
 // CiA 402-2's figure for a method: which edge home is measured from and on which side of it home
 // lies (+1 right, -1 left). The edge is the first position in the switch's new state as the drive
@@ -69,8 +72,9 @@ figure figure_of(int method, const homing_machine& m) {
 
 std::int64_t expected_home(int method, const homing_machine& m, std::int64_t start) {
   if (method == 35 || method == 37) return start;
-  if (method == 33) return pulse_at_or_below(m, start);
-  if (method == 34) return pulse_at_or_above(m, start);
+  // 33 / 34 from a shaft standing at `start`: a pulse under it is not latched (no edge), the next is.
+  if (method == 33) return pulse_below(m, start);
+  if (method == 34) return pulse_above(m, start);
   const figure f = figure_of(method, m);
   if (method >= 17) return f.edge;  // no index pulse: the edge itself
   return f.side > 0 ? pulse_at_or_above(m, f.edge) : pulse_at_or_below(m, f.edge);
@@ -135,12 +139,18 @@ TEST(homing, every_method_of_0x60E3_homes_where_its_figure_says_and_again_there_
       EXPECT_EQ(first.s.position, home_at) << "the shaft stands at home";
       EXPECT_EQ(first.s.velocity, 0);
       EXPECT_EQ(first.s.position + first.offset, home_offset) << "home reads as 0x607C";
-      // Again, from home: the switches and pulses have not moved, so neither does home.
+      // Again, from home: the switches and pulses have not moved, so neither does home (33 and 34
+      // go on to the next pulse: the one under the standing shaft is not latched).
       const run second = home(c.method, *c.machine, first.s.position, first.offset);
       ASSERT_FALSE(second.status.error);
       ASSERT_TRUE(second.status.attained && second.status.target_reached);
-      EXPECT_EQ(second.s.position, first.s.position);
-      EXPECT_EQ(second.offset, first.offset);
+      const std::int64_t again_at = expected_home(c.method, *c.machine, first.s.position);
+      EXPECT_EQ(second.s.position, again_at);
+      EXPECT_EQ(second.s.position + second.offset, home_offset);
+      if (c.method != 33 && c.method != 34) {
+        EXPECT_EQ(second.s.position, first.s.position);
+        EXPECT_EQ(second.offset, first.offset);
+      }
     }
   }
   // Every method the drive announces, no more.

@@ -15,7 +15,10 @@
 //            reverse at the positive limit switch, 11..14 the mirror image; home at the index pulse
 //            left / right of the lower edge (7, 8 / 14, 13) or the upper edge (9, 10 / 12, 11);
 //   17 .. 30 as 1 .. 14, without the index pulse: home is the edge itself;
-//   33 / 34  the first index pulse in the negative / positive direction;
+//   33 / 34  the first index pulse in the negative / positive direction that the shaft reaches.
+// An index pulse is latched on its edge as the shaft moves across it, as an encoder latch does: a
+// run of 33 / 34 started standing exactly on a pulse does not take that one, it searches on to the
+// next, a revolution on. (1..14 search their pulse only after an edge, moving.)
 //   35 / 37  the present position is home (35 is the older number of 37); no motion.
 // A method's first move (and its first move after a reversal at a limit switch) runs at 0x6099
 // sub 1; the moves after it, which find the edge home is measured from, and the search for the
@@ -106,8 +109,20 @@ class homing {
   /// How far a search may travel before it is given up (homing error): no switch or index found.
   static constexpr std::int64_t max_search_revolutions = 1000;
 
-  /// Not started, at whatever the shaft does (as when the mode is entered).
-  void reset() noexcept { *this = homing{}; }
+  /// Not started, at whatever the shaft does (as when the mode is entered). `start_now` is control
+  /// bit 4 as it is now: it counts as the previous value, so entering the mode with bit 4 already 1
+  /// starts nothing; only a 0->1 edge after it does.
+  void reset(bool start_now = false) noexcept {
+    *this = homing{};
+    last_start_ = start_now;
+  }
+  /// A cycle in which the mode does not move the shaft (the drive not enabled, a stop or a halt
+  /// running): a running search is interrupted, and bit 4 is taken as seen, so that a run starts only
+  /// on a 0->1 edge after it.
+  void stand_by(bool start_bit) noexcept {
+    interrupt();
+    last_start_ = start_bit;
+  }
   /// One cycle: `start` is control-word bit 4 (its rising edge starts a run, its fall interrupts
   /// one). `s` is the shaft in its own increments, which the run moves; `offset` is what the drive
   /// adds to s.position to report its position (0x6064), which the run sets once home is found.
@@ -128,6 +143,7 @@ class homing {
   void start(const homing_parameters& par, const homing_machine& m, shaft& s, std::int64_t& offset) noexcept;
   void follow_plan(std::int8_t method, const homing_machine& m, std::int64_t here, bool after_limit) noexcept;
   void edge_found(const homing_machine& m, std::int64_t resolution, std::int64_t here) noexcept;
+  std::int64_t first_pulse_ahead(const homing_machine& m, std::int64_t resolution, const shaft& s) const noexcept;
   void search(const homing_parameters& par, const homing_machine& m, const shaft& s) noexcept;
 
   stage stage_ = stage::idle;
