@@ -3,6 +3,7 @@
 // mapping changes only while the PDO is invalid and its count is 0), then its mapping entries and
 // count, its other communication parameters, and last its COB-ID as it was (valid or not).
 #include <algorithm>
+#include <deque>
 #include <map>
 
 #include "cia402/canopen/301/slave.hpp"
@@ -80,11 +81,16 @@ void can_link::close() {
   if (stage_ == stage::closed || stage_ == stage::restoring) return;
   word_.reset();
   if (stage_ == stage::acyclic || stage_ == stage::recording) {
-    // Nothing was set up: nothing to put back.
+    // Nothing was set up: nothing to put back. Every transfer still queued (the one under way
+    // too) ends now, cancelled, as on a lost link: its caller waits for it otherwise for ever, as
+    // a closed link polls no more.
     if (own_busy_) sdo_.cancel();
     own_busy_ = false;
-    own_.clear();
-    return finish_close();
+    std::deque<transfer> queued;
+    queued.swap(own_);
+    finish_close();
+    axes::cancel_transfers(queued, short_name() + ": the link was closed before the transfer ended");
+    return;
   }
   stage_ = stage::restoring;
   restoring_ = restore_order();
