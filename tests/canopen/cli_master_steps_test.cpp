@@ -137,6 +137,59 @@ TEST(cli_master_steps, options_belong_to_the_step_before_them) {
   EXPECT_NE(two.out.find(R"({"node":1,"event":"reached","position":1500})"), std::string::npos) << two.out;
 }
 
+// Issue 42: NMT stop and start within one run. A STOPPED node serves no SDO: the link holds its
+// transfers (the session's start-up reads among them) until NMT start instead of losing the node to
+// an SDO time-out, and after stop the status word it knew is old until a PDO brings a new one.
+TEST(cli_master_steps, nmt_stop_then_start_goes_on_in_the_same_run) {
+  const result r = run_tool({"master", "--can", "virtual", "--node", "2", "nmt", "stop", "nmt", "start", "state"});
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("node 2: SWITCH_ON_DISABLED (statusword 0x1250)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("does not answer"), std::string::npos) << r.err;
+  const result waited = run_tool({"master", "--can", "virtual", "--node", "2", "nmt", "stop", "wait", "100", "nmt", "start",
+                                  "state"});
+  ASSERT_EQ(waited.status, 0) << waited.err << waited.out;
+}
+
+TEST(cli_master_steps, after_nmt_stop_and_start_the_state_is_the_drives_new_one_not_the_last_seen) {
+  // Enabled, the drive takes NMT STOPPED for a lost connection (0x6007 = 1: a fault, 0x8130); the
+  // state after NMT start is that FAULT, not the OPERATION ENABLED seen before the stop.
+  const result r = run_tool({"master", "--can", "virtual", "--node", "2", "--json", "enable", "nmt", "stop", "nmt", "start",
+                             "state"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto lines = lines_of(r.out);
+  bool started = false;
+  std::string first_after;
+  for (const auto& l : lines) {
+    if (l["event"] == "nmt" && l["command"] == "start") started = true;
+    if (started && first_after.empty() && (l["event"] == "state" || l["event"] == "status")) first_after = l["state"];
+  }
+  EXPECT_EQ(first_after, "FAULT") << r.out;
+  const result again = run_tool({"master", "--can", "virtual", "--node", "2", "enable", "nmt", "stop", "nmt", "start", "enable"});
+  EXPECT_EQ(again.status, 1) << "not 'reached' from the old status word" << again.out;
+  EXPECT_NE(again.err.find("enable: the drive is in FAULT: error code 0x8130"), std::string::npos) << again.err;
+}
+
+TEST(cli_master_steps, a_stopped_node_is_said_stopped_and_set_up_from_pre_operational) {
+  const result r = run_tool({"master", "--can", "virtual", "--node", "2", "nmt", "stop", "state"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("node 2 is STOPPED (NMT stop): it serves no SDO until NMT start or preop"), std::string::npos)
+      << r.err;
+  const result enabled = run_tool({"master", "--can", "virtual", "--node", "2", "nmt", "stop", "enable"});
+  ASSERT_EQ(enabled.status, 0) << enabled.err << enabled.out;
+  EXPECT_NE(enabled.out.find("node 2: reached OPERATION_ENABLED"), std::string::npos) << enabled.out;
+  const result left = run_tool({"master", "--can", "virtual", "--node", "2", "enable", "nmt", "stop"});
+  ASSERT_EQ(left.status, 0) << left.err;
+  EXPECT_NE(left.out.find("0x1A00 (TPDO1 mapping parameter) not put back: node 2 is STOPPED (NMT stop)"), std::string::npos)
+      << left.out;
+  EXPECT_NE(left.out.find("NMT state STOPPED, as NMT stop left it"), std::string::npos) << left.out;
+}
+
+TEST(cli_master_steps, a_node_reset_after_it_was_read_is_read_again) {
+  const result r = run_tool({"master", "--can", "virtual", "--node", "2", "state", "nmt", "reset", "state"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("node 2: node 2 restarted (boot-up message)"), std::string::npos) << r.out;
+}
+
 TEST(cli_master_steps, nmt_on_ethercat_is_refused_before_the_line_is_opened) {
   const result r = run_tool({"master", "--ecat", "no-such-interface", "nmt", "start"});
   EXPECT_EQ(r.status, 2);

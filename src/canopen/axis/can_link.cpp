@@ -89,7 +89,7 @@ bool can_link::cyclic() const {
   return (stage_ == stage::cyclic || stage_ == stage::restoring) && master_->phase() == master_phase::running;
 }
 
-bool can_link::status_known() const { return cyclic() && master_->status_known(); }
+bool can_link::status_known() const { return cyclic() && master_->status_known() && !pdos_quiet_; }
 
 std::uint16_t can_link::status_word() const { return master_ ? master_->status_word() : 0; }
 
@@ -102,6 +102,7 @@ std::optional<std::uint16_t> can_link::error_code() const {
 
 std::uint32_t can_link::poll(std::uint32_t elapsed_us) {
   if (stage_ == stage::closed) return no_deadline;
+  now_us_ += elapsed_us;
   if (failure_.empty() && !master_) {
     if (const std::error_code ec = bus_->failure()) fail_own("the bus connection failed: " + ec.message());
   }
@@ -114,6 +115,11 @@ std::uint32_t can_link::poll(std::uint32_t elapsed_us) {
     if (own_busy_) next = earliest(next, sdo_.process(0));
   } else {
     next = master_->process(elapsed_us);
+    run_held();
+  }
+  if ((sdo_held_ || booting_) && !own_.empty() && !own_busy_) {
+    const std::uint64_t held = now_us_ - held_since_us_;
+    next = earliest(next, held < config_.sdo_timeout_us ? static_cast<std::uint32_t>(config_.sdo_timeout_us - held) : 0);
   }
   if (stage_ == stage::recording && !own_busy_ && own_.empty() && failure_.empty()) record_next();
   if (stage_ == stage::setting_up && master_->phase() == master_phase::running) {
@@ -137,6 +143,10 @@ void can_link::on_frame(const frame& f) {
     return;
   }
   if (f.extended || f.rtr) return;
+  if (f.id == cob::heartbeat + config_.node_id && f.len >= 1 &&
+      f.data[0] == static_cast<std::uint8_t>(nmt_state::initialising)) {
+    return on_boot_up();
+  }
   if (sdo_.on_frame(f)) return;
   if (f.id == cob::emcy + config_.node_id && f.len >= 3 && on_emergency) {
     on_emergency(static_cast<std::uint16_t>(get_le(f.data.data(), 2)), f.data[2],
@@ -167,8 +177,90 @@ void can_link::run_own_transfers(std::uint32_t elapsed_us) {
     results_.emplace_back(std::move(t), r);
   }
   if (own_busy_ || own_.empty() || !failure_.empty()) return;
+  if (booting_ && now_us_ - held_since_us_ >= config_.sdo_timeout_us) booting_ = false;  // no boot-up came: go on
+  if (sdo_held_ && now_us_ - held_since_us_ >= config_.sdo_timeout_us) return end_held();
+  if (sdo_held_ || booting_) return;
   const transfer& t = own_.front();
+  talked_ = true;
   own_busy_ = t.download ? sdo_.start_download(t.index, t.sub, t.bytes) : sdo_.start_upload(t.index, t.sub);
+}
+
+// --- NMT ----------------------------------------------------------------------------------------
+
+std::error_code can_link::send_nmt(nmt_command c) {
+  if (const std::error_code ec = bus_->send(nmt_frame(c, config_.node_id))) return ec;
+  switch (c) {
+    case nmt_command::stop:
+      // CiA 301 §7.3.2.2.4: a STOPPED node serves no SDO and sends no PDO; an SDO under way is lost.
+      hold_own_transfer();
+      sdo_held_ = true;
+      pdos_quiet_ = true;
+      start_sent_ = false;
+      break;
+    case nmt_command::enter_pre_operational:
+      // PRE-OPERATIONAL: SDO again, still no PDO.
+      sdo_held_ = false;
+      pdos_quiet_ = true;
+      start_sent_ = false;
+      break;
+    case nmt_command::start:
+      sdo_held_ = false;
+      start_sent_ = true;
+      break;
+    case nmt_command::reset_node:
+    case nmt_command::reset_communication:
+      sdo_held_ = false;
+      // In the cyclic stage the 402 master sets the node up again on its boot-up message.
+      if (master_ && stage_ != stage::recording) break;
+      hold_own_transfer();
+      booting_ = true;
+      break;
+  }
+  return {};
+}
+
+void can_link::hold_own_transfer() {
+  held_since_us_ = now_us_;
+  if (!own_busy_) return;
+  // The node drops it: the transfer stays first in the queue and goes again when the node answers.
+  sdo_.cancel();
+  sdo_.clear();
+  own_busy_ = false;
+}
+
+void can_link::end_held() {
+  axes::transfer_result r;
+  r.error = short_name() + " is STOPPED (NMT stop): it serves no SDO until NMT start or preop";
+  for (transfer& t : own_) results_.emplace_back(std::move(t), r);
+  own_.clear();
+}
+
+void can_link::run_held() {
+  // The cyclic stage: transfers held while the node is STOPPED go to the master once it is not.
+  if (own_.empty() || stage_ != stage::cyclic) return;
+  if (sdo_held_) {
+    if (now_us_ - held_since_us_ >= config_.sdo_timeout_us) end_held();
+    return;
+  }
+  std::deque<transfer> go;
+  go.swap(own_);
+  if (master_->phase() != master_phase::running) {
+    return axes::cancel_transfers(go, short_name() + ": " + master_->phase_text());
+  }
+  for (transfer& t : go) (void)forward(std::move(t));
+}
+
+void can_link::on_boot_up() {
+  booting_ = false;
+  sdo_held_ = false;
+  pdos_quiet_ = false;
+  hold_own_transfer();  // lost with the restart: it goes again
+  if (!talked_ || stage_ != stage::acyclic || !failure_.empty()) return;
+  // A node this link talked to started afresh (its defaults): what was read there is old.
+  talked_ = false;
+  const std::string why = short_name() + " restarted (boot-up message)";
+  axes::cancel_transfers(own_, why);
+  if (on_event) on_event(axes::link_event::restarted, why);
 }
 
 void can_link::fail_own(std::string text) {
@@ -194,26 +286,31 @@ void can_link::note_name(std::uint16_t index, std::uint8_t sub, const std::vecto
 
 bool can_link::upload(std::uint16_t index, std::uint8_t sub, axes::transfer_done done) {
   if (phase() != axes::link_phase::running) return false;
-  if (stage_ == stage::acyclic) {
-    own_.push_back({index, sub, false, {}, std::move(done)});
-    return true;
-  }
-  return master_->upload(index, sub, [this, index, sub, done = std::move(done)](const sdo_result& r) {
-    const axes::transfer_result t = result_of(r, short_name(), index, sub);
-    if (t.ok) note_name(index, sub, t.data);
-    if (done) done(t);
-  });
+  return queue({index, sub, false, {}, std::move(done)});
 }
 
 bool can_link::download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes, axes::transfer_done done) {
   if (phase() != axes::link_phase::running || bytes.empty()) return false;
-  if (stage_ == stage::acyclic) {
-    own_.push_back({index, sub, true, std::move(bytes), std::move(done)});
-    return true;
-  }
-  return master_->download(index, sub, std::move(bytes), [this, index, sub, done = std::move(done)](const sdo_result& r) {
-    if (done) done(result_of(r, short_name(), index, sub));
-  });
+  return queue({index, sub, true, std::move(bytes), std::move(done)});
+}
+
+bool can_link::queue(transfer t) {
+  if (stage_ != stage::acyclic && !sdo_held_) return forward(std::move(t));
+  if ((sdo_held_ || booting_) && own_.empty()) held_since_us_ = now_us_;
+  own_.push_back(std::move(t));
+  return true;
+}
+
+bool can_link::forward(transfer t) {
+  const std::uint16_t index = t.index;
+  const std::uint8_t sub = t.sub;
+  auto done = [this, index, sub, done = std::move(t.done)](const sdo_result& r) {
+    const axes::transfer_result x = result_of(r, short_name(), index, sub);
+    if (x.ok) note_name(index, sub, x.data);
+    if (done) done(x);
+  };
+  return t.download ? master_->download(index, sub, std::move(t.bytes), std::move(done))
+                    : master_->upload(index, sub, std::move(done));
 }
 
 std::optional<axes::value_format> can_link::describe(std::uint16_t index, std::uint8_t sub) const {
@@ -227,12 +324,13 @@ std::optional<axes::value_format> can_link::describe(std::uint16_t index, std::u
   return std::nullopt;
 }
 
-std::error_code can_link::send_nmt(nmt_command c) { return bus_->send(nmt_frame(c, config_.node_id)); }
-
 // --- the cyclic exchange ------------------------------------------------------------------------
 
 void can_link::start_cyclic() {
   if (stage_ != stage::acyclic || !failure_.empty()) return;
+  // The set-up reads and writes by SDO: a node this link stopped is brought to PRE-OPERATIONAL
+  // first (the set-up's NMT start takes it on to OPERATIONAL).
+  if (sdo_held_) (void)send_nmt(nmt_command::enter_pre_operational);
   make_master();
   to_record_ = master_->objects_written();
   recorded_.clear();
@@ -268,6 +366,8 @@ void can_link::make_master() {
   mc.map_position = config_.map_position;
   master_ = std::make_unique<drive_master>(*bus_, mc);
   master_->on_status = [this](std::uint16_t) {
+    if (pdos_quiet_ && !start_sent_ && stage_ == stage::cyclic) return;  // sent before the NMT stop or preop
+    pdos_quiet_ = false;
     ++status_count_;
     // Every status word gets the control word back, as a SYNC master's RPDO1 answers TPDO1.
     if (word_ && stage_ == stage::cyclic) master_->send_control_word(*word_);
@@ -278,7 +378,12 @@ void can_link::make_master() {
   master_->before_sync = [this] {
     if (before_cycle) before_cycle();
   };
-  master_->on_phase = [this](master_phase, phase_reason why) {
+  master_->on_phase = [this](master_phase p, phase_reason why) {
+    if (p == master_phase::running) {
+      // The set-up ends with NMT start: the node serves SDO and sends its PDOs again.
+      sdo_held_ = false;
+      pdos_quiet_ = false;
+    }
     if (!on_event) return;
     if (why == phase_reason::failed) on_event(axes::link_event::failed, master_->failure_text());
     if (why == phase_reason::node_restarted) on_event(axes::link_event::restarted, master_->phase_text());
@@ -302,7 +407,7 @@ void can_link::learn_cyclic() {
 }
 
 std::optional<std::int64_t> can_link::cyclic_input(std::uint16_t index, std::uint8_t sub) const {
-  if (!cyclic() || sub != 0 || !master_->status_known()) return std::nullopt;
+  if (!status_known() || sub != 0) return std::nullopt;
   switch (index) {
     case object_index::status_word: return master_->status_word();
     case object_index::error_code:

@@ -80,22 +80,32 @@ std::vector<can_link::recorded> can_link::restore_order() const {
 void can_link::close() {
   if (stage_ == stage::closed || stage_ == stage::restoring) return;
   word_.reset();
+  // Every transfer still queued in the link (the one under way too; in the cyclic stage those held
+  // while the node is STOPPED) ends now, cancelled: its caller would wait for it otherwise for ever,
+  // as a closed link polls no more.
+  if (own_busy_) sdo_.cancel();
+  own_busy_ = false;
+  std::deque<transfer> queued;
+  queued.swap(own_);
   if (stage_ == stage::acyclic || stage_ == stage::recording) {
-    // Nothing was set up: nothing to put back. Every transfer still queued (the one under way
-    // too) ends now, cancelled, as on a lost link: its caller waits for it otherwise for ever, as
-    // a closed link polls no more.
-    if (own_busy_) sdo_.cancel();
-    own_busy_ = false;
-    std::deque<transfer> queued;
-    queued.swap(own_);
-    finish_close();
-    axes::cancel_transfers(queued, short_name() + ": the link was closed before the transfer ended");
-    return;
+    finish_close();  // nothing was set up: nothing to put back
+  } else {
+    stage_ = stage::restoring;
+    restoring_ = restore_order();
+    restore_at_ = 0;
+    restore_busy_ = false;
+    if (sdo_held_) {
+      // A node this link stopped answers no SDO: said once per object, not found out by a time-out each.
+      std::vector<std::uint16_t> objects;
+      for (const recorded& r : restoring_) {
+        if (std::find(objects.begin(), objects.end(), r.index) != objects.end()) continue;
+        objects.push_back(r.index);
+        report_.left.push_back(name_of(r.index) + " not put back: " + short_name() + " is STOPPED (NMT stop)");
+      }
+      restore_at_ = restoring_.size();
+    }
   }
-  stage_ = stage::restoring;
-  restoring_ = restore_order();
-  restore_at_ = 0;
-  restore_busy_ = false;
+  axes::cancel_transfers(queued, short_name() + ": the link was closed before the transfer ended");
 }
 
 void can_link::restore_next() {
@@ -128,13 +138,21 @@ void can_link::finish_close() {
     if (std::find(objects.begin(), objects.end(), r.index) == objects.end()) objects.push_back(r.index);
   }
   for (std::uint16_t index : objects) {
-    const std::string prefix = hex(index, 4) + ":";
-    const bool refused = std::any_of(report_.left.begin(), report_.left.end(),
-                                     [&](const std::string& l) { return l.rfind(prefix, 0) == 0; });
+    const std::string entry = hex(index, 4) + ":";
+    const std::string object = name_of(index) + " ";
+    const bool refused = std::any_of(report_.left.begin(), report_.left.end(), [&](const std::string& l) {
+      return l.rfind(entry, 0) == 0 || l.rfind(object, 0) == 0;
+    });
     if (!refused) report_.restored.push_back(name_of(index));
   }
   if (master_ && stage_ == stage::restoring) {
-    report_.left.push_back("NMT state OPERATIONAL: this master started the node (the state before is not known)");
+    if (sdo_held_) {
+      report_.left.push_back("NMT state STOPPED, as NMT stop left it");
+    } else if (pdos_quiet_ && !start_sent_) {
+      report_.left.push_back("NMT state PRE-OPERATIONAL, as NMT preop left it");
+    } else {
+      report_.left.push_back("NMT state OPERATIONAL: this master started the node (the state before is not known)");
+    }
     master_->clear_target();
   }
   report_.done = true;

@@ -12,7 +12,17 @@
 // - close(): the recorded objects are written back in reverse order, each PDO invalid while its
 //   mapping is put back (CiA 301's rule), then its own COB-ID as it was; what could not be written
 //   is said in the report. The NMT state the master started the node into stays (it cannot know
-//   the one before: the node's heartbeat was off), and the report says so.
+//   the one before: the node's heartbeat was off), and the report says so. Every transfer still
+//   queued in the link ends then, cancelled, with the reason.
+//
+// NMT through send_nmt(): the link knows what it asked of the node. After NMT stop the node serves
+// no SDO (CiA 301 §7.3.2.2.4): a transfer under way goes again, and every transfer waits, until NMT
+// start or preop (one that waits longer than the SDO timeout ends with that reason; the link does
+// not count the node lost). After stop or preop the node sends no PDO: the status word known is
+// old, and the link says it does not know it until the first one after NMT start. After a reset
+// before the cyclic stage, transfers wait for the boot-up message; a node that boots up after the
+// link talked to it is a restart (link_event::restarted, transfers queued cancelled), as in the
+// cyclic stage, where the 402 master sets it up again.
 //
 // Types for describe(): an EDS or DCF given by the user first, then the project's CANopen drive
 // dictionary for CiA 301's objects 0x1000..0x1FFF, and for a node that calls itself "cia402 virtual
@@ -108,6 +118,12 @@ class can_link final : public axes::link_base {
   void record_next();
   void note_name(std::uint16_t index, std::uint8_t sub, const std::vector<std::uint8_t>& data);
   void fail_own(std::string text);
+  bool queue(transfer t);
+  bool forward(transfer t);
+  void hold_own_transfer();
+  void run_held();
+  void end_held();
+  void on_boot_up();
   void learn_cyclic();
   // can_restore.cpp
   std::vector<recorded> restore_order() const;
@@ -119,13 +135,22 @@ class can_link final : public axes::link_base {
   stage stage_ = stage::acyclic;
   std::string failure_;  // the acyclic stage's own failure (no answer, bus gone)
   sdo_client sdo_;
-  std::deque<transfer> own_;      // transfers through sdo_ (acyclic, recording)
+  std::deque<transfer> own_;      // transfers through sdo_ (acyclic, recording), or held while STOPPED
   bool own_busy_ = false;
   std::vector<std::pair<std::uint16_t, std::uint8_t>> to_record_;
   std::vector<recorded> recorded_;
   std::unique_ptr<drive_master> master_;
   std::vector<transfer> finished_;  // transfers done, said at the next poll
   std::vector<std::pair<transfer, axes::transfer_result>> results_;
+
+  // What this link's own NMT commands did to the node (send_nmt), until the node shows otherwise.
+  bool sdo_held_ = false;    // NMT stop sent: no SDO until NMT start or preop
+  bool booting_ = false;     // NMT reset sent before the cyclic stage: SDO waits for the boot-up
+  bool pdos_quiet_ = false;  // NMT stop or preop sent: the status word known is old
+  bool start_sent_ = false;  // NMT start sent since: the next status word is new
+  bool talked_ = false;      // a transfer went to the node: a boot-up from now on is a restart
+  std::uint64_t now_us_ = 0;
+  std::uint64_t held_since_us_ = 0;
 
   std::optional<std::uint16_t> word_;
   std::string device_name_;
