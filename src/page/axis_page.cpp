@@ -62,7 +62,7 @@ void axis_page::impl::start_session(const profile& p) {
   table = &p;
   axes::session_config sc;
   sc.drive_profile = &p;
-  sc.lease_us = config.lease_us;
+  sc.lease_us = lease_armed ? config.lease_us : 0;  // see renew_lease()
   sc.poll_us = config.poll_us;
   sc.reset_pulse_us = config.reset_pulse_us != 0 ? config.reset_pulse_us : config.cycle_us;
   session = std::make_unique<axes::session>(*drive.link, sc);
@@ -534,7 +534,7 @@ std::string axis_page::info_json(bool control, bool token_required) const {
   // The period of the drive's cycles, one scope sample each: a step here, the link's cycle on a bus
   // (the SYNC period over CANopen, the LRW's over EtherCAT), not the page's own step.
   j["cycle_us"] = m.drive.plant != nullptr ? m.config.cycle_us : m.session->link().cycle_us();
-  j["lease_ms"] = m.session->lease_us() / 1000;
+  j["lease_ms"] = m.config.lease_us / 1000;
   // Snapshots come at most this often (the plot holds a value across a gap between them).
   j["publish_ms"] = m.config.publish_us / 1000.0;
   j["capabilities"] = m.capabilities();

@@ -411,7 +411,13 @@ reply axis_page::impl::change_bus_plant(std::unique_lock<std::mutex>& lock, cons
 
 void axis_page::renew_lease() {
   std::lock_guard lock(impl_->mutex);
-  impl_->session->renew("the page");
+  impl& m = *impl_;
+  // A fresh serve that no page has opened yet lost no sign of life: the lease starts here.
+  if (!m.lease_armed && m.config.lease_us != 0) {
+    m.lease_armed = true;
+    m.session->set_lease(m.config.lease_us);
+  }
+  m.session->renew("the page");
 }
 
 }  // namespace cia402::page

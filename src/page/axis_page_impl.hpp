@@ -55,6 +55,8 @@ struct axis_page::impl {
   bool reset_sent_since_change = false;  // for the inference (a fault-reset edge went out)
   std::map<std::uint16_t, std::int64_t> objects;  // a bus drive's objects as read at start or written
   std::uint16_t injected_fault = 0;               // what the page wrote to 0x2001 (a bus node)
+  /// The lease runs from the first renewal on: before any client came, no sign of life was lost.
+  bool lease_armed = false;
   std::optional<std::uint16_t> last_emergency;    // the newest emergency's error code
   // Each error code 0x603F took, newest first, with the page's time it was first seen: the history
   // the page shows (the drive's own is 0x1003, without times).

@@ -25,6 +25,7 @@
 
 #include "server_http.hpp"
 #include "json_text.hpp"
+#include "server_control.hpp"
 #include "web_assets.hpp"
 
 namespace cia402::page {
@@ -33,6 +34,7 @@ namespace {
 using json = nlohmann::json;
 
 constexpr const char* token_header = "X-Cia402-Token";
+constexpr const char* client_header = "X-Cia402-Client";
 
 using detail::answer_and_close;
 using detail::host_of;
@@ -94,6 +96,7 @@ struct server::impl {
   std::atomic<bool> stopping{false};
   std::atomic<bool> listen_returned{false};  // the listening thread is done (or never listened)
   std::atomic<int> streams{0};
+  detail::control_board control{axes.size(), options.control_hold};  // which page holds each axis
   int port = -1;
   std::string error;
 
@@ -162,6 +165,48 @@ struct server::impl {
     return !options.token_required || has_token(req);
   }
 
+  // The page a request comes from (server_control.hpp): its header, or ?client= (the event
+  // stream's); empty for a program without one.
+  static std::string client_of(const httplib::Request& req) {
+    if (req.has_header(client_header)) return detail::valid_client_id(req.get_header_value(client_header));
+    return req.has_param("client") ? detail::valid_client_id(req.get_param_value("client")) : std::string();
+  }
+  // A client that may control is there: a program renews the axis it names, a page every axis it holds.
+  void renew_for(std::size_t k, const std::string& client) {
+    if (client.empty()) return axes[k].drive->renew_lease();
+    for (const std::size_t held : control.renew(client, detail::control_board::clock::now())) {
+      axes[held].drive->renew_lease();
+    }
+  }
+  std::size_t index_of(const axis* a) const { return static_cast<std::size_t>(a - axes.data()); }
+  json control_json(std::size_t k, const std::string& client) const {
+    const auto now = detail::control_board::clock::now();
+    json held = json::array();
+    for (std::size_t i = 0; i < axes.size(); ++i) {
+      if (control.standing(i, client, now) == detail::control_standing::here) held.push_back(i + 1);
+    }
+    return {{"axis", k + 1}, {"control", detail::standing_name(control.standing(k, client, now))}, {"held", held}};
+  }
+  // GET and POST /api/control: where the axis stands for this page; {"hold": true} takes control of
+  // it from any other page, {"hold": false} lets it go.
+  void on_control(const httplib::Request& req, httplib::Response& res, bool post) {
+    const axis* a = axis_named(req, res);
+    if (a == nullptr) return;
+    const std::size_t k = index_of(a);
+    const std::string client = client_of(req);
+    if (post) {
+      if (const auto e = check_post(req, options.max_body)) return send_error(res, e->status, e->reason);
+      if (client.empty()) return send_error(res, 400, std::string("a page names itself with ") + client_header);
+      const json body = json::parse(req.body, nullptr, false);
+      if (!body.is_object() || body.size() != 1 || !body.contains("hold") || !body["hold"].is_boolean()) {
+        return send_error(res, 400, "the body is {\"hold\": true} (take control) or {\"hold\": false} (let go)");
+      }
+      control.set_hold(k, client, body["hold"].get<bool>(), detail::control_board::clock::now());
+      if (body["hold"].get<bool>()) renew_for(k, client);
+    }
+    send_json(res, 200, control_json(k, client));
+  }
+
   // The checks every POST passes before its body is read as JSON.
   std::optional<request_error> check_post(const httplib::Request& req, std::size_t max_body) const {
     if (options.token_required) {
@@ -205,9 +250,17 @@ struct server::impl {
       send_error(res, e->status, e->reason);
       return std::nullopt;
     }
-    backend* inst = axis_of(req, res);
-    if (inst == nullptr) return std::nullopt;
-    inst->renew_lease();  // a client that controls is there
+    const axis* a = axis_named(req, res);
+    if (a == nullptr) return std::nullopt;
+    backend* inst = a->drive;
+    // One page controls an axis at a time: another page's command is refused until it takes control.
+    const std::string client = client_of(req);
+    if (!control.claim(index_of(a), client, detail::control_board::clock::now())) {
+      send_json(res, 409, json{{"error", a->label + " is controlled by another page: take control to command it here"},
+                               {"controlled_elsewhere", true}});
+      return std::nullopt;
+    }
+    renew_for(index_of(a), client);  // a client that controls is there
     // A key given twice is refused: "last wins" would act on a value the sender may not have meant.
     std::vector<std::set<std::string>> keys;
     bool duplicate = false;
@@ -267,80 +320,6 @@ struct server::impl {
   backend* axis_of(const httplib::Request& req, httplib::Response& res) const {
     const axis* a = axis_named(req, res);
     return a != nullptr ? a->drive : nullptr;
-  }
-
-  std::variant<reply, request_error> on_command(backend& inst, const json& body) {
-    if (auto k = unknown_key(body, {"command", "bit"})) return request_error{400, *k};
-    if (!body.contains("command") || !body["command"].is_string()) {
-      return request_error{400, "'command' (a string) is required"};
-    }
-    const std::string& name = body["command"].get_ref<const std::string&>();
-    if (name == "toggle_bit") {
-      if (!body.contains("bit")) return request_error{400, "toggle_bit needs 'bit' (0..15)"};
-      const auto bit = integer_of(body["bit"]);
-      if (!bit || *bit < 0 || *bit > 15) return request_error{400, "'bit' must be 0..15"};
-      return inst.toggle_control_bit(static_cast<int>(*bit));
-    }
-    if (body.contains("bit")) return request_error{400, "'bit' belongs to toggle_bit only"};
-    if (name == "new_setpoint") return inst.new_setpoint();
-    page_command c{};
-    if (!parse_page_command(name, c)) {
-      return request_error{400, "unknown command '" + name +
-                                    "' (shutdown, switch_on, enable_operation, disable_operation, "
-                                    "disable_voltage, quick_stop, fault_reset, halt, toggle_bit, "
-                                    "new_setpoint)"};
-    }
-    return inst.command(c);
-  }
-
-  std::variant<reply, request_error> on_plant(backend& inst, const json& body) {
-    if (auto k = unknown_key(body, {"target_velocity", "fault", "fault_code", "fault_class",
-                                    "dc_link", "sto"})) {
-      return request_error{400, *k};
-    }
-    if (body.empty()) return request_error{400, "nothing to change"};
-    plant_change c;
-    if (body.contains("target_velocity")) {
-      const json& v = body["target_velocity"];
-      if (!v.is_number_integer() && !v.is_number_unsigned()) {
-        return request_error{400, "'target_velocity' must be an integer (rpm)"};
-      }
-      const auto n = integer_of(v);
-      if (!n) return request_error{400, "'target_velocity' is out of range"};
-      c.target_velocity = *n;
-    }
-    for (const char* key : {"fault", "dc_link", "sto"}) {
-      if (body.contains(key) && !body[key].is_boolean()) {
-        return request_error{400, "'" + std::string(key) + "' must be true or false"};
-      }
-    }
-    if (body.contains("fault")) c.fault = body["fault"].get<bool>();
-    const bool fault_on = c.fault && *c.fault;
-    if (body.contains("fault_code")) {
-      if (!fault_on) return request_error{400, "'fault_code' goes with \"fault\": true"};
-      const auto code = integer_of(body["fault_code"]);
-      if (!code || *code < 1 || *code > 0xFFFF) {
-        return request_error{400, "'fault_code' must be 0x0001..0xFFFF"};
-      }
-      c.fault_code = static_cast<std::uint16_t>(*code);
-    }
-    if (body.contains("fault_class")) {
-      if (!fault_on) return request_error{400, "'fault_class' goes with \"fault\": true"};
-      const auto cls = integer_of(body["fault_class"]);
-      if (!cls || *cls < 0 || *cls > 4) return request_error{400, "'fault_class' must be 0..4"};
-      c.fault_class = static_cast<std::uint8_t>(*cls);
-    }
-    if (body.contains("dc_link")) c.dc_link = body["dc_link"].get<bool>();
-    if (body.contains("sto")) c.sto = body["sto"].get<bool>();
-    return inst.change_plant(c);
-  }
-
-  std::variant<reply, request_error> on_profile(backend& inst, const json& body) {
-    if (auto k = unknown_key(body, {"profile"})) return request_error{400, *k};
-    if (!body.contains("profile") || !body["profile"].is_string()) {
-      return request_error{400, "'profile' (a profile's name) is required"};
-    }
-    return inst.select_profile(body["profile"].get_ref<const std::string&>());
   }
 
   void routes() {
@@ -426,12 +405,15 @@ struct server::impl {
       j["axes"] = axes.size();
       res.set_content(detail::json_text(j), "application/json");
     });
-    http.Get("/api/axes", [this](const httplib::Request&, httplib::Response& res) {
+    http.Get("/api/control", [this](const httplib::Request& req, httplib::Response& res) { on_control(req, res, false); });
+    http.Post("/api/control", [this](const httplib::Request& req, httplib::Response& res) { on_control(req, res, true); });
+    http.Get("/api/axes", [this](const httplib::Request& req, httplib::Response& res) {
       // The overview: each axis's present state in a few values.
       json list = json::array();
       for (std::size_t k = 0; k < axes.size(); ++k) {
         const json s = json::parse(axes[k].drive->snapshot_json(), nullptr, false);
-        json entry{{"axis", k + 1}, {"label", axes[k].label}};
+        json entry{{"axis", k + 1}, {"label", axes[k].label},
+                   {"control", detail::standing_name(control.standing(k, client_of(req), detail::control_board::clock::now()))}};
         if (s.is_object()) {
           for (const char* key : {"profile", "state", "status_word", "velocity", "error_code", "error_text"}) {
             if (s.contains(key)) entry[key] = s[key];
@@ -442,17 +424,22 @@ struct server::impl {
       send_json(res, 200, list);
     });
     http.Get("/api/state", [this](const httplib::Request& req, httplib::Response& res) {
-      backend* inst = axis_of(req, res);
-      if (inst == nullptr) return;
-      if (may_control(req)) inst->renew_lease();  // a client that polls the state is there
-      res.set_content(inst->snapshot_json(), "application/json");
+      const axis* a = axis_named(req, res);
+      if (a == nullptr) return;
+      if (may_control(req)) renew_for(index_of(a), client_of(req));  // a client that polls the state is there
+      res.set_content(a->drive->snapshot_json(), "application/json");
     });
     http.Get("/api/errors", [this](const httplib::Request& req, httplib::Response& res) {
       // The drive's 0x1003 as last read (the snapshot's drive_errors); POST /api/errors/read reads anew.
       if (backend* inst = axis_of(req, res)) send_json(res, 200, json::parse(inst->snapshot_json())["drive_errors"]);
     });
     http.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
-      if (backend* inst = axis_of(req, res)) detail::serve_events(*inst, res, options, streams, stopping);
+      const axis* a = axis_named(req, res);
+      if (a == nullptr) return;
+      // Each write renews: a program's stream its axis, a page's every axis it holds.
+      std::function<void()> renew = [] {};
+      if (may_control(req)) renew = [this, k = index_of(a), client = client_of(req)] { renew_for(k, client); };
+      detail::serve_events(*a->drive, res, options, streams, stopping, std::move(renew));
     });
     http.Get("/api/recording", [this](const httplib::Request& req, httplib::Response& res) {
       std::uint64_t seen[2] = {0, 0};
@@ -488,16 +475,16 @@ struct server::impl {
                       "text/plain");
     });
     http.Post("/api/command", [this](const httplib::Request& req, httplib::Response& res) {
-      post(req, res, [this](backend& d, const json& b) { return on_command(d, b); });
+      post(req, res, &detail::command_request);
     });
     http.Post("/api/plant", [this](const httplib::Request& req, httplib::Response& res) {
-      post(req, res, [this](backend& d, const json& b) { return on_plant(d, b); });
+      post(req, res, &detail::plant_request);
     });
     http.Post("/api/object", [this](const httplib::Request& req, httplib::Response& res) {
       post(req, res, &detail::object_request);
     });
     http.Post("/api/profile", [this](const httplib::Request& req, httplib::Response& res) {
-      post(req, res, [this](backend& d, const json& b) { return on_profile(d, b); });
+      post(req, res, &detail::profile_request);
     });
     // One-click enable and stop, and the jog with its dead-man (commissioning.hpp).
     for (const auto& [path, act] : {std::pair{"/api/enable", &detail::bare_request<&backend::enable>},

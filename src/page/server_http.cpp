@@ -98,6 +98,80 @@ std::optional<std::string> unknown_key(const json& body, std::initializer_list<c
   return std::nullopt;
 }
 
+std::variant<reply, request_error> command_request(backend& inst, const json& body) {
+  if (auto k = unknown_key(body, {"command", "bit"})) return request_error{400, *k};
+  if (!body.contains("command") || !body["command"].is_string()) {
+    return request_error{400, "'command' (a string) is required"};
+  }
+  const std::string& name = body["command"].get_ref<const std::string&>();
+  if (name == "toggle_bit") {
+    if (!body.contains("bit")) return request_error{400, "toggle_bit needs 'bit' (0..15)"};
+    const auto bit = integer_of(body["bit"]);
+    if (!bit || *bit < 0 || *bit > 15) return request_error{400, "'bit' must be 0..15"};
+    return inst.toggle_control_bit(static_cast<int>(*bit));
+  }
+  if (body.contains("bit")) return request_error{400, "'bit' belongs to toggle_bit only"};
+  if (name == "new_setpoint") return inst.new_setpoint();
+  page_command c{};
+  if (!parse_page_command(name, c)) {
+    return request_error{400, "unknown command '" + name +
+                                  "' (shutdown, switch_on, enable_operation, disable_operation, "
+                                  "disable_voltage, quick_stop, fault_reset, halt, toggle_bit, "
+                                  "new_setpoint)"};
+  }
+  return inst.command(c);
+}
+
+std::variant<reply, request_error> plant_request(backend& inst, const json& body) {
+  if (auto k = unknown_key(body, {"target_velocity", "fault", "fault_code", "fault_class",
+                                  "dc_link", "sto"})) {
+    return request_error{400, *k};
+  }
+  if (body.empty()) return request_error{400, "nothing to change"};
+  plant_change c;
+  if (body.contains("target_velocity")) {
+    const json& v = body["target_velocity"];
+    if (!v.is_number_integer() && !v.is_number_unsigned()) {
+      return request_error{400, "'target_velocity' must be an integer (rpm)"};
+    }
+    const auto n = integer_of(v);
+    if (!n) return request_error{400, "'target_velocity' is out of range"};
+    c.target_velocity = *n;
+  }
+  for (const char* key : {"fault", "dc_link", "sto"}) {
+    if (body.contains(key) && !body[key].is_boolean()) {
+      return request_error{400, "'" + std::string(key) + "' must be true or false"};
+    }
+  }
+  if (body.contains("fault")) c.fault = body["fault"].get<bool>();
+  const bool fault_on = c.fault && *c.fault;
+  if (body.contains("fault_code")) {
+    if (!fault_on) return request_error{400, "'fault_code' goes with \"fault\": true"};
+    const auto code = integer_of(body["fault_code"]);
+    if (!code || *code < 1 || *code > 0xFFFF) {
+      return request_error{400, "'fault_code' must be 0x0001..0xFFFF"};
+    }
+    c.fault_code = static_cast<std::uint16_t>(*code);
+  }
+  if (body.contains("fault_class")) {
+    if (!fault_on) return request_error{400, "'fault_class' goes with \"fault\": true"};
+    const auto cls = integer_of(body["fault_class"]);
+    if (!cls || *cls < 0 || *cls > 4) return request_error{400, "'fault_class' must be 0..4"};
+    c.fault_class = static_cast<std::uint8_t>(*cls);
+  }
+  if (body.contains("dc_link")) c.dc_link = body["dc_link"].get<bool>();
+  if (body.contains("sto")) c.sto = body["sto"].get<bool>();
+  return inst.change_plant(c);
+}
+
+std::variant<reply, request_error> profile_request(backend& inst, const json& body) {
+  if (auto k = unknown_key(body, {"profile"})) return request_error{400, *k};
+  if (!body.contains("profile") || !body["profile"].is_string()) {
+    return request_error{400, "'profile' (a profile's name) is required"};
+  }
+  return inst.select_profile(body["profile"].get_ref<const std::string&>());
+}
+
 std::variant<reply, request_error> jog_request(backend& drive, const json& body) {
   if (auto k = unknown_key(body, {"velocity", "ttl_ms"})) return request_error{400, *k};
   const auto velocity = body.contains("velocity") && body["velocity"].is_number_integer()
@@ -201,7 +275,7 @@ request_error wait_for_head(socket_t sock, std::chrono::milliseconds read_timeou
 }
 
 void serve_events(backend& inst, httplib::Response& res, const server_options& options, std::atomic<int>& streams,
-                  const std::atomic<bool>& stopping) {
+                  const std::atomic<bool>& stopping, std::function<void()> renew) {
   if (streams.fetch_add(1) >= options.max_event_streams) {
     streams.fetch_sub(1);
     return send_error(res, 503, "too many event streams open");
@@ -216,7 +290,7 @@ void serve_events(backend& inst, httplib::Response& res, const server_options& o
   auto st = std::make_shared<stream_state>();
   res.set_chunked_content_provider(
       "text/event-stream",
-      [st, &inst, &options, &stopping](std::size_t, httplib::DataSink& sink) {
+      [st, &inst, &options, &stopping, renew = std::move(renew)](std::size_t, httplib::DataSink& sink) {
         std::string chunk;
         if (!st->started) {
           st->started = true;
@@ -260,7 +334,7 @@ void serve_events(backend& inst, httplib::Response& res, const server_options& o
         st->last_write = std::chrono::steady_clock::now();
         if (!sink.write(chunk.data(), chunk.size())) return false;
         // Only a write that went out renews: a page that has gone stops renewing with its stream.
-        inst.renew_lease();
+        renew();
         return true;
       },
       [&streams](bool) { streams.fetch_sub(1); });

@@ -47,6 +47,13 @@ struct request_error {
   std::string reason;
 };
 
+/// POST /api/command: {"command": a page command's name, "toggle_bit" with "bit" (0..15), or
+/// "new_setpoint"}.
+std::variant<reply, request_error> command_request(backend& drive, const nlohmann::json& body);
+/// POST /api/plant: any of target_velocity, fault (with fault_code, fault_class), dc_link, sto.
+std::variant<reply, request_error> plant_request(backend& drive, const nlohmann::json& body);
+/// POST /api/profile: {"profile": a profile's name}.
+std::variant<reply, request_error> profile_request(backend& drive, const nlohmann::json& body);
 /// POST /api/jog: {"velocity": rpm (signed; 0 releases), "ttl_ms": 20..1000, 300 if not given}.
 std::variant<reply, request_error> jog_request(backend& drive, const nlohmann::json& body);
 /// A request with an empty object for its body, which asks `action` of the drive: POST /api/enable
@@ -90,10 +97,10 @@ request_error wait_for_head(socket_t sock, std::chrono::milliseconds read_timeou
                             std::size_t max_headers);
 
 /// GET /api/events for one drive: its present snapshot at once, then each one published, and a
-/// comment line after min(keep_alive, sign_of_life) without a write; each write that goes out renews
-/// the drive's lease (backend::renew_lease). At most `max_event_streams` open (`streams` counts them);
-/// ends when `stopping` is set or the drive is closed.
+/// comment line after min(keep_alive, sign_of_life) without a write; each write that goes out calls
+/// `renew` (the leases of the client's axes). At most `max_event_streams` open (`streams` counts
+/// them); ends when `stopping` is set or the drive is closed.
 void serve_events(backend& inst, httplib::Response& res, const server_options& options, std::atomic<int>& streams,
-                  const std::atomic<bool>& stopping);
+                  const std::atomic<bool>& stopping, std::function<void()> renew);
 
 }  // namespace cia402::page::detail

@@ -17,7 +17,8 @@
 //   POST /api/profile      {"profile":"s300-profibus"}: a virtual drive starts again under it
 //
 // The sign of life (docs/page.md): each write of an open event stream, each POST and each GET
-// /api/state of a client that may control renew the drive's lease (backend::renew_lease).
+// /api/state of a client that may control renew the drive's lease (backend::renew_lease); a page
+// with a client id renews every axis it holds instead (server_control.hpp).
 //
 // Every /api/ path but /api/axes takes ?axis=K (1..N) to name one of several drives; without it,
 // the first.
@@ -69,6 +70,9 @@ struct server_options {
   /// out, and writes a comment at least this often so a closed page is noticed (its second write
   /// after the close fails).
   std::chrono::milliseconds sign_of_life{250};
+  /// A page holds the axes it commands while it is there (docs/instrument-page.md, "Control
+  /// model"); a hold nothing renewed for this long lets another page command the axis.
+  std::chrono::milliseconds control_hold{1000};
 };
 
 /// 32 hex digits (128 bits) from std::random_device.
