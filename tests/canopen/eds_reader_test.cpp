@@ -282,6 +282,7 @@ std::string generated_entries(int node) {
   var(data_type::visible_string, "DefaultValue=a text\nParameterValue=another\n");
   out << "[3000]\nParameterName=Compact\nObjectType=0x8\nDataType=0x0004\nCompactSubObj=3\nDefaultValue=-5\n"
       << "LowLimit=-10\n"
+      << "[3002]\nObjectType=0x8\nDataType=0x0005\nCompactSubObj=2\n"  // unnamed: subs "1", "2" (the fuzzer's)
       << "[3001]\nParameterName=Record\nObjectType=0x9\n"
       << "[3001sub0]\nParameterName=Highest\nDataType=0x0005\nDefaultValue=0x0C\n"
       << "[3001sub0C]\nParameterName=Twelve\nDataType=0x0007\nDefaultValue=$NODEID+0x80000180\n"

@@ -309,7 +309,8 @@ class reader {
     for (std::int64_t i = 1; i <= count; ++i) {
       sub_entry sub = e;
       sub.sub = static_cast<std::uint8_t>(i);
-      sub.name = o.name + " " + std::to_string(i);
+      // Trimmed as the file's own names are, so the name a DCF writes of it reads back.
+      sub.name = o.name.empty() ? std::to_string(i) : o.name + " " + std::to_string(i);
       o.subs.push_back(std::move(sub));
     }
     return true;
