@@ -198,8 +198,50 @@ void session::finish(outcome end, std::string error) {
   result& r = op->res;
   r.end = end;
   r.error = std::move(error);
+  if (op->limited) {
+    const std::string limit = "the drive limited the set-point: status bit 11 (internal limit active) was set";
+    if (end == outcome::failed) r.error += "; " + limit;
+    else r.note += (r.note.empty() ? "" : "; ") + limit;
+  }
+  // S20: a motion command that failed stops what it set moving before it says so.
+  if (end == outcome::failed && op->motion && op->commanded && stop_after_failure(op)) return;
   fill_result(r);
   if (op->done) op->done(r);
+}
+
+void session::cancel(std::string why) {
+  if (!op_ || op_->stop) return;
+  finish(outcome::failed, std::move(why));
+}
+
+bool session::stop_after_failure(std::unique_ptr<operation>& op) {
+  result& r = op->res;
+  if (link_->phase() != link_phase::running || !status_known()) {
+    r.error += "; the link is down: the drive stops as its 0x6007 says (0x6007 = " +
+               std::to_string(option_code(option::abort_connection)) + ")";
+    return false;
+  }
+  if (observed_ == state::fault || observed_ == state::fault_reaction_active) {
+    r.error += "; the drive's fault reaction stops it (0x605E = " + std::to_string(option_code(option::fault_reaction)) + ")";
+    return false;
+  }
+  if (observed_ == state::quick_stop_active) {
+    r.error += "; the drive stops in QUICK STOP ACTIVE as 0x605A = " + std::to_string(option_code(option::quick_stop)) + " says";
+    return false;
+  }
+  if (observed_ != state::operation_enabled) return false;  // no torque: nothing turns by the drive
+  auto said = std::make_shared<std::string>();
+  std::shared_ptr<operation> failed(std::move(op));
+  begin("stop after a failure", {failure_stop(said)}, [this, failed, said](const result& stop) {
+    result& out = failed->res;
+    out.error += "; " + (stop.ok() || stop.error.empty() ? *said : *said + " (cut short: " + stop.error + ")");
+    fill_result(out);
+    if (failed->done) failed->done(out);
+  }, false);
+  op_->stop = true;
+  op_->fault_ok = true;
+  op_->commanded = true;
+  return true;
 }
 
 // --- the control word ---------------------------------------------------------------------------
@@ -278,9 +320,12 @@ void session::check_lease() {
   if (lease_us_ == 0 || lapsed_ || closing_ || now_us_ - lease_renewed_us_ < lease_us_) return;
   lapsed_ = true;
   const std::string who = client_.empty() ? std::string("the client") : client_;
-  const bool moving = op_ && op_->motion;
-  const bool enabled = status_known() && observed_ == state::operation_enabled;
-  if (control_ == control::none || (!moving && !enabled)) {
+  // Every operation under way stops, the way up to OPERATION ENABLED too: a drive still switching
+  // on would otherwise end enabled with nobody renewing (S20).
+  const bool moving = op_ && (op_->motion || op_->commanded) && !op_->stop;
+  const bool enabling = control_ == control::target && policy_.target == state::operation_enabled;
+  const bool enabled = status_known() && (observed_ == state::operation_enabled || observed_ == state::quick_stop_active);
+  if (control_ == control::none || (!moving && !enabling && !enabled)) {
     if (on_lease_lapsed) on_lease_lapsed(who + " stopped renewing its lease; the drive is not enabled: nothing to stop");
     return;
   }
@@ -317,6 +362,7 @@ std::string session::stop_as_0x6007(const std::string& why) {
   if (op_) finish(outcome::superseded, why);
   begin("stop (" + why + ")", std::move(steps), nullptr, false);
   op_->fault_ok = true;
+  op_->stop = true;
   return action;
 }
 

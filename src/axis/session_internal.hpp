@@ -20,6 +20,8 @@ struct session::operation {
   bool streaming = false;   // source_ is its set-point source
   bool jogging = false;     // turning at a jog velocity until released
   bool commanded = false;   // it has given the drive a word (a target, a command, an edge)
+  bool stop = false;        // a stop the session runs: not cancelled, not stopped again
+  bool limited = false;     // status bit 11 was seen while it ran (internal limit active)
   completion done;
   result res;
   std::string error;        // set by the step that failed

@@ -200,17 +200,30 @@ std::uint64_t session::write_object(std::uint16_t index, std::uint8_t sub, const
   if (res->format && !encode_value(v, *res->format, bytes, why)) return refuse(why);
   if (!res->format) bytes = v.what == value_format::kind::text ? std::vector<std::uint8_t>(v.text.begin(), v.text.end()) : v.bytes;
   const std::int64_t number = v.what == value_format::kind::integer ? v.number : 0;
-  queue_download(index, sub, std::move(bytes), [this, res, index, sub, number, done](const transfer_result& r) {
+  queue_download(index, sub, std::move(bytes), [this, res, index, sub, done](const transfer_result& r) {
     if (!r.ok) {
       res->end = outcome::failed;
       res->abort = r.abort;
       res->error = "writing " + object_name(index, sub) + ": " + transfer_failure(r);
-    } else if (sub == 0) {
-      // An option code written is the drive's from now on: the planner and the lease use it.
-      (void)write_option(*profile_, options_, index, static_cast<std::int32_t>(number));
     }
-    fill_result(*res);
-    if (done) done(*res);
+    bool is_option = false;
+    for (int k = 0; k < option_count; ++k) is_option |= sub == 0 && index == option_index(static_cast<option>(k));
+    if (!is_option || r.cancelled) {
+      fill_result(*res);
+      if (done) done(*res);
+      return;
+    }
+    // An option code is what the drive reads back, whatever the write's answer said: a lost or
+    // garbled answer can make a write the drive took look refused. The planner, the stops and the
+    // lease use it.
+    queue_upload(index, 0, [this, res, index, done](const transfer_result& back) {
+      if (back.ok && !back.data.empty() && back.data.size() <= 2) {
+        const object_value v = decode_value(back.data, value_format::integer(static_cast<unsigned>(back.data.size()), true));
+        (void)write_option(*profile_, options_, index, static_cast<std::int32_t>(v.number));
+      }
+      fill_result(*res);
+      if (done) done(*res);
+    }, true);
   });
   return id;
 }

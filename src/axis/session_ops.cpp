@@ -52,12 +52,16 @@ session::step session::read_position_step() {
 
 // The way into every motion command: the link and start-up, what would stop it at once, the mode
 // (switched by the command itself), then OPERATION ENABLED by the planner.
-std::vector<session::step> session::motion_start(std::int8_t m) {
+std::vector<session::step> session::motion_start(std::int8_t m, std::vector<step> limits) {
   std::vector<step> steps;
   steps.push_back(need_prepared());
   steps.push_back(need_cyclic());
   steps.push_back(check(true));
+  // S20: every limit is read and judged before the first word that could move the drive.
+  steps.push_back(mode_supported(m));
+  for (step& l : limits) steps.push_back(std::move(l));
   steps.push_back(call_step([this] {
+    op_->commanded = true;  // from here on a failure stops the drive (S20)
     halt_by_stop_ = false;
     set_mode_bits(0);
   }));
@@ -230,7 +234,11 @@ std::uint64_t session::set_mode(std::int8_t m, completion done) {
 // --- motion -------------------------------------------------------------------------------------
 
 std::uint64_t session::move(const move_request& r, completion done) {
-  std::vector<step> steps = motion_start(mode::profile_position);
+  std::vector<step> limits = position_limits(r.target, r.relative);
+  if (r.velocity) {
+    for (step& l : velocity_limits(*r.velocity, "profile velocity")) limits.push_back(std::move(l));
+  }
+  std::vector<step> steps = motion_start(mode::profile_position, std::move(limits));
   if (r.velocity) steps.push_back(write_step(object_index::profile_velocity, 0, *r.velocity));
   // After OPERATION ENABLED: entering it clears the set-points on some profiles (002's T4).
   steps.push_back(write_step(object_index::target_position, 0, r.target));
@@ -266,8 +274,8 @@ std::uint64_t session::move(const move_request& r, completion done) {
 // the actual value within 1 % (at least 1) of it, from a status word after the write.
 std::uint64_t session::reach(const char* name, std::int8_t m, std::uint16_t set_point, std::uint16_t actual_index,
                              std::int64_t target, progress_kind kind, std::optional<std::int64_t> result::*field,
-                             completion done) {
-  std::vector<step> steps = motion_start(m);
+                             std::vector<step> limits, completion done) {
+  std::vector<step> steps = motion_start(m, std::move(limits));
   steps.push_back(write_step(set_point, 0, target));
   auto since = std::make_shared<moment>();
   steps.push_back(call_step([this, since, actual_index, target, kind, field] {
@@ -277,6 +285,7 @@ std::uint64_t session::reach(const char* name, std::int8_t m, std::uint16_t set_
     progress(kind);
   }));
   steps.push_back(wait_step([this, since, actual_index, target, field] {
+    if (settled() && (link_->status_word() & status_bit::internal_limit_active) != 0) op_->limited = true;
     const auto v = fresh(actual_index, *since);
     if (!v) return false;
     op_->res.*field = *v;
@@ -287,19 +296,24 @@ std::uint64_t session::reach(const char* name, std::int8_t m, std::uint16_t set_
 
 std::uint64_t session::velocity(std::int32_t rpm, completion done) {
   return reach("velocity", mode::profile_velocity, object_index::target_velocity, object_index::velocity_actual_value, rpm,
-               progress_kind::target_velocity, &result::velocity, std::move(done));
+               progress_kind::target_velocity, &result::velocity, velocity_limits(rpm, "velocity"), std::move(done));
 }
 
 std::uint64_t session::torque(std::int16_t permille, completion done) {
+  std::vector<step> limits;
+  limits.push_back(torque_limit(permille));
   return reach("torque", mode::profile_torque, object_index::target_torque, object_index::torque_actual_value, permille,
-               progress_kind::target_torque, &result::torque, std::move(done));
+               progress_kind::target_torque, &result::torque, std::move(limits), std::move(done));
 }
 
 std::uint64_t session::home(const home_request& r, completion done) {
-  std::vector<step> steps{need_prepared(), need_cyclic(), check(true), call_step([this] {
-                            halt_by_stop_ = false;
-                            set_mode_bits(0);
-                          })};
+  std::vector<step> steps{need_prepared(), need_cyclic(), check(true), mode_supported(mode::homing)};
+  if (r.method) steps.push_back(homing_method_supported(*r.method));
+  steps.push_back(call_step([this] {
+    op_->commanded = true;
+    halt_by_stop_ = false;
+    set_mode_bits(0);
+  }));
   if (r.method) steps.push_back(write_step(object_index::homing_method, 0, *r.method));
   if (r.offset) steps.push_back(write_step(object_index::home_offset, 0, *r.offset));
   steps.push_back(mode_step(mode::homing));
@@ -323,7 +337,7 @@ std::uint64_t session::home(const home_request& r, completion done) {
 }
 
 std::uint64_t session::jog(std::int32_t rpm, std::uint64_t hold_us, completion done) {
-  std::vector<step> steps = motion_start(mode::profile_velocity);
+  std::vector<step> steps = motion_start(mode::profile_velocity, velocity_limits(rpm, "jog velocity"));
   steps.push_back(write_step(object_index::target_velocity, 0, rpm));
   steps.push_back(call_step([this, rpm, hold_us] {
     jog_until_us_ = now_us_ + hold_us;

@@ -61,7 +61,8 @@ std::string session::fault_text() const {
 
 std::optional<std::string> session::cannot_command(bool motion) const {
   if (link_->phase() == link_phase::failed) return link_->short_name() + ": " + link_->phase_text();
-  if (lapsed_) return std::string("the client's lease lapsed and the drive was stopped: renew it first");
+  // A stop is never refused, not even to a client whose lease lapsed.
+  if (lapsed_ && motion) return std::string("the client's lease lapsed and the drive was stopped: renew it first");
   if (!status_known()) return std::nullopt;
   const std::uint16_t sw = link_->status_word();
   if (observed_ == state::fault || observed_ == state::fault_reaction_active) return fault_text() + "; reset it first";
@@ -290,24 +291,85 @@ session::step session::command_step(command c) {
 }
 
 session::step session::wait_stopped(bool halted) {
-  return {nullptr, [this, halted] {
+  auto since = std::make_shared<std::uint64_t>(0);
+  return {[this, since] { *since = now_us_; },
+          [this, halted, since] {
             if (!settled()) return step_state::running;
             const std::uint16_t sw = link_->status_word();
+            const auto waited = [&] {
+              if (now_us_ - *since < config_.stop_timeout_us) return step_state::running;
+              return fail_step("the drive did not show standstill within " + std::to_string(config_.stop_timeout_us / 1000) +
+                               " ms (it shows " + state_text() + ")");
+            };
             if (halted) {
               const auto v = actual(object_index::velocity_actual_value);
               const bool still = (sw & status_bit::target_reached) != 0 || (v && std::abs(*v) <= 1);
-              return still || observed_ != state::operation_enabled ? step_state::done : step_state::running;
+              return still || observed_ != state::operation_enabled ? step_state::done : waited();
             }
-            if (control_ == control::command && command_ == command::quick_stop && observed_ == state::quick_stop_active) {
+            if (observed_ == state::quick_stop_active) {
               // Ended as 0x605A says (S5): 0 coasting into QUICK STOP ACTIVE, 5..8 at standstill there
-              // (status bit 10); 1..4 leave it for SWITCH ON DISABLED (T12).
+              // (status bit 10); 1..4 leave it for SWITCH ON DISABLED (T12). Standstill there ends the
+              // wait whatever the session believes of the code: a belief can be wrong.
               const int code = option_code(option::quick_stop);
-              const bool held = code == 0 || (code >= 5 && (sw & status_bit::target_reached) != 0);
-              return held ? step_state::done : step_state::running;
+              const bool held = code == 0 || (sw & status_bit::target_reached) != 0;
+              return held ? step_state::done : waited();
             }
+            const bool torque_off = observed_ != state::operation_enabled && observed_ != state::fault_reaction_active;
+            return torque_off ? step_state::done : waited();
+          }};
+}
+
+session::step session::failure_stop(std::shared_ptr<std::string> said) {
+  struct status {
+    int stage = 0;  // 0 halt, 1 quick stop, 2 Disable voltage
+    moment since;
+    std::uint64_t began = 0;
+  };
+  auto s = std::make_shared<status>();
+  const auto enter = [this, s](int stage) {
+    s->stage = stage;
+    s->since = now_moment();
+    if (stage == 0) {
+      halt_by_stop_ = true;
+      set_mode_bits(0);
+      if (control_ != control::target) set_target(state::operation_enabled);
+    } else {
+      set_command(stage == 1 ? command::quick_stop : command::disable_voltage);
+    }
+  };
+  const bool has_halt = profile_->spec(option::halt).exists();
+  return {[this, s, enter, has_halt] {
+            s->began = now_us_;
+            need(object_index::velocity_actual_value);
+            enter(has_halt ? 0 : 1);
+          },
+          [this, s, said, enter] {
+            if (!settled()) return step_state::running;
+            const std::uint16_t sw = link_->status_word();
+            const auto v = fresh(object_index::velocity_actual_value, s->since);
+            const bool still = v ? std::abs(*v) <= 1 : (sw & status_bit::target_reached) != 0;
             const bool torque_off = observed_ != state::operation_enabled && observed_ != state::quick_stop_active &&
                                     observed_ != state::fault_reaction_active;
-            return torque_off ? step_state::done : step_state::running;
+            const std::string ms = std::to_string((now_us_ - s->began) / 1000) + " ms";
+            static const char* how[] = {"halt (control bit 8, as 0x605D = ", "quick stop (as 0x605A = ", "Disable voltage ("};
+            const auto what = [&](int stage) {
+              return std::string(how[stage]) +
+                     (stage == 0 ? std::to_string(option_code(option::halt)) + ")"
+                                 : stage == 1 ? std::to_string(option_code(option::quick_stop)) + ")" : "torque off)");
+            };
+            if (still || torque_off) {
+              *said += (said->empty() ? "stopped by " : "; then ") + what(s->stage) + ": " +
+                       (torque_off ? std::string("the drive shows ") + state_name(observed_) : std::string("at standstill")) +
+                       " after " + ms;
+              if (s->stage == 0) *said += "; halt stays set until the next motion command";
+              return step_state::done;
+            }
+            if (now_us_ - s->since.us < config_.stop_timeout_us) return step_state::running;
+            *said += (said->empty() ? "" : "; then ") + what(s->stage) + " did not stop the shaft within " +
+                     std::to_string(config_.stop_timeout_us / 1000) + " ms";
+            if (s->stage == 2) return fail_step(*said + " (the drive shows " + state_text() + ")");
+            enter(s->stage + 1);
+            return step_state::running;
           }};
 }
 

@@ -71,8 +71,8 @@ void session::stream_tick() {
   (void)put_output(stream_object_, 0, *next);
 }
 
-std::vector<session::step> session::stream_steps(std::int8_t m, setpoint_source source, std::vector<step> before_mode,
-                                                 std::function<void(result&)> describe) {
+std::vector<session::step> session::stream_steps(std::int8_t m, setpoint_source source, std::vector<step> limits,
+                                                 std::vector<step> before_mode, std::function<void(result&)> describe) {
   const stream_objects objects = *objects_of(m);
   std::vector<step> steps{need_prepared(), need_cyclic(), step{nullptr, [this, objects] {
                             if (!carries(link_->cyclic_outputs(), objects.set_point) ||
@@ -83,10 +83,13 @@ std::vector<session::step> session::stream_steps(std::int8_t m, setpoint_source 
                             }
                             return step_state::done;
                           }},
-                          check(true), call_step([this] {
-                            halt_by_stop_ = false;
-                            set_mode_bits(0);
-                          })};
+                          check(true), mode_supported(m)};
+  for (step& l : limits) steps.push_back(std::move(l));
+  steps.push_back(call_step([this] {
+    op_->commanded = true;  // from here on a failure stops the drive (S20)
+    halt_by_stop_ = false;
+    set_mode_bits(0);
+  }));
   steps.insert(steps.end(), before_mode.begin(), before_mode.end());
   steps.push_back(mode_step(m));
   steps.push_back(target_step(state::operation_enabled));
@@ -132,7 +135,7 @@ std::uint64_t session::stream(std::int8_t m, setpoint_source source, completion 
   if (!objects_of(m)) {
     return refuse_now(mode_words(m) + " is not a cyclic synchronous mode (csp, csv, cst)", std::move(done), true);
   }
-  return begin("stream", stream_steps(m, std::move(source), {}, nullptr), std::move(done), true);
+  return begin("stream", stream_steps(m, std::move(source), {}, {}, nullptr), std::move(done), true);
 }
 
 std::uint64_t session::csp_stream(std::int32_t to, std::uint32_t rpm, completion done) {
@@ -182,7 +185,10 @@ std::uint64_t session::csp_stream(std::int32_t to, std::uint32_t rpm, completion
     r.stream_to = to;
     r.velocity = rpm;
   };
-  return begin("csp stream", stream_steps(mode::cyclic_synchronous_position, std::move(ramp), std::move(before), describe),
+  std::vector<step> limits = position_limits(to, false);
+  for (step& l : velocity_limits(rpm, "csp velocity")) limits.push_back(std::move(l));
+  return begin("csp stream",
+               stream_steps(mode::cyclic_synchronous_position, std::move(ramp), std::move(limits), std::move(before), describe),
                std::move(done), true);
 }
 

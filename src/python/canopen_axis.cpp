@@ -99,6 +99,12 @@ class axis_handle {
         });
         if (started) running_ = b;
         wait_locked(lock, *b, timeout_s);
+        if (!b->done && !b->started) {
+          // S20: the request fails with the time-out, and what it set moving is stopped before the
+          // exception says so (the stop has a bound of its own: three stages of stop_timeout_us).
+          s.cancel(std::string(what) + " did not end within " + std::to_string(timeout_s) + " s");
+          wait_locked(lock, *b, 3 * axes::session_config{}.stop_timeout_us / 1e6 + 1);
+        }
         done = b->done;
         began = b->started;
         out = b->result;

@@ -112,10 +112,21 @@ TEST(session, home_sets_the_position_to_the_home_offset) {
   EXPECT_EQ(b.link.drive.view().position(), 1234);
 }
 
+TEST(session, a_homing_method_0x60E3_does_not_list_is_refused_before_anything_is_sent) {
+  bench b;
+  // Method 15 is reserved (CiA 402-2): 0x60E3 does not list it.
+  const result r = b.finish([&](completion d) { return b.s->home({std::int8_t{15}, std::nullopt}, std::move(d)); });
+  EXPECT_FALSE(r.ok());
+  EXPECT_TRUE(r.bad_input);
+  EXPECT_NE(r.error.find("homing method 15 is not among 0x60E3"), std::string::npos) << r.error;
+  EXPECT_TRUE(b.link.words.empty()) << "no control word went out";
+  EXPECT_TRUE(b.link.downloads.empty()) << "no object was written";
+}
+
 TEST(session, a_homing_method_the_drive_refuses_names_0x6098_and_its_abort) {
   bench b;
-  // Method 15 is reserved (CiA 402-2): 0x60E3 does not list it, and the drive refuses 0x6098 = 15.
-  const result r = b.finish([&](completion d) { return b.s->home({std::int8_t{15}, std::nullopt}, std::move(d)); });
+  b.link.refused[{object_index::homing_method, 0}] = sdo_abort::invalid_value;
+  const result r = b.finish([&](completion d) { return b.s->home({std::int8_t{35}, std::nullopt}, std::move(d)); });
   EXPECT_FALSE(r.ok());
   EXPECT_NE(r.error.find("0x6098"), std::string::npos) << r.error;
   EXPECT_NE(r.error.find("SDO abort 0x06090030"), std::string::npos) << r.error;

@@ -193,11 +193,11 @@ class runner {
     while (busy()) {
       if (stop_signal()) return interrupted(s);
       if (limit != 0 && passed >= limit && s.verb != "watch") {
+        // S20: the session stops what the step set moving, then ends it with the cause and what it did.
         for (auto& r : drives_) {
-          if (!r->pending) continue;
-          r->pending = false;
-          fail(r->d.tag, s, "did not finish within " + std::to_string(a_.timeout_ms) + " ms (" + situation(*r->session) + ")", failed);
+          if (r->pending) r->session->cancel("did not finish within " + std::to_string(a_.timeout_ms) + " ms (" + situation(*r->session) + ")");
         }
+        drain(s, "its stop did not end");
         return false;
       }
       passed += pump();
@@ -214,8 +214,29 @@ class runner {
   }
 
   bool interrupted(const master_step& s) {
-    for (auto& r : drives_) fail(r->d.tag, s, "interrupted", failed);
+    for (auto& r : drives_) {
+      if (r->pending) r->session->cancel("interrupted");
+      else fail(r->d.tag, s, "interrupted", failed);
+    }
+    drain(s, "interrupted, and its stop did not end");
     return false;
+  }
+
+  // Runs the sessions until every cancelled step has ended (its stop has a bound of its own, three
+  // stages of stop_timeout_us); one that still has not is reported as it stands.
+  void drain(const master_step& s, const std::string& why) {
+    const std::uint64_t limit = 3 * axes::session_config{}.stop_timeout_us + 1'000'000;
+    for (std::uint64_t passed = 0; passed < limit;) {
+      bool any = false;
+      for (auto& r : drives_) any |= r->pending;
+      if (!any) return;
+      passed += pump();
+    }
+    for (auto& r : drives_) {
+      if (!r->pending) continue;
+      r->pending = false;
+      fail(r->d.tag, s, why + " (" + situation(*r->session) + ")", failed);
+    }
   }
 
   bool fail(const drive_tag& tag, const master_step& s, const std::string& why, int status) {

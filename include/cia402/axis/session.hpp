@@ -21,6 +21,14 @@
 //   link, FAULT with 0x603F and its text, remote off, the drive's SDO abort); a motion command
 //   switches the mode itself first where that is its meaning (move -> pp, velocity -> pv, torque ->
 //   tq, home -> hm, jog -> pv);
+// - limits before motion (S20): a motion command reads the drive's own limits first (0x607F and
+//   0x6080 for a velocity, 0x6072 for a torque, 0x607D for a position, 0x60E3 for a homing method,
+//   0x6502 for the mode) and refuses a target beyond them at once (bad_input), naming the object,
+//   its value and the target, before anything is sent;
+// - the failure path (S20): a motion command that fails once it commanded the drive (a time-out,
+//   a fault, a lost link, a refused SDO, a blocker, cancel()) stops what it set moving: halt as
+//   0x605D says, then quick stop, then Disable voltage, each within stop_timeout_us. Its completion
+//   comes once the shaft stands, and its error says the cause and what was done;
 // - the lease: with `lease_us` set, a client that stops calling renew() gets the drive stopped as
 //   0x6007 says (docs/master.md, "The lease"): within lease_us plus one cycle of the link.
 #pragma once
@@ -56,6 +64,9 @@ struct session_config {
   /// this long after it (a link that sends on change only).
   std::uint32_t settle_us = 50'000;
   std::uint64_t lease_us = 0;                        ///< 0: no lease
+  /// Each stage of a stop (halt, then quick stop, then Disable voltage) waits this long for the
+  /// drive to show standstill before the next; every wait for a stop ends.
+  std::uint64_t stop_timeout_us = 10'000'000;
 };
 
 enum class outcome : std::uint8_t {
@@ -163,6 +174,9 @@ class session {
   /// csp (8), csv (9) or cst (10) with set-points from `source`; the mode's set-point object
   /// (0x607A, 0x60FF, 0x6071) must be cyclic.
   std::uint64_t stream(std::int8_t mode, setpoint_source source, completion done);
+  /// The running request fails with `why` (a client's own time-out, an interrupt); what it set
+  /// moving is stopped first as for any failure (S20). A stop the session runs is not cancelled.
+  void cancel(std::string why);
   /// The cyclic exchange, never commanding the drive: done once it runs.
   std::uint64_t watch(completion done);
   /// The client's own control word, every bit as given (the instrument page's command buttons and
@@ -253,6 +267,11 @@ class session {
   void note_status();
   void run_operation();
   void finish(outcome end, std::string error);
+  /// A failed motion command's drive is stopped: true if a stop began (it then completes `op`).
+  bool stop_after_failure(std::unique_ptr<operation>& op);
+  /// Halt, then quick stop, then Disable voltage, each stage within stop_timeout_us; `said` gets
+  /// what was done.
+  step failure_stop(std::shared_ptr<std::string> said);
   void drive_control_word();
   void check_lease();
   std::string stop_as_0x6007(const std::string& why);
@@ -290,6 +309,15 @@ class session {
   /// Waits for the words of control::words to have gone out and been answered (reset_timeout_us at most).
   step edge_sent();
   step wait_stopped(bool halted);
+  /// Motion commands' limits (S20): each reads what it needs from the drive and refuses beyond it.
+  step mode_supported(std::int8_t mode);
+  std::vector<step> velocity_limits(std::int64_t rpm, const char* what);
+  step torque_limit(std::int64_t permille);
+  std::vector<step> position_limits(std::int64_t target, bool relative);
+  step homing_method_supported(std::int8_t method);
+  /// Reads `index:sub` (absent: no limit) and refuses the request with `judge`'s words, if any.
+  step limit_step(std::uint16_t index, std::uint8_t sub,
+                  std::function<std::optional<std::string>(std::int64_t)> judge);
   std::optional<std::string> cannot_command(bool motion) const;
   std::string fault_text() const;
   std::string state_text() const;
@@ -311,15 +339,16 @@ class session {
   /// by a transfer; `done` gets "" or the reason it failed.
   void write_integer(std::uint16_t index, std::uint8_t sub, std::int64_t value, std::function<void(std::string)> done);
   // session_ops.cpp
-  std::vector<step> motion_start(std::int8_t mode);
+  /// need_prepared, need_cyclic, check, `limits`, then the mode and OPERATION ENABLED.
+  std::vector<step> motion_start(std::int8_t mode, std::vector<step> limits = {});
   std::uint64_t reach(const char* name, std::int8_t mode, std::uint16_t set_point, std::uint16_t actual_index,
                       std::int64_t target, progress_kind kind, std::optional<std::int64_t> result::*field,
-                      completion done);
+                      std::vector<step> limits, completion done);
   step progress_step(progress_kind kind);
   step read_position_step();
   // session_stream.cpp
   void stream_tick();
-  std::vector<step> stream_steps(std::int8_t mode, setpoint_source source, std::vector<step> before_mode,
+  std::vector<step> stream_steps(std::int8_t mode, setpoint_source source, std::vector<step> limits, std::vector<step> before_mode,
                                  std::function<void(result&)> describe);
 
   drive_link* link_;
