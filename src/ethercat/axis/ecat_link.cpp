@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "cia402/manufacturer_objects.hpp"
+#include "cia402/master.hpp"
 #include "cia402/objects.hpp"
 
 namespace cia402::ethercat {
@@ -11,6 +12,18 @@ namespace {
 // Frames lost (or short of their working counter) in a row before the line counts as gone: with a
 // 1 ms cycle, 25 ms, well inside a drive's 100 ms sync-manager watchdog.
 constexpr int lost_cycles_limit = 25;
+
+// How long close() gives an enabled drive to come down to SWITCH ON DISABLED before the line leaves
+// OP all the same: a drive still turning is quick-stopped first (for at most the first limit), then
+// Disable voltage.
+constexpr std::uint64_t quick_stop_limit_us = 2'000'000;
+constexpr std::uint64_t stop_limit_us = 3'000'000;
+
+// The states in which leaving OP is a lost connection to a drive with something to stop (0x6007
+// acts; SWITCHED ON carries torque in some profiles).
+bool carries_torque(state s) {
+  return s == state::switched_on || s == state::operation_enabled || s == state::quick_stop_active;
+}
 
 std::string hex4(std::uint32_t v) {
   static const char* d = "0123456789ABCDEF";
@@ -107,7 +120,8 @@ void ecat_line::detach_closed() {
   std::vector<std::string> left_in;
   for (const ecat_link* d : drives_) {
     state s = state::start;
-    const bool known = d->status_known() && decode_status(*profile_, d->status_word(), s);
+    // (status_known() is false by now: the link is closed.)
+    const bool known = d->status_count_ > 0 && decode_status(*profile_, d->status_word(), s);
     const bool enabled = s == state::operation_enabled || s == state::quick_stop_active;
     left_in.push_back(!known ? " left in PRE-OP with the drive's state unknown: 0x6007 acts if it was enabled"
                       : enabled ? std::string(" left in PRE-OP with the drive in ") + state_name(s) +
@@ -178,6 +192,10 @@ std::uint32_t ecat_link::poll(std::uint32_t) {
   }
   std::uint32_t next = line_->service();
   if (line_->failed() && failure_.empty()) fail(line_->failure());
+  if (stopping_ && !failure_.empty()) {
+    report_.left.push_back(short_name() + " not brought down to SWITCH ON DISABLED: " + failure_);
+    finish_close();
+  }
   if (phase() == axes::link_phase::running && !transfers_.empty()) {
     run_one_transfer();
     next = 0;  // the process data is due again (and the next transfer may run)
@@ -197,6 +215,7 @@ void ecat_link::after_cycle(bool ok) {
   for (; emergencies_seen_ < s.emergencies.size(); ++emergencies_seen_) {
     if (on_emergency) on_emergency(s.emergencies[emergencies_seen_], 0, {});
   }
+  if (stopping_) step_stop();
 }
 
 void ecat_link::restart() {
@@ -223,7 +242,8 @@ std::optional<std::uint16_t> ecat_link::error_code() const {
 }
 
 void ecat_link::set_control_word(std::uint16_t word) {
-  if (phase() == axes::link_phase::running) line_->master().send_control_word(position_, word);
+  // Once close() is bringing the drive down, the control word is the link's.
+  if (phase() == axes::link_phase::running && !stopping_) line_->master().send_control_word(position_, word);
 }
 
 std::optional<std::int64_t> ecat_link::cyclic_input(std::uint16_t index, std::uint8_t sub) const {
@@ -232,7 +252,7 @@ std::optional<std::int64_t> ecat_link::cyclic_input(std::uint16_t index, std::ui
 }
 
 bool ecat_link::set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) {
-  if (phase() != axes::link_phase::running) return false;
+  if (phase() != axes::link_phase::running || stopping_) return false;
   return line_->master().set_output(position_, index, value, sub);
 }
 
@@ -274,9 +294,50 @@ std::optional<axes::value_format> ecat_link::describe(std::uint16_t index, std::
 }
 
 void ecat_link::close() {
-  if (closed_) return;
-  closed_ = true;
+  if (closed_ || stopping_) return;
   axes::cancel_transfers(transfers_, "closed");
+  state s = state::start;
+  if (failure_.empty() && phase() == axes::link_phase::running && status_known() &&
+      decode_status(*line_->profile_, status_word(), s) && carries_torque(s)) {
+    // A drive left enabled would take the line leaving OP for a lost connection and do what its
+    // 0x6007 says (1 by default: a fault). Brought down to SWITCH ON DISABLED first, it has
+    // nothing for 0x6007 to stop, and the next run finds it without a fault.
+    stopping_ = true;
+    stop_from_ = s;
+    stop_started_us_ = line_->link_->now_us();
+    step_stop();
+    return;
+  }
+  finish_close();
+}
+
+void ecat_link::step_stop() {
+  const std::uint64_t took = line_->link_->now_us() - stop_started_us_;
+  state s = state::start;
+  const bool known = decode_status(*line_->profile_, status_word(), s);
+  if (known && !carries_torque(s)) {
+    report_.restored.push_back(short_name() + " brought from " + state_name(stop_from_) + " to " + state_name(s) +
+                               " before the line left OP (no lost connection for 0x6007)");
+    return finish_close();
+  }
+  if (took >= stop_limit_us) {
+    report_.left.push_back(short_name() + " still in " + (known ? state_name(s) : "an unknown state") + " " +
+                           std::to_string(stop_limit_us / 1000) +
+                           " ms after the close began to disable it: 0x6007 acts as the line leaves OP");
+    return finish_close();
+  }
+  // Still turning: the quick stop its 0x605A describes first, rather than let the shaft coast.
+  const std::optional<std::int64_t> v = cyclic_input(object_index::velocity_actual_value, 0);
+  const bool turning = v && *v != 0 && took < quick_stop_limit_us &&
+                       (s == state::operation_enabled || s == state::quick_stop_active);
+  std::uint16_t word = turning ? 0x0002 : 0x0000;
+  (void)encode_command(*line_->profile_, turning ? cia402::command::quick_stop : cia402::command::disable_voltage, 0, word);
+  line_->master().send_control_word(position_, word);
+}
+
+void ecat_link::finish_close() {
+  stopping_ = false;
+  closed_ = true;
   line_->detach_closed();
   if (!line_->left_op_) report_.done = true;  // the line leaves OP with its last drive
 }

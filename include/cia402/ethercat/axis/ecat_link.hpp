@@ -13,14 +13,18 @@
 // - describe(): the types of ETG.1000.6's CoE objects (0x1000, 0x1001, 0x1008..0x100A, 0x1018, the
 //   PDO mapping and assignment objects, 0x1C00), and for the project's virtual drive (its SII
 //   name) its manufacturer objects;
-// - close(): nothing in a drive's dictionary was changed (the mapping is read, not written); once
-//   every drive's link is closed the line leaves OP for PRE-OP at once, rather than by the sync
-//   managers' watchdog. A drive left enabled reacts as its 0x6007 says to its master going; one
-//   left disabled (READY TO SWITCH ON, say) has nothing to stop, and the report says which.
+// - close(): nothing in a drive's dictionary was changed (the mapping is read, not written). A drive
+//   the run left enabled (SWITCHED ON, OPERATION ENABLED, QUICK STOP ACTIVE) is first brought down
+//   to SWITCH ON DISABLED in the process data (Disable voltage, after a quick stop while it still
+//   turns; the link's control word from then on), within 3 s: leaving OP is then no lost
+//   connection for its 0x6007 (1 by default: a fault), and the next run finds it without a fault.
+//   Once every drive's link is closed the line leaves OP for PRE-OP at once, rather than by the
+//   sync managers' watchdog; the report says how each drive was left.
 #pragma once
 
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -117,6 +121,8 @@ class ecat_link final : public axes::link_base {
   void fail(std::string why);
   void restart();  // the line is back in OP: the link runs afresh
   void run_one_transfer();
+  void step_stop();     // close(): an enabled drive on its way to SWITCH ON DISABLED, each cycle
+  void finish_close();
 
   ecat_line* line_;
   std::size_t position_;
@@ -125,6 +131,9 @@ class ecat_link final : public axes::link_base {
   std::size_t emergencies_seen_ = 0;
   std::deque<transfer> transfers_;
   bool closed_ = false;
+  bool stopping_ = false;  // closing: the drive first brought down to SWITCH ON DISABLED
+  state stop_from_ = state::start;
+  std::uint64_t stop_started_us_ = 0;
 };
 
 }  // namespace cia402::ethercat
