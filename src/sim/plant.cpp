@@ -147,8 +147,9 @@ void follow(const profile& p, const plant_constants& k, axis_state& a,
     status = move_in_mode(k, a, out, s, torque_set);
   } else {
     status = velocity_follow(p, k, a, out, s, brake_holds);
-    // No set-point survives a stop, and no run; bit 4 is still seen, so only an edge after it acts.
-    if (a.operation_mode == cia402::mode::profile_position) a.pp.reset(s, bit_4(a));
+    // No set-point survives a stop, and no run. Bit 4 held high through it is no new edge; one that
+    // falls and rises while the mode cannot move (the brake still releasing) waits for it.
+    if (a.operation_mode == cia402::mode::profile_position) a.pp.reset(s, a.pp.new_setpoint_seen() && bit_4(a));
     if (a.operation_mode == cia402::mode::homing) a.homing.stand_by(bit_4(a));
     a.demand = s.position;
     a.torque_demand = 0;

@@ -116,12 +116,13 @@ class homing {
     *this = homing{};
     last_start_ = start_now;
   }
-  /// A cycle in which the mode does not move the shaft (the drive not enabled, a stop or a halt
-  /// running): a running search is interrupted, and bit 4 is taken as seen, so that a run starts only
-  /// on a 0->1 edge after it.
+  /// A cycle in which the mode does not move the shaft (the drive not enabled, the brake still
+  /// releasing, a stop or a halt running): a running search is interrupted. Bit 4 held 1 through
+  /// such cycles is no new edge; once it falls, its next rise starts a run, at the first cycle the
+  /// mode moves again.
   void stand_by(bool start_bit) noexcept {
     interrupt();
-    last_start_ = start_bit;
+    last_start_ = last_start_ && start_bit;
   }
   /// One cycle: `start` is control-word bit 4 (its rising edge starts a run, its fall interrupts
   /// one). `s` is the shaft in its own increments, which the run moves; `offset` is what the drive
