@@ -79,8 +79,12 @@ TEST(cli_master, home_sets_the_position_to_the_home_offset) {
     ASSERT_EQ(r.status, 0) << method << r.err;
     EXPECT_NE(r.out.find("node 1: homing attained, position 1234"), std::string::npos) << method << r.out;
   }
+  // Method 15 is reserved (CiA 402-2): 0x60E3 does not list it, so it is refused before anything is
+  // sent (S20), exit 2.
   const result refused = run_tool({"master", "--can", "virtual", "home", "--method", "15"});
-  EXPECT_EQ(refused.status, 1) << "method 15 is reserved (CiA 402-2): the drive refuses it";
+  EXPECT_EQ(refused.status, 2);
+  EXPECT_NE(refused.err.find("homing method 15 is not among 0x60E3 (supported homing methods)"), std::string::npos)
+      << refused.err;
 }
 
 TEST(cli_master, csp_stream_ramps_0x607A_by_rpdo3_and_follows_by_tpdo3) {
@@ -100,8 +104,14 @@ TEST(cli_master, csp_stream_ramps_0x607A_by_rpdo3_and_follows_by_tpdo3) {
   ASSERT_EQ(json.status, 0) << json.err;
   EXPECT_NE(json.out.find(R"({"node":1,"event":"streamed","position":-3000,"set_points":30,)"), std::string::npos)
       << json.out;
-  // Faster than the motor can follow: the following error fault, exit 1.
-  const result lost = run_tool({"master", "--can", "virtual", "csp-stream", "--to", "200000000", "--velocity", "100000"});
+  // Beyond 0x607F: refused before anything moves (S20), exit 2.
+  const result beyond = run_tool({"master", "--can", "virtual", "csp-stream", "--to", "200000000", "--velocity", "100000"});
+  EXPECT_EQ(beyond.status, 2);
+  EXPECT_NE(beyond.err.find("csp velocity 100000 rpm is beyond 0x607F (max profile velocity) = 6000 rpm"), std::string::npos)
+      << beyond.err;
+  // With the limits raised, faster than the motor can follow: the following error fault, exit 1.
+  const result lost = run_tool({"master", "--can", "virtual", "sdo", "write", "0x607F", "100000", "sdo", "write", "0x6080",
+                                "100000", "csp-stream", "--to", "200000000", "--velocity", "100000"});
   EXPECT_EQ(lost.status, 1);
   EXPECT_NE(lost.err.find("following error"), std::string::npos) << lost.err;
   EXPECT_EQ(run_tool({"master", "--can", "virtual", "csp-stream", "--to", "100"}).status, 2) << "no --velocity";
