@@ -1,0 +1,100 @@
+"""S20 by the real `cia402 master` over both buses: a step beyond the drive's limits is refused
+before anything moves (exit 2, the object named), a step that times out stops the motion it started
+(exit 1, the stop named), and the next run finds the shaft at standstill.
+
+can:  `cia402 bus` on a free loopback port.
+ecat: `cia402 ecat-slave` on one end of a veth pair (root; exit 77 otherwise).
+Usage: failure_path_runs.py CIA402_BINARY can|ecat"""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+
+SKIP = 77
+
+
+def master(cia402, bus, steps, options=()):
+    done = subprocess.run([cia402, "master"] + bus + list(options) + steps, capture_output=True, text=True,
+                          timeout=120)
+    return done
+
+
+def read(cia402, bus, index):
+    done = master(cia402, bus, ["sdo", "read", index], ["--json"])
+    assert done.returncode == 0, done.stdout + done.stderr
+    lines = [json.loads(line) for line in done.stdout.splitlines()]
+    return next(e for e in lines if e["event"] == "sdo" and e["object"] == index + ":0")["value"]
+
+
+def check_runs(cia402, bus):
+    beyond = master(cia402, bus, ["enable", "velocity", "99999"])
+    assert beyond.returncode == 2, beyond.stdout + beyond.stderr
+    assert "velocity 99999 rpm is beyond 0x607F (max profile velocity) = 6000 rpm" in beyond.stderr, beyond.stderr
+    assert abs(read(cia402, bus, "0x606C")) <= 1, "a refused velocity moved the shaft"
+
+    torque = master(cia402, bus, ["enable", "torque", "5000"])
+    assert torque.returncode == 2, torque.stdout + torque.stderr
+    assert "torque 5000 permille is beyond 0x6072 (max torque) = 3000 permille" in torque.stderr, torque.stderr
+
+    slow = master(cia402, bus, ["sdo", "write", "0x6083", "100", "enable", "velocity", "3000"], ["--timeout", "300"])
+    assert slow.returncode == 1, slow.stdout + slow.stderr
+    assert "did not finish within 300 ms" in slow.stderr and "stopped by halt" in slow.stderr, slow.stderr
+    assert "at standstill" in slow.stderr, slow.stderr
+    after = read(cia402, bus, "0x606C")
+    assert abs(after) <= 1, "the shaft still turns at %d rpm after the run" % after
+    restore = master(cia402, bus, ["sdo", "write", "0x6083", "1000"])
+    assert restore.returncode == 0, restore.stdout + restore.stderr
+
+
+def over_can(cia402):
+    bus = subprocess.Popen([cia402, "bus", "--listen", "127.0.0.1:0", "--nodes", "1"], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
+    try:
+        first = bus.stdout.readline()
+        assert "socketcand on 127.0.0.1:" in first, first + bus.stderr.read()
+        port = int(first.split("127.0.0.1:")[1].split()[0])
+        check_runs(cia402, ["--can", "socketcand://127.0.0.1:%d/can0" % port, "--node", "1"])
+    finally:
+        bus.send_signal(signal.SIGTERM)
+        bus.wait(timeout=10)
+    print("CANopen: limits refused, a timed-out velocity stopped, the next run finds the shaft standing")
+    return 0
+
+
+def over_ecat(cia402):
+    if os.geteuid() != 0:
+        print("SKIPPED: a raw socket and a veth pair need root")
+        return SKIP
+    if shutil.which("ip") is None:
+        print("FAILED: ip (iproute2) is missing (scripts/install-deps.sh installs it)")
+        return 1
+    tag = "%d" % (os.getpid() % 10000)
+    m, s = "c4fm" + tag, "c4fs" + tag
+    subprocess.run(["ip", "link", "add", m, "type", "veth", "peer", "name", s], check=True)
+    slave = None
+    try:
+        for name in (m, s):
+            subprocess.run(["ip", "link", "set", name, "up"], check=True)
+        slave = subprocess.Popen([cia402, "ecat-slave", "--iface", s, "--nodes", "1"], stdout=subprocess.PIPE,
+                                 stderr=subprocess.PIPE, text=True)
+        first = slave.stdout.readline()
+        assert "1 drive(s) on %s" % s in first, first + slave.stderr.read()
+        check_runs(cia402, ["--ecat", m, "--position", "0"])
+    finally:
+        if slave is not None:
+            slave.send_signal(signal.SIGTERM)
+            slave.wait(timeout=10)
+        subprocess.run(["ip", "link", "del", m], capture_output=True)
+    print("EtherCAT: limits refused, a timed-out velocity stopped, the next run finds the shaft standing")
+    return 0
+
+
+def main():
+    cia402, bus = sys.argv[1], sys.argv[2]
+    return over_can(cia402) if bus == "can" else over_ecat(cia402)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
