@@ -1,8 +1,8 @@
 // The instrument control page: its parts, started once /api/info is in, and each snapshot of the
 // event stream handed to them. boot.js loads it and calls start().
-import { buildAxes, buildProfileChoice } from './axes.js';
+import { buildAxes, buildProfileChoice, watchControl } from './axes.js';
 import { drawDiagram, updateDiagram } from './diagram.js';
-import { api, el, page, stateLabel, token } from './page.js';
+import { api, el, headers, page, stateLabel } from './page.js';
 import { applyCapabilities, buildObjects, buildPlant, buildSetpoints, showPlant } from './plant.js';
 import { buildModePanel, showModePanel } from './modes.js';
 import { drawTimeline, onRecording, pollRecording } from './recorder.js';
@@ -10,7 +10,7 @@ import { buildScope, drawScopeFrame } from './scope.js';
 import { addRows, addSamples, addSnapshot } from './scope_data.js';
 import { connect, setControl } from './stream.js';
 import { buildBits, buildCommands, buildModes, showWords } from './words.js';
-import './jog.js';
+import { showJog } from './jog.js';
 import { buildParameters } from './parameters.js';
 
 function update(s, missed) {
@@ -31,6 +31,7 @@ function update(s, missed) {
   showWords(s);
   showPlant(s);
   showModePanel(s);
+  showJog(s);
   addSnapshot(s, missed);
 }
 
@@ -41,8 +42,7 @@ function animate() {
 }
 
 export async function start() {
-  const headers = token ? { 'X-Cia402-Token': token } : {};
-  const res = await fetch(api('/api/info'), { headers });
+  const res = await fetch(api('/api/info'), { headers: headers() });
   page.info = await res.json();
   const p = page.info.profile;
   el('profile').textContent = `${p.title} (profile ${p.name})`;
@@ -51,6 +51,7 @@ export async function start() {
   for (const a of document.querySelectorAll('.exports a')) a.href = api(a.getAttribute('href'));
   buildProfileChoice();
   buildAxes();
+  if (page.info.control) watchControl();
   drawDiagram();
   buildBits();
   buildCommands();

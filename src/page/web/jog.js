@@ -4,7 +4,7 @@
 // stops the drive by itself when the renewals stop, whatever happens to this page. The page also
 // releases at once when the button is let go, the pointer leaves it, the tab loses focus or is
 // hidden, or the event stream is lost.
-import { post } from './page.js';
+import { el, label, page, post } from './page.js';
 
 const TTL_MS = 300;
 const RENEW_MS = 100;
@@ -30,16 +30,36 @@ const renew = () => {
   renewing = true;
   send({ velocity: mine.velocity, ttl_ms: TTL_MS }).then((reply) => {
     renewing = false;
-    if (reply === null && held === mine) release();  // refused (shown): stop asking
+    // Refused (shown): stop asking. No release is sent: no jog runs, and its "nothing to do" would
+    // take the place of the refusal on the page.
+    if (reply === null && held === mine) drop();
   });
 };
 
-function release() {
-  if (!held) return;
+function drop() {
   clearInterval(held.timer);
   held.button.classList.remove('held');
   held = null;
+}
+
+function release() {
+  if (!held) return;
+  drop();
   send({ velocity: 0 });
+}
+
+// The jog buttons act in OPERATION ENABLED only (the server refuses a jog elsewhere with 409): off
+// otherwise, with the reason as their title.
+export function showJog(s) {
+  const reason = s.state === 'OPERATION_ENABLED' ? ''
+    : `jog runs in OPERATION ENABLED only (now ${label(s.state)}): Enable first`;
+  el('jog-note').textContent = reason;
+  el('jog-note').hidden = !reason;
+  for (const b of document.querySelectorAll('.jog')) {
+    b.disabled = Boolean(reason) || !(page.info && page.info.control);
+    b.title = reason || 'hold to run; released when let go';
+  }
+  if (reason && held) drop();
 }
 
 const hold = (button, event) => {

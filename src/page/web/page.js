@@ -17,6 +17,32 @@ export const token = (() => {
   }
   try { return sessionStorage.getItem('cia402-token') || ''; } catch (e) { return ''; }
 })();
+// This tab's name for the server (docs/instrument-page.md, "Control model"): kept for the tab
+// (sessionStorage), so showing another axis is the same page, which holds the axes it commanded.
+export const clientId = (() => {
+  const bytes = new Uint8Array(12);
+  const fresh = () => {
+    if (globalThis.crypto && crypto.getRandomValues) crypto.getRandomValues(bytes);
+    else for (let i = 0; i < bytes.length; ++i) bytes[i] = Math.floor(Math.random() * 256);
+    return Array.from(bytes, (b) => b.toString(16).padStart(2, '0')).join('');
+  };
+  try {
+    let id = sessionStorage.getItem('cia402-client');
+    if (!id) {
+      id = fresh();
+      sessionStorage.setItem('cia402-client', id);
+    }
+    return id;
+  } catch (e) {
+    return fresh();
+  }
+})();
+// The headers of every request: the token where there is one, and this page's client id.
+export function headers(more = {}) {
+  const h = { 'X-Cia402-Client': clientId, ...more };
+  if (token) h['X-Cia402-Token'] = token;
+  return h;
+}
 // Which of the server's drives this page shows (?axis=K; the first without it).
 const axisParam = params.get('axis') || '';
 
@@ -39,10 +65,9 @@ export function serverNow() {
 
 // A POST with the token: `{ ok, status, reply }` (the reply's JSON, `{ error }` without a connection).
 export async function send(path, body) {
-  const headers = { 'Content-Type': 'application/json' };
-  if (token) headers['X-Cia402-Token'] = token;
   try {
-    const res = await fetch(api(path), { method: 'POST', headers, body: JSON.stringify(body) });
+    const res = await fetch(api(path), { method: 'POST', headers: headers({ 'Content-Type': 'application/json' }),
+      body: JSON.stringify(body) });
     return { ok: res.ok, status: res.status, reply: await res.json().catch(() => ({})) };
   } catch (e) {
     return { ok: false, status: 0, reply: { error: `no connection to the server (${e.message})` } };

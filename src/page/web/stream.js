@@ -1,7 +1,7 @@
 // The event stream (/api/events): one snapshot per message, the newest the server has when it
 // writes. Versions count the snapshots the drive published: a version that skips says the page
 // missed some (the browser or the connection could not keep up), and the page says so.
-import { api, el } from './page.js';
+import { api, clientId, el } from './page.js';
 
 export function setControl(allowed) {
   document.body.classList.toggle('view-only', !allowed);
@@ -15,7 +15,8 @@ export function setControl(allowed) {
 // `takeSamples(batch)`: each batch of the drive's cycles (scope_samples.js).
 export function connect(take, takeSamples = null) {
   let version = null;
-  const source = new EventSource(api('/api/events'));
+  // The stream names this page (an EventSource sends no header): each write renews every axis it holds.
+  const source = new EventSource(api(`/api/events?client=${clientId}`));
   // While the stream is down every value on the page is old: the whole instrument is marked stale
   // (grayed, controls off) until the next snapshot arrives.
   const stale = (on) => {

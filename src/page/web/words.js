@@ -118,6 +118,7 @@ export function buildModes() {
 }
 
 
+let shownResult = '';  // the newest result shown: id, outcome and text
 // The words and the results of the newest snapshot.
 export function showWords(s) {
   el('sw-hex').textContent = s.status_word;
@@ -141,7 +142,11 @@ export function showWords(s) {
   nameModeBits(s.mode);
 
   const [latest, ...older] = s.results;
-  if (latest) showResult(latest.outcome, `${label(latest.action)}: ${latest.text}`);
+  // The newest result once it is new or changed: a refusal the server answered (post()) stays
+  // shown until then, not overwritten by the next snapshot's older result.
+  const key = latest ? `${latest.id} ${latest.outcome} ${latest.text}` : '';
+  if (latest && key !== shownResult) showResult(latest.outcome, `${label(latest.action)}: ${latest.text}`);
+  shownResult = key;
   const list = el('results');
   list.textContent = '';
   for (const r of older.slice(0, 3)) {
