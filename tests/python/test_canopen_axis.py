@@ -93,6 +93,28 @@ def test_a_request_that_does_not_end_in_time_raises_axiserror(axis):
         axis.move(10_000_000, velocity=10, timeout=0.05)
 
 
+def test_a_target_beyond_the_drives_limits_is_refused_before_anything_moves(axis):
+    # S20: 0x607F = 6000 rpm and 0x6072 = 3000 permille are the virtual drive's limits.
+    with pytest.raises(cia402.AxisError, match=r"velocity 99999 rpm is beyond 0x607F \(max profile velocity\) = 6000"):
+        axis.velocity(99999)
+    with pytest.raises(cia402.AxisError, match=r"torque 5000 permille is beyond 0x6072"):
+        axis.torque(5000)
+    assert axis.state == "SWITCH_ON_DISABLED", "nothing was sent"
+    assert axis.sdo_read(0x606C) == 0
+
+
+def test_a_request_that_times_out_stops_the_motion_it_started(axis):
+    # S20: with 0x6083 = 100 rpm/s a velocity of 3000 rpm cannot be reached in 0.3 s; the time-out
+    # halts the shaft before the exception says so, and the next request needs no reset.
+    axis.sdo_write(0x6083, 100)
+    with pytest.raises(cia402.AxisError, match="did not end within .*stopped by halt .*at standstill"):
+        axis.velocity(3000, timeout=0.3)
+    assert abs(axis.sdo_read(0x606C)) <= 1
+    assert axis.state == "OPERATION_ENABLED"
+    axis.sdo_write(0x6083, 1000)
+    assert axis.velocity(200)["velocity"] == 200
+
+
 def test_an_axis_needs_a_node_on_the_bus_and_refuses_work_once_closed():
     with VirtualBus(nodes=[NODE], virtual_time=True) as bus:
         with pytest.raises(cia402.ArgumentError):
