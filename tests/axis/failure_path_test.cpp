@@ -146,6 +146,29 @@ TEST(failure_path, a_refused_set_point_stops_what_the_command_already_moved) {
   EXPECT_LE(std::abs(b.link.drive.view().velocity_rpm()), 1);
 }
 
+// --- what a disable holds -------------------------------------------------------------------------
+
+TEST(failure_path, once_asked_to_disable_the_session_never_sends_enable_operation_again) {
+  bench b;
+  ASSERT_TRUE(b.enable().ok());
+  const result off = b.finish([&](completion d) { return b.s->go_to(state::switch_on_disabled, std::move(d)); });
+  ASSERT_TRUE(off.ok()) << off.error;
+  const std::size_t from = b.link.words.size();
+  b.run_ms(200);
+  ASSERT_TRUE(b.s->control_word());
+  EXPECT_EQ(*b.s->control_word() & 0x008F, 0x0000) << "Disable voltage is held, not the 0x000F a path from START ends on";
+  for (std::size_t i = from; i < b.link.words.size(); ++i) EXPECT_NE(b.link.words[i].second & 0x000F, 0x000F) << i;
+  // A quick stop held with 0x605A = 6: a disable from there goes to SWITCH ON DISABLED, never back up (T16).
+  ASSERT_TRUE(b.finish([&](completion d) { return b.s->write_object(0x605A, 0, object_value::of_integer(6), std::move(d)); }).ok());
+  EXPECT_EQ(b.s->option_code(option::quick_stop), 6);
+  ASSERT_TRUE(b.finish([&](completion d) { return b.s->velocity(500, std::move(d)); }).ok());
+  ASSERT_TRUE(b.finish([&](completion d) { return b.s->go_to(state::quick_stop_active, std::move(d)); }).ok());
+  const result down = b.finish([&](completion d) { return b.s->go_to(state::switch_on_disabled, std::move(d)); });
+  ASSERT_TRUE(down.ok()) << down.error;
+  b.run_ms(200);
+  EXPECT_EQ(b.link.drive.view().current(), state::switch_on_disabled);
+}
+
 // --- the lease and the stops ------------------------------------------------------------------------
 
 TEST(failure_path, a_lease_that_lapses_on_the_way_up_stops_the_enable_and_a_quick_stop_is_not_refused) {
