@@ -6,13 +6,10 @@ can:  `cia402 bus` on a free loopback port.
 ecat: `cia402 ecat-slave` on one end of a veth pair (root; exit 77 otherwise).
 Usage: failure_path_runs.py CIA402_BINARY can|ecat"""
 import json
-import os
-import shutil
-import signal
 import subprocess
 import sys
 
-SKIP = 77
+import buses
 
 
 def master(cia402, bus, steps, options=()):
@@ -48,52 +45,17 @@ def check_runs(cia402, bus):
     assert restore.returncode == 0, restore.stdout + restore.stderr
 
 
-def over_can(cia402):
-    bus = subprocess.Popen([cia402, "bus", "--listen", "127.0.0.1:0", "--nodes", "1"], stdout=subprocess.PIPE,
-                           stderr=subprocess.PIPE, text=True)
-    try:
-        first = bus.stdout.readline()
-        assert "socketcand on 127.0.0.1:" in first, first + bus.stderr.read()
-        port = int(first.split("127.0.0.1:")[1].split()[0])
-        check_runs(cia402, ["--can", "socketcand://127.0.0.1:%d/can0" % port, "--node", "1"])
-    finally:
-        bus.send_signal(signal.SIGTERM)
-        bus.wait(timeout=10)
-    print("CANopen: limits refused, a timed-out velocity stopped, the next run finds the shaft standing")
-    return 0
-
-
-def over_ecat(cia402):
-    if os.geteuid() != 0:
-        print("SKIPPED: a raw socket and a veth pair need root")
-        return SKIP
-    if shutil.which("ip") is None:
-        print("FAILED: ip (iproute2) is missing (scripts/install-deps.sh installs it)")
-        return 1
-    tag = "%d" % (os.getpid() % 10000)
-    m, s = "c4fm" + tag, "c4fs" + tag
-    subprocess.run(["ip", "link", "add", m, "type", "veth", "peer", "name", s], check=True)
-    slave = None
-    try:
-        for name in (m, s):
-            subprocess.run(["ip", "link", "set", name, "up"], check=True)
-        slave = subprocess.Popen([cia402, "ecat-slave", "--iface", s, "--nodes", "1"], stdout=subprocess.PIPE,
-                                 stderr=subprocess.PIPE, text=True)
-        first = slave.stdout.readline()
-        assert "1 drive(s) on %s" % s in first, first + slave.stderr.read()
-        check_runs(cia402, ["--ecat", m, "--position", "0"])
-    finally:
-        if slave is not None:
-            slave.send_signal(signal.SIGTERM)
-            slave.wait(timeout=10)
-        subprocess.run(["ip", "link", "del", m], capture_output=True)
-    print("EtherCAT: limits refused, a timed-out velocity stopped, the next run finds the shaft standing")
-    return 0
-
-
 def main():
-    cia402, bus = sys.argv[1], sys.argv[2]
-    return over_can(cia402) if bus == "can" else over_ecat(cia402)
+    cia402, which = sys.argv[1], sys.argv[2]
+    try:
+        with (buses.can_bus(cia402) if which == "can" else buses.ecat_line(cia402, "c4f")) as bus:
+            check_runs(cia402, bus)
+    except buses.Skip as why:
+        print("SKIPPED: %s" % why)
+        return buses.SKIP
+    print("%s: limits refused, a timed-out velocity stopped, the next run finds the shaft standing" %
+          ("CANopen" if which == "can" else "EtherCAT"))
+    return 0
 
 
 if __name__ == "__main__":

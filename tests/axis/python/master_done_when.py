@@ -11,13 +11,10 @@ ecat: `cia402 ecat-slave` on one end of a veth pair, `--ecat IF --position 0` on
       UNSIGNED32 every drive has) in its place.
 Usage: master_done_when.py CIA402_BINARY can|ecat"""
 import json
-import os
-import shutil
-import signal
 import subprocess
 import sys
 
-SKIP = 77
+import buses
 STEPS = ["enable", "mode", "pp", "move", "20000", "mode", "pv", "velocity", "300", "wait", "500", "home", "37",
          "sdo", "write", "0x1017", "100", "sdo", "read", "0x1017", "sdo", "read", "0x1008", "quick-stop", "reset",
          "disable"]
@@ -47,56 +44,25 @@ def check(done, lines, key, register):
 
 
 def over_can(cia402):
-    bus = subprocess.Popen([cia402, "bus", "--listen", "127.0.0.1:0", "--nodes", "1"], stdout=subprocess.PIPE,
-                           stderr=subprocess.PIPE, text=True)
-    try:
-        first = bus.stdout.readline()
-        assert "socketcand on 127.0.0.1:" in first, first + bus.stderr.read()
-        port = int(first.split("127.0.0.1:")[1].split()[0])
-        done, lines = run_master(cia402, ["--can", "socketcand://127.0.0.1:%d/can0" % port, "--node", "1"], STEPS)
+    with buses.can_bus(cia402) as bus:
+        done, lines = run_master(cia402, bus, STEPS)
         check(done, lines, "node", "0x1017")
         closed = [e for e in lines if e["event"] == "closed"]
         assert closed and "0x1017 (Producer heartbeat time)" in closed[0]["restored"], closed
-    finally:
-        bus.send_signal(signal.SIGTERM)
-        bus.wait(timeout=10)
     print("CANopen: the done-when command exits 0, %d JSON lines" % len(lines))
     return 0
 
 
-def start_slave(cia402, interface):
-    slave = subprocess.Popen([cia402, "ecat-slave", "--iface", interface, "--nodes", "1"], stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True)
-    first = slave.stdout.readline()
-    assert "1 drive(s) on %s" % interface in first, first + slave.stderr.read()
-    return slave
-
-
 def over_ecat(cia402):
-    if os.geteuid() != 0:
-        print("SKIPPED: a raw socket and a veth pair need root")
-        return SKIP
-    if shutil.which("ip") is None:
-        print("FAILED: ip (iproute2) is missing (scripts/install-deps.sh installs it)")
-        return 1
-    tag = "%d" % (os.getpid() % 10000)
-    m, s = "c4dm" + tag, "c4ds" + tag
-    subprocess.run(["ip", "link", "add", m, "type", "veth", "peer", "name", s], check=True)
-    slave = None
     try:
-        for name in (m, s):
-            subprocess.run(["ip", "link", "set", name, "up"], check=True)
-        slave = start_slave(cia402, s)
-        options = ["--ecat", m, "--position", "0"]
-        done, lines = run_master(cia402, options, STEPS)
-        register = "0x1017"  # the CoE slave keeps CiA 301's 0x1017 (stored, no heartbeat on EtherCAT)
-        check(done, lines, "slave", register)
-        assert [e for e in lines if e["event"] == "done"][0]["lost_frames"] == 0, lines
-    finally:
-        if slave is not None:
-            slave.send_signal(signal.SIGTERM)
-            slave.wait(timeout=10)
-        subprocess.run(["ip", "link", "del", m], capture_output=True)
+        with buses.ecat_line(cia402, "c4d") as bus:
+            done, lines = run_master(cia402, bus, STEPS)
+            register = "0x1017"  # the CoE slave keeps CiA 301's 0x1017 (stored, no heartbeat on EtherCAT)
+            check(done, lines, "slave", register)
+            assert [e for e in lines if e["event"] == "done"][0]["lost_frames"] == 0, lines
+    except buses.Skip as why:
+        print("SKIPPED: %s" % why)
+        return buses.SKIP
     print("EtherCAT: the done-when command exits 0, %d JSON lines" % len(lines))
     return 0
 
