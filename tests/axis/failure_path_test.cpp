@@ -85,6 +85,19 @@ TEST(limits, a_drive_without_the_limit_objects_is_not_judged) {
   EXPECT_TRUE(r.ok()) << r.error;
 }
 
+TEST(limits, a_drive_that_cuts_the_set_point_while_running_is_said_to_with_bit_11) {
+  bench b;
+  // pv towards the end of 0x607D: the drive brakes for the limit and shows status bit 11.
+  ASSERT_EQ(b.link.drive.write(object_index::software_position_limit, 2, 30000), sdo_abort::none);
+  std::optional<result> got;
+  b.s->velocity(1000, [&](const result& r) { got = r; });
+  ASSERT_TRUE(b.run_until([&] { return (b.link.status_word() & status_bit::internal_limit_active) != 0; }, 10000));
+  b.run_ms(50);
+  b.s->cancel("given up");
+  ASSERT_TRUE(b.run_until([&] { return got.has_value(); }, 20000));
+  EXPECT_TRUE(has(got->error, "the drive limited the set-point: status bit 11 (internal limit active) was set")) << got->error;
+}
+
 // --- a failed step stops what it started ----------------------------------------------------------
 
 TEST(failure_path, a_velocity_cut_short_by_its_client_is_halted_to_standstill_and_says_so) {
