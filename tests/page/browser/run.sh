@@ -41,6 +41,10 @@ fi
 
 export CIA402_NODE_MODULES="$work/node_modules"
 export CIA402_CHROMIUM="$chromium"
+# CIA402_BROWSER_ONLY=control.test.mjs: that script alone (a CTest entry of its own).
+if [ -n "${CIA402_BROWSER_ONLY:-}" ]; then
+  exec node "$here/$CIA402_BROWSER_ONLY" "$cia402" "$work/output"
+fi
 node "$here/instrument_page.test.mjs" "$cia402" "$work/output" "$screenshot"
 node "$here/instrument_page_servers.test.mjs" "$cia402" "$work/output"
 node "$here/scope.test.mjs" "$cia402" "$work/output"
