@@ -12,7 +12,7 @@ shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   targets=(profile_file_fuzz scenario_file_fuzz replay_fuzz canopen_node_fuzz socketcand_fuzz
-           eds_file_fuzz page_commands_fuzz ethercat_slave_fuzz ethercat_master_fuzz)
+           eds_file_fuzz page_commands_fuzz page_http_text_fuzz ethercat_slave_fuzz ethercat_master_fuzz)
 fi
 cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz --target "${targets[@]}"
