@@ -78,6 +78,10 @@ void drive_master::go_running() {
     consumer_.configure({{config_.node_id, static_cast<std::uint16_t>(std::min<std::uint32_t>(
                                                3u * config_.drive_heartbeat_ms, 0xFFFF))}});
   }
+  // The drive watches this master's heartbeat (0x1016) only from the first one it hears: one goes
+  // now, before any control word, so a bus that falls silent after the enable reaches the drive's
+  // 0x6007 however soon it does.
+  producer_.send_now(*out_, config_.master_node_id, nmt_state::operational);
   next_poll_us_ = now_us_ + config_.poll_us;
   word_sent_ = false;
   set_phase(master_phase::running, phase_reason::running);

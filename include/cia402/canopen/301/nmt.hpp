@@ -43,6 +43,13 @@ class heartbeat_producer {
   void configure(std::uint16_t period_ms) noexcept {
     if (period_ms == 0) timer_.stop(); else timer_.start(period_ms * 1000u);
   }
+  /// A heartbeat now, and the period counted from here: a consumer watches only from the first one
+  /// it hears (CiA 301), so a master sends one before it commands anything.
+  void send_now(channel& out, std::uint8_t node_id, nmt_state s) noexcept {
+    if (!timer_.running()) return;
+    (void)out.send(heartbeat_frame(node_id, s));
+    timer_.start(timer_.period());
+  }
   /// Returns when the next heartbeat is due.
   std::uint32_t process(std::uint32_t elapsed_us, channel& out, std::uint8_t node_id,
                         nmt_state s) noexcept {
