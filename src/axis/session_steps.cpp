@@ -150,7 +150,10 @@ void session::write_integer(std::uint16_t index, std::uint8_t sub, std::int64_t 
   queue_download(index, sub, std::move(bytes), [this, index, sub, value, done](const transfer_result& r) {
     if (index == object_index::modes_of_operation) mode_written_us_ = now_us_;
     if (r.ok) return done({});
-    done("the drive refused " + object_name(index, sub) + " = " + std::to_string(value) + ": " + transfer_failure(r));
+    // Only an abort is the drive's refusal; anything else is the way to it failing.
+    const std::string what = r.abort != sdo_abort::none ? "the drive refused " : "writing ";
+    done(what + object_name(index, sub) + " = " + std::to_string(value) + (r.abort != sdo_abort::none ? ": " : " failed: ") +
+         transfer_failure(r));
   });
 }
 

@@ -40,7 +40,7 @@ class mailbox_owner {
 
 }  // namespace
 
-bool ecat_master::mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe) {
+bool ecat_master::mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe, bool* answered) {
   s.mailbox_counter = next_mailbox_counter(s.mailbox_counter);
   mailbox_header h;
   h.type = mailbox_type::coe;
@@ -50,6 +50,7 @@ bool ecat_master::mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& c
   if (m.empty()) return false;
   for (const std::uint64_t start = link_->now_us();;) {
     const single r = one(command::fpwr, s.station | (static_cast<std::uint32_t>(s.sii.mailbox_out_start) << 16), m);
+    if (r.ok && answered != nullptr) *answered = true;
     if (r.ok && r.wkc == 1) return true;  // 0: the slave has not read the one before yet
     if (link_->now_us() - start > mailbox_us) return false;
     pause(poll_us);
@@ -112,8 +113,13 @@ ecat_slave* ecat_master::sdo_slave(std::size_t i, ecat_sdo_result& result) {
 std::optional<sdo_frame> ecat_master::sdo_exchange(ecat_slave& s, const std::vector<std::uint8_t>& request,
                                                    std::uint16_t index, std::uint8_t sub, sdo_command expected,
                                                    std::vector<std::uint8_t>& reply, ecat_sdo_result& result) {
-  if (!mailbox_send(s, request)) {
-    result.error = slave_text(s) + ": its receive mailbox stays full";
+  bool answered = false;
+  if (!mailbox_send(s, request, &answered)) {
+    // A full mailbox answers with a working counter of 0; a line that brings no frame back is no
+    // full mailbox (a cable pulled mid-transfer), and is said as such.
+    result.error = slave_text(s) + (answered ? ": its receive mailbox stays full"
+                                             : ": the line does not answer: no frame came back within " +
+                                                   std::to_string(mailbox_us / 1000) + " ms");
     return std::nullopt;
   }
   const bool initiate = expected == sdo_command::initiate_upload || expected == sdo_command::initiate_download;

@@ -192,7 +192,8 @@ class ecat_master {
   bool configure_process_data(ecat_slave& s, std::uint32_t& logical);
   bool configure_distributed_clocks();
   bool start_sync0();
-  bool mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe);
+  /// `answered`, when given, is set once any frame of the attempt came back.
+  bool mailbox_send(ecat_slave& s, const std::vector<std::uint8_t>& coe, bool* answered = nullptr);
   std::optional<std::vector<std::uint8_t>> mailbox_receive(ecat_slave& s);
   bool request_mailbox_repeat(ecat_slave& s);
   // The slave `i` names, with its CoE mailbox, or an error in `result`.
