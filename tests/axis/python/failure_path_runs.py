@@ -1,6 +1,7 @@
 """S20 by the real `cia402 master` over both buses: a step beyond the drive's limits is refused
 before anything moves (exit 2, the object named), a step that times out stops the motion it started
-(exit 1, the stop named), and the next run finds the shaft at standstill.
+(exit 1, the stop named), the next run finds the shaft at standstill, and a run that ended with
+the drive enabled leaves it so the next finds no fault.
 
 can:  `cia402 bus` on a free loopback port.
 ecat: `cia402 ecat-slave` on one end of a veth pair (root; exit 77 otherwise).
@@ -43,6 +44,16 @@ def check_runs(cia402, bus):
     assert abs(after) <= 1, "the shaft still turns at %d rpm after the run" % after
     restore = master(cia402, bus, ["sdo", "write", "0x6083", "1000"])
     assert restore.returncode == 0, restore.stdout + restore.stderr
+
+    # Runs chain: a run that ended well with the drive enabled leaves it so the next finds no fault
+    # (on EtherCAT the link brings it down before the line leaves OP, docs/ethercat.md).
+    moved = master(cia402, bus, ["enable", "mode", "pp", "move", "5000"])
+    assert moved.returncode == 0, moved.stdout + moved.stderr
+    found = master(cia402, bus, ["state"], ["--json"])
+    assert found.returncode == 0, found.stdout + found.stderr
+    shown = [json.loads(line) for line in found.stdout.splitlines()]
+    status = [e for e in shown if e["event"] == "status"]
+    assert status and "FAULT" not in status[0]["state"], shown
 
 
 def main():
