@@ -1,5 +1,5 @@
-// The instrument page's actions in any order: a refused action changes nothing the page shows, and
-// no sequence crashes. Each input byte pair is one action; cycles pass between them.
+// The instrument page's actions in any order: a refused action changes nothing the page shows (while
+// nothing the page started earlier is still under way), and no sequence crashes. Each input byte pair is one action; cycles pass between them.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -31,6 +31,18 @@ nlohmann::json observable(const axis_page& inst) {
           s["target_velocity"], s["objects"], s["profile"]};
 }
 
+// Something the page started goes on by itself: a pending result, a homing run. A request the page
+// answers only once the drive did (an SDO write the drive refuses) lets the drive's cycles pass
+// meanwhile, and what runs moves on in them (homing raises bit 4 when its turn comes): that is the
+// earlier request's doing, not the refused one's.
+bool under_way(const axis_page& inst) {
+  const nlohmann::json s = nlohmann::json::parse(inst.snapshot_json());
+  for (const auto& r : s["results"]) {
+    if (r["outcome"] == "pending") return true;
+  }
+  return s["homing"].is_object() && s["homing"].value("running", false);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -41,6 +53,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::uint8_t what = data[i];
     const std::uint8_t arg = data[i + 1];
     const nlohmann::json before = observable(inst);
+    const bool busy = under_way(inst);
     reply r = accepted{};
     switch (what % 7) {
       case 0: r = inst.command(static_cast<page_command>(arg % 8)); break;
@@ -86,7 +99,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         for (int k = 0; k < arg % 64; ++k) inst.step();
         continue;
     }
-    if (std::holds_alternative<refused>(r) && observable(inst) != before) std::abort();
+    if (std::holds_alternative<refused>(r) && !busy && observable(inst) != before) std::abort();
     inst.step();
   }
   return 0;
