@@ -120,6 +120,8 @@ async function main() {
   await check('jog: runs while held, 0x60FF = 0 on release and on leaving the button', async () => {
     await page.fill('#jog-slow', '120');
     const button = page.locator('button.jog[data-sign="1"][data-speed="slow"]');
+    // Live only once the page's own snapshot shows OPERATION ENABLED (jog.js).
+    await page.waitForSelector('button.jog[data-sign="1"][data-speed="slow"]:not([disabled])', { timeout: patience });
     await button.hover();
     await page.mouse.down();
     await untilDrive(main.url, (s) => s.target_velocity === 120 && s.velocity > 0, 'the jog did not start');

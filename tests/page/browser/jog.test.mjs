@@ -147,6 +147,8 @@ async function enable(page, url) {
 async function holdJog(page, url) {
   await page.fill('#jog-slow', String(SPEED));
   const fromMs = (await driveState(url)).time_ms;
+  // The jog buttons are live only once the page's own snapshot shows OPERATION ENABLED (jog.js).
+  await page.waitForSelector('button.jog[data-sign="1"][data-speed="slow"]:not([disabled])', { timeout: patience });
   await page.locator('button.jog[data-sign="1"][data-speed="slow"]').hover();
   await page.mouse.down();
   const running = await untilDrive(url, atSpeed, `the held jog did not reach ${SPEED} rpm`);
