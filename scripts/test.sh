@@ -39,7 +39,7 @@ trap finish EXIT
 banner() { step=$1; printf '\n======== %s ========\n' "$step"; }
 
 # Tests in a preset: "N tests" from ctest's own listing.
-test_count() { ctest --preset "$1" -N | sed -n 's/^Total Tests: //p'; }
+test_count() { ctest --preset "$1" -N "${@:2}" | sed -n 's/^Total Tests: //p'; }
 
 banner install-deps
 bash scripts/install-deps.sh
@@ -57,7 +57,7 @@ for preset in dev asan-ubsan; do
   label_filter=()
   [ "$preset" = asan-ubsan ] && label_filter=(-LE browser)
   ctest --preset "$preset" --repeat until-pass:2 "${label_filter[@]}"
-  done_steps+=("$preset: $(test_count "$preset") tests passed")
+  done_steps+=("$preset: $(test_count "$preset" "${label_filter[@]}") tests passed")
 done
 
 banner soak
