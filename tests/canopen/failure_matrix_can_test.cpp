@@ -27,6 +27,7 @@
 #include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cia402/drive402/sim_device.hpp"
 #include "cia402/objects.hpp"
+#include "failure_matrix.hpp"
 
 namespace cia402::canopen {
 namespace {
@@ -147,67 +148,13 @@ struct bench {
   }
 };
 
-enum class kind { move, velocity, jog, csp, home, torque };
-enum class failure { cancel, link_lost, fault, sto, dc_link_lost, refused_sdo };
-constexpr kind kinds[] = {kind::move, kind::velocity, kind::jog, kind::csp, kind::home, kind::torque};
-constexpr failure failures[] = {failure::cancel, failure::link_lost, failure::fault,
-                                failure::sto,    failure::dc_link_lost, failure::refused_sdo};
+using namespace failure_matrix;
 
-const char* name(kind k) {
-  switch (k) {
-    case kind::move: return "move";
-    case kind::velocity: return "velocity";
-    case kind::jog: return "jog";
-    case kind::csp: return "csp stream";
-    case kind::home: return "home";
-    case kind::torque: return "torque";
-  }
-  return "?";
-}
-const char* name(failure f) {
-  switch (f) {
-    case failure::cancel: return "cancel";
-    case failure::link_lost: return "link lost";
-    case failure::fault: return "fault";
-    case failure::sto: return "STO";
-    case failure::dc_link_lost: return "DC link lost";
-    case failure::refused_sdo: return "refused SDO";
-  }
-  return "?";
-}
+// How this bus says a lost link.
+const std::string link_lost_words = "node 1 does not answer";
 
-// What the error may name for each failure: the failure itself, or what the drive showed of it (STO
-// before the enable is a transition that does not come, with the warning bit; a DC link gone before
-// it is a refusal). The link lost: the node's heartbeat missing, or an SDO under way unanswered.
-std::vector<std::string> cause_words(failure f) {
-  switch (f) {
-    case failure::cancel: return {"the client gave up"};
-    case failure::link_lost: return {"node 1 does not answer"};
-    case failure::fault: return {"error code 0x7121"};
-    case failure::sto: return {"FAULT", "safe torque off"};
-    case failure::dc_link_lost: return {"FAULT", "no DC link"};
-    case failure::refused_sdo: return {"SDO abort 0x06090030"};
-  }
-  return {};
-}
-
-bool names_one(const std::string& error, const std::vector<std::string>& words) {
-  for (const std::string& w : words) {
-    if (error.find(w) != std::string::npos) return true;
-  }
-  return false;
-}
-
-void start(bench& b, kind k, axes::completion done) {
-  switch (k) {
-    case kind::move: b.s->move({2'000'000, false, 3000u}, std::move(done)); break;
-    case kind::velocity: b.s->velocity(3000, std::move(done)); break;
-    case kind::jog: b.s->jog(1500, 10'000'000, std::move(done)); break;
-    case kind::csp: b.s->csp_stream(2'000'000, 1200, std::move(done)); break;
-    case kind::home: b.s->home({std::int8_t{17}, 0}, std::move(done)); break;
-    case kind::torque: b.s->torque(100, std::move(done)); break;
-  }
-}
+// The command of kind `k` on this bench's session.
+void start(bench& b, kind k, axes::completion done) { failure_matrix::start(*b.s, k, std::move(done)); }
 
 void inject(bench& b, failure f) {
   switch (f) {
@@ -239,7 +186,7 @@ void run_one(kind k, failure f, int at_ms) {
   // The bound: the failure stop's three stages, and the time to say it.
   ASSERT_TRUE(b.run_until([&] { return got.has_value(); }, 3 * 10'000 + 2000)) << "the request never ended";
   if (ended_before || got->ok()) return;  // the failure came after the end, or changed nothing the command needed
-  EXPECT_TRUE(names_one(got->error, cause_words(f))) << got->error;
+  EXPECT_TRUE(names_one(got->error, cause_words(f, link_lost_words))) << got->error;
   if (f == failure::link_lost) {
     if (enabled) EXPECT_NE(got->error.find("0x6007"), std::string::npos) << got->error;
     // Out of the session's hands: the drive watches the master's heartbeat and stops as 0x6007 says.
