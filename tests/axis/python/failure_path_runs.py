@@ -7,6 +7,7 @@ can:  `cia402 bus` on a free loopback port.
 ecat: `cia402 ecat-slave` on one end of a veth pair (root; exit 77 otherwise).
 Usage: failure_path_runs.py CIA402_BINARY can|ecat"""
 import json
+import signal
 import subprocess
 import sys
 
@@ -42,6 +43,19 @@ def check_runs(cia402, bus):
     assert "at standstill" in slow.stderr, slow.stderr
     after = read(cia402, bus, "0x606C")
     assert abs(after) <= 1, "the shaft still turns at %d rpm after the run" % after
+    # Ctrl-C while the velocity ramps up: the step is cut short, stopped, and said so.
+    ramp = subprocess.Popen([cia402, "master"] + bus + ["enable", "velocity", "3000"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    for line in ramp.stdout:
+        if "0x60FF target velocity = 3000" in line:
+            break
+    ramp.send_signal(signal.SIGINT)
+    out, err = ramp.communicate(timeout=60)
+    assert ramp.returncode == 1, out + err
+    assert "interrupted; stopped by halt" in err, err
+    after = read(cia402, bus, "0x606C")
+    assert abs(after) <= 1, "the shaft still turns at %d rpm after Ctrl-C" % after
+
     restore = master(cia402, bus, ["sdo", "write", "0x6083", "1000"])
     assert restore.returncode == 0, restore.stdout + restore.stderr
 
