@@ -13,31 +13,21 @@
 #include <vector>
 
 #include "cia402/motion/homing.hpp"
+#include "homing_support.hpp"
 
 namespace cia402::motion {
 namespace {
 
-constexpr std::uint32_t cycle_us = 1000;
-constexpr std::int64_t revolution = 10000;
+using test::cam;
+using test::cycle_us;
+using test::floor_div;
+using test::home;
+using test::negative_home_switch;
+using test::positive_home_switch;
+using test::revolution;
+using run = test::homing_run;
+
 constexpr std::int64_t home_offset = 777;
-
-// floor(x / d) for d > 0.
-std::int64_t floor_div(std::int64_t x, std::int64_t d) { return x / d - (x % d != 0 && x < 0 ? 1 : 0); }
-
-// The machines: limit switches at -200,000 and +300,000, index pulses every revolution from 3,000,
-// and a home switch that suits the method.
-homing_machine with_home_switch(std::int64_t low, std::int64_t high) {
-  homing_machine m;
-  m.negative_limit = -200000;
-  m.positive_limit = 300000;
-  m.home_switch_low = low;
-  m.home_switch_high = high;
-  m.index_at = 3000;
-  return m;
-}
-const homing_machine positive_home_switch = with_home_switch(50000, homing_machine::none_above);
-const homing_machine negative_home_switch = with_home_switch(homing_machine::none_below, 50000);
-const homing_machine cam = with_home_switch(50000, 80000);  // an edge either side
 
 // The first index pulse at or above / at or below a position, and strictly above / below it.
 std::int64_t pulse_at_or_above(const homing_machine& m, std::int64_t at) {
@@ -80,31 +70,6 @@ std::int64_t expected_home(int method, const homing_machine& m, std::int64_t sta
   return f.side > 0 ? pulse_at_or_above(m, f.edge) : pulse_at_or_below(m, f.edge);
 }
 
-struct run {
-  homing_status status;
-  shaft s;
-  std::int64_t offset = 0;
-  long cycles = 0;
-};
-
-// One homing run from a shaft at rest at `start` (offset as given), until attained at rest or error.
-run home(int method, const homing_machine& m, std::int64_t start, std::int64_t offset = 0,
-         long max_cycles = 200000) {
-  homing h;
-  homing_parameters par;
-  par.method = static_cast<std::int8_t>(method);
-  par.home_offset = home_offset;
-  run r;
-  r.s.position = start;
-  r.offset = offset;
-  h.step(false, par, m, r.s, r.offset, cycle_us);
-  for (r.cycles = 1; r.cycles <= max_cycles; ++r.cycles) {
-    r.status = h.step(true, par, m, r.s, r.offset, cycle_us);
-    if (r.status.error || (r.status.attained && r.status.target_reached)) break;
-  }
-  return r;
-}
-
 struct homing_case {
   int method;
   const homing_machine* machine;
@@ -133,7 +98,7 @@ TEST(homing, every_method_of_0x60E3_homes_where_its_figure_says_and_again_there_
     for (const std::int64_t start : c.starts) {
       SCOPED_TRACE("method " + std::to_string(c.method) + " from " + std::to_string(start));
       const std::int64_t home_at = expected_home(c.method, *c.machine, start);
-      const run first = home(c.method, *c.machine, start);
+      const run first = home(c.method, *c.machine, start, home_offset);
       ASSERT_FALSE(first.status.error);
       ASSERT_TRUE(first.status.attained && first.status.target_reached) << "not done in " << first.cycles;
       EXPECT_EQ(first.s.position, home_at) << "the shaft stands at home";
@@ -141,7 +106,7 @@ TEST(homing, every_method_of_0x60E3_homes_where_its_figure_says_and_again_there_
       EXPECT_EQ(first.s.position + first.offset, home_offset) << "home reads as 0x607C";
       // Again, from home: the switches and pulses have not moved, so neither does home (33 and 34
       // go on to the next pulse: the one under the standing shaft is not latched).
-      const run second = home(c.method, *c.machine, first.s.position, first.offset);
+      const run second = home(c.method, *c.machine, first.s.position, home_offset, first.offset);
       ASSERT_FALSE(second.status.error);
       ASSERT_TRUE(second.status.attained && second.status.target_reached);
       const std::int64_t again_at = expected_home(c.method, *c.machine, first.s.position);
@@ -166,7 +131,7 @@ TEST(homing, a_default_method_3_run_ends_within_two_seconds) {
   // The plant's defaults: a home switch from 5 revolutions up, index pulses from 0, 0x6099 and
   // 0x609A as homing_parameters has them.
   homing_machine m;
-  const run r = home(3, m, 0);
+  const run r = home(3, m, 0, home_offset);
   ASSERT_TRUE(r.status.attained && r.status.target_reached);
   EXPECT_EQ(r.s.position, 40000);
   EXPECT_LT(r.cycles, 2000);
@@ -187,7 +152,7 @@ TEST(homing, a_limit_switch_where_the_method_expects_none_is_a_homing_error) {
                             bad_case{5, &positive_home_switch, 0}, bad_case{6, &positive_home_switch, 0},
                             bad_case{33, &no_pulse_room, 0}}) {
     SCOPED_TRACE(c.method);
-    const run r = home(c.method, *c.machine, c.start);
+    const run r = home(c.method, *c.machine, c.start, home_offset);
     ASSERT_TRUE(r.status.error);
     EXPECT_FALSE(r.status.attained);
     EXPECT_EQ(r.offset, 0) << "nothing redefined";
@@ -209,7 +174,7 @@ TEST(homing, a_switch_the_machine_lacks_is_searched_for_1000_revolutions_then_a_
                           lacking{3, &bare}, lacking{19, &bare}, lacking{14, &bare}, lacking{30, &bare},
                           lacking{10, &endless}, lacking{26, &endless}, lacking{11, &endless}, lacking{5, &endless}}) {
     SCOPED_TRACE(c.method);
-    const run r = home(c.method, *c.machine, 0, 0, 2000000);
+    const run r = home(c.method, *c.machine, 0, home_offset, 0, 2000000);
     ASSERT_TRUE(r.status.error);
     EXPECT_LE(std::llabs(r.s.position), (homing::max_search_revolutions + 10) * revolution);
     EXPECT_EQ(r.offset, 0);

@@ -12,15 +12,19 @@
 
 #include "cia402/motion/homing.hpp"
 #include "cia402/motion/trajectory.hpp"
+#include "homing_support.hpp"
 
 namespace cia402::motion {
 namespace {
 
-constexpr std::uint32_t cycle_us = 1000;
-constexpr std::int64_t revolution = 10000;
-
-// floor(x / d) for d > 0.
-std::int64_t floor_div(std::int64_t x, std::int64_t d) { return x / d - (x % d != 0 && x < 0 ? 1 : 0); }
+using test::cam;
+using test::cycle_us;
+using test::floor_div;
+using test::home;
+using test::negative_home_switch;
+using test::positive_home_switch;
+using test::revolution;
+using run = test::homing_run;
 
 // --- bit 4's edge ---------------------------------------------------------------------------------
 
@@ -108,48 +112,6 @@ TEST(homing_bit_4, stand_by_interrupts_a_run_bit_4_held_through_it_is_no_edge_a_
 
 // --- the index pulse under the shaft --------------------------------------------------------------
 
-struct run {
-  homing_status status;
-  shaft s;
-  std::int64_t offset = 0;
-  // The cycle in which the run found home (its search ended): where the shaft was before and after.
-  bool latched = false;
-  std::int64_t latch_from = 0;
-  std::int64_t latch_to = 0;
-  std::int64_t latch_velocity = 0;
-};
-
-bool searching(homing_phase p) {
-  return p == homing_phase::not_started || p == homing_phase::searching_home_switch ||
-         p == homing_phase::searching_limit_switch || p == homing_phase::searching_index_pulse;
-}
-
-// One homing run from a shaft at rest exactly at `start`, until attained at rest or error.
-run home(int method, const homing_machine& m, std::int64_t start, std::int64_t home_offset,
-         std::int64_t offset = 0) {
-  homing h;
-  homing_parameters par;
-  par.method = static_cast<std::int8_t>(method);
-  par.home_offset = home_offset;
-  run r;
-  r.s.position = start;
-  r.offset = offset;
-  h.step(false, par, m, r.s, r.offset, cycle_us);
-  for (long c = 0; c < 400000; ++c) {
-    const homing_phase before = h.phase();
-    const std::int64_t from = r.s.position;
-    r.status = h.step(true, par, m, r.s, r.offset, cycle_us);
-    if (!r.latched && searching(before) && !searching(h.phase())) {
-      r.latched = true;
-      r.latch_from = from;
-      r.latch_to = r.s.position;
-      r.latch_velocity = r.s.velocity;
-    }
-    if (r.status.error || (r.status.attained && r.status.target_reached)) break;
-  }
-  return r;
-}
-
 TEST(homing_index, method_34_run_twice_goes_on_one_revolution_to_the_next_pulse) {
   // Issue 42: 0x607C = 2,500; the second run starts standing on the pulse the first found.
   const homing_machine m;  // index pulses every revolution from 0
@@ -172,37 +134,17 @@ TEST(homing_index, method_34_run_twice_goes_on_one_revolution_to_the_next_pulse)
 }
 
 TEST(homing_index, a_shaft_a_fraction_above_a_pulse_still_crosses_it_going_down) {
-  homing h;
-  homing_parameters par;
-  par.method = 33;
   const homing_machine m;
-  shaft s;
-  s.position = 10000;
-  s.fraction = shaft::fraction_unit / 2;  // 10,000.5 increments
-  std::int64_t offset = 0;
-  h.step(false, par, m, s, offset, cycle_us);
-  homing_status st;
-  for (int c = 0; c < 20000 && !(st.attained && st.target_reached); ++c) st = h.step(true, par, m, s, offset, cycle_us);
-  ASSERT_TRUE(st.attained && st.target_reached);
-  EXPECT_EQ(s.position, 10000);
-  EXPECT_EQ(s.fraction, 0);
+  shaft start;
+  start.position = 10000;
+  start.fraction = shaft::fraction_unit / 2;  // 10,000.5 increments
+  const run r = home(33, m, start, 0, 0, 20000);
+  ASSERT_TRUE(r.status.attained && r.status.target_reached);
+  EXPECT_EQ(r.s.position, 10000);
+  EXPECT_EQ(r.s.fraction, 0);
 }
 
-// The machines of homing_test.cpp: limit switches at -200,000 and +300,000, index pulses every
-// revolution from 3,000, and a home switch that suits the method.
-homing_machine with_home_switch(std::int64_t low, std::int64_t high) {
-  homing_machine m;
-  m.negative_limit = -200000;
-  m.positive_limit = 300000;
-  m.home_switch_low = low;
-  m.home_switch_high = high;
-  m.index_at = 3000;
-  return m;
-}
-const homing_machine positive_home_switch = with_home_switch(50000, homing_machine::none_above);
-const homing_machine negative_home_switch = with_home_switch(homing_machine::none_below, 50000);
-const homing_machine cam = with_home_switch(50000, 80000);
-
+// The machines are homing_test.cpp's (homing_support.hpp).
 struct index_case {
   int method;
   const homing_machine* machine;
