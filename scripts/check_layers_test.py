@@ -3,25 +3,14 @@
 simulator, on a CoE codec that includes canopen, on a rule table that would allow either, and on a stale
 exception, and passes a tree that keeps the rules."""
 import os
-import subprocess
 import sys
-import tempfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from check_test_support import report, run_check  # noqa: E402
 
 
 def run(files, exceptions=""):
-    with tempfile.TemporaryDirectory() as root:
-        for path, text in files.items():
-            os.makedirs(os.path.dirname(os.path.join(root, path)), exist_ok=True)
-            with open(os.path.join(root, path), "w", encoding="utf-8") as f:
-                f.write(text)
-        os.makedirs(os.path.join(root, "scripts"), exist_ok=True)
-        with open(os.path.join(root, "scripts", "layer_exceptions.txt"), "w", encoding="utf-8") as f:
-            f.write(exceptions)
-        r = subprocess.run([sys.executable, os.path.join(HERE, "check_layers.py"), root],
-                           capture_output=True, text=True)
-        return r.returncode, r.stdout
+    return run_check("check_layers.py", "layer_exceptions.txt", files, exceptions)
 
 
 def main():
@@ -58,7 +47,6 @@ def main():
     codec["src/ethercat/coe/sdo.cpp"] = '#include "cia402/canopen/301/device.hpp"\n'
     code, out = run(codec)
     checks.append(("the CoE codec including canopen/301 fails", code == 1 and "ethercat/coe may not include canopen/301" in out))
-    sys.path.insert(0, HERE)
     import check_layers
     widened = {layer: set(seen) for layer, seen in check_layers.ALLOWED.items()}
     widened["canopen/402"].add("sim")
@@ -67,11 +55,7 @@ def main():
                    check_layers.check_rules(check_layers.ALLOWED) == [] and
                    ("canopen/402", "sim") in check_layers.check_rules(widened) and
                    ("ethercat/master", "ethercat/slave") in check_layers.check_rules(widened)))
-    failed = [name for name, ok in checks if not ok]
-    for name, ok in checks:
-        print(("ok   " if ok else "FAIL ") + name)
-    print(f"{len(checks) - len(failed)} passed, {len(failed)} failed")
-    return 1 if failed else 0
+    return report(checks)
 
 
 if __name__ == "__main__":

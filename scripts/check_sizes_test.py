@@ -3,24 +3,14 @@
 a class that long), and on a stale exception, and passes a listed breach and a tree that keeps the
 rules."""
 import os
-import subprocess
 import sys
-import tempfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from check_test_support import report, run_check  # noqa: E402
 
 
 def run(files, exceptions=""):
-    with tempfile.TemporaryDirectory() as root:
-        for path, text in files.items():
-            os.makedirs(os.path.dirname(os.path.join(root, path)), exist_ok=True)
-            with open(os.path.join(root, path), "w", encoding="utf-8") as f:
-                f.write(text)
-        os.makedirs(os.path.join(root, "scripts"), exist_ok=True)
-        with open(os.path.join(root, "scripts", "size_exceptions.txt"), "w", encoding="utf-8") as f:
-            f.write(exceptions)
-        r = subprocess.run([sys.executable, os.path.join(HERE, "check_sizes.py"), root], capture_output=True, text=True)
-        return r.returncode, r.stdout
+    return run_check("check_sizes.py", "size_exceptions.txt", files, exceptions)
 
 
 def function(name, body_lines):
@@ -49,11 +39,7 @@ def main():
     checks.append(("a listed breach passes", code == 0))
     code, out = run(sound, "src/sim/c.cpp:cut_me  # why\n")
     checks.append(("a listed breach that is gone fails", code == 1 and "remove it" in out))
-    failed = [name for name, ok in checks if not ok]
-    for name, ok in checks:
-        print(("ok   " if ok else "FAIL ") + name)
-    print(f"{len(checks) - len(failed)} passed, {len(failed)} failed")
-    return 1 if failed else 0
+    return report(checks)
 
 
 if __name__ == "__main__":
