@@ -32,6 +32,16 @@ pp_parameters profile_of(std::uint32_t velocity_rpm, std::uint32_t acceleration_
   return par;
 }
 
+// Offers `target` as a master does in one cycle: bit 4 high for that cycle, then low again in
+// `cmd` for the cycles that follow; returns that cycle's status.
+pp_status offer(profile_position& pp, pp_command& cmd, const pp_parameters& par, std::int64_t target) {
+  cmd.target = target;
+  cmd.new_setpoint = true;
+  const pp_status st = pp.step(cmd, par, cycle_us);
+  cmd.new_setpoint = false;
+  return st;
+}
+
 struct run_result {
   int cycles_to_reach = -1;     // first cycle whose status shows target reached
   int cycles_to_ack = -1;
@@ -132,15 +142,9 @@ TEST(profile_position, the_queue_and_change_immediately) {
   profile_position pp;
   pp.reset(0);
   pp_command cmd;
-  cmd.target = 10000;
-  cmd.new_setpoint = true;
-  pp.step(cmd, par, cycle_us);
-  cmd.new_setpoint = false;
+  offer(pp, cmd, par, 10000);
   for (int c = 0; c < 50; ++c) pp.step(cmd, par, cycle_us);
-  cmd.target = 20000;
-  cmd.new_setpoint = true;  // queued behind 10000
-  EXPECT_TRUE(pp.step(cmd, par, cycle_us).setpoint_acknowledge);
-  cmd.new_setpoint = false;
+  EXPECT_TRUE(offer(pp, cmd, par, 20000).setpoint_acknowledge) << "queued behind 10000";
   EXPECT_TRUE(pp.step(cmd, par, cycle_us).setpoint_acknowledge) << "still queued";
   EXPECT_EQ(pp.target(), 10000);
   bool stopped_at_first = false;
@@ -152,18 +156,12 @@ TEST(profile_position, the_queue_and_change_immediately) {
   EXPECT_EQ(pp.state().position, 20000);
 
   // Change immediately, while moving to 40000: turn back to 0 at once.
-  cmd.target = 40000;
-  cmd.new_setpoint = true;
-  pp.step(cmd, par, cycle_us);
-  cmd.new_setpoint = false;
+  offer(pp, cmd, par, 40000);
   for (int c = 0; c < 60; ++c) pp.step(cmd, par, cycle_us);
   ASSERT_GT(pp.state().velocity, 0);
-  cmd.target = 0;
-  cmd.new_setpoint = true;
   cmd.change_immediately = true;
-  pp.step(cmd, par, cycle_us);
+  offer(pp, cmd, par, 0);
   EXPECT_EQ(pp.target(), 0);
-  cmd.new_setpoint = false;
   std::int64_t furthest = 0;
   for (int c = 0; c < 5000 && pp.moving(); ++c) {
     pp.step(cmd, par, cycle_us);
@@ -179,16 +177,10 @@ TEST(profile_position, change_on_setpoint_blends_into_the_next_target) {
   profile_position pp;
   pp.reset(0);
   pp_command cmd;
-  cmd.target = 20000;
-  cmd.new_setpoint = true;
+  offer(pp, cmd, par, 20000);
   pp.step(cmd, par, cycle_us);
-  cmd.new_setpoint = false;
-  pp.step(cmd, par, cycle_us);
-  cmd.target = 40000;
-  cmd.new_setpoint = true;
   cmd.change_on_setpoint = true;
-  pp.step(cmd, par, cycle_us);
-  cmd.new_setpoint = false;
+  offer(pp, cmd, par, 40000);
   bool passed_at_speed = false;
   int cycles = 3;
   for (; cycles < 5000 && !(pp.state().position == 40000 && pp.state().velocity == 0); ++cycles) {
@@ -206,10 +198,7 @@ TEST(profile_position, halt_stops_on_the_deceleration_ramp_and_clearing_it_resum
   profile_position pp;
   pp.reset(0);
   pp_command cmd;
-  cmd.target = 100000;
-  cmd.new_setpoint = true;
-  pp.step(cmd, par, cycle_us);
-  cmd.new_setpoint = false;
+  offer(pp, cmd, par, 100000);
   for (int c = 0; c < 200; ++c) pp.step(cmd, par, cycle_us);
   ASSERT_EQ(pp.state().velocity, 600 * 1000000);
   cmd.halt = true;
