@@ -15,6 +15,12 @@ namespace {
 using test::replay;
 using test::settled;
 
+// A profile's name as a test's name: gtest takes no '-'.
+std::string test_name(std::string profile) {
+  std::replace(profile.begin(), profile.end(), '-', '_');
+  return profile;
+}
+
 // The words each profile is enabled with: seed 004_e07fd68605b3a8c6.txt needs bit 4 (fast stop,
 // active low) set as well, the others bits 0..3 alone.
 struct profile_words {
@@ -68,13 +74,7 @@ INSTANTIATE_TEST_SUITE_P(builtin, every_profile,
                                            profile_words{"lexium32", "0x0F"},
                                            profile_words{"s300-profibus", "0x0F"},
                                            profile_words{"ax2000-profibus", "0x1F"}),
-                         [](const auto& info) {
-                           std::string n = info.param.name;
-                           for (char& c : n) {
-                             if (c == '-') c = '_';
-                           }
-                           return n;
-                         });
+                         [](const auto& info) { return test_name(info.param.name); });
 
 TEST(replay_profiles, every_builtin_is_listed_in_the_every_profile_suite) {
   // The suite above names the profiles by hand; a new built-in must be added there.
@@ -85,6 +85,47 @@ TEST(replay_profiles, every_builtin_is_listed_in_the_every_profile_suite) {
     EXPECT_NE(std::find(std::begin(covered), std::end(covered), name), std::end(covered)) << name;
   }
 }
+
+// --- the profiles whose quick stop holds in QUICK STOP ACTIVE -----------------------------------
+// Each seed's words: the quick stop (fast stop) taken from OPERATION ENABLED by T11, Enable
+// operation back by T16, and the word that leaves the quick stop for SWITCH ON DISABLED.
+struct holding_quick_stop {
+  const char* name;
+  const char* enable;      ///< Enable operation
+  const char* quick_stop;  ///< Quick stop (fast stop) from OPERATION ENABLED
+  const char* leave;       ///< the word that ends the quick stop in SWITCH ON DISABLED
+  const char* leave_transition;
+};
+
+class quick_stop_holds : public ::testing::TestWithParam<holding_quick_stop> {};
+
+TEST_P(quick_stop_holds, in_quick_stop_active_by_t11_and_enable_operation_takes_t16) {
+  const holding_quick_stop& p = GetParam();
+  const auto r = replay(p.name, std::string("cw 0x06\ncw ") + p.enable + "\ncw " + p.quick_stop +
+                                    "\ncw " + p.enable + "\n");
+  EXPECT_EQ(r.lines.at(3), settled("QUICK_STOP_ACTIVE", test::qsa_standstill, "11"));
+  EXPECT_EQ(r.lines.at(4), settled("OPERATION_ENABLED", test::oe, "16"));
+}
+
+TEST_P(quick_stop_holds, its_leaving_word_in_quick_stop_active_ends_in_switch_on_disabled_at_once) {
+  const holding_quick_stop& p = GetParam();
+  const auto r = replay(p.name, std::string("cw 0x06\ncw ") + p.enable + "\ncw " + p.quick_stop +
+                                    "\ncw " + p.leave + "\n");
+  EXPECT_EQ(r.lines.at(4), settled("SWITCH_ON_DISABLED", test::sod, p.leave_transition));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    builtin, quick_stop_holds,
+    ::testing::Values(
+        // seed 001_f9323c8e43dc977c.txt: Disable voltage takes T12.
+        holding_quick_stop{"lexium32", "0x0F", "0x0B", "0x00", "12"},
+        // seed 003_83442f2f4b0b2bb9.txt: fast stop on bit 2 cleared, T16 on bit 2 set; bit 1
+        // cleared in fast stop takes T12.
+        holding_quick_stop{"s300-profibus", "0x0F", "0x0B", "0x09", "12"},
+        // seed 004_e07fd68605b3a8c6.txt: fast stop on bit 4 cleared, T16 on bit 4 set; bit 2
+        // cleared in fast stop takes T17.
+        holding_quick_stop{"ax2000-profibus", "0x1F", "0x0F", "0x0B", "17"}),
+    [](const auto& info) { return test_name(info.param.name); });
 
 // --- no-quick-stop, seed 000_44b471b7401b86be.txt: "'Quick Stop' is not supported" -------------
 
@@ -104,17 +145,6 @@ TEST(replay_no_quick_stop, quick_stop_option_object_does_not_exist) {
 }
 
 // --- lexium32, seed 001_f9323c8e43dc977c.txt ---------------------------------------------------
-
-TEST(replay_lexium32, quick_stop_holds_in_quick_stop_active_and_enable_operation_takes_t16) {
-  const auto r = replay("lexium32", "cw 0x06\ncw 0x0F\ncw 0x0B\ncw 0x0F\n");
-  EXPECT_EQ(r.lines.at(3), settled("QUICK_STOP_ACTIVE", test::qsa_standstill, "11"));
-  EXPECT_EQ(r.lines.at(4), settled("OPERATION_ENABLED", test::oe, "16"));
-}
-
-TEST(replay_lexium32, disable_voltage_in_quick_stop_active_takes_t12_at_once) {
-  EXPECT_EQ(replay("lexium32", "cw 0x06\ncw 0x0F\ncw 0x0B\ncw 0x00\n").lines.at(4),
-            settled("SWITCH_ON_DISABLED", test::sod, "12"));
-}
 
 TEST(replay_lexium32, class_3_fault_goes_straight_through_to_fault) {
   EXPECT_EQ(replay("lexium32", "cw 0x06\ncw 0x0F\nfault 0x2310 3\n").lines.at(3),
@@ -151,17 +181,6 @@ TEST(replay_lexium32, class_1_error_in_operation_enabled_quick_stops_and_holds) 
 
 // --- s300-profibus, seed 003_83442f2f4b0b2bb9.txt: fast stop on bit 2 -------------------------
 
-TEST(replay_s300, bit_2_cleared_in_operation_enabled_is_fast_stop_and_bit_2_set_takes_t16) {
-  const auto r = replay("s300-profibus", "cw 0x06\ncw 0x0F\ncw 0x0B\ncw 0x0F\n");
-  EXPECT_EQ(r.lines.at(3), settled("QUICK_STOP_ACTIVE", test::qsa_standstill, "11"));
-  EXPECT_EQ(r.lines.at(4), settled("OPERATION_ENABLED", test::oe, "16"));
-}
-
-TEST(replay_s300, bit_1_cleared_in_fast_stop_takes_t12) {
-  EXPECT_EQ(replay("s300-profibus", "cw 0x06\ncw 0x0F\ncw 0x0B\ncw 0x09\n").lines.at(4),
-            settled("SWITCH_ON_DISABLED", test::sod, "12"));
-}
-
 TEST(replay_s300, option_objects_do_not_exist_on_profibus) {
   EXPECT_NE(replay("s300-profibus", "set 0x605A 6\n").lines.at(1).find("0x06020000"),
             std::string::npos);
@@ -169,19 +188,8 @@ TEST(replay_s300, option_objects_do_not_exist_on_profibus) {
 
 // --- ax2000-profibus, seed 004_e07fd68605b3a8c6.txt: fast stop on bit 4, T17 on bit 2 ----------
 
-TEST(replay_ax2000, bit_4_cleared_in_operation_enabled_is_fast_stop_and_bit_4_set_takes_t16) {
-  const auto r = replay("ax2000-profibus", "cw 0x06\ncw 0x1F\ncw 0x0F\ncw 0x1F\n");
-  EXPECT_EQ(r.lines.at(3), settled("QUICK_STOP_ACTIVE", test::qsa_standstill, "11"));
-  EXPECT_EQ(r.lines.at(4), settled("OPERATION_ENABLED", test::oe, "16"));
-}
-
 TEST(replay_ax2000, bit_2_cleared_in_operation_enabled_takes_t17_to_switch_on_disabled) {
   EXPECT_EQ(replay("ax2000-profibus", "cw 0x06\ncw 0x1F\ncw 0x1B\n").lines.at(3),
-            settled("SWITCH_ON_DISABLED", test::sod, "17"));
-}
-
-TEST(replay_ax2000, bit_2_cleared_in_fast_stop_takes_t17) {
-  EXPECT_EQ(replay("ax2000-profibus", "cw 0x06\ncw 0x1F\ncw 0x0F\ncw 0x0B\n").lines.at(4),
             settled("SWITCH_ON_DISABLED", test::sod, "17"));
 }
 
