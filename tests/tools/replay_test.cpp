@@ -8,9 +8,9 @@
 
 #include <algorithm>
 #include <sstream>
-#include <variant>
 
 #include "cia402/profile_file.hpp"
+#include "../profile_file/helpers.hpp"
 #include "replay_support.hpp"
 
 namespace cia402 {
@@ -391,7 +391,7 @@ TEST(replay, profile_and_profile_file_together_are_refused) {
 
 TEST(replay, settling_is_bounded_when_a_profile_never_comes_to_rest) {
   // Two automatic rows that undo each other: the drive never settles, replay must still end.
-  profile_load_result loaded = load_profile_toml(R"(base = "cia402"
+  const custom_profile restless = test::load_ok(R"(base = "cia402"
 name = "restless"
 [[rows]]
 number = 0
@@ -413,13 +413,12 @@ number = 7
 from = ["ready_to_switch_on"]
 to = "switch_on_disabled"
 any = ["automatic"]
-)",
-                                                 "restless.toml");
-  ASSERT_TRUE(std::holds_alternative<custom_profile>(loaded));
+)");
+  ASSERT_FALSE(::testing::Test::HasFailure()) << "the restless profile was refused";
   std::istringstream in("cw 0x06\n");
   std::ostringstream out;
   std::ostringstream err;
-  EXPECT_EQ(cli::run_replay(std::get<custom_profile>(loaded).get(), {}, in, out, err), 0);
+  EXPECT_EQ(cli::run_replay(restless.get(), {}, in, out, err), 0);
   std::istringstream lines(out.str());
   std::string first;
   std::getline(lines, first);
