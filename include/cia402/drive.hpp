@@ -139,8 +139,15 @@ inline drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noe
 #if !defined(__OPTIMIZE_SIZE__)
   drive_outputs out;
   if (detail::quiet_step(p, a, in, out)) return out;
-#endif
+  // The full step on a copy: the only place the inputs' address is taken, so a caller's inputs
+  // built in locals stay in registers on the ordinary path instead of being stored every cycle
+  // for a call that seldom comes (97 instructions a quiet step where the copy makes it fewer,
+  // bench/instructions).
+  const drive_inputs copy = in;
+  return detail::full_step(p, a, copy);
+#else
   return detail::full_step(p, a, in);
+#endif
 }
 
 /// The same cycle, its outputs written into `out` where the caller keeps them (a simulator's axis):
@@ -149,8 +156,11 @@ inline drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noe
 inline void step(const profile& p, axis& a, const drive_inputs& in, drive_outputs& out) noexcept {
 #if !defined(__OPTIMIZE_SIZE__)
   if (detail::quiet_step(p, a, in, out)) return;
-#endif
+  const drive_inputs copy = in;  // as above
+  out = detail::full_step(p, a, copy);
+#else
   out = detail::full_step(p, a, in);
+#endif
 }
 
 /// Writes an option code (0x605A..0x605E, 0x6007). A value the profile does not support is refused

@@ -231,6 +231,18 @@ struct option_spec {
 };
 
 inline constexpr std::size_t max_rows = 32;
+
+/// The values of profile::ordinary_rows: bits 0..5 the row that fires plus 1 (0: none, quiet).
+namespace ordinary {
+inline constexpr std::uint8_t quiet = 0;
+inline constexpr std::uint8_t row = 0x3F;
+/// A row up to the match reads fact::fault_reset: a cycle with a fault-reset edge takes the full step.
+inline constexpr std::uint8_t reset_reads = 1u << 6;
+/// The row runs a stop first where torque is on (S7): such a cycle takes the full step.
+inline constexpr std::uint8_t stops = 1u << 7;
+/// Every cycle of this state and command takes the full step (no row index is 63).
+inline constexpr std::uint8_t full = 0xFF;
+}  // namespace ordinary
 inline constexpr std::size_t max_decoder_rules = 8;
 
 /// Rows as a profile stores them, built at compile time from rows as written:
@@ -297,6 +309,13 @@ struct profile {
   /// by an option code (QUICK STOP ACTIVE, FAULT REACTION ACTIVE): a cycle with none of these facts
   /// changes nothing (the quiet step, drive.hpp), and no row can fire without one.
   std::array<std::uint32_t, state_count> busy_from{};
+  /// What an ordinary cycle (detail/quiet_step.hpp: default inputs, no stop running, |speed| below
+  /// the limit) does in each state under each decoded command, at ordinary_index(state, command):
+  /// ordinary::quiet, a row that fires at once (its index + 1), or ordinary::full when the facts
+  /// an ordinary cycle does not fix (halt, stop complete, 0x605A's facts, the axis's fault flags)
+  /// could change the outcome, or the state stops by an option code, or the row goes to one that
+  /// does. 72 bytes; the full step stays the reference for everything else.
+  std::array<std::uint8_t, state_count * 8> ordinary_rows{};
 
   /// Points the profile at stored rows (stored_rows<...>) that outlive it.
   template <std::size_t NRows, std::size_t NSets>
@@ -333,6 +352,52 @@ struct profile {
           act == state_activity::quick_stop || act == state_activity::fault_reaction;
       busy_from[s] = stopping ? 0xFFFFFFFFu : triggers;
     }
+    for (int s = 0; s < state_count; ++s) {
+      for (unsigned c = 0; c < 8; ++c) ordinary_rows[ordinary_index(s, c)] = ordinary_entry(s, c);
+    }
+  }
+
+  /// Where the ordinary cycle of state s under command c is: s * 8 + c.
+  static constexpr std::size_t ordinary_index(int s, unsigned c) noexcept {
+    return static_cast<std::size_t>(s) * 8u + c;
+  }
+
+  /// The ordinary-cycle entry of state s under command c (finalize()): the first row leaving s that
+  /// fires on the facts every ordinary cycle has, unless a row before it or it reads a fact such a
+  /// cycle does not fix. A fault-reset edge sets fact::fault_reset, so rows up to the match that
+  /// read it mark the entry ordinary::reset_reads (the full step takes a cycle with an edge).
+  constexpr std::uint8_t ordinary_entry(int s, unsigned c) const noexcept {
+    const state_activity act = states[s].activity;
+    if (c >= static_cast<unsigned>(command_count) || act == state_activity::quick_stop ||
+        act == state_activity::fault_reaction) {
+      return ordinary::full;
+    }
+    constexpr std::uint32_t unfixed =
+        static_cast<std::uint32_t>(fact::halt) | static_cast<std::uint32_t>(fact::stop_complete) |
+        static_cast<std::uint32_t>(fact::quick_stop_ends) |
+        static_cast<std::uint32_t>(fact::quick_stop_stays) |
+        static_cast<std::uint32_t>(fact::entered_by_fault) |
+        static_cast<std::uint32_t>(fact::fault_latched);
+    const std::uint32_t f = static_cast<std::uint32_t>(fact::automatic) |
+                            static_cast<std::uint32_t>(fact::dc_link) |
+                            static_cast<std::uint32_t>(fact::below_speed_limit) |
+                            static_cast<std::uint32_t>(command_fact(static_cast<command>(c)));
+    std::uint8_t reset = 0;
+    for (std::size_t r = 0; r < row_count && r < max_rows; ++r) {
+      if (((rows[r].from() >> s) & 1u) == 0) continue;
+      const std::uint32_t any = fact_sets[rows[r].any], all = fact_sets[rows[r].all],
+                          none = fact_sets[rows[r].none];
+      if ((any | all | none) & unfixed) return ordinary::full;
+      if ((any | all | none) & static_cast<std::uint32_t>(fact::fault_reset)) reset = ordinary::reset_reads;
+      if ((any & f) && (all & f) == all && !(none & f)) {
+        if (static_cast<unsigned>(rows[r].to) >= static_cast<unsigned>(state_count)) return ordinary::full;
+        const state_activity to = states[static_cast<int>(rows[r].to)].activity;
+        if (to == state_activity::quick_stop || to == state_activity::fault_reaction) return ordinary::full;
+        return static_cast<std::uint8_t>((r + 1) | reset |
+                                         (rows[r].stop != row_stop::immediate ? ordinary::stops : 0u));
+      }
+    }
+    return reset;  // ordinary::quiet, or quiet but for an edge
   }
 
   /// Row i as written (i < row_count).

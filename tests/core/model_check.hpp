@@ -250,6 +250,19 @@ inline report check(const profile& p, const std::array<std::int8_t, option_count
           (!same_outputs(out, quiet_out) || std::memcmp(&next, &quiet, sizeof(axis)) != 0)) {
         violation("the quiet step differs from full_step", from, in);
       }
+      // The step every layer runs (the ordinary cycle's table, else the full step), also with
+      // every status bit reported: the table's rows decide more than the quiet cycle.
+      for (const std::uint16_t reported : {std::uint16_t{0}, std::uint16_t{0xFFFF}}) {
+        drive_inputs with = in;
+        with.status_bits = reported;
+        axis full_axis = from, step_axis = from;
+        const drive_outputs full_out = detail::full_step(p, full_axis, with);
+        const drive_outputs step_out = step(p, step_axis, with);
+        if (!same_outputs(full_out, step_out) ||
+            std::memcmp(&full_axis, &step_axis, sizeof(axis)) != 0) {
+          violation("step(profile) differs from full_step", from, with);
+        }
+      }
 
       // Safety (S12, S13, S14, S4): torque only where the state allows it, never without DC link or
       // under STO, the brake released only with torque, a coast-demanding fault cuts torque now.

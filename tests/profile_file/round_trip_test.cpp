@@ -49,6 +49,7 @@ void expect_same_tables(const profile& a, const profile& b) {
   EXPECT_EQ(a.command_of_bits, b.command_of_bits);
   EXPECT_EQ(a.rows_from, b.rows_from);
   EXPECT_EQ(a.busy_from, b.busy_from);
+  EXPECT_EQ(a.ordinary_rows, b.ordinary_rows) << "a loaded profile's ordinary cycle, computed at load";
 }
 
 // Random plant inputs, biased towards the words and events the tables react to.
