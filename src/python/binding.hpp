@@ -66,6 +66,18 @@ inline void check_access(sdo_abort code, std::uint16_t index, std::uint8_t sub,
   if (code != sdo_abort::none) raise_sdo_error(code, index, sub, action);
 }
 [[noreturn]] void raise_argument_error(const std::string& message);
+
+/// The names of a table of named entries (each with a `name`), joined by ", ": what an
+/// ArgumentError for a name the table lacks lists as the names there are.
+template <typename Table>
+std::string names_of(const Table& table) {
+  std::string names;
+  for (const auto& each : table) {
+    if (!names.empty()) names += ", ";
+    names += each.name;
+  }
+  return names;
+}
 [[noreturn]] void raise_profile_error(const profile_file_error& e);
 [[noreturn]] void raise_profile_error(const std::string& message);
 [[noreturn]] void raise_scenario_error(const sim::scenario_error& e);

@@ -85,12 +85,7 @@ plant_config plant_config_from(const py::handle& plant) {
     const auto* f = std::find_if(std::begin(plant_fields), std::end(plant_fields),
                                  [&](const plant_field& each) { return name == each.name; });
     if (f == std::end(plant_fields)) {
-      std::string known;
-      for (const plant_field& each : plant_fields) {
-        if (!known.empty()) known += ", ";
-        known += each.name;
-      }
-      raise_argument_error("unknown plant key '" + name + "' (the keys: " + known + ")");
+      raise_argument_error("unknown plant key '" + name + "' (the keys: " + names_of(plant_fields) + ")");
     }
     set_field(c, *f, value);
   }

@@ -81,12 +81,7 @@ const trace_column& find_column(const std::string& name) {
   for (const trace_column& c : trace_columns) {
     if (name == c.name) return c;
   }
-  std::string known;
-  for (const trace_column& c : trace_columns) {
-    if (!known.empty()) known += ", ";
-    known += c.name;
-  }
-  raise_argument_error("no trace column '" + name + "' (the columns: " + known + ")");
+  raise_argument_error("no trace column '" + name + "' (the columns: " + names_of(trace_columns) + ")");
 }
 
 template <typename Write>
