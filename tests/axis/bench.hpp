@@ -52,6 +52,12 @@ struct bench {
   result enable() {
     return finish([this](completion d) { return s->go_to(state::operation_enabled, std::move(d)); });
   }
+  /// Raises a fault (0x603F = code) in the drive and polls until the session sees FAULT, at most
+  /// `ms`; true if it did.
+  bool fault(std::uint16_t code = 0x2310, int ms = 1000) {
+    link.drive.view().inject_fault(code);
+    return run_until([this] { return s->observed() == state::fault; }, ms);
+  }
   bool sent(std::uint16_t mask, std::uint16_t value) const {
     for (const auto& [t, w] : link.words) {
       if ((w & mask) == value) return true;

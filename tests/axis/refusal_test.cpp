@@ -43,8 +43,7 @@ TEST(refusal, a_mode_0x6061_never_shows_is_named_with_what_it_shows) {
 TEST(refusal, a_drive_in_fault_is_named_with_its_error_code_and_text) {
   bench b;
   ASSERT_TRUE(b.enable().ok());
-  b.link.drive.view().inject_fault(0x2310);
-  ASSERT_TRUE(b.run_until([&] { return b.s->observed() == state::fault; }, 1000));
+  ASSERT_TRUE(b.fault(0x2310));
   const std::size_t words = b.link.words.size();
   for (const auto& request : std::vector<std::function<std::uint64_t(completion)>>{
            [&](completion d) { return b.s->move({100, false, std::nullopt}, std::move(d)); },

@@ -201,8 +201,7 @@ TEST(session, reset_clears_a_fault_with_an_edge_and_leaves_a_healthy_drive_alone
   EXPECT_TRUE(b.link.words.empty()) << "looked, sent nothing";
 
   ASSERT_TRUE(b.enable().ok());
-  b.link.drive.view().inject_fault(0x2310);
-  ASSERT_TRUE(b.run_until([&] { return b.s->observed() == state::fault; }, 1000));
+  ASSERT_TRUE(b.fault(0x2310));
   b.link.drive.view().clear_faults();
   const result r = b.finish([&](completion d) { return b.s->reset(std::move(d)); });
   ASSERT_TRUE(r.ok()) << r.error;
@@ -218,8 +217,7 @@ TEST(session, a_fault_reset_edge_reaches_a_drive_that_steps_slower_than_the_puls
   bench b(c);
   b.link.cycle = 40'000;
   ASSERT_TRUE(b.enable().ok());
-  b.link.drive.view().inject_fault(0x2310);
-  ASSERT_TRUE(b.run_until([&] { return b.s->observed() == state::fault; }, 2000));
+  ASSERT_TRUE(b.fault(0x2310, 2000));
   b.link.drive.view().clear_faults();
   const result r = b.finish([&](completion d) { return b.s->reset(std::move(d)); });
   ASSERT_TRUE(r.ok()) << r.error;
@@ -229,8 +227,7 @@ TEST(session, a_fault_reset_edge_reaches_a_drive_that_steps_slower_than_the_puls
 TEST(session, a_fault_reset_edge_to_a_drive_that_stopped_answering_ends_and_says_so) {
   bench b;
   ASSERT_TRUE(b.enable().ok());
-  b.link.drive.view().inject_fault(0x2310);
-  ASSERT_TRUE(b.run_until([&] { return b.s->observed() == state::fault; }, 1000));
+  ASSERT_TRUE(b.fault(0x2310));
   b.link.drive.view().clear_faults();
   b.link.cycle = 100'000'000;  // no status word for 100 s
   const result r = b.finish([&](completion d) { return b.s->reset(std::move(d)); }, 5000);
@@ -241,8 +238,7 @@ TEST(session, a_fault_reset_edge_to_a_drive_that_stopped_answering_ends_and_says
 TEST(session, a_reset_whose_cause_persists_says_so) {
   bench b;
   ASSERT_TRUE(b.enable().ok());
-  b.link.drive.view().inject_fault(0x2310);
-  ASSERT_TRUE(b.run_until([&] { return b.s->observed() == state::fault; }, 1000));
+  ASSERT_TRUE(b.fault(0x2310));
   const result r = b.finish([&](completion d) { return b.s->reset(std::move(d)); });
   EXPECT_FALSE(r.ok());
   EXPECT_NE(r.error.find("still in FAULT after the fault-reset edge: error code 0x2310 (continuous over-current)"),
