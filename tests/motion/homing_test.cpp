@@ -18,14 +18,7 @@
 namespace cia402::motion {
 namespace {
 
-using test::cam;
-using test::cycle_us;
-using test::floor_div;
-using test::home;
-using test::negative_home_switch;
-using test::positive_home_switch;
-using test::revolution;
-using run = test::homing_run;
+using namespace test;  // homing_support.hpp
 
 constexpr std::int64_t home_offset = 777;
 
@@ -98,7 +91,7 @@ TEST(homing, every_method_of_0x60E3_homes_where_its_figure_says_and_again_there_
     for (const std::int64_t start : c.starts) {
       SCOPED_TRACE("method " + std::to_string(c.method) + " from " + std::to_string(start));
       const std::int64_t home_at = expected_home(c.method, *c.machine, start);
-      const run first = home(c.method, *c.machine, start, home_offset);
+      const homing_run first = home(c.method, *c.machine, start, home_offset);
       ASSERT_FALSE(first.status.error);
       ASSERT_TRUE(first.status.attained && first.status.target_reached) << "not done in " << first.cycles;
       EXPECT_EQ(first.s.position, home_at) << "the shaft stands at home";
@@ -106,7 +99,7 @@ TEST(homing, every_method_of_0x60E3_homes_where_its_figure_says_and_again_there_
       EXPECT_EQ(first.s.position + first.offset, home_offset) << "home reads as 0x607C";
       // Again, from home: the switches and pulses have not moved, so neither does home (33 and 34
       // go on to the next pulse: the one under the standing shaft is not latched).
-      const run second = home(c.method, *c.machine, first.s.position, home_offset, first.offset);
+      const homing_run second = home(c.method, *c.machine, first.s.position, home_offset, first.offset);
       ASSERT_FALSE(second.status.error);
       ASSERT_TRUE(second.status.attained && second.status.target_reached);
       const std::int64_t again_at = expected_home(c.method, *c.machine, first.s.position);
@@ -131,7 +124,7 @@ TEST(homing, a_default_method_3_run_ends_within_two_seconds) {
   // The plant's defaults: a home switch from 5 revolutions up, index pulses from 0, 0x6099 and
   // 0x609A as homing_parameters has them.
   homing_machine m;
-  const run r = home(3, m, 0, home_offset);
+  const homing_run r = home(3, m, 0, home_offset);
   ASSERT_TRUE(r.status.attained && r.status.target_reached);
   EXPECT_EQ(r.s.position, 40000);
   EXPECT_LT(r.cycles, 2000);
@@ -152,7 +145,7 @@ TEST(homing, a_limit_switch_where_the_method_expects_none_is_a_homing_error) {
                             bad_case{5, &positive_home_switch, 0}, bad_case{6, &positive_home_switch, 0},
                             bad_case{33, &no_pulse_room, 0}}) {
     SCOPED_TRACE(c.method);
-    const run r = home(c.method, *c.machine, c.start, home_offset);
+    const homing_run r = home(c.method, *c.machine, c.start, home_offset);
     ASSERT_TRUE(r.status.error);
     EXPECT_FALSE(r.status.attained);
     EXPECT_EQ(r.offset, 0) << "nothing redefined";
@@ -174,7 +167,7 @@ TEST(homing, a_switch_the_machine_lacks_is_searched_for_1000_revolutions_then_a_
                           lacking{3, &bare}, lacking{19, &bare}, lacking{14, &bare}, lacking{30, &bare},
                           lacking{10, &endless}, lacking{26, &endless}, lacking{11, &endless}, lacking{5, &endless}}) {
     SCOPED_TRACE(c.method);
-    const run r = home(c.method, *c.machine, 0, home_offset, 0, 2000000);
+    const homing_run r = home(c.method, *c.machine, 0, home_offset, 0, 2000000);
     ASSERT_TRUE(r.status.error);
     EXPECT_LE(std::llabs(r.s.position), (homing::max_search_revolutions + 10) * revolution);
     EXPECT_EQ(r.offset, 0);

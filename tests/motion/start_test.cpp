@@ -17,14 +17,7 @@
 namespace cia402::motion {
 namespace {
 
-using test::cam;
-using test::cycle_us;
-using test::floor_div;
-using test::home;
-using test::negative_home_switch;
-using test::positive_home_switch;
-using test::revolution;
-using run = test::homing_run;
+using namespace test;  // homing_support.hpp
 
 // --- bit 4's edge ---------------------------------------------------------------------------------
 
@@ -115,11 +108,11 @@ TEST(homing_bit_4, stand_by_interrupts_a_run_bit_4_held_through_it_is_no_edge_a_
 TEST(homing_index, method_34_run_twice_goes_on_one_revolution_to_the_next_pulse) {
   // Issue 42: 0x607C = 2,500; the second run starts standing on the pulse the first found.
   const homing_machine m;  // index pulses every revolution from 0
-  const run first = home(34, m, 1234, 2500);
+  const homing_run first = home(34, m, 1234, 2500);
   ASSERT_TRUE(first.status.attained && first.status.target_reached);
   EXPECT_EQ(first.s.position, 10000);
   EXPECT_EQ(first.s.position + first.offset, 2500);
-  const run second = home(34, m, first.s.position, 2500, first.offset);
+  const homing_run second = home(34, m, first.s.position, 2500, first.offset);
   ASSERT_TRUE(second.status.attained && second.status.target_reached);
   EXPECT_EQ(second.s.position, 20000) << "one revolution on, not the pulse it stood on";
   EXPECT_EQ(second.s.position + second.offset, 2500) << "the new home reads as 0x607C";
@@ -128,7 +121,7 @@ TEST(homing_index, method_34_run_twice_goes_on_one_revolution_to_the_next_pulse)
   EXPECT_LT(second.latch_from, 20000);
   EXPECT_GE(second.latch_to, 20000) << "latched moving across it";
   // And 33 the mirror image: from the pulse at 0, the one at -10,000.
-  const run down = home(33, m, 0, 2500);
+  const homing_run down = home(33, m, 0, 2500);
   ASSERT_TRUE(down.status.attained && down.status.target_reached);
   EXPECT_EQ(down.s.position, -10000);
 }
@@ -138,7 +131,7 @@ TEST(homing_index, a_shaft_a_fraction_above_a_pulse_still_crosses_it_going_down)
   shaft start;
   start.position = 10000;
   start.fraction = shaft::fraction_unit / 2;  // 10,000.5 increments
-  const run r = home(33, m, start, 0, 0, 20000);
+  const homing_run r = home(33, m, start, 0, 0, 20000);
   ASSERT_TRUE(r.status.attained && r.status.target_reached);
   EXPECT_EQ(r.s.position, 10000);
   EXPECT_EQ(r.s.fraction, 0);
@@ -170,7 +163,7 @@ class every_index_method_test : public ::testing::TestWithParam<index_case> {};
 TEST_P(every_index_method_test, a_start_standing_on_a_pulse_takes_only_a_pulse_it_moves_across) {
   const index_case c = GetParam();
   const homing_machine& m = *c.machine;
-  const run reference = home(c.method, m, 0, 777);
+  const homing_run reference = home(c.method, m, 0, 777);
   ASSERT_TRUE(reference.status.attained && reference.status.target_reached);
   const std::int64_t pulse_home = reference.s.position;
   ASSERT_EQ(floor_div(pulse_home - m.index_at, revolution) * revolution, pulse_home - m.index_at);
@@ -179,7 +172,7 @@ TEST_P(every_index_method_test, a_start_standing_on_a_pulse_takes_only_a_pulse_i
     const std::int64_t expected = c.method == 33   ? start - revolution
                                   : c.method == 34 ? start + revolution
                                                    : pulse_home;
-    const run r = home(c.method, m, start, 777);
+    const homing_run r = home(c.method, m, start, 777);
     ASSERT_FALSE(r.status.error);
     ASSERT_TRUE(r.status.attained && r.status.target_reached);
     EXPECT_EQ(r.s.position, expected);
