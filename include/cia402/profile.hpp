@@ -305,17 +305,14 @@ struct profile {
   // rows that leave it (bit i = rows[i]), so a step that can fire nothing costs one AND.
   std::array<std::uint8_t, 32> command_of_bits{};
   std::array<std::uint32_t, state_count> rows_from{};
-  /// The union of the triggers of the rows leaving each state, or every fact for states that stop
-  /// by an option code (QUICK STOP ACTIVE, FAULT REACTION ACTIVE): a cycle with none of these facts
-  /// changes nothing (the quiet step, drive.hpp), and no row can fire without one.
-  std::array<std::uint32_t, state_count> busy_from{};
   /// What an ordinary cycle (detail/quiet_step.hpp: default inputs, no stop running, |speed| below
   /// the limit) does in each state under each decoded command, at ordinary_index(state, command):
   /// ordinary::quiet, a row that fires at once (its index + 1), or ordinary::full when the facts
   /// an ordinary cycle does not fix (halt, stop complete, 0x605A's facts, the axis's fault flags)
   /// could change the outcome, or the state stops by an option code, or the row goes to one that
-  /// does. 72 bytes; the full step stays the reference for everything else.
-  std::array<std::uint8_t, state_count * 8> ordinary_rows{};
+  /// does. 54 bytes (a firmware's flash: bench/cortex_m4); the full step stays the reference for
+  /// everything else. The decoder yields commands below command_count (check_profile).
+  std::array<std::uint8_t, state_count * command_count> ordinary_rows{};
 
   /// Points the profile at stored rows (stored_rows<...>) that outlive it.
   template <std::size_t NRows, std::size_t NSets>
@@ -340,26 +337,18 @@ struct profile {
     }
     for (int s = 0; s < state_count; ++s) {
       rows_from[s] = 0;
-      std::uint32_t triggers = 0;
       for (std::size_t r = 0; r < row_count && r < max_rows; ++r) {
-        if ((rows[r].from() >> s) & 1u) {
-          rows_from[s] |= 1u << r;
-          triggers |= fact_sets[rows[r].any];
-        }
+        if ((rows[r].from() >> s) & 1u) rows_from[s] |= 1u << r;
       }
-      const state_activity act = states[s].activity;
-      const bool stopping =
-          act == state_activity::quick_stop || act == state_activity::fault_reaction;
-      busy_from[s] = stopping ? 0xFFFFFFFFu : triggers;
-    }
-    for (int s = 0; s < state_count; ++s) {
-      for (unsigned c = 0; c < 8; ++c) ordinary_rows[ordinary_index(s, c)] = ordinary_entry(s, c);
+      for (unsigned c = 0; c < static_cast<unsigned>(command_count); ++c) {
+        ordinary_rows[ordinary_index(s, c)] = ordinary_entry(s, c);
+      }
     }
   }
 
-  /// Where the ordinary cycle of state s under command c is: s * 8 + c.
+  /// Where the ordinary cycle of state s under command c is.
   static constexpr std::size_t ordinary_index(int s, unsigned c) noexcept {
-    return static_cast<std::size_t>(s) * 8u + c;
+    return static_cast<std::size_t>(s) * static_cast<std::size_t>(command_count) + c;
   }
 
   /// The ordinary-cycle entry of state s under command c (finalize()): the first row leaving s that
@@ -368,10 +357,7 @@ struct profile {
   /// read it mark the entry ordinary::reset_reads (the full step takes a cycle with an edge).
   constexpr std::uint8_t ordinary_entry(int s, unsigned c) const noexcept {
     const state_activity act = states[s].activity;
-    if (c >= static_cast<unsigned>(command_count) || act == state_activity::quick_stop ||
-        act == state_activity::fault_reaction) {
-      return ordinary::full;
-    }
+    if (act == state_activity::quick_stop || act == state_activity::fault_reaction) return ordinary::full;
     constexpr std::uint32_t unfixed =
         static_cast<std::uint32_t>(fact::halt) | static_cast<std::uint32_t>(fact::stop_complete) |
         static_cast<std::uint32_t>(fact::quick_stop_ends) |

@@ -149,7 +149,7 @@ axis make_axis(const profile& p) noexcept {
   return a;
 }
 
-// Everything but the quiet cycle (detail/quiet_step.hpp): facts, the first matching row, pending
+// Everything but the ordinary cycle (detail/quiet_step.hpp): facts, the first matching row, pending
 // stops (S7), outputs.
 drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& in) noexcept {
   drive_outputs out;
@@ -250,15 +250,13 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   // The first row leaving the present state whose facts hold.
   const int from = static_cast<int>(a.current);
   std::uint8_t match = no_row;
-  if (p.busy_from[from] & f) {
-    for (std::uint32_t rows = p.rows_from[from]; rows != 0; rows &= rows - 1) {
-      const std::uint8_t i = static_cast<std::uint8_t>(detail::lowest_bit(rows));
-      const stored_row& r = p.rows[i];
-      const std::uint32_t all = p.fact_sets[r.all];
-      if ((p.fact_sets[r.any] & f) && (all & f) == all && !(p.fact_sets[r.none] & f)) {
-        match = i;
-        break;
-      }
+  for (std::uint32_t rows = p.rows_from[from]; rows != 0; rows &= rows - 1) {
+    const std::uint8_t i = static_cast<std::uint8_t>(detail::lowest_bit(rows));
+    const stored_row& r = p.rows[i];
+    const std::uint32_t all = p.fact_sets[r.all];
+    if ((p.fact_sets[r.any] & f) && (all & f) == all && !(p.fact_sets[r.none] & f)) {
+      match = i;
+      break;
     }
   }
 

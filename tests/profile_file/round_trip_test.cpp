@@ -48,7 +48,6 @@ void expect_same_tables(const profile& a, const profile& b) {
   EXPECT_EQ(a.words, b.words) << "the bit names (word_names)";
   EXPECT_EQ(a.command_of_bits, b.command_of_bits);
   EXPECT_EQ(a.rows_from, b.rows_from);
-  EXPECT_EQ(a.busy_from, b.busy_from);
   EXPECT_EQ(a.ordinary_rows, b.ordinary_rows) << "a loaded profile's ordinary cycle, computed at load";
 }
 

@@ -39,8 +39,8 @@ inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_
   // Halt (S8) ramps by 0x605D; a value outside 1..4 is the full step's to decide.
   const bool halt_asked = (cw & 0x100u) && p.options[3].supported != 0;
   const bool odd_halt = halt_asked && static_cast<std::uint8_t>(a.options[3] - 1) >= 4u;
-  const std::uint8_t entry = p.ordinary_rows[static_cast<std::size_t>(a.current) * 8u +
-                                             p.command_of_bits[cw & 0x1Fu]];
+  const std::uint8_t entry = p.ordinary_rows[profile::ordinary_index(static_cast<int>(a.current),
+                                                                    p.command_of_bits[cw & 0x1Fu])];
   const bool torque_was_on = (flags & axis_flag::torque_on) != 0;
   if (unusual_inputs | (a.pending_row != 0xFF) | beyond_limit | odd_halt | (entry == ordinary::full) |
       ((edge != 0) & ((entry & ordinary::reset_reads) != 0)) |
