@@ -186,6 +186,11 @@ class session {
   /// word held reset_pulse_us. Done once the drive has had the last word; a drive in FAULT takes it
   /// too (it is how a client resets one by hand).
   std::uint64_t send_word(std::uint16_t word, bool reset_edge, completion done);
+  /// Profile position's set-point offer (the page's "new set-point"): `word` with control bit 4
+  /// rising (down first if it was up), held until status bit 12 acknowledges it, then bit 4 down
+  /// again, all on the session's cycle. Bit 4 comes down also when no acknowledge came within
+  /// acknowledge_timeout_us: then the result failed and says so. Another request supersedes it.
+  std::uint64_t offer_set_point(std::uint16_t word, completion done);
   /// An object with its type (the core's table, then the link's describe()); without one, an
   /// upload gives its bytes.
   std::uint64_t read_object(std::uint16_t index, std::uint8_t sub, completion done);
