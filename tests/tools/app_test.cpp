@@ -2,6 +2,9 @@
 // errors that exit 2 like every refusal of the tool (not CLI11's own codes 105..109).
 #include <gtest/gtest.h>
 
+#include <string>
+#include <vector>
+
 #include "replay_support.hpp"
 
 namespace {
@@ -38,6 +41,25 @@ TEST(app, argument_errors_exit_2) {
   EXPECT_EQ(run_tool({"diagram", "--format", "png"}).exit_code, 2);    // a value not allowed
   EXPECT_EQ(run_tool({"eds", "--node", "0"}).exit_code, 2);            // out of range
   EXPECT_EQ(run_tool({"path", "SOD"}).exit_code, 2);
+}
+
+TEST(app, an_output_file_that_cannot_be_written_exits_2_and_names_the_path) {
+  const std::string nowhere = "/nonexistent-cia402-dir/out";
+  const std::string scenario = CIA402_EXAMPLE_PROFILES_DIR "/../scenarios/quick-stop-2.toml";
+  struct refusal {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  for (const refusal& c : {refusal{{"eds", "-o", nowhere}, "cia402 eds: cannot write " + nowhere},
+                           refusal{{"esi", "-o", nowhere}, "cia402 esi: cannot write " + nowhere},
+                           refusal{{"simulate", scenario, "--trace", nowhere + ".csv"},
+                                   "cia402 simulate: cannot write " + nowhere + ".csv"},
+                           refusal{{"simulate", scenario, "--plot", nowhere + ".svg"},
+                                   "cia402 simulate: cannot write " + nowhere + ".svg"}}) {
+    const auto r = run_tool(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.message;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "cli/common.hpp"
 
 #include <CLI/CLI.hpp>
+#include <fstream>
 #include <limits>
 #include <ostream>
 #include <variant>
@@ -34,6 +35,14 @@ const volatile std::sig_atomic_t& stop_signals::flag() noexcept { return stop_fl
 std::optional<std::int64_t> parse_number(std::string_view text) {
   return support::parse_integer(text, std::numeric_limits<std::int32_t>::min(),
                                 std::numeric_limits<std::uint32_t>::max());
+}
+
+bool open_output(std::ofstream& file, const std::string& path, std::string_view command, std::ostream& err,
+                 std::ios::openmode mode) {
+  file.open(path, mode | std::ios::out);
+  if (file) return true;
+  err << "cia402 " << command << ": cannot write " << path << "\n";
+  return false;
 }
 
 std::string builtin_profile_names() {

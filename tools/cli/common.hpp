@@ -4,6 +4,7 @@
 
 #include <csignal>
 #include <cstdint>
+#include <ios>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -57,6 +58,11 @@ class stop_signals {
   struct sigaction old_int_ {};
   struct sigaction old_term_ {};
 };
+
+/// Opens `path` for writing (mode: std::ios::binary and the like); if it cannot, says
+/// "cia402 COMMAND: cannot write PATH" on err and returns false.
+bool open_output(std::ofstream& file, const std::string& path, std::string_view command, std::ostream& err,
+                 std::ios::openmode mode = std::ios::out);
 
 /// "cia402, no-quick-stop, ..." for messages.
 std::string builtin_profile_names();

@@ -51,11 +51,8 @@ int run_eds(const eds_args& args, std::ostream& out, std::ostream& err) {
     canopen::write_eds(node, info, out);
     return 0;
   }
-  std::ofstream file(args.output);
-  if (!file) {
-    err << "cia402 eds: cannot write " << args.output << "\n";
-    return 2;
-  }
+  std::ofstream file;
+  if (!open_output(file, args.output, "eds", err)) return 2;
   info.file_name = args.output.substr(args.output.find_last_of('/') + 1);
   canopen::write_eds(node, info, file);
   return file ? 0 : 2;

@@ -6,6 +6,7 @@
 
 #include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/sii/slave_information.hpp"
+#include "cli/common.hpp"
 
 namespace cia402::cli {
 
@@ -23,11 +24,8 @@ int run_esi(const esi_args& args, std::ostream& out, std::ostream& err) {
     out << xml;
     return 0;
   }
-  std::ofstream file(args.output);
-  if (!file) {
-    err << "cia402 esi: cannot write " << args.output << "\n";
-    return 2;
-  }
+  std::ofstream file;
+  if (!open_output(file, args.output, "esi", err)) return 2;
   file << xml;
   return file ? 0 : 2;
 }

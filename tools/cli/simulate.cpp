@@ -8,6 +8,7 @@
 
 #include "cia402/sim/scenario.hpp"
 #include "cia402/sim/trace.hpp"
+#include "cli/common.hpp"
 
 namespace cia402::cli {
 namespace {
@@ -71,20 +72,8 @@ int run_simulate(const simulate_args& args, std::ostream& out, std::ostream& err
   // Open the outputs before running, so a path that cannot be written refuses the run.
   std::ofstream trace_file;
   std::ofstream plot_file;
-  if (!args.trace.empty()) {
-    trace_file.open(args.trace, std::ios::binary);
-    if (!trace_file) {
-      err << "cia402 simulate: cannot write " << args.trace << "\n";
-      return refused;
-    }
-  }
-  if (!args.plot.empty()) {
-    plot_file.open(args.plot, std::ios::binary);
-    if (!plot_file) {
-      err << "cia402 simulate: cannot write " << args.plot << "\n";
-      return refused;
-    }
-  }
+  if (!args.trace.empty() && !open_output(trace_file, args.trace, "simulate", err, std::ios::binary)) return refused;
+  if (!args.plot.empty() && !open_output(plot_file, args.plot, "simulate", err, std::ios::binary)) return refused;
 
   const std::uint64_t duration_us = (s.cycles - 1) * s.plant.cycle_us;
   if (!args.quiet) {
