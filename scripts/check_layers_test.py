@@ -35,6 +35,16 @@ def main():
     checks.append(("a listed breach passes", code == 0))
     code, out = run(sound, "src/sim/scenario_file.cpp -> src/core/profiles/rows.hpp  # why\n")
     checks.append(("a listed breach that is gone fails", code == 1 and "remove it" in out))
+    steering = dict(sound)
+    steering["src/axis/session.cpp"] = "cia402::master m; master_policy p;\n"
+    steering["src/ethercat/master/ecat_master.cpp"] = "// frames, not cia402::master steering\n"
+    code, out = run(steering)
+    checks.append(("the axis session may steer, a comment naming the master step is no steering", code == 0))
+    steering["src/canopen/402/drive_master.cpp"] = "  s.policy = master_policy::make(p, a, t);\n"
+    code, out = run(steering)
+    checks.append(("a bus master that steers fails", code == 1 and "canopen/402 steers a drive" in out))
+    code, out = run(steering, "src/canopen/402/drive_master.cpp -> steering  # why\n")
+    checks.append(("a listed steering breach passes", code == 0))
     fieldbus = dict(sound)
     fieldbus["include/cia402/sim/virtual_drive.hpp"] = "#pragma once\n"
     fieldbus["src/canopen/402/drive_master.cpp"] = '#include "cia402/sim/virtual_drive.hpp"\n'
