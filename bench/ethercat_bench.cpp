@@ -16,6 +16,7 @@
 #include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/esc/esc.hpp"
 #include "cia402/ethercat/master/ecat_master.hpp"
+#include "cia402/master.hpp"
 #include "cia402/profile.hpp"
 
 namespace {
@@ -98,9 +99,18 @@ void drive_line_1ms_cycle(benchmark::State& st) {
     st.SkipWithError(master.error().c_str());
     return;
   }
-  for (std::size_t i = 0; i < n; ++i) master.set_target(i, cia402::state::operation_enabled);
+  // The master carries words: each drive's control word comes from the core's master step, as the
+  // axis session's does over the EtherCAT link, given before the cycle that sends it.
+  const cia402::profile& p = cia402::standard_profile();
+  const cia402::master_policy policy = cia402::master_policy::make(p, cia402::make_axis(p), cia402::state::operation_enabled);
+  std::vector<cia402::master> steering(n);
+  for (cia402::master& m : steering) m.set_target(policy, link.now_us(), 2'000'000);
   std::uint64_t short_counts = 0;
   for (auto _ : st) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const ecat_slave& s = master.slaves()[i];
+      master.send_control_word(i, steering[i].step(s.last_status, link.now_us(), s.last_error_code));
+    }
     short_counts += master.cycle() ? 0 : 1;
     link.wait_us(1000);
   }
