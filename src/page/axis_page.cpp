@@ -71,7 +71,7 @@ void axis_page::impl::start_session(const profile& p) {
   session->on_link = [this](axes::link_event e, const std::string& text) {
     if (e == axes::link_event::failed) {
       observed.reset();
-      handshake.reset();
+      offering.reset();
       log.finish_pending(text.c_str());
     } else if (e == axes::link_event::restarted) {
       injected_fault = 0;
@@ -118,7 +118,6 @@ void axis_page::impl::advance(std::uint32_t elapsed_us) {
     note_error_code(drive.plant != nullptr ? drive.plant->view().outputs().error_code : session->error_code());
   }
   keep_views_read();
-  run_handshake();
   check_enable_walk();
   if (log.pending()) log.settle(now_us, busy_now());
   if (now_us >= next_publish_us) {
@@ -219,29 +218,6 @@ void axis_page::impl::record_bus_row() {
   row.torque_permille = static_cast<std::int32_t>(value_of(object_index::torque_actual_value).value_or(0));
   row.mode = static_cast<std::int8_t>(value_of(object_index::modes_of_operation_display).value_or(0));
   recording.record(row);
-}
-
-// Bit 4 goes up once the session sent the word before it, and falls at status bit 12 (or
-// unacknowledged after new_setpoint_wait_us).
-void axis_page::impl::run_handshake() {
-  if (!handshake || requested_word) return;
-  constexpr std::uint16_t bit4 = 1u << 4;
-  handshake_run& h = *handshake;
-  if (!h.raised) {
-    h.raised = true;
-    h.give_up_us = now_us + detail::new_setpoint_wait_us;
-    send_word(static_cast<std::uint16_t>(h.word | bit4), false);
-    return;
-  }
-  const bool acknowledged = (word_shown() & bit4) != 0 && (session->status_word() & (1u << 12)) != 0;
-  if (!acknowledged && now_us < h.give_up_us) return;
-  if (!acknowledged) {
-    log.report_now("NEW_SET-POINT", "refused",
-                   "refused: no set-point acknowledge (status bit 12) within " +
-                       std::to_string(detail::new_setpoint_wait_us / 1000) + " ms; bit 4 cleared" + conditions());
-  }
-  handshake.reset();
-  send_word(static_cast<std::uint16_t>(word_shown() & ~bit4), false);
 }
 
 // The walk to OPERATION ENABLED ends where the drive's own inputs block it (a fault, STO, no DC

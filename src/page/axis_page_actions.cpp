@@ -6,9 +6,11 @@
 #include "axis_page_impl.hpp"
 
 #include <limits>
+#include <memory>
 
 #include "cia402/manufacturer_objects.hpp"
 #include "cia402/objects.hpp"
+#include "cia402/words.hpp"
 #include "commissioning.hpp"
 #include "page_json.hpp"
 #include "page_names.hpp"
@@ -44,7 +46,7 @@ void axis_page::impl::send_word(std::uint16_t word, bool reset_edge) {
 
 // Logs a command or bit toggle and gives its word to the session.
 std::uint64_t axis_page::impl::change_word(const detail::word_change& w) {
-  handshake.reset();  // a word given by hand ends the handshake: bit 4 as the word has it
+  offering.reset();  // a word given by hand ends the handshake: bit 4 as the word has it
   const std::uint16_t before = word_base();
   const std::uint64_t id = w.tracked ? log.track(w.action, true, observed, now_us, w.expect_in(*table, before, observed))
                                      : log.report_now(w.action, "done", w.text);
@@ -158,15 +160,20 @@ reply axis_page::new_setpoint() {
   std::optional<std::int64_t> mode = m.value_of(object_index::modes_of_operation_display);
   if (!mode) mode = m.value_of(object_index::modes_of_operation);
   if (auto no = detail::new_setpoint_refusal(*m.table, mode)) return *no;
-  constexpr std::uint16_t bit4 = 1u << 4;
   const std::uint16_t word = m.word_base();
-  // A rising edge: bit 4 low for a moment first if it was up.
-  m.handshake = impl::handshake_run{static_cast<std::uint16_t>(word & ~bit4), false, 0};
-  if ((word & bit4) != 0) m.send_word(static_cast<std::uint16_t>(word & ~bit4), false);
+  // The session raises bit 4 (down first if it was up), holds it until status bit 12, then drops it.
+  m.requested_word.reset();
+  auto sid = std::make_shared<std::uint64_t>(0);
+  *sid = m.session->offer_set_point(word, [&m, sid](const axes::result& r) {
+    if (m.offering != *sid) return;  // superseded: the request after it has the word
+    m.offering.reset();
+    if (!r.ok()) m.log.report_now("NEW_SET-POINT", "refused", "refused: " + r.error + m.conditions());
+  });
+  if (*sid != 0) m.offering = *sid;
   std::string options;
-  if ((word & (1u << 5)) != 0) options += ", change set immediately";
-  if ((word & (1u << 6)) != 0) options += ", relative";
-  if ((word & (1u << 9)) != 0) options += ", change on set-point";
+  if ((word & control_bit::change_set_immediately) != 0) options += ", change set immediately";
+  if ((word & control_bit::relative) != 0) options += ", relative";
+  if ((word & control_bit::change_on_set_point) != 0) options += ", change on set-point";
   const auto target = m.value_of(object_index::target_position);
   return accepted{m.log.report_now(
       "NEW_SET-POINT", "done",
@@ -187,7 +194,7 @@ reply axis_page::enable() {
     m.log.report_now("ENABLE", "refused", text);
     return refused{409, text};
   }
-  m.handshake.reset();
+  m.offering.reset();
   if (m.enabling) {
     m.log.update({m.enabling->id, "ENABLE", "refused", "refused: Enable pressed again", m.enabling->transitions});
     m.enabling.reset();
@@ -205,7 +212,7 @@ reply axis_page::stop() {
   impl& m = *impl_;
   if (auto no = m.not_running()) return *no;
   if (m.jogging) m.jogging->why_ended = "Stop pressed";
-  m.handshake.reset();
+  m.offering.reset();
   if (m.stopping) {
     m.log.update({m.stopping->id, "STOP", "refused", "refused: Stop pressed again", m.stopping->transitions});
     m.stopping.reset();
@@ -301,7 +308,7 @@ reply axis_page::select_profile(std::string_view name) {
   m.enabling.reset();
   m.stopping.reset();
   m.jogging.reset();
-  m.handshake.reset();
+  m.offering.reset();
   m.requested_word.reset();
   m.open_row.reset();
   m.observed.reset();

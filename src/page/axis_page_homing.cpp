@@ -228,7 +228,7 @@ reply axis_page::home(const homing_request& request) {
     return accepted{m.log.report_now("HOMING PARAMETERS", "done", "done: " + written), written};
   }
   if (m.jogging) m.jogging->why_ended = "homing started";
-  m.handshake.reset();
+  m.offering.reset();
   if (m.homing_run) {
     m.log.update({m.homing_run->id, m.homing_run->action, "refused", "refused: superseded by another homing request", {}});
     m.homing_run.reset();

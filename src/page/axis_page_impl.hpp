@@ -83,13 +83,9 @@ struct axis_page::impl {
   std::uint64_t open_row_cycle = 0;        // the simulator's cycle count when it began
   state open_row_state = state::start;     // the drive's state when it began
 
-  // Profile position's handshake (backend::new_setpoint): bit 4 up until status bit 12, then down.
-  struct handshake_run {
-    std::uint16_t word = 0;  // the word bit 4 goes up in
-    bool raised = false;
-    std::uint64_t give_up_us = 0;
-  };
-  std::optional<handshake_run> handshake;
+  // Profile position's handshake (backend::new_setpoint), the session's offer_set_point: its id
+  // while it runs; reset when another request supersedes it (its end is then no news).
+  std::optional<std::uint64_t> offering;
   // One-click Enable and Stop, and the jog: at most one of each, the session runs them.
   struct operation {
     std::uint64_t id = 0;
@@ -146,7 +142,6 @@ struct axis_page::impl {
   void push_bus_sample();
   std::vector<std::string> polled_signals() const;
   json set_point_json() const;
-  void run_handshake();
   void check_enable_walk();
   bool busy_now() const;
   std::optional<std::int64_t> value_of(std::uint16_t index) const;
