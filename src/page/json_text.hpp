@@ -64,8 +64,8 @@ inline std::string display_text(std::string_view s) {
     if (c < 0x80) {
       out += ch;
     } else {
-      out += static_cast<char>(0xC0 | (c >> 6));
-      out += static_cast<char>(0x80 | (c & 0x3F));
+      out += static_cast<char>(0xC0 | (c >> 6));        // UTF-8 lead byte: not a control word
+      out += static_cast<char>(0x80 | (c & 0x3F));  // UTF-8 continuation: not a control word
     }
   }
   return out;
