@@ -18,6 +18,7 @@ namespace {
 
 using namespace cia402;
 using namespace cia402::canopen;
+using namespace cia402::dictionary;
 
 struct node {
   std::unique_ptr<cia402::apps::virtual_drive_node> drive;

@@ -38,6 +38,8 @@ LAYERS = [
     ("canopen/transport", "src/canopen/transport/"),
     ("canopen/monitor", "include/cia402/canopen/monitor/"),
     ("canopen/monitor", "src/canopen/monitor/"),
+    ("dictionary", "include/cia402/dictionary/"),
+    ("dictionary", "src/dictionary/"),
     ("canopen/301", "include/cia402/canopen/301/"),
     ("canopen/301", "src/canopen/301/"),
     ("ethercat/esc", "include/cia402/ethercat/esc/"),
@@ -75,56 +77,65 @@ ALLOWED = {
     "diagram": {"core"},
     "replay": {"core", "support"},
     "sim": {"core", "profile_file", "motion", "support"},
+    "dictionary": {"core"},
     "canopen/can": {"core"},
-    "canopen/301": {"core", "canopen/can"},
-    "canopen/306": {"core", "support", "canopen/can", "canopen/301"},
+    "canopen/301": {"core", "dictionary", "canopen/can"},
+    "canopen/306": {"core", "support", "dictionary", "canopen/can", "canopen/301"},
     "canopen/transport": {"core", "support", "canopen/can"},
-    "canopen/monitor": {"core", "canopen/can", "canopen/301"},
+    "canopen/monitor": {"core", "dictionary", "canopen/can", "canopen/301"},
     "canopen/402": {"core", "support", "canopen/can", "canopen/301", "canopen/306"},
-    "drive402": {"core", "motion", "sim", "canopen/301"},
+    "drive402": {"core", "motion", "sim", "dictionary"},
     "ethercat/esc": set(),
     "ethercat/sii": {"support"},
     "ethercat/coe": {"core"},
-    "ethercat/slave": {"core", "canopen/301", "ethercat/esc", "ethercat/sii", "ethercat/coe"},
+    "ethercat/slave": {"core", "dictionary", "ethercat/esc", "ethercat/sii", "ethercat/coe"},
     "ethercat/master": {"core", "ethercat/esc", "ethercat/sii", "ethercat/coe"},
     # The axis session and its links: the session sees the core only; each link its own fieldbus.
     "axis": {"core"},
-    "canopen/axis": {"core", "axis", "support", "canopen/can", "canopen/301", "canopen/306", "canopen/402"},
+    "canopen/axis": {"core", "axis", "support", "dictionary", "canopen/can", "canopen/301", "canopen/306", "canopen/402"},
     "ethercat/axis": {"core", "axis", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/master"},
     # The compositions: canopen/axis for the CiA 301 types' value formats the local link shares.
-    "apps": {"axis", "canopen/axis", "ethercat/master", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/slave", "drive402", "sim", "motion", "support",
+    "apps": {"axis", "dictionary", "canopen/axis", "ethercat/master", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/slave", "drive402", "sim", "motion", "support",
              "core", "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
              "canopen/monitor"},
     # The page is a client of the axis session; `cia402 serve` (tools) builds the link.
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "axis"},
     # The Python binding: the core, profile files, the replay, the simulator, and the fieldbuses as
     # the apps layer composes them (the virtual CAN bus with its drives, the axis session).
-    "python": {"core", "motion", "support", "profile_file", "replay", "sim", "apps", "drive402",
+    "python": {"core", "motion", "support", "profile_file", "replay", "sim", "apps", "drive402", "dictionary",
                "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
                "canopen/monitor", "axis", "canopen/axis", "ethercat/esc", "ethercat/sii",
                "ethercat/coe", "ethercat/slave", "ethercat/master", "ethercat/axis"},
-    "tools": {"core", "motion", "support", "profile_file", "diagram", "replay", "sim", "canopen/can",
+    "tools": {"core", "motion", "support", "profile_file", "diagram", "replay", "sim", "dictionary", "canopen/can",
               "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "canopen/monitor",
               "drive402", "apps", "page", "axis", "canopen/axis", "ethercat/axis",
               "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/slave", "ethercat/master"},
 }
 
 # What a layer may never see, whatever ALLOWED says: the fieldbuses know no simulated drive (the
-# drive402 device sits above canopen/301, the compositions that put it on a bus are the apps layer's),
-# the CoE codec sees only the core so the master can use it, the master nothing of the slave side,
-# the drive no fieldbus beyond the device interface of canopen/301, and the page no fieldbus at all
+# drive402 device sits on the neutral object dictionary, the compositions that put it on a bus are the
+# apps layer's), the CoE codec sees only the core so the master can use it, the master nothing of the
+# slave side, the drive and the dictionary no fieldbus at all, and the page no fieldbus at all
 # (a client of the axis session; `cia402 serve` builds the link). check_rules() holds ALLOWED to
 # these before any file is read, so the table cannot be widened past them by accident.
 NEVER = [
     ("canopen/", {"sim", "motion", "drive402", "apps", "page"}),
     ("ethercat/", {"sim", "motion", "drive402", "apps", "page"}),
     ("ethercat/coe", {"canopen/can", "canopen/301"}),
-    ("ethercat/master", {"ethercat/slave", "canopen/301"}),
+    ("ethercat/master", {"ethercat/slave"}),
     ("page", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
               "canopen/monitor", "canopen/axis", "ethercat/esc", "ethercat/sii", "ethercat/coe",
               "ethercat/slave", "ethercat/master", "ethercat/axis", "apps", "drive402"}),
-    ("drive402", {"canopen/can", "canopen/transport", "canopen/402", "ethercat/esc", "ethercat/sii",
-                  "ethercat/coe", "ethercat/slave", "ethercat/master"}),
+    ("drive402", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+                  "canopen/monitor", "canopen/axis", "ethercat/esc", "ethercat/sii", "ethercat/coe",
+                  "ethercat/slave", "ethercat/master", "ethercat/axis"}),
+    # The object dictionary is fieldbus-neutral, and no EtherCAT layer sees CANopen: the CoE slave
+    # mounts the same dictionary the CANopen node does.
+    ("dictionary", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+                    "canopen/monitor", "canopen/axis", "ethercat/esc", "ethercat/sii", "ethercat/coe",
+                    "ethercat/slave", "ethercat/master", "ethercat/axis"}),
+    ("ethercat/", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+                   "canopen/monitor", "canopen/axis"}),
 ]
 
 # Where a quoted include is looked for, after the including file's own folder.

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The layer check fails on an upward include, on a private include, on a fieldbus that includes the
-simulator, on a CoE codec that includes canopen, on a rule table that would allow either, and on a stale
+simulator, on a CoE codec, a drive device, a CoE slave or the object dictionary that
+includes canopen, on a rule table that would allow either, and on a stale
 exception, and passes a tree that keeps the rules."""
 import os
 import sys
@@ -53,10 +54,25 @@ def main():
     checks.append(("canopen or ethercat including sim fails",
                    code == 1 and "canopen/402 may not include sim" in out and "ethercat/slave may not include sim" in out))
     codec = dict(sound)
-    codec["include/cia402/canopen/301/device.hpp"] = "#pragma once\n"
-    codec["src/ethercat/coe/sdo.cpp"] = '#include "cia402/canopen/301/device.hpp"\n'
+    codec["include/cia402/canopen/301/slave.hpp"] = "#pragma once\n"
+    codec["src/ethercat/coe/sdo.cpp"] = '#include "cia402/canopen/301/slave.hpp"\n'
     code, out = run(codec)
     checks.append(("the CoE codec including canopen/301 fails", code == 1 and "ethercat/coe may not include canopen/301" in out))
+    neutral = dict(sound)
+    neutral["include/cia402/dictionary/device.hpp"] = "#pragma once\n"
+    neutral["src/drive402/drive_objects.cpp"] = '#include "cia402/dictionary/device.hpp"\n'
+    neutral["src/ethercat/slave/coe_slave.cpp"] = '#include "cia402/dictionary/device.hpp"\n'
+    code, out = run(neutral)
+    checks.append(("the drive device and the CoE slave on the neutral dictionary pass", code == 0))
+    neutral["include/cia402/canopen/301/slave.hpp"] = "#pragma once\n"
+    neutral["src/drive402/drive_objects.cpp"] = '#include "cia402/canopen/301/slave.hpp"\n'
+    neutral["src/ethercat/slave/coe_slave.cpp"] = '#include "cia402/canopen/301/slave.hpp"\n'
+    neutral["src/dictionary/object_dictionary.cpp"] = '#include "cia402/canopen/301/slave.hpp"\n'
+    code, out = run(neutral)
+    checks.append(("the drive device, the CoE slave or the dictionary including CANopen fails",
+                   code == 1 and "drive402 may not include canopen/301" in out and
+                   "ethercat/slave may not include canopen/301" in out and
+                   "dictionary may not include canopen/301" in out))
     import check_layers
     widened = {layer: set(seen) for layer, seen in check_layers.ALLOWED.items()}
     widened["canopen/402"].add("sim")

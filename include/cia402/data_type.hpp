@@ -91,4 +91,15 @@ constexpr const char* type_name(data_type t) noexcept {
   return "?";
 }
 
+/// Little-endian helpers: CiA 301 puts every multi-byte value least significant byte first, on
+/// CAN and in CoE alike.
+inline void put_le(std::uint8_t* p, std::uint64_t v, unsigned bytes) noexcept {
+  for (unsigned i = 0; i < bytes; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+inline std::uint64_t get_le(const std::uint8_t* p, unsigned bytes) noexcept {
+  std::uint64_t v = 0;
+  for (unsigned i = 0; i < bytes; ++i) v |= static_cast<std::uint64_t>(p[i]) << (8 * i);
+  return v;
+}
+
 }  // namespace cia402

@@ -2,8 +2,9 @@
 
 #include <string>
 
-#include "cia402/canopen/301/dictionary_access.hpp"
-#include "cia402/canopen/301/object_builders.hpp"
+#include "cia402/dictionary/dictionary_access.hpp"
+#include "cia402/dictionary/error_history.hpp"
+#include "cia402/dictionary/object_builders.hpp"
 #include "cia402/canopen/axis/can_link.hpp"
 #include "cia402/drive402/drive_objects.hpp"
 #include "cia402/objects.hpp"
@@ -11,17 +12,13 @@
 namespace cia402::apps {
 namespace {
 
-using namespace canopen;
+using namespace dictionary;
 
-// 0x1003 as CiA 301 §7.5.2.5 has it: sub-index 0 the number of errors (writing 0 empties the list),
-// then one UNSIGNED32 a kept error, the newest at sub-index 1.
+// 0x1003 with the device's depth, its values read from the device (the plant keeps the list).
 object_entry error_field(std::uint8_t size) {
-  std::vector<sub_entry> subs{on_device(variable(0, "Number of errors", data_type::unsigned8, access::rw, 0))};
-  for (std::uint8_t k = 1; k <= size; ++k) {
-    subs.push_back(on_device(variable(k, "Standard error field", data_type::unsigned32, access::ro, 0)));
-  }
-  return group(error_history_index, "Pre-defined error field", object_code::array, object_category::optional,
-               std::move(subs));
+  object_entry e = error_history_object(size);
+  for (sub_entry& sub : e.subs) sub = on_device(std::move(sub));
+  return e;
 }
 
 std::vector<object_entry> local_objects(std::uint8_t history) {

@@ -1,8 +1,8 @@
-#include "cia402/canopen/301/dictionary_access.hpp"
+#include "cia402/dictionary/dictionary_access.hpp"
 
 #include <algorithm>
 
-namespace cia402::canopen {
+namespace cia402::dictionary {
 
 sdo_abort dictionary_access::read(std::uint16_t index, std::uint8_t sub, std::int64_t& value) {
   sdo_abort a = sdo_abort::none;
@@ -93,4 +93,4 @@ sdo_abort dictionary_access::upload(std::uint16_t index, std::uint8_t sub,
   return sdo_abort::none;
 }
 
-}  // namespace cia402::canopen
+}  // namespace cia402::dictionary

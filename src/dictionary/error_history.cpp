@@ -1,16 +1,16 @@
-#include "cia402/canopen/301/error_history.hpp"
+#include "cia402/dictionary/error_history.hpp"
 
 #include <string>
 #include <vector>
 
-#include "cia402/canopen/301/object_builders.hpp"
+#include "cia402/dictionary/object_builders.hpp"
 
-namespace cia402::canopen {
+namespace cia402::dictionary {
 
-object_entry error_history_object() {
+object_entry error_history_object(std::uint8_t depth) {
   std::vector<sub_entry> subs;
   subs.push_back(variable(0, "Number of errors", data_type::unsigned8, access::rw, 0));
-  for (int i = 1; i <= error_history_depth; ++i) {
+  for (int i = 1; i <= depth; ++i) {
     subs.push_back(variable(static_cast<std::uint8_t>(i), "Standard error field " + std::to_string(i),
                             data_type::unsigned32, access::ro, 0));
   }
@@ -35,4 +35,4 @@ sdo_abort write_error_history(object_dictionary& od, std::uint8_t sub, std::int6
   return sdo_abort::none;
 }
 
-}  // namespace cia402::canopen
+}  // namespace cia402::dictionary

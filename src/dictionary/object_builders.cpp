@@ -1,8 +1,8 @@
-#include "cia402/canopen/301/object_builders.hpp"
+#include "cia402/dictionary/object_builders.hpp"
 
 #include <utility>
 
-namespace cia402::canopen {
+namespace cia402::dictionary {
 
 sub_entry variable(std::uint8_t sub, std::string name, data_type t, access a, std::int64_t default_value) {
   sub_entry e;
@@ -75,4 +75,4 @@ object_entry pdo_mapping(std::uint16_t index, std::string name, const pdo_map& d
   return group(index, std::move(name), object_code::record, object_category::optional, std::move(subs));
 }
 
-}  // namespace cia402::canopen
+}  // namespace cia402::dictionary

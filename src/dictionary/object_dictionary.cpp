@@ -1,10 +1,9 @@
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 
 #include <algorithm>
 
-#include "cia402/canopen/can/frame.hpp"
 
-namespace cia402::canopen {
+namespace cia402::dictionary {
 
 const char* access_name(access a) noexcept {
   switch (a) {
@@ -98,4 +97,4 @@ void object_dictionary::set_number(std::uint16_t index, std::uint8_t sub, std::i
   if (slot* s = find(index, sub, ignored)) s->number = v;
 }
 
-}  // namespace cia402::canopen
+}  // namespace cia402::dictionary

@@ -2,12 +2,12 @@
 
 #include <string>
 
-#include "cia402/canopen/301/object_builders.hpp"
+#include "cia402/dictionary/object_builders.hpp"
 #include "cia402/objects.hpp"
 
 namespace cia402::drive402 {
 
-using namespace canopen;
+using namespace dictionary;
 
 namespace {
 

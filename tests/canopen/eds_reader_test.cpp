@@ -17,6 +17,8 @@
 namespace cia402::canopen {
 namespace {
 
+using namespace cia402::dictionary;
+
 std::string drive_eds(std::uint8_t node_id = 0) {
   virtual_bus bus;
   auto ch = bus.attach();

@@ -152,7 +152,7 @@ namespace {
 // The CANopen dictionary takes the drive profile's objects from the one table: same type, access,
 // PDO mapping and limits, and their values are the device's.
 TEST(eds, the_dictionary_holds_every_object_of_the_one_table_as_it_describes_it) {
-  const std::vector<cia402::canopen::object_entry> od = cia402::drive402::drive_objects();
+  const std::vector<cia402::dictionary::object_entry> od = cia402::drive402::drive_objects();
   for (std::size_t i = 0; i < cia402::drive_object_count(); ++i) {
     const cia402::object_description& d = cia402::drive_object(i);
     SCOPED_TRACE(d.name);
@@ -160,7 +160,7 @@ TEST(eds, the_dictionary_holds_every_object_of_the_one_table_as_it_describes_it)
     ASSERT_NE(it, od.end());
     const auto sub = std::find_if(it->subs.begin(), it->subs.end(), [&](const auto& e) { return e.sub == d.sub; });
     ASSERT_NE(sub, it->subs.end());
-    const cia402::canopen::sub_entry& e = *sub;
+    const cia402::dictionary::sub_entry& e = *sub;
     const bool has_subs = cia402::find_drive_object(d.index, 1) != nullptr;
     // An array or record: its count (sub-index 0) and the entries it counts.
     const std::size_t entries = has_subs ? static_cast<std::size_t>(cia402::find_drive_object(d.index, 0)->default_value) : 0;
@@ -168,14 +168,14 @@ TEST(eds, the_dictionary_holds_every_object_of_the_one_table_as_it_describes_it)
     if (has_subs && d.sub == 0) {
       // An array's count is the dictionary's own constant.
       EXPECT_EQ(e.default_value, d.default_value);
-      EXPECT_EQ(e.acc, cia402::canopen::access::ro);
+      EXPECT_EQ(e.acc, cia402::dictionary::access::ro);
       continue;
     }
     EXPECT_EQ(static_cast<unsigned>(e.type), static_cast<unsigned>(d.type));
     EXPECT_EQ(e.name, d.name);
     EXPECT_EQ(e.pdo_mappable, d.pdo_mappable);
-    EXPECT_EQ(e.acc == cia402::canopen::access::ro, d.access == cia402::object_access::read_only);
-    EXPECT_EQ(e.where, cia402::canopen::backing::device);
+    EXPECT_EQ(e.acc == cia402::dictionary::access::ro, d.access == cia402::object_access::read_only);
+    EXPECT_EQ(e.where, cia402::dictionary::backing::device);
     if (e.has_limits) {
       EXPECT_EQ(e.low, d.low);
       EXPECT_EQ(e.high, d.high);

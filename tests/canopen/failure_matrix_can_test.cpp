@@ -32,9 +32,11 @@
 namespace cia402::canopen {
 namespace {
 
+using namespace cia402::dictionary;
+
 // A device in front of the virtual drive's that refuses writes of the objects in `refused` with
 // 0x06090030 (invalid value for parameter); everything else, the drive's reports too, passes through.
-class refusing_device final : public device {
+class refusing_device final : public dictionary::device {
  public:
   explicit refusing_device(drive402::sim_device& inner) : inner_(&inner), relay_{this} { inner.attach(&relay_); }
   ~refusing_device() override { inner_->attach(nullptr); }

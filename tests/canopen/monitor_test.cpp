@@ -17,6 +17,8 @@
 namespace cia402::canopen::monitor {
 namespace {
 
+using namespace cia402::dictionary;
+
 using test::network;
 using test::sdo_request;
 

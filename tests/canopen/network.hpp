@@ -18,7 +18,7 @@
 namespace cia402::canopen::test {
 
 struct node {
-  std::unique_ptr<device> dev;
+  std::unique_ptr<dictionary::device> dev;
   std::unique_ptr<virtual_channel> ch;
   std::unique_ptr<slave> sl;
 };
@@ -28,7 +28,7 @@ class network {
   network() : tester_(bus_.attach()) {}
 
   /// A slave on a test_device (or on `dev`), node-ID `id`.
-  slave& add(std::uint8_t id, std::unique_ptr<device> dev = nullptr, std::uint16_t heartbeat_ms = 0,
+  slave& add(std::uint8_t id, std::unique_ptr<dictionary::device> dev = nullptr, std::uint16_t heartbeat_ms = 0,
              std::uint32_t sdo_timeout_us = 1000000) {
     node n;
     n.dev = dev ? std::move(dev) : std::make_unique<test_device>();

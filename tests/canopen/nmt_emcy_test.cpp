@@ -7,6 +7,8 @@
 namespace cia402::canopen::test {
 namespace {
 
+using namespace cia402::dictionary;
+
 constexpr std::uint8_t id = 7;
 
 std::uint16_t emcy_code(const frame& f) { return static_cast<std::uint16_t>(get_le(f.data.data(), 2)); }

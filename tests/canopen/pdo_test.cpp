@@ -12,6 +12,8 @@
 namespace cia402::canopen::test {
 namespace {
 
+using namespace cia402::dictionary;
+
 constexpr std::uint8_t id = 3;
 
 class pdo_test : public ::testing::Test {
@@ -362,7 +364,7 @@ TEST_F(pdo_test, rpdo_shorter_than_its_mapping_is_dropped_with_emcy_0x8210) {
 
 // Objects with sub-indices map as (index, sub): a device that holds an array (as the virtual drive
 // holds 0x607D, 0x6099) is read and written with the sub-index the mapping entry names.
-class array_device final : public device {
+class array_device final : public dictionary::device {
  public:
   static constexpr std::uint16_t index = 0x2100;
   sdo_abort read(std::uint16_t i, std::uint8_t sub, std::int64_t& v) noexcept override {

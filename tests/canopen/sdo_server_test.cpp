@@ -11,6 +11,8 @@
 namespace cia402::canopen::test {
 namespace {
 
+using namespace cia402::dictionary;
+
 constexpr std::uint8_t node_id = 5;
 
 class sdo_server_test : public ::testing::Test {

@@ -1,4 +1,4 @@
-// A test double for canopen::device: the core drive (cia402::drive) on an ideal plant (always at
+// A test double for dictionary::device: the core drive (cia402::drive) on an ideal plant (always at
 // standstill, every ramp done at once), stepping once per millisecond. It counts what the node asks
 // of it, so tests can see the node's calls, and it does not depend on the simulator.
 #pragma once
@@ -6,12 +6,12 @@
 #include <array>
 #include <cstdint>
 
-#include "cia402/canopen/301/device.hpp"
+#include "cia402/dictionary/device.hpp"
 #include "cia402/drive.hpp"
 
 namespace cia402::canopen::test {
 
-class test_device final : public device {
+class test_device final : public dictionary::device {
  public:
   explicit test_device(const profile& p = standard_profile()) : profile_(&p), drive_(p) {}
 

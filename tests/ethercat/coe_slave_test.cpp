@@ -1,4 +1,4 @@
-// The CoE slave (ethercat/slave) is generic: any canopen::device behind it, described by its own
+// The CoE slave (ethercat/slave) is generic: any dictionary::device behind it, described by its own
 // dictionary; its process data bound on the way to SAFE-OP keep the dictionary's rules; 0x1017 is
 // served on EtherCAT too; and our master moves objects longer than a mailbox in segments both ways.
 #include <gtest/gtest.h>
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "cia402/apps/virtual_drive_slave.hpp"
-#include "cia402/canopen/301/object_builders.hpp"
+#include "cia402/dictionary/object_builders.hpp"
 #include "cia402/ethercat/master/ecat_master.hpp"
 #include "cia402/ethercat/slave/coe_slave.hpp"
 #include "cia402/profile.hpp"
@@ -18,14 +18,14 @@
 namespace cia402::ethercat {
 namespace {
 
-using canopen::access;
+using dictionary::access;
 using cia402::data_type;
-using canopen::object_category;
-using canopen::object_code;
+using dictionary::object_category;
+using dictionary::object_code;
 
 // A device of another profile: a set-point register (0x2100) whose double is the actual value
 // (0x2101). It takes any value: the limits of 0x2100 (0..1000) are the dictionary's alone.
-class register_device final : public canopen::device {
+class register_device final : public dictionary::device {
  public:
   sdo_abort read(std::uint16_t index, std::uint8_t sub, std::int64_t& v) noexcept override {
     if (sub != 0) return sdo_abort::sub_index_does_not_exist;
@@ -53,29 +53,29 @@ const std::string long_text(300, 'x');
 // With a control and a status word (stored in the dictionary), so our master, which runs CiA 402
 // drives, takes it to OP.
 coe_slave_config register_config() {
-  using canopen::limited;
-  using canopen::mappable;
-  using canopen::on_device;
-  using canopen::variable;
+  using dictionary::limited;
+  using dictionary::mappable;
+  using dictionary::on_device;
+  using dictionary::variable;
   coe_slave_config c;
   c.objects = {
-      canopen::single(0x1000, object_category::mandatory,
+      dictionary::single(0x1000, object_category::mandatory,
                       variable(0, "Device type", data_type::unsigned32, access::ro, 0x00000191)),
-      canopen::single(0x1008, object_category::optional,
-                      canopen::text(0, "Manufacturer device name", access::constant, "register box", 0)),
-      canopen::group(0x1018, "Identity object", object_code::record, object_category::mandatory,
+      dictionary::single(0x1008, object_category::optional,
+                      dictionary::text(0, "Manufacturer device name", access::constant, "register box", 0)),
+      dictionary::group(0x1018, "Identity object", object_code::record, object_category::mandatory,
                      {variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 4),
                       variable(1, "Vendor-ID", data_type::unsigned32, access::ro, 0x00ABCDEF),
                       variable(2, "Product code", data_type::unsigned32, access::ro, 0x401),
                       variable(3, "Revision number", data_type::unsigned32, access::ro, 1),
                       variable(4, "Serial number", data_type::unsigned32, access::ro, 9)}),
-      canopen::single(0x2100, object_category::manufacturer,
+      dictionary::single(0x2100, object_category::manufacturer,
                       limited(mappable(on_device(variable(0, "Set-point", data_type::unsigned16, access::rw))), 0, 1000)),
-      canopen::single(0x2101, object_category::manufacturer,
+      dictionary::single(0x2101, object_category::manufacturer,
                       mappable(on_device(variable(0, "Actual", data_type::integer32, access::ro)))),
-      canopen::single(0x2200, object_category::manufacturer, canopen::text(0, "Notes", access::rw, long_text, 300)),
-      canopen::single(0x6040, object_category::mandatory, mappable(variable(0, "Controlword", data_type::unsigned16, access::rw))),
-      canopen::single(0x6041, object_category::mandatory,
+      dictionary::single(0x2200, object_category::manufacturer, dictionary::text(0, "Notes", access::rw, long_text, 300)),
+      dictionary::single(0x6040, object_category::mandatory, mappable(variable(0, "Controlword", data_type::unsigned16, access::rw))),
+      dictionary::single(0x6041, object_category::mandatory,
                       mappable(variable(0, "Statusword", data_type::unsigned16, access::ro, 0x0250)))};
   c.rx_pdo = detail::make_pdo_map({{0x6040, 0, 16}, {0x2100, 0, 16}}, pdo_maps::on_change);
   c.tx_pdo = detail::make_pdo_map({{0x6041, 0, 16}, {0x2101, 0, 32}}, pdo_maps::on_change);
@@ -127,8 +127,8 @@ TEST(coe_slave, a_device_of_another_profile_is_described_by_its_own_dictionary) 
 
 TEST(coe_slave, a_device_table_that_holds_the_slaves_own_objects_is_refused) {
   coe_slave_config c = register_config();
-  c.objects.push_back(canopen::single(0x1C12, object_category::optional,
-                                      canopen::variable(0, "RxPDO assign", data_type::unsigned8, access::rw)));
+  c.objects.push_back(dictionary::single(0x1C12, object_category::optional,
+                                      dictionary::variable(0, "RxPDO assign", data_type::unsigned8, access::rw)));
   register_device dev;
   EXPECT_THROW(coe_slave(dev, c), std::invalid_argument);
 }

@@ -7,17 +7,17 @@
 #include <string>
 #include <vector>
 
-#include "cia402/canopen/301/dictionary_access.hpp"
+#include "cia402/dictionary/dictionary_access.hpp"
 #include "cia402/ethercat/slave/coe_server.hpp"
 
 namespace cia402::ethercat {
 namespace {
 
-using canopen::access;
+using dictionary::access;
 using cia402::data_type;
-using canopen::object_code;
-using canopen::object_entry;
-using canopen::sub_entry;
+using dictionary::object_code;
+using dictionary::object_entry;
+using dictionary::sub_entry;
 
 sub_entry entry(std::uint8_t sub, std::string name, data_type t, access a, std::int64_t def = 0) {
   sub_entry e;
@@ -68,16 +68,16 @@ std::vector<object_entry> table() {
 }
 
 // Stored values, and one rule of its own: an assigned PDO must be 0x1600 or 0x1601 (or 0).
-class stored_access final : public canopen::dictionary_access {
+class stored_access final : public dictionary::dictionary_access {
  public:
-  explicit stored_access(canopen::object_dictionary& od) : dictionary_access(od) {}
+  explicit stored_access(dictionary::object_dictionary& od) : dictionary_access(od) {}
 
  private:
-  sdo_abort read_value(const canopen::object_dictionary::slot& s, std::int64_t& v) override {
+  sdo_abort read_value(const dictionary::object_dictionary::slot& s, std::int64_t& v) override {
     v = s.number;
     return sdo_abort::none;
   }
-  sdo_abort write_value(canopen::object_dictionary::slot& s, std::int64_t v) override {
+  sdo_abort write_value(dictionary::object_dictionary::slot& s, std::int64_t v) override {
     if (s.object->index == 0x1C12 && s.entry->sub != 0 && v != 0 && v != 0x1600 && v != 0x1601) {
       return sdo_abort::invalid_value;
     }
@@ -87,7 +87,7 @@ class stored_access final : public canopen::dictionary_access {
 };
 
 struct fixture : ::testing::Test {
-  canopen::object_dictionary od{table(), 1};
+  dictionary::object_dictionary od{table(), 1};
   stored_access access_{od};
   coe_server coe{access_, od, 64, 0x1001};
 
@@ -291,7 +291,7 @@ TEST_F(fixture, a_long_list_comes_in_fragments) {
     o.subs.push_back(entry(0, "object", data_type::unsigned8, access::rw));
     many.push_back(o);
   }
-  canopen::object_dictionary big(many, 1);
+  dictionary::object_dictionary big(many, 1);
   stored_access a(big);
   coe_server server(a, big, 64);
   server.on_mailbox(mailbox(coe_service::sdo_information, {1, 0, 0, 0, 1, 0}));

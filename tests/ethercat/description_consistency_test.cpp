@@ -101,8 +101,8 @@ TEST(drive_description, sdo_information_gives_each_record_the_type_of_its_struct
   EXPECT_EQ(described_type(b, 0x1A00), 0x0021) << "PDO mapping";
   EXPECT_EQ(described_type(b, 0x60C2), 0x002A) << "a record of the profile";
   // Every record of the dictionary: a type, never 0.
-  for (const canopen::object_entry& o : b.slave.slave().dictionary().table()) {
-    if (o.code != canopen::object_code::record) continue;
+  for (const dictionary::object_entry& o : b.slave.slave().dictionary().table()) {
+    if (o.code != dictionary::object_code::record) continue;
     EXPECT_NE(described_type(b, o.index), 0) << std::hex << o.index;
   }
 }

@@ -12,7 +12,7 @@
 namespace cia402::ethercat {
 namespace {
 
-const canopen::object_entry* find(const std::vector<canopen::object_entry>& t, std::uint16_t index) {
+const dictionary::object_entry* find(const std::vector<dictionary::object_entry>& t, std::uint16_t index) {
   const auto it = std::find_if(t.begin(), t.end(), [&](const auto& o) { return o.index == index; });
   return it == t.end() ? nullptr : &*it;
 }

@@ -34,7 +34,7 @@ namespace {
 
 // A device in front of the virtual drive's that refuses writes of the objects in `refused` with
 // 0x06090030 (invalid value for parameter); everything else, the drive's reports too, passes through.
-class refusing_device final : public canopen::device {
+class refusing_device final : public dictionary::device {
  public:
   explicit refusing_device(drive402::sim_device& inner) : inner_(&inner), relay_{this} { inner.attach(&relay_); }
   ~refusing_device() override { inner_->attach(nullptr); }
@@ -56,7 +56,7 @@ class refusing_device final : public canopen::device {
   std::set<std::uint16_t> refused;
 
  private:
-  struct relay final : canopen::device_events {
+  struct relay final : dictionary::device_events {
     explicit relay(refusing_device* d) : owner(d) {}
     void object_changed(std::uint16_t index, std::uint8_t sub) noexcept override { owner->changed(index, sub); }
     void error_changed(std::uint16_t code) noexcept override { owner->device::error_changed(code); }

@@ -11,6 +11,7 @@
 #include "cia402/profile.hpp"
 
 using namespace cia402::canopen;
+using namespace cia402::dictionary;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   virtual_bus bus;

@@ -19,6 +19,7 @@ namespace {
 
 using namespace cia402;
 using namespace cia402::canopen;
+using namespace cia402::dictionary;
 
 [[noreturn]] void fail(const char* what, const std::string& a = {}, const std::string& b = {}) {
   std::fprintf(stderr, "eds_file_fuzz: %s\n--- first\n%s\n--- second\n%s\n", what, a.c_str(), b.c_str());

@@ -22,27 +22,27 @@ std::string one_line(std::string text) {
   return text;
 }
 
-canopen::access access_of(const std::string& a) {
-  if (a == "rw") return canopen::access::rw;
-  if (a == "wo") return canopen::access::wo;
-  if (a == "const") return canopen::access::constant;
-  return canopen::access::ro;
+dictionary::access access_of(const std::string& a) {
+  if (a == "rw") return dictionary::access::rw;
+  if (a == "wo") return dictionary::access::wo;
+  if (a == "const") return dictionary::access::constant;
+  return dictionary::access::ro;
 }
 
 // The page's entries as the dictionary's objects: one VAR where an index has only sub-index 0, else
 // a RECORD named by its sub-index 0 (CiA 301 §7.4.3).
-std::vector<canopen::object_entry> objects_of(const std::vector<page::parameter_entry>& entries) {
+std::vector<dictionary::object_entry> objects_of(const std::vector<page::parameter_entry>& entries) {
   std::map<std::uint16_t, std::vector<const page::parameter_entry*>> by_index;
   for (const page::parameter_entry& e : entries) by_index[e.index].push_back(&e);
-  std::vector<canopen::object_entry> out;
+  std::vector<dictionary::object_entry> out;
   for (const auto& [index, subs] : by_index) {
-    canopen::object_entry o;
+    dictionary::object_entry o;
     o.index = index;
     o.name = one_line(subs.front()->name);
     const bool var = subs.size() == 1 && subs.front()->sub == 0;
-    o.code = var ? canopen::object_code::var : canopen::object_code::record;
+    o.code = var ? dictionary::object_code::var : dictionary::object_code::record;
     for (const page::parameter_entry* e : subs) {
-      canopen::sub_entry s;
+      dictionary::sub_entry s;
       s.sub = e->sub;
       s.name = !var && e->sub == 0 ? "Highest sub-index supported" : one_line(e->name);
       s.type = static_cast<data_type>(e->data_type);
@@ -81,7 +81,7 @@ canopen::eds_info file_info(int node) {
 
 std::string write_file(const std::vector<page::parameter_entry>& entries,
                        const std::vector<std::optional<std::string>>& values, int node) {
-  const std::vector<canopen::object_entry> objects = objects_of(entries);
+  const std::vector<dictionary::object_entry> objects = objects_of(entries);
   canopen::dcf_values given;
   for (std::size_t i = 0; i < entries.size() && i < values.size(); ++i) {
     if (!values[i]) continue;
@@ -94,7 +94,7 @@ std::string write_file(const std::vector<page::parameter_entry>& entries,
     const std::string& text = *values[i];
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), number);
     if (ec != std::errc() || end != text.data() + text.size()) continue;  // not a number: no value
-    canopen::sub_entry s;
+    dictionary::sub_entry s;
     s.type = static_cast<data_type>(e.data_type);
     // A value its type cannot hold (a peer's answer) would make a file the reader refuses: no value.
     if (number < type_min(s.type) || number > type_max(s.type)) continue;
@@ -112,8 +112,8 @@ std::variant<std::vector<page::parameter_value>, page::parameter_file_error> rea
   }
   const canopen::eds_contents& dcf = std::get<canopen::eds_contents>(parsed);
   std::vector<page::parameter_value> out;
-  for (const canopen::object_entry& o : dcf.objects) {
-    for (const canopen::sub_entry& s : o.subs) {
+  for (const dictionary::object_entry& o : dcf.objects) {
+    for (const dictionary::sub_entry& s : o.subs) {
       if (!s.parameter_value) continue;
       if (s.type == data_type::visible_string) {
         out.push_back({o.index, s.sub, s.default_text});
@@ -144,17 +144,17 @@ page::parameter_file_format dcf_parameter_file() {
   return f;
 }
 
-std::vector<page::parameter_entry> parameter_entries(const std::vector<canopen::object_entry>& objects,
+std::vector<page::parameter_entry> parameter_entries(const std::vector<dictionary::object_entry>& objects,
                                                      int node_id) {
   std::vector<page::parameter_entry> out;
-  for (const canopen::object_entry& o : objects) {
-    for (const canopen::sub_entry& s : o.subs) {
+  for (const dictionary::object_entry& o : objects) {
+    for (const dictionary::sub_entry& s : o.subs) {
       page::parameter_entry e;
       e.index = o.index;
       e.sub = s.sub;
-      e.name = o.code == canopen::object_code::var || s.sub == 0 ? o.name : s.name;
+      e.name = o.code == dictionary::object_code::var || s.sub == 0 ? o.name : s.name;
       e.data_type = static_cast<std::uint16_t>(s.type);
-      e.access = canopen::access_name(s.acc);
+      e.access = dictionary::access_name(s.acc);
       e.pdo_mappable = s.pdo_mappable;
       if (s.has_limits) {
         e.low = s.low;

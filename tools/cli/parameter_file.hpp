@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 #include "cia402/page/parameters.hpp"
 
 namespace cia402::cli {
@@ -16,7 +16,7 @@ namespace cia402::cli {
 page::parameter_file_format dcf_parameter_file();
 
 /// The entries of a node's objects (its dictionary, or an EDS) as the page lists them.
-std::vector<page::parameter_entry> parameter_entries(const std::vector<canopen::object_entry>& objects,
+std::vector<page::parameter_entry> parameter_entries(const std::vector<dictionary::object_entry>& objects,
                                                      int node_id);
 
 }  // namespace cia402::cli

@@ -100,7 +100,7 @@ int open_can(const serve_args& args, const profile& p, page::axis_page_config pc
     return refused;
   }
   // The nodes' EDS or DCF: what their objects are, for the link and the page's parameter list.
-  std::vector<canopen::object_entry> eds;
+  std::vector<dictionary::object_entry> eds;
   if (!args.eds.empty()) {
     std::ifstream in(args.eds);
     if (!in) {

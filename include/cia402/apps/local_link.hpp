@@ -6,7 +6,7 @@
 //   (0x6040, 0x6060, 0x607A, 0x60FF, 0x6071, as EtherCAT's RxPDO 0x1600) go in before the step,
 //   and every mappable object the drive can read is a cyclic input of that cycle;
 // - a transfer (upload, download) ends at the next poll, by the dictionary rules both buses apply
-//   (canopen::dictionary_access over drive402::drive_objects()), so a value refused here is refused
+//   (dictionary::dictionary_access over drive402::drive_objects()), so a value refused here is refused
 //   on a bus with the same abort code;
 // - 0x1003, the pre-defined error field (CiA 301 §7.5.2.5), kept as a CiA 301 node keeps it: each new
 //   error code the drive raises goes in at sub-index 1, the older ones move down, at most

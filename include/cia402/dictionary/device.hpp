@@ -19,7 +19,7 @@
 
 #include "cia402/sdo_abort.hpp"
 
-namespace cia402::canopen {
+namespace cia402::dictionary {
 
 /// The node's side of a device's reports.
 class device_events {
@@ -64,4 +64,4 @@ class device {
   device_events* events_ = nullptr;
 };
 
-}  // namespace cia402::canopen
+}  // namespace cia402::dictionary

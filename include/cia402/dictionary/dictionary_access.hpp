@@ -9,10 +9,10 @@
 #include <span>
 #include <vector>
 
-#include "cia402/canopen/301/object_dictionary.hpp"
-#include "cia402/canopen/301/sdo_server.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
+#include "cia402/dictionary/object_access.hpp"
 
-namespace cia402::canopen {
+namespace cia402::dictionary {
 
 class dictionary_access : public object_access {
  public:
@@ -47,4 +47,4 @@ class dictionary_access : public object_access {
   object_dictionary* od_;
 };
 
-}  // namespace cia402::canopen
+}  // namespace cia402::dictionary

@@ -10,17 +10,19 @@
 
 #include <cstdint>
 
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 #include "cia402/sdo_abort.hpp"
 
-namespace cia402::canopen {
+namespace cia402::dictionary {
 
 inline constexpr std::uint16_t error_history_index = 0x1003;
 /// Errors held (CiA 301 allows 1..254): 8, as many as an EMCY consumer usually shows.
 inline constexpr std::uint8_t error_history_depth = 8;
 
-/// The object: an ARRAY, sub-index 0 rw UNSIGNED8, 1..depth ro UNSIGNED32, all 0.
-object_entry error_history_object();
+/// The object: an ARRAY, sub-index 0 rw UNSIGNED8, 1..depth ro UNSIGNED32, all 0. A dictionary
+/// that keeps the list itself uses the default depth (record_error and write_error_history assume
+/// it); one whose device keeps the list (a local plant) asks for the device's depth.
+object_entry error_history_object(std::uint8_t depth = error_history_depth);
 
 /// Records an error at sub-index 1; the others move down one, the oldest beyond the depth is
 /// dropped. `info` goes into bits 16..31. Code 0 (the "error reset" EMCY) records nothing.
@@ -30,4 +32,4 @@ void record_error(object_dictionary& od, std::uint16_t code, std::uint16_t info)
 /// 0 empties the field, any other value is 0x06090030 and changes nothing.
 sdo_abort write_error_history(object_dictionary& od, std::uint8_t sub, std::int64_t v) noexcept;
 
-}  // namespace cia402::canopen
+}  // namespace cia402::dictionary

@@ -9,17 +9,17 @@
 #include <string>
 #include <vector>
 
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 #include "cia402/pdo_maps.hpp"
 
-namespace cia402::canopen {
+namespace cia402::dictionary {
 
 /// A numeric entry: sub-index, name, type, access, default.
 sub_entry variable(std::uint8_t sub, std::string name, data_type t, access a, std::int64_t default_value = 0);
 /// A VISIBLE_STRING entry of at most `capacity` bytes (0: as long as its default, for a constant).
 sub_entry text(std::uint8_t sub, std::string name, access a, std::string default_text, std::size_t capacity);
 sub_entry mappable(sub_entry e);
-/// The value is the device's (canopen::device::read / write), not stored in the dictionary.
+/// The value is the device's (dictionary::device::read / write), not stored in the dictionary.
 sub_entry on_device(sub_entry e);
 /// The default is node-ID + default ($NODEID+ in an EDS).
 sub_entry plus_node_id(sub_entry e);
@@ -35,4 +35,4 @@ object_entry group(std::uint16_t index, std::string name, object_code code, obje
 /// holding `defaults` as it starts.
 object_entry pdo_mapping(std::uint16_t index, std::string name, const pdo_map& defaults, std::uint8_t capacity);
 
-}  // namespace cia402::canopen
+}  // namespace cia402::dictionary

@@ -12,7 +12,7 @@
 #include "cia402/data_type.hpp"
 #include "cia402/sdo_abort.hpp"
 
-namespace cia402::canopen {
+namespace cia402::dictionary {
 
 /// Access types as the EDS spells them (CiA 306 §4.6.3): ro, wo, rw, const.
 enum class access : std::uint8_t { ro, wo, rw, constant };
@@ -27,7 +27,7 @@ enum class object_code : std::uint8_t { var = 7, array = 8, record = 9 };
 enum class object_category : std::uint8_t { mandatory, optional, manufacturer };
 
 /// Where a value lives. `stored`: in the dictionary. `device`: the device behind the node answers
-/// (canopen::device::read / write), so the CiA 402 objects are the virtual drive's own.
+/// (dictionary::device::read / write), so the CiA 402 objects are the virtual drive's own.
 enum class backing : std::uint8_t { stored, device };
 
 /// One sub-index.
@@ -101,4 +101,4 @@ std::int64_t decode_value(data_type t, std::span<const std::uint8_t> bytes) noex
 /// Value -> its type_size(t) little-endian bytes.
 void encode_value(data_type t, std::int64_t v, std::vector<std::uint8_t>& out);
 
-}  // namespace cia402::canopen
+}  // namespace cia402::dictionary

@@ -3,7 +3,7 @@
 // manufacturer objects (0x2000 device label, 0x2001 fault injection: cia402/manufacturer_objects.hpp)
 // and the drive objects of CiA 402 it has, from the core's one object table (cia402/objects.hpp).
 // A fieldbus adds the communication objects it serves itself: the CANopen node 0x1005..0x1BFF
-// (canopen/301/slave.hpp), the CoE slave 0x1600.., 0x1A00.., 0x1C00, 0x1C12, 0x1C13
+// (canopen/301/slave.hpp) and the CoE slave 0x1600.., 0x1A00.., 0x1C00, 0x1C12, 0x1C13
 // (ethercat/slave/coe_slave.hpp).
 //
 // Choices, with the reason:
@@ -21,7 +21,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 #include "cia402/manufacturer_objects.hpp"
 
 namespace cia402::drive402 {
@@ -39,6 +39,6 @@ inline constexpr const char* software_version = "0.1.0";
 /// The drive's objects: 0x1000, 0x1001, 0x1008..0x100A, 0x1018 (sub 4 = `serial` + node-ID), 0x2000,
 /// 0x2001 and the 0x6xxx objects; 0x1001, 0x2001 and the 0x6xxx objects are backed by the device
 /// (sim_device), the rest stored.
-std::vector<canopen::object_entry> drive_objects(std::uint32_t serial = 0);
+std::vector<dictionary::object_entry> drive_objects(std::uint32_t serial = 0);
 
 }  // namespace cia402::drive402

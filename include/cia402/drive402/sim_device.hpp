@@ -1,4 +1,4 @@
-// The virtual CiA 402 drive as a fieldbus device (canopen/301/device.hpp): the simulator's virtual
+// The virtual CiA 402 drive as a fieldbus device (dictionary/device.hpp): the simulator's virtual
 // drive (sim/virtual_drive.hpp), the core state machine and a plant, stepped once per plant cycle of
 // the time the fieldbus passes in. It answers the drive's objects (drive_objects.hpp) and takes fault
 // injection (0x2001); the CANopen node and the CoE slave mount it unchanged.
@@ -19,13 +19,13 @@
 #include <cstdint>
 #include <memory>
 
-#include "cia402/canopen/301/device.hpp"
+#include "cia402/dictionary/device.hpp"
 #include "cia402/profile.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 
 namespace cia402::drive402 {
 
-class sim_device final : public canopen::device {
+class sim_device final : public dictionary::device {
  public:
   /// Most cycles one step() runs; a longer gap (a stalled host) is dropped, not replayed.
   static constexpr std::uint32_t max_catch_up_cycles = 1000;

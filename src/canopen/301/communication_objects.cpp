@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "cia402/canopen/301/error_history.hpp"
-#include "cia402/canopen/301/object_builders.hpp"
+#include "cia402/dictionary/error_history.hpp"
+#include "cia402/dictionary/object_builders.hpp"
 #include "cia402/canopen/301/slave.hpp"
 #include "cia402/canopen/can/frame.hpp"
 
@@ -21,7 +21,7 @@ std::string hex4(std::uint16_t v) {
   return s;
 }
 
-void add_pdos(std::vector<object_entry>& t, const slave_config& c) {
+void add_pdos(std::vector<dictionary::object_entry>& t, const slave_config& c) {
   for (const bool transmit : {false, true}) {
     const std::string kind = transmit ? "TPDO" : "RPDO";
     const std::uint16_t offset = transmit ? 0x400 : 0;
@@ -30,17 +30,17 @@ void add_pdos(std::vector<object_entry>& t, const slave_config& c) {
       const auto name = kind + std::to_string(n + 1);
       const std::uint32_t cob_id = (m.count == 0 || !m.valid ? pdo_cob_invalid : 0u) +
                                    (transmit ? cob::tpdo1 : cob::rpdo1) + 0x100u * static_cast<std::uint32_t>(n);
-      std::vector<sub_entry> parameters = {
-          variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, transmit ? 5 : 2),
-          plus_node_id(variable(1, "COB-ID used by " + kind, data_type::unsigned32, access::rw, cob_id)),
-          variable(2, "Transmission type", data_type::unsigned8, access::rw, m.transmission_type)};
+      std::vector<dictionary::sub_entry> parameters = {
+          variable(0, "Highest sub-index supported", data_type::unsigned8, dictionary::access::ro, transmit ? 5 : 2),
+          plus_node_id(variable(1, "COB-ID used by " + kind, data_type::unsigned32, dictionary::access::rw, cob_id)),
+          variable(2, "Transmission type", data_type::unsigned8, dictionary::access::rw, m.transmission_type)};
       if (transmit) {
-        parameters.push_back(variable(3, "Inhibit time", data_type::unsigned16, access::rw, m.inhibit_100us));
-        parameters.push_back(variable(5, "Event timer", data_type::unsigned16, access::rw, m.event_timer_ms));
+        parameters.push_back(variable(3, "Inhibit time", data_type::unsigned16, dictionary::access::rw, m.inhibit_100us));
+        parameters.push_back(variable(5, "Event timer", data_type::unsigned16, dictionary::access::rw, m.event_timer_ms));
       }
       t.push_back(group(static_cast<std::uint16_t>(0x1400 + offset + n), name + " communication parameter",
-                        object_code::record, object_category::optional, std::move(parameters)));
-      t.push_back(pdo_mapping(static_cast<std::uint16_t>(0x1600 + offset + n), name + " mapping parameter", m,
+                        dictionary::object_code::record, dictionary::object_category::optional, std::move(parameters)));
+      t.push_back(dictionary::pdo_mapping(static_cast<std::uint16_t>(0x1600 + offset + n), name + " mapping parameter", m,
                               max_mapped_objects));
     }
   }
@@ -48,40 +48,40 @@ void add_pdos(std::vector<object_entry>& t, const slave_config& c) {
 
 }  // namespace
 
-std::vector<object_entry> communication_objects(const slave_config& c) {
-  using enum object_category;
-  std::vector<object_entry> t;
-  t.push_back(error_history_object());
-  t.push_back(single(0x1005, optional, variable(0, "COB-ID SYNC message", data_type::unsigned32, access::rw, cob::sync)));
+std::vector<dictionary::object_entry> communication_objects(const slave_config& c) {
+  using enum dictionary::object_category;
+  std::vector<dictionary::object_entry> t;
+  t.push_back(dictionary::error_history_object());
+  t.push_back(single(0x1005, optional, variable(0, "COB-ID SYNC message", data_type::unsigned32, dictionary::access::rw, cob::sync)));
   t.push_back(single(0x1014, optional,
-                     plus_node_id(variable(0, "COB-ID EMCY", data_type::unsigned32, access::ro, cob::emcy))));
-  std::vector<sub_entry> consumers;
-  consumers.push_back(variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, heartbeat_consumers));
+                     plus_node_id(variable(0, "COB-ID EMCY", data_type::unsigned32, dictionary::access::ro, cob::emcy))));
+  std::vector<dictionary::sub_entry> consumers;
+  consumers.push_back(variable(0, "Highest sub-index supported", data_type::unsigned8, dictionary::access::ro, heartbeat_consumers));
   for (int i = 1; i <= heartbeat_consumers; ++i) {
     consumers.push_back(variable(static_cast<std::uint8_t>(i), "Consumer heartbeat time " + std::to_string(i),
-                                 data_type::unsigned32, access::rw));
+                                 data_type::unsigned32, dictionary::access::rw));
   }
-  t.push_back(group(0x1016, "Consumer heartbeat time", object_code::array, optional, std::move(consumers)));
+  t.push_back(group(0x1016, "Consumer heartbeat time", dictionary::object_code::array, optional, std::move(consumers)));
   t.push_back(single(0x1017, optional,
-                     variable(0, "Producer heartbeat time", data_type::unsigned16, access::rw, c.heartbeat_ms)));
-  t.push_back(group(0x1200, "SDO server parameter", object_code::record, optional,
-                    {variable(0, "Highest sub-index supported", data_type::unsigned8, access::ro, 2),
-                     plus_node_id(variable(1, "COB-ID client to server", data_type::unsigned32, access::ro, cob::sdo_rx)),
-                     plus_node_id(variable(2, "COB-ID server to client", data_type::unsigned32, access::ro, cob::sdo_tx))}));
+                     variable(0, "Producer heartbeat time", data_type::unsigned16, dictionary::access::rw, c.heartbeat_ms)));
+  t.push_back(group(0x1200, "SDO server parameter", dictionary::object_code::record, optional,
+                    {variable(0, "Highest sub-index supported", data_type::unsigned8, dictionary::access::ro, 2),
+                     plus_node_id(variable(1, "COB-ID client to server", data_type::unsigned32, dictionary::access::ro, cob::sdo_rx)),
+                     plus_node_id(variable(2, "COB-ID server to client", data_type::unsigned32, dictionary::access::ro, cob::sdo_tx))}));
   add_pdos(t, c);
   return t;
 }
 
-std::vector<object_entry> node_objects(const slave_config& c) {
-  std::vector<object_entry> t = communication_objects(c);
-  for (const object_entry& o : c.objects) {
-    if (std::any_of(t.begin(), t.end(), [&](const object_entry& mine) { return mine.index == o.index; })) {
+std::vector<dictionary::object_entry> node_objects(const slave_config& c) {
+  std::vector<dictionary::object_entry> t = communication_objects(c);
+  for (const dictionary::object_entry& o : c.objects) {
+    if (std::any_of(t.begin(), t.end(), [&](const dictionary::object_entry& mine) { return mine.index == o.index; })) {
       throw std::invalid_argument("the device's table has " + hex4(o.index) +
                                   ", a communication object the CiA 301 node serves itself");
     }
   }
   t.insert(t.end(), c.objects.begin(), c.objects.end());
-  std::sort(t.begin(), t.end(), [](const object_entry& a, const object_entry& b) { return a.index < b.index; });
+  std::sort(t.begin(), t.end(), [](const dictionary::object_entry& a, const dictionary::object_entry& b) { return a.index < b.index; });
   return t;
 }
 

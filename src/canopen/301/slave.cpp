@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "cia402/canopen/301/error_history.hpp"
+#include "cia402/dictionary/error_history.hpp"
 
 
 namespace cia402::canopen {
@@ -15,8 +15,8 @@ bool is_pdo_parameter(std::uint16_t index) noexcept {
 
 }  // namespace
 
-slave::slave(device& d, channel& out, const slave_config& config)
-    : dictionary_access(od_),
+slave::slave(dictionary::device& d, channel& out, const slave_config& config)
+    : dictionary::dictionary_access(od_),
       device_(&d),
       out_(&out),
       config_(config),
@@ -146,8 +146,8 @@ void slave::configure_consumer() {
   consumer_.configure(entries);
 }
 
-sdo_abort slave::read_value(const object_dictionary::slot& s, std::int64_t& v) {
-  if (s.entry->where == backing::device) {
+sdo_abort slave::read_value(const dictionary::object_dictionary::slot& s, std::int64_t& v) {
+  if (s.entry->where == dictionary::backing::device) {
     const sdo_abort a = device_->read(s.object->index, s.entry->sub, v);
     if (a == sdo_abort::none && s.object->index == 0x1001 && (heartbeat_error_ || pdo_length_error_)) {
       v |= 0x11;  // generic + communication error (CiA 301 §7.5.2.2)
@@ -158,10 +158,10 @@ sdo_abort slave::read_value(const object_dictionary::slot& s, std::int64_t& v) {
   return sdo_abort::none;
 }
 
-sdo_abort slave::write_value(object_dictionary::slot& s, std::int64_t v) {
+sdo_abort slave::write_value(dictionary::object_dictionary::slot& s, std::int64_t v) {
   const std::uint16_t index = s.object->index;
   const std::uint8_t sub = s.entry->sub;
-  if (s.entry->where == backing::device) {
+  if (s.entry->where == dictionary::backing::device) {
     const sdo_abort a = device_->write(index, sub, v);
     if (a == sdo_abort::none) object_changed(index, sub);  // a TPDO mapping it sends it
     return a;
@@ -169,7 +169,7 @@ sdo_abort slave::write_value(object_dictionary::slot& s, std::int64_t v) {
   if (is_pdo_parameter(index)) return write_pdo_parameter(s, v);
   const auto u = static_cast<std::uint32_t>(v);
   switch (index) {
-    case error_history_index: return write_error_history(od_, sub, v);
+    case dictionary::error_history_index: return dictionary::write_error_history(od_, sub, v);
     case 0x1005:
       // This node consumes SYNC only (bit 30 would make it the producer); 11-bit identifiers; an
       // identifier of its own services taken as SYNC would silence them.
@@ -256,7 +256,7 @@ void slave::note_error(std::uint16_t code) noexcept {
   // 0x1003 keeps every error the node signals, also one that arises in STOPPED where no EMCY goes:
   // the code, and the first two bytes of the EMCY's manufacturer field (a drive: its status word).
   const std::array<std::uint8_t, 5> field = device_->manufacturer_error_field();
-  record_error(od_, code, static_cast<std::uint16_t>(field[0] | (field[1] << 8)));
+  dictionary::record_error(od_, code, static_cast<std::uint16_t>(field[0] | (field[1] << 8)));
 }
 
 void slave::send_emcy(std::uint16_t code) {

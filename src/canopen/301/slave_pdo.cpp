@@ -38,7 +38,7 @@ void slave::apply_rpdo(rpdo_state& r, const std::uint8_t* data) {
   std::size_t offset = 0;
   for (std::uint8_t i = 0; i < r.cfg.count; ++i) {
     const mapped_object& m = r.cfg.map[i];
-    const std::int64_t v = decode_value(m.type, std::span<const std::uint8_t>(data + offset, m.bytes));
+    const std::int64_t v = dictionary::decode_value(m.type, std::span<const std::uint8_t>(data + offset, m.bytes));
     offset += m.bytes;
     // The slot bound when the mapping was configured, with the rules of an SDO write. A value the
     // object refuses is dropped: a PDO has no answer to carry an abort code.
@@ -113,7 +113,7 @@ pdo_config slave::resolve(std::uint16_t comm, std::uint16_t mapping) {
   for (std::uint8_t i = 0; i < c.count && i < c.map.size(); ++i) {
     const auto entry = static_cast<std::uint32_t>(od_.number(mapping, static_cast<std::uint8_t>(i + 1)));
     sdo_abort ignored = sdo_abort::none;
-    object_dictionary::slot* s = od_.find(map_index(entry), map_sub(entry), ignored);
+    dictionary::object_dictionary::slot* s = od_.find(map_index(entry), map_sub(entry), ignored);
     if (s == nullptr) {  // cannot happen: entries are checked when written
       c.valid = false;
       c.count = i;
@@ -137,18 +137,18 @@ void slave::resolve_pdos() {
 
 sdo_abort slave::check_mapping_entry(bool receive, std::uint32_t entry) const {
   sdo_abort a = sdo_abort::none;
-  const object_dictionary::slot* s =
-      const_cast<object_dictionary&>(od_).find(map_index(entry), map_sub(entry), a);
+  const dictionary::object_dictionary::slot* s =
+      const_cast<dictionary::object_dictionary&>(od_).find(map_index(entry), map_sub(entry), a);
   if (s == nullptr) return a;
-  const sub_entry& e = *s->entry;
-  if (!e.pdo_mappable || (receive ? !writable(e.acc) : !readable(e.acc)) ||
+  const dictionary::sub_entry& e = *s->entry;
+  if (!e.pdo_mappable || (receive ? !dictionary::writable(e.acc) : !dictionary::readable(e.acc)) ||
       map_bits(entry) != type_size(e.type) * 8) {
     return sdo_abort::cannot_map_to_pdo;
   }
   return sdo_abort::none;
 }
 
-sdo_abort slave::write_pdo_parameter(object_dictionary::slot& s, std::int64_t v) {
+sdo_abort slave::write_pdo_parameter(dictionary::object_dictionary::slot& s, std::int64_t v) {
   const std::uint16_t index = s.object->index;
   const std::uint8_t sub = s.entry->sub;
   const bool receive = index < 0x1800;

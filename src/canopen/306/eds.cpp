@@ -32,16 +32,16 @@ std::string number_text(data_type type, std::int64_t v);
 
 // "$NODEID+X" with X as number_text writes it, so a signed type's negative X reads back (its hex
 // two's complement, 0xFFFFFFFFFFFFFFFB, is no INTEGER the reader takes).
-std::string node_text(const sub_entry& e) {
+std::string node_text(const dictionary::sub_entry& e) {
   return "$NODEID+" + (type_is_signed(e.type) ? std::to_string(e.default_value)
                                                : hex(static_cast<std::uint64_t>(e.default_value), 0));
 }
 
 // The value at power-up as the EDS writes it; false if the device lacks the object.
-bool default_text(slave& node, const object_entry& o, const sub_entry& e, std::string& out) {
+bool default_text(slave& node, const dictionary::object_entry& o, const dictionary::sub_entry& e, std::string& out) {
   if (e.type == data_type::visible_string) {
     std::vector<std::uint8_t> bytes;
-    if (readable(e.acc)) (void)node.read_bytes(o.index, e.sub, bytes);
+    if (dictionary::readable(e.acc)) (void)node.read_bytes(o.index, e.sub, bytes);
     out.assign(bytes.begin(), bytes.end());
     return true;
   }
@@ -50,7 +50,7 @@ bool default_text(slave& node, const object_entry& o, const sub_entry& e, std::s
     return true;
   }
   std::int64_t v = e.default_value;
-  if (e.where == backing::device) {
+  if (e.where == dictionary::backing::device) {
     const sdo_abort a = node.read(o.index, e.sub, v);
     if (a == sdo_abort::object_does_not_exist) return false;
     if (a != sdo_abort::none) v = 0;
@@ -60,13 +60,13 @@ bool default_text(slave& node, const object_entry& o, const sub_entry& e, std::s
 }
 
 // One entry's section; `parameter` (a DCF's) is the value the node has now (CiA 306 §4.6.4).
-void write_sub(std::ostream& out, const std::string& section, const object_entry& o, const sub_entry& e,
+void write_sub(std::ostream& out, const std::string& section, const dictionary::object_entry& o, const dictionary::sub_entry& e,
                const std::string& value, const std::string* parameter = nullptr) {
   out << "[" << section << "]\n"
-      << "ParameterName=" << (o.subs.size() == 1 && o.code == object_code::var ? o.name : e.name) << "\n"
+      << "ParameterName=" << (o.subs.size() == 1 && o.code == dictionary::object_code::var ? o.name : e.name) << "\n"
       << "ObjectType=0x7\n"
       << "DataType=" << hex(static_cast<std::uint16_t>(e.type), 4) << "\n"
-      << "AccessType=" << access_name(e.acc) << "\n"
+      << "AccessType=" << dictionary::access_name(e.acc) << "\n"
       << "DefaultValue=" << value << "\n";
   if (parameter != nullptr) out << "ParameterValue=" << *parameter << "\n";
   if (e.has_limits) {
@@ -98,22 +98,22 @@ void write_commissioning(std::ostream& out, const eds_info& info) {
 
 // The three object lists (CiA 306 §4.6.2) and each object's sections; `value_of` gives an entry's
 // DefaultValue text, `parameter_of` its ParameterValue (nullptr: none).
-void write_objects(std::ostream& out, const std::vector<const object_entry*>& present,
-                   const std::function<std::string(const object_entry&, const sub_entry&)>& value_of,
-                   const std::function<const std::string*(const object_entry&, const sub_entry&)>& parameter_of) {
+void write_objects(std::ostream& out, const std::vector<const dictionary::object_entry*>& present,
+                   const std::function<std::string(const dictionary::object_entry&, const dictionary::sub_entry&)>& value_of,
+                   const std::function<const std::string*(const dictionary::object_entry&, const dictionary::sub_entry&)>& parameter_of) {
   const char* list_names[3] = {"MandatoryObjects", "OptionalObjects", "ManufacturerObjects"};
   for (int c = 0; c < 3; ++c) {
-    std::vector<const object_entry*> in;
-    for (const object_entry* o : present) {
+    std::vector<const dictionary::object_entry*> in;
+    for (const dictionary::object_entry* o : present) {
       if (eds_list_of(o->index) == c) in.push_back(o);
     }
     out << "[" << list_names[c] << "]\nSupportedObjects=" << in.size() << "\n";
     for (std::size_t i = 0; i < in.size(); ++i) out << i + 1 << "=" << hex(in[i]->index, 4) << "\n";
     out << "\n";
-    for (const object_entry* o : in) {
+    for (const dictionary::object_entry* o : in) {
       const std::string name = section_name(o->index);
-      if (o->code == object_code::var) {
-        const sub_entry& e = o->subs.front();
+      if (o->code == dictionary::object_code::var) {
+        const dictionary::sub_entry& e = o->subs.front();
         write_sub(out, name, *o, e, value_of(*o, e), parameter_of(*o, e));
         continue;
       }
@@ -121,7 +121,7 @@ void write_objects(std::ostream& out, const std::vector<const object_entry*>& pr
           << "ParameterName=" << o->name << "\n"
           << "ObjectType=" << hex(static_cast<unsigned>(o->code), 0) << "\n"
           << "SubNumber=" << hex(o->subs.size(), 0) << "\n\n";
-      for (const sub_entry& e : o->subs) {
+      for (const dictionary::sub_entry& e : o->subs) {
         write_sub(out, name + "sub" + hex(e.sub, 0).substr(2), *o, e, value_of(*o, e), parameter_of(*o, e));
       }
     }
@@ -138,15 +138,15 @@ std::string number_text(data_type type, std::int64_t v) {
 
 void write_eds(slave& node, const eds_info& info, std::ostream& out) {
   // Which objects the node really has (a profile may lack an option-code object).
-  std::vector<const object_entry*> present;
-  for (const object_entry& o : node.dictionary().table()) {
+  std::vector<const dictionary::object_entry*> present;
+  for (const dictionary::object_entry& o : node.dictionary().table()) {
     std::string ignored;
     if (default_text(node, o, o.subs.front(), ignored)) present.push_back(&o);
   }
 
   // The PDOs the node has: its communication parameter objects (RPDO 0x1400.., TPDO 0x1800..).
   int rpdos = 0, tpdos = 0;
-  for (const object_entry& o : node.dictionary().table()) {
+  for (const dictionary::object_entry& o : node.dictionary().table()) {
     if (o.index >= 0x1400 && o.index <= 0x15FF) ++rpdos;
     if (o.index >= 0x1800 && o.index <= 0x19FF) ++tpdos;
   }
@@ -174,37 +174,37 @@ void write_eds(slave& node, const eds_info& info, std::ostream& out) {
   write_commissioning(out, info);
   write_objects(
       out, present,
-      [&node](const object_entry& o, const sub_entry& e) {
+      [&node](const dictionary::object_entry& o, const dictionary::sub_entry& e) {
         std::string value;
         default_text(node, o, e, value);
         return value;
       },
-      [](const object_entry&, const sub_entry&) -> const std::string* { return nullptr; });
+      [](const dictionary::object_entry&, const dictionary::sub_entry&) -> const std::string* { return nullptr; });
 }
 
-std::string dcf_value_text(const sub_entry& e, std::int64_t value) { return number_text(e.type, value); }
+std::string dcf_value_text(const dictionary::sub_entry& e, std::int64_t value) { return number_text(e.type, value); }
 
-std::string dcf_entry_text(const sub_entry& e) {
+std::string dcf_entry_text(const dictionary::sub_entry& e) {
   if (e.type == data_type::visible_string) return e.default_text;
   if (e.plus_node_id) return node_text(e);
   return number_text(e.type, e.default_value);
 }
 
-void write_dcf(const std::vector<object_entry>& objects, const dcf_values& values, const eds_info& info,
+void write_dcf(const std::vector<dictionary::object_entry>& objects, const dcf_values& values, const eds_info& info,
                std::ostream& out) {
   write_file_info(out, info);
   out << "[DeviceInfo]\nVendorName=" << info.vendor_name << "\nProductName=" << info.product_name << "\n\n";
   write_commissioning(out, info);
-  std::vector<const object_entry*> present;
-  for (const object_entry& o : objects) {
+  std::vector<const dictionary::object_entry*> present;
+  for (const dictionary::object_entry& o : objects) {
     if (!o.subs.empty()) present.push_back(&o);
   }
   std::sort(present.begin(), present.end(),
-            [](const object_entry* a, const object_entry* b) { return a->index < b->index; });
+            [](const dictionary::object_entry* a, const dictionary::object_entry* b) { return a->index < b->index; });
   write_objects(
       out, present,
-      [](const object_entry&, const sub_entry& e) { return dcf_entry_text(e); },
-      [&values](const object_entry& o, const sub_entry& e) -> const std::string* {
+      [](const dictionary::object_entry&, const dictionary::sub_entry& e) { return dcf_entry_text(e); },
+      [&values](const dictionary::object_entry& o, const dictionary::sub_entry& e) -> const std::string* {
         const auto it = values.find({o.index, e.sub});
         return it == values.end() ? nullptr : &it->second;
       });

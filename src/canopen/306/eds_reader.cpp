@@ -101,12 +101,12 @@ class reader {
       if (name.size() != 4) continue;
       const auto index = hex_number(name, 4);
       if (!index) continue;
-      object_entry o;
+      dictionary::object_entry o;
       if (!object(static_cast<std::uint16_t>(*index), s, o)) return error_;
       if (!o.subs.empty()) out.objects.push_back(std::move(o));
     }
     std::sort(out.objects.begin(), out.objects.end(),
-              [](const object_entry& a, const object_entry& b) { return a.index < b.index; });
+              [](const dictionary::object_entry& a, const dictionary::object_entry& b) { return a.index < b.index; });
     return out;
   }
 
@@ -167,7 +167,7 @@ class reader {
 
   // One sub-index from its section (the object's own for a VAR). `keep` is false for a data type
   // the dictionary cannot hold.
-  bool entry(const section& s, std::uint8_t sub, sub_entry& e, bool& keep) {
+  bool entry(const section& s, std::uint8_t sub, dictionary::sub_entry& e, bool& keep) {
     e.sub = sub;
     if (const value_line* v = find(s, "ParameterName")) e.name = v->text;
     std::optional<std::int64_t> type;
@@ -178,10 +178,10 @@ class reader {
     e.type = static_cast<data_type>(*type);
     if (const value_line* v = find(s, "AccessType")) {
       const std::string a = lower(v->text);
-      if (a == "ro") e.acc = access::ro;
-      else if (a == "wo") e.acc = access::wo;
-      else if (a == "rw" || a == "rwr" || a == "rww") e.acc = access::rw;
-      else if (a == "const") e.acc = access::constant;
+      if (a == "ro") e.acc = dictionary::access::ro;
+      else if (a == "wo") e.acc = dictionary::access::wo;
+      else if (a == "rw" || a == "rwr" || a == "rww") e.acc = dictionary::access::rw;
+      else if (a == "const") e.acc = dictionary::access::constant;
       else return fail(v->line, "AccessType '" + v->text + "' is not ro, wo, rw, rwr, rww or const");
     }
     std::optional<std::int64_t> mapping;
@@ -200,7 +200,7 @@ class reader {
     const value_line* standard = find(s, "DefaultValue");
     e.parameter_value = parameter != nullptr && !parameter->text.empty();
     if (e.parameter_value && standard != nullptr) {
-      sub_entry left = e;
+      dictionary::sub_entry left = e;
       if (!default_value(*standard, left)) return false;
     }
     const value_line* value = e.parameter_value ? parameter : standard;
@@ -224,7 +224,7 @@ class reader {
     return std::string(type_name(t)) + " (" + std::to_string(type_min(t)) + ".." + std::to_string(type_max(t)) + ")";
   }
 
-  bool default_value(const value_line& v, sub_entry& e) {
+  bool default_value(const value_line& v, dictionary::sub_entry& e) {
     if (e.type == data_type::visible_string) {
       e.default_text = v.text;
       e.capacity = v.text.size();
@@ -260,17 +260,17 @@ class reader {
     return true;
   }
 
-  bool object(std::uint16_t index, const section& s, object_entry& o) {
+  bool object(std::uint16_t index, const section& s, dictionary::object_entry& o) {
     o.index = index;
     if (const value_line* v = find(s, "ParameterName")) o.name = v->text;
     std::optional<std::int64_t> code;
     if (!number_key(s, "ObjectType", code)) return false;
     const std::int64_t c = code.value_or(7);
     if (c != 7 && c != 8 && c != 9) return true;  // NULL, DOMAIN, DEFTYPE, DEFSTRUCT: no values
-    o.code = static_cast<object_code>(c);
-    o.category = index >= 0x2000 && index <= 0x5FFF ? object_category::manufacturer : object_category::optional;
+    o.code = static_cast<dictionary::object_code>(c);
+    o.category = index >= 0x2000 && index <= 0x5FFF ? dictionary::object_category::manufacturer : dictionary::object_category::optional;
     if (c == 7) {
-      sub_entry e;
+      dictionary::sub_entry e;
       bool keep = false;
       if (!entry(s, 0, e, keep)) return false;
       if (keep) o.subs.push_back(std::move(e));
@@ -284,22 +284,22 @@ class reader {
       if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
       const auto sub = hex_number(std::string_view(name).substr(prefix.size()), 2);
       if (!sub) continue;
-      sub_entry e;
+      dictionary::sub_entry e;
       bool keep = false;
       if (!entry(sub_section, static_cast<std::uint8_t>(*sub), e, keep)) return false;
       if (keep) o.subs.push_back(std::move(e));
     }
-    std::sort(o.subs.begin(), o.subs.end(), [](const sub_entry& a, const sub_entry& b) { return a.sub < b.sub; });
+    std::sort(o.subs.begin(), o.subs.end(), [](const dictionary::sub_entry& a, const dictionary::sub_entry& b) { return a.sub < b.sub; });
     return true;
   }
 
   // CiA 306 compact storage: sub-index 0 holds the count, subs 1..N share the object's keys.
-  bool compact_subs(const section& s, std::int64_t count, object_entry& o) {
+  bool compact_subs(const section& s, std::int64_t count, dictionary::object_entry& o) {
     if (count > 254) return fail(s.line, "CompactSubObj above 254");
-    sub_entry e;
+    dictionary::sub_entry e;
     bool keep = false;
     if (!entry(s, 1, e, keep)) return false;
-    sub_entry highest;
+    dictionary::sub_entry highest;
     highest.sub = 0;
     highest.name = "Highest sub-index supported";
     highest.type = data_type::unsigned8;
@@ -307,7 +307,7 @@ class reader {
     o.subs.push_back(highest);
     if (!keep) return true;
     for (std::int64_t i = 1; i <= count; ++i) {
-      sub_entry sub = e;
+      dictionary::sub_entry sub = e;
       sub.sub = static_cast<std::uint8_t>(i);
       // Trimmed as the file's own names are, so the name a DCF writes of it reads back.
       sub.name = o.name.empty() ? std::to_string(i) : o.name + " " + std::to_string(i);
@@ -333,7 +333,7 @@ class reader {
 
 std::variant<eds_contents, eds_error> read_eds(std::string_view text) { return reader(text).run(); }
 
-std::optional<std::int64_t> value_for_node(const sub_entry& e, int node_id) {
+std::optional<std::int64_t> value_for_node(const dictionary::sub_entry& e, int node_id) {
   std::int64_t v = e.default_value;
   if (e.plus_node_id && __builtin_add_overflow(v, std::int64_t{node_id}, &v)) return std::nullopt;
   if (v < type_min(e.type) || v > type_max(e.type)) return std::nullopt;

@@ -31,11 +31,11 @@ axes::transfer_result result_of(const sdo_result& r, const std::string& node, st
   return t;
 }
 
-std::optional<axes::value_format> find_format(const std::vector<object_entry>& table, std::uint16_t index,
+std::optional<axes::value_format> find_format(const std::vector<dictionary::object_entry>& table, std::uint16_t index,
                                               std::uint8_t sub) {
-  for (const object_entry& o : table) {
+  for (const dictionary::object_entry& o : table) {
     if (o.index != index) continue;
-    for (const sub_entry& e : o.subs) {
+    for (const dictionary::sub_entry& e : o.subs) {
       if (e.sub == sub) return axes::format_of(e.type);
     }
   }

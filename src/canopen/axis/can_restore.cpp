@@ -26,8 +26,8 @@ std::uint16_t pdo_of(std::uint16_t index) { return pdo_mapping(index) ? static_c
 
 // What the master restores is CiA 301's communication objects: their names are any node's.
 std::string name_of(std::uint16_t index) {
-  static const std::vector<object_entry> table = communication_objects(slave_config{});
-  for (const object_entry& o : table) {
+  static const std::vector<dictionary::object_entry> table = communication_objects(slave_config{});
+  for (const dictionary::object_entry& o : table) {
     if (o.index == index) return hex(index, 4) + " (" + o.name + ")";
   }
   return hex(index, 4);

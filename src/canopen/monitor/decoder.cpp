@@ -40,14 +40,14 @@ const char* kind_name(frame_kind k) noexcept {
 decoder::decoder() = default;
 decoder::~decoder() = default;
 
-void decoder::describe_node(std::uint8_t node_id, std::vector<object_entry> objects) {
+void decoder::describe_node(std::uint8_t node_id, std::vector<dictionary::object_entry> objects) {
   if (!valid_node_id(node_id)) return;
-  described_[node_id] = std::make_shared<const std::vector<object_entry>>(std::move(objects));
+  described_[node_id] = std::make_shared<const std::vector<dictionary::object_entry>>(std::move(objects));
   reset_node(node(node_id), node_id);
 }
 
-void decoder::describe_other_nodes(std::vector<object_entry> objects) {
-  others_ = std::make_shared<const std::vector<object_entry>>(std::move(objects));
+void decoder::describe_other_nodes(std::vector<dictionary::object_entry> objects) {
+  others_ = std::make_shared<const std::vector<dictionary::object_entry>>(std::move(objects));
   for (auto& [id, n] : nodes_) {
     if (described_.count(id) == 0) reset_node(*n, id);
   }

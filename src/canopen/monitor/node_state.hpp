@@ -64,12 +64,12 @@ struct sdo_follow {
 };
 
 struct decoder::node_state {
-  std::shared_ptr<const std::vector<object_entry>> table;  ///< its description, or null
+  std::shared_ptr<const std::vector<dictionary::object_entry>> table;  ///< its description, or null
   std::map<std::uint16_t, pdo_map> pdos;  ///< by communication index, 0x1400.. and 0x1800..
   sdo_follow sdo;
 };
 
-using object_table = std::vector<object_entry>;
+using object_table = std::vector<dictionary::object_entry>;
 
 /// "0x6041:0".
 std::string object_ref(std::uint16_t index, std::uint8_t sub);

@@ -29,8 +29,8 @@ pdo_map& map_of(decoder::node_state& n, std::uint8_t node_id, std::uint16_t comm
   return it->second;
 }
 
-const sub_entry* sub_of(const object_entry& o, std::uint8_t sub) {
-  for (const sub_entry& e : o.subs) {
+const dictionary::sub_entry* sub_of(const dictionary::object_entry& o, std::uint8_t sub) {
+  for (const dictionary::sub_entry& e : o.subs) {
     if (e.sub == sub) return &e;
   }
   return nullptr;
@@ -39,7 +39,7 @@ const sub_entry* sub_of(const object_entry& o, std::uint8_t sub) {
 // A COB-ID entry's value on node `node_id`: "$NODEID+X" summed with the overflow checked; nothing
 // when the sum overflows or leaves the entry's type (a description written for another node, or a
 // hostile one), so no PDO is taken to be on an identifier its description never meant.
-std::optional<std::uint32_t> cob_id_of(const sub_entry& e, std::uint8_t node_id) {
+std::optional<std::uint32_t> cob_id_of(const dictionary::sub_entry& e, std::uint8_t node_id) {
   std::int64_t v = e.default_value;
   if (e.plus_node_id && __builtin_add_overflow(v, std::int64_t{node_id}, &v)) return std::nullopt;
   if (v < type_min(e.type) || v > type_max(e.type) || v < 0 || v > 0xFFFFFFFF) return std::nullopt;
@@ -56,16 +56,16 @@ std::string pdo_name(std::uint16_t communication) {
 void load_pdos(decoder::node_state& n, std::uint8_t node_id) {
   n.pdos.clear();
   if (!n.table) return;
-  for (const object_entry& o : *n.table) {
+  for (const dictionary::object_entry& o : *n.table) {
     if (!communication_index(o.index)) continue;
     pdo_map m;
-    if (const sub_entry* e = sub_of(o, 1)) m.cob_id = cob_id_of(*e, node_id).value_or(pdo_cob_invalid);
-    for (const object_entry& map : *n.table) {
+    if (const dictionary::sub_entry* e = sub_of(o, 1)) m.cob_id = cob_id_of(*e, node_id).value_or(pdo_cob_invalid);
+    for (const dictionary::object_entry& map : *n.table) {
       if (map.index != o.index + 0x200) continue;
-      if (const sub_entry* count = sub_of(map, 0)) {
+      if (const dictionary::sub_entry* count = sub_of(map, 0)) {
         m.count = static_cast<std::uint8_t>(std::clamp<std::int64_t>(count->default_value, 0, max_mapped_entries));
       }
-      for (const sub_entry& e : map.subs) {
+      for (const dictionary::sub_entry& e : map.subs) {
         if (e.sub >= 1 && e.sub <= max_mapped_entries) {
           m.entries[e.sub - 1u] = static_cast<std::uint32_t>(e.default_value);
         }

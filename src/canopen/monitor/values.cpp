@@ -26,11 +26,11 @@ object_info info_of(const object_table* table, std::uint16_t index, std::uint8_t
     info.unit = d->unit;
   }
   if (table == nullptr) return info;
-  for (const object_entry& o : *table) {
+  for (const dictionary::object_entry& o : *table) {
     if (o.index != index) continue;
-    for (const sub_entry& e : o.subs) {
+    for (const dictionary::sub_entry& e : o.subs) {
       if (e.sub != sub) continue;
-      info.name = o.code == object_code::var || e.name.empty() ? o.name : o.name + ": " + e.name;
+      info.name = o.code == dictionary::object_code::var || e.name.empty() ? o.name : o.name + ": " + e.name;
       info.typed = true;
       info.type = e.type;
     }

@@ -4,25 +4,25 @@
 #include <stdexcept>
 #include <string>
 
-#include "cia402/canopen/301/error_history.hpp"
-#include "cia402/canopen/301/object_builders.hpp"
+#include "cia402/dictionary/error_history.hpp"
+#include "cia402/dictionary/object_builders.hpp"
 #include "cia402/ethercat/slave/coe_slave.hpp"
 
 namespace cia402::ethercat {
 namespace {
 
-using canopen::access;
+using dictionary::access;
 using cia402::data_type;
-using canopen::object_category;
-using canopen::object_code;
-using canopen::object_entry;
-using canopen::sub_entry;
-using canopen::variable;
+using dictionary::object_category;
+using dictionary::object_code;
+using dictionary::object_entry;
+using dictionary::sub_entry;
+using dictionary::variable;
 
 object_entry pdo_assignment(std::uint16_t index, std::string name, std::uint16_t first_pdo, bool assigned) {
-  return canopen::group(
+  return dictionary::group(
       index, std::move(name), object_code::array, object_category::optional,
-      {canopen::limited(variable(0, "Number of assigned PDOs", data_type::unsigned8, access::rw, assigned ? 1 : 0), 0, 2),
+      {dictionary::limited(variable(0, "Number of assigned PDOs", data_type::unsigned8, access::rw, assigned ? 1 : 0), 0, 2),
        variable(1, "PDO 1", data_type::unsigned16, access::rw, assigned ? first_pdo : 0),
        variable(2, "PDO 2", data_type::unsigned16, access::rw, 0)});
 }
@@ -31,7 +31,7 @@ object_entry pdo_assignment(std::uint16_t index, std::string name, std::uint16_t
 // master chooses (written in PRE-OP; DC SYNC0 also taken from 0x0981 on the way to SAFE-OP), the
 // cycle, the modes this slave offers (free run, SM-synchronous, DC SYNC0) and what SYNC0 ran.
 object_entry sync_manager_parameter(std::uint16_t index, std::string name, std::uint32_t cycle_us) {
-  return canopen::group(
+  return dictionary::group(
       index, std::move(name), object_code::record, object_category::optional,
       {variable(0, "Number of sub-indices", data_type::unsigned8, access::ro, sync_parameter::sync_error_count),
        variable(sync_parameter::mode, "Sync mode", data_type::unsigned16, access::rw, sync_mode::free_run),
@@ -99,16 +99,16 @@ pdo_description pdo_of(const std::vector<object_entry>& t, std::uint16_t index, 
 std::vector<object_entry> coe_communication_objects(const coe_slave_config& c) {
   std::vector<object_entry> t;
   // The emergencies' history (CiA 301 §7.5.2.5), as the CANopen node keeps it.
-  t.push_back(canopen::error_history_object());
+  t.push_back(dictionary::error_history_object());
   // EtherCAT has no heartbeat (the sync manager watchdog watches the master): 0x1017 is stored and
   // does nothing, so a master that sets it on every bus is not refused.
-  t.push_back(canopen::single(0x1017, object_category::optional,
+  t.push_back(dictionary::single(0x1017, object_category::optional,
                               variable(0, "Producer heartbeat time", data_type::unsigned16, access::rw)));
-  t.push_back(canopen::pdo_mapping(0x1600, "RxPDO 1 mapping", c.rx_pdo, max_pdo_entries));
-  t.push_back(canopen::pdo_mapping(0x1601, "RxPDO 2 mapping", pdo_map{}, max_pdo_entries));
-  t.push_back(canopen::pdo_mapping(0x1A00, "TxPDO 1 mapping", c.tx_pdo, max_pdo_entries));
-  t.push_back(canopen::pdo_mapping(0x1A01, "TxPDO 2 mapping", pdo_map{}, max_pdo_entries));
-  t.push_back(canopen::group(0x1C00, "Sync manager communication type", object_code::array, object_category::optional,
+  t.push_back(dictionary::pdo_mapping(0x1600, "RxPDO 1 mapping", c.rx_pdo, max_pdo_entries));
+  t.push_back(dictionary::pdo_mapping(0x1601, "RxPDO 2 mapping", pdo_map{}, max_pdo_entries));
+  t.push_back(dictionary::pdo_mapping(0x1A00, "TxPDO 1 mapping", c.tx_pdo, max_pdo_entries));
+  t.push_back(dictionary::pdo_mapping(0x1A01, "TxPDO 2 mapping", pdo_map{}, max_pdo_entries));
+  t.push_back(dictionary::group(0x1C00, "Sync manager communication type", object_code::array, object_category::optional,
                              {variable(0, "Number of used sync managers", data_type::unsigned8, access::ro, 4),
                               variable(1, "SM0 (mailbox receive)", data_type::unsigned8, access::ro, 1),
                               variable(2, "SM1 (mailbox send)", data_type::unsigned8, access::ro, 2),

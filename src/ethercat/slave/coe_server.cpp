@@ -5,9 +5,9 @@
 namespace cia402::ethercat {
 namespace {
 
-using canopen::object_code;
-using canopen::object_entry;
-using canopen::sub_entry;
+using dictionary::object_code;
+using dictionary::object_entry;
+using dictionary::sub_entry;
 
 // Objects whose writes configure the process data: writable in PRE-OP only (ETG.1000.6).
 bool pdo_configuration(std::uint16_t index) noexcept {
@@ -20,10 +20,10 @@ bool pdo_configuration(std::uint16_t index) noexcept {
 // one it only reads (an actual value) an input.
 std::uint16_t access_bits(std::uint16_t index, const sub_entry& e) noexcept {
   std::uint16_t bits = 0;
-  if (canopen::readable(e.acc)) bits |= 0x0007;
-  if (canopen::writable(e.acc)) bits |= static_cast<std::uint16_t>(pdo_configuration(index) ? 0x0008 : 0x0038);
-  if (e.pdo_mappable && canopen::writable(e.acc)) bits |= 0x0040;
-  if (e.pdo_mappable && !canopen::writable(e.acc)) bits |= 0x0080;
+  if (dictionary::readable(e.acc)) bits |= 0x0007;
+  if (dictionary::writable(e.acc)) bits |= static_cast<std::uint16_t>(pdo_configuration(index) ? 0x0008 : 0x0038);
+  if (e.pdo_mappable && dictionary::writable(e.acc)) bits |= 0x0040;
+  if (e.pdo_mappable && !dictionary::writable(e.acc)) bits |= 0x0080;
   return bits;
 }
 
@@ -40,8 +40,8 @@ bool in_list(const object_entry& o, std::uint16_t list) noexcept {
   const auto any = [&](auto pred) { return std::any_of(o.subs.begin(), o.subs.end(), pred); };
   switch (list) {
     case 1: return true;
-    case 2: return any([](const sub_entry& e) { return e.pdo_mappable && canopen::writable(e.acc); });
-    case 3: return any([](const sub_entry& e) { return e.pdo_mappable && !canopen::writable(e.acc); });
+    case 2: return any([](const sub_entry& e) { return e.pdo_mappable && dictionary::writable(e.acc); });
+    case 3: return any([](const sub_entry& e) { return e.pdo_mappable && !dictionary::writable(e.acc); });
     default: return false;
   }
 }
@@ -63,7 +63,7 @@ std::uint16_t record_data_type(std::uint16_t index) noexcept {
 
 }  // namespace
 
-coe_server::coe_server(canopen::object_access& access, const canopen::object_dictionary& dictionary,
+coe_server::coe_server(dictionary::object_access& access, const dictionary::object_dictionary& dictionary,
                        std::uint16_t mailbox_size, std::uint16_t station_address)
     : access_(&access),
       dictionary_(&dictionary),

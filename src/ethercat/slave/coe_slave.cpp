@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "cia402/canopen/301/error_history.hpp"
+#include "cia402/dictionary/error_history.hpp"
 
 namespace cia402::ethercat {
 namespace {
@@ -21,7 +21,7 @@ constexpr int sm_inputs = 3;
 
 }  // namespace
 
-coe_slave::coe_slave(canopen::device& d, const coe_slave_config& c)
+coe_slave::coe_slave(dictionary::device& d, const coe_slave_config& c)
     : dictionary_access(od_),
       device_(&d),
       od_(coe_objects(c), 0),
@@ -40,23 +40,23 @@ coe_slave::~coe_slave() { device_->attach(nullptr); }
 
 // ---- the dictionary's rules -------------------------------------------------------------------
 
-sdo_abort coe_slave::read_value(const canopen::object_dictionary::slot& s, std::int64_t& v) {
-  if (s.entry->where == canopen::backing::device) return device_->read(s.object->index, s.entry->sub, v);
+sdo_abort coe_slave::read_value(const dictionary::object_dictionary::slot& s, std::int64_t& v) {
+  if (s.entry->where == dictionary::backing::device) return device_->read(s.object->index, s.entry->sub, v);
   v = s.number;
   return sdo_abort::none;
 }
 
 bool coe_slave::entry_mappable(std::uint16_t mapping, std::uint32_t m) const {
   // An entry names an object of the dictionary, mappable in this direction, of its own size.
-  const canopen::object_dictionary::slot* target = od_.find(static_cast<std::uint16_t>(m >> 16),
+  const dictionary::object_dictionary::slot* target = od_.find(static_cast<std::uint16_t>(m >> 16),
                                                               static_cast<std::uint8_t>(m >> 8));
   const bool rx = mapping < 0x1A00;
   return target != nullptr && target->entry->pdo_mappable &&
-         (rx ? canopen::writable(target->entry->acc) : !canopen::writable(target->entry->acc)) &&
+         (rx ? dictionary::writable(target->entry->acc) : !dictionary::writable(target->entry->acc)) &&
          type_size(target->entry->type) * 8 == (m & 0xFFu) && (m & 0xFFu) != 0;
 }
 
-sdo_abort coe_slave::write_pdo_configuration(canopen::object_dictionary::slot& s, std::int64_t v) {
+sdo_abort coe_slave::write_pdo_configuration(dictionary::object_dictionary::slot& s, std::int64_t v) {
   const std::uint16_t index = s.object->index;
   const std::uint8_t sub = s.entry->sub;
   // The process data are configured in PRE-OP only.
@@ -84,7 +84,7 @@ sdo_abort coe_slave::write_pdo_configuration(canopen::object_dictionary::slot& s
   return sdo_abort::none;
 }
 
-sdo_abort coe_slave::write_sync_mode(canopen::object_dictionary::slot& s, std::int64_t v) {
+sdo_abort coe_slave::write_sync_mode(dictionary::object_dictionary::slot& s, std::int64_t v) {
   // The synchronisation is chosen in PRE-OP, as the process data are.
   if (state_ != al_state::pre_operational) return sdo_abort::cannot_store_in_present_state;
   if (s.entry->sub == sync_parameter::mode) {
@@ -97,12 +97,12 @@ sdo_abort coe_slave::write_sync_mode(canopen::object_dictionary::slot& s, std::i
   return sdo_abort::none;
 }
 
-sdo_abort coe_slave::write_value(canopen::object_dictionary::slot& s, std::int64_t v) {
+sdo_abort coe_slave::write_value(dictionary::object_dictionary::slot& s, std::int64_t v) {
   const std::uint16_t index = s.object->index;
-  if (s.entry->where == canopen::backing::device) return device_->write(index, s.entry->sub, v);
+  if (s.entry->where == dictionary::backing::device) return device_->write(index, s.entry->sub, v);
   if (index == sync_parameter::outputs || index == sync_parameter::inputs) return write_sync_mode(s, v);
   if (mapping_object(index) || assignment_object(index)) return write_pdo_configuration(s, v);
-  if (index == canopen::error_history_index) return canopen::write_error_history(od_, s.entry->sub, v);
+  if (index == dictionary::error_history_index) return dictionary::write_error_history(od_, s.entry->sub, v);
   s.number = v;
   return sdo_abort::none;
 }
@@ -111,8 +111,8 @@ void coe_slave::error_changed(std::uint16_t code) noexcept {
   std::int64_t reg = 0;
   (void)read(0x1001, 0, reg);
   const std::array<std::uint8_t, 5> field = device_->manufacturer_error_field();
-  // 0x1003 keeps what the emergencies said, as the CANopen node does (canopen/301/error_history.hpp).
-  canopen::record_error(od_, code, static_cast<std::uint16_t>(field[0] | (field[1] << 8)));
+  // 0x1003 keeps what the emergencies said, as the CANopen node does (dictionary/error_history.hpp).
+  dictionary::record_error(od_, code, static_cast<std::uint16_t>(field[0] | (field[1] << 8)));
   coe_.emergency(code, static_cast<std::uint8_t>(reg), field);
 }
 

@@ -55,7 +55,7 @@ bool coe_slave::bind(std::uint16_t assignment, std::vector<bound_entry>& out, un
     for (std::int64_t k = 1; k <= entries; ++k) {
       const auto m = static_cast<std::uint32_t>(od_.number(pdo, static_cast<std::uint8_t>(k)));
       sdo_abort ignored = sdo_abort::none;
-      canopen::object_dictionary::slot* s = od_.find(static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8), ignored);
+      dictionary::object_dictionary::slot* s = od_.find(static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8), ignored);
       const auto length = static_cast<std::uint8_t>(m);
       // An entry cleared after its count was written names nothing: the mapping cannot run.
       if (s == nullptr || length == 0 || length > 64 || length % 8 != 0) return false;

@@ -5,7 +5,7 @@
 #include <array>
 #include <cstdint>
 
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 
 namespace cia402::canopen {
 
@@ -32,7 +32,7 @@ struct mapped_object {
   std::uint8_t sub = 0;
   data_type type = data_type::unsigned8;
   std::uint8_t bytes = 0;
-  object_dictionary::slot* slot = nullptr;
+  dictionary::object_dictionary::slot* slot = nullptr;
 };
 
 /// One PDO as configured by its two parameter objects.

@@ -11,31 +11,16 @@
 
 #include "cia402/canopen/can/channel.hpp"
 #include "cia402/canopen/301/timing.hpp"
+#include "cia402/dictionary/object_access.hpp"
 #include "cia402/sdo_abort.hpp"
 
 namespace cia402::canopen {
 
-/// What the SDO server reads and writes: the node's object dictionary.
-class object_access {
- public:
-  virtual ~object_access() = default;
-  /// Whether a download of `size` bytes (if known) may start: existence, access, size.
-  virtual sdo_abort check_download(std::uint16_t index, std::uint8_t sub, std::size_t size,
-                                   bool size_known) noexcept = 0;
-  /// The whole value. Without `size_indicated` (an expedited download that gave no size) the object
-  /// takes as many bytes as its type needs.
-  virtual sdo_abort download(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
-                             bool size_indicated) noexcept = 0;
-  virtual sdo_abort upload(std::uint16_t index, std::uint8_t sub,
-                           std::vector<std::uint8_t>& data) noexcept = 0;
-};
-
 class sdo_server {
  public:
-  /// Longest value a segmented download may carry.
-  static constexpr std::size_t max_download = 1024;
+  static constexpr std::size_t max_download = dictionary::max_download;
 
-  sdo_server(object_access& od, channel& out, std::uint8_t node_id,
+  sdo_server(dictionary::object_access& od, channel& out, std::uint8_t node_id,
              std::uint32_t timeout_us = 1000000) noexcept
       : od_(&od), out_(&out), node_id_(node_id), timeout_us_(timeout_us) {}
 
@@ -55,7 +40,7 @@ class sdo_server {
   // §7.2.4.3.4); otherwise the transfer ends with the abort, and false.
   bool segment_continues(mode open, std::uint8_t command);
 
-  object_access* od_;
+  dictionary::object_access* od_;
   channel* out_;
   std::uint8_t node_id_;
   std::uint32_t timeout_us_;

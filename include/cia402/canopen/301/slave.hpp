@@ -47,10 +47,10 @@
 #include <vector>
 
 #include "cia402/canopen/can/channel.hpp"
-#include "cia402/canopen/301/device.hpp"
-#include "cia402/canopen/301/dictionary_access.hpp"
+#include "cia402/dictionary/device.hpp"
+#include "cia402/dictionary/dictionary_access.hpp"
 #include "cia402/canopen/301/nmt.hpp"
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 #include "cia402/canopen/301/pdo.hpp"
 #include "cia402/canopen/301/sdo_server.hpp"
 #include "cia402/canopen/301/timing.hpp"
@@ -71,7 +71,7 @@ struct slave_config {
   /// The device's objects, given by the layer above (a CiA 402 drive's: drive402::drive_objects()):
   /// its identity, its profile's objects, its own. The node adds the communication objects it serves
   /// itself (communication_objects()), so this CiA 301 node knows no device profile.
-  std::vector<object_entry> objects;
+  std::vector<dictionary::object_entry> objects;
   /// RPDO1..4 / TPDO1..4 as they start and after a reset: mapping, transmission type, inhibit time,
   /// event timer (a CiA 402 drive's: cia402::pdo_maps). A PDO with no entries starts invalid.
   std::array<pdo_map, pdo_count> rpdo{};
@@ -83,11 +83,11 @@ struct slave_config {
 /// producer heartbeat time, 0x1200 SDO server, 0x1400..0x1403 / 0x1600..0x1603 RPDO communication
 /// and mapping, 0x1800..0x1803 / 0x1A00..0x1A03 TPDO communication and mapping; defaults from the
 /// predefined connection set (CiA 301 §7.3.5) and `c`.
-std::vector<object_entry> communication_objects(const slave_config& c);
+std::vector<dictionary::object_entry> communication_objects(const slave_config& c);
 /// The whole table a node of configuration `c` serves (and its EDS lists): the device's objects and
 /// the communication objects, by index. Throws std::invalid_argument when the device's objects hold
 /// one of the node's own.
-std::vector<object_entry> node_objects(const slave_config& c);
+std::vector<dictionary::object_entry> node_objects(const slave_config& c);
 
 /// Error codes the node raises itself (not the drive).
 namespace node_error {
@@ -95,12 +95,12 @@ inline constexpr std::uint16_t heartbeat_lost = 0x8130;   ///< life guard / hear
 inline constexpr std::uint16_t pdo_length = 0x8210;       ///< PDO not processed: length error
 }  // namespace node_error
 
-class slave final : private dictionary_access, private device_events {
+class slave final : private dictionary::dictionary_access, private dictionary::device_events {
  public:
   /// Sends the boot-up message and enters PRE-OPERATIONAL. Device and channel must outlive it; the
   /// node attaches itself to the device's reports until it is destroyed. Throws
   /// std::invalid_argument as node_objects() does.
-  slave(device& d, channel& out, const slave_config& config);
+  slave(dictionary::device& d, channel& out, const slave_config& config);
   ~slave();
   slave(const slave&) = delete;
   slave& operator=(const slave&) = delete;
@@ -114,12 +114,12 @@ class slave final : private dictionary_access, private device_events {
   nmt_state state() const noexcept { return state_; }
   std::uint8_t node_id() const noexcept { return config_.node_id; }
   bool connection_lost() const noexcept { return consumer_.any_lost(); }
-  const object_dictionary& dictionary() const noexcept { return od_; }
+  const dictionary::object_dictionary& dictionary() const noexcept { return od_; }
 
   /// Local object access with every rule the SDO server applies (what an application on the node
   /// would use). Values travel as int64; strings through read_text / write_text.
-  using dictionary_access::read;
-  using dictionary_access::write;
+  using dictionary::dictionary_access::read;
+  using dictionary::dictionary_access::write;
   /// Any object as its bytes on the bus (strings as text).
   sdo_abort read_bytes(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t>& bytes) {
     return upload(index, sub, bytes);
@@ -151,12 +151,12 @@ class slave final : private dictionary_access, private device_events {
   void error_changed(std::uint16_t code) noexcept override;
 
   // dictionary_access: what a value that keeps the dictionary's rules does.
-  sdo_abort write_value(object_dictionary::slot& s, std::int64_t v) override;
+  sdo_abort write_value(dictionary::object_dictionary::slot& s, std::int64_t v) override;
   /// A CAN identifier this node may not take for `writing` (0x1005, 0x1014 or a PDO's communication
   /// object): reserved by CiA 301, or already SYNC, this node's EMCY or another PDO in use.
   bool cob_id_taken(std::uint32_t id, std::uint16_t writing) const;
-  sdo_abort write_pdo_parameter(object_dictionary::slot& s, std::int64_t v);
-  sdo_abort read_value(const object_dictionary::slot& s, std::int64_t& v) override;
+  sdo_abort write_pdo_parameter(dictionary::object_dictionary::slot& s, std::int64_t v);
+  sdo_abort read_value(const dictionary::object_dictionary::slot& s, std::int64_t& v) override;
   sdo_abort check_mapping_entry(bool receive, std::uint32_t entry) const;
   void resolve_pdos();
   pdo_config resolve(std::uint16_t comm, std::uint16_t mapping);
@@ -176,10 +176,10 @@ class slave final : private dictionary_access, private device_events {
   void note_error(std::uint16_t code) noexcept;
   void send_emcy(std::uint16_t code);
 
-  device* device_;
+  dictionary::device* device_;
   channel* out_;
   slave_config config_;
-  object_dictionary od_;
+  dictionary::object_dictionary od_;
   sdo_server sdo_;
   heartbeat_producer producer_;
   heartbeat_consumer consumer_;

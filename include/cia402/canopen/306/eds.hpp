@@ -13,7 +13,7 @@
 #include <vector>
 #include <string>
 
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 #include "cia402/canopen/301/slave.hpp"
 
 namespace cia402::canopen {
@@ -38,16 +38,16 @@ void write_eds(slave& node, const eds_info& info, std::ostream& out);
 using dcf_values = std::map<std::pair<std::uint16_t, std::uint8_t>, std::string>;
 
 /// A number as a DCF writes an entry of its type: decimal when signed, 0x-hexadecimal when not.
-std::string dcf_value_text(const sub_entry& e, std::int64_t value);
+std::string dcf_value_text(const dictionary::sub_entry& e, std::int64_t value);
 
 /// The entry's default value as write_dcf writes it (DefaultValue): a string's text, "$NODEID+X",
 /// or dcf_value_text of the number. As a ParameterValue it reads back as the entry's value.
-std::string dcf_entry_text(const sub_entry& e);
+std::string dcf_entry_text(const dictionary::sub_entry& e);
 
 /// Writes a device configuration file (CiA 306 DCF): `objects` as an EDS describes them, each entry
 /// with a value in `values` with its ParameterValue too; read_eds (eds_reader.hpp) reads it back,
 /// ParameterValue over DefaultValue. Objects without entries are left out.
-void write_dcf(const std::vector<object_entry>& objects, const dcf_values& values, const eds_info& info,
+void write_dcf(const std::vector<dictionary::object_entry>& objects, const dcf_values& values, const eds_info& info,
                std::ostream& out);
 
 }  // namespace cia402::canopen

@@ -26,12 +26,12 @@
 #include <variant>
 #include <vector>
 
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 
 namespace cia402::canopen {
 
 struct eds_contents {
-  std::vector<object_entry> objects;  ///< in index order
+  std::vector<dictionary::object_entry> objects;  ///< in index order
   std::uint8_t node_id = 0;           ///< [DeviceComissioning] NodeID, 0 when the file has none
 };
 
@@ -45,6 +45,6 @@ std::variant<eds_contents, eds_error> read_eds(std::string_view text);
 /// An entry's number on node `node_id`: its default value, plus the node-ID when it is "$NODEID+X";
 /// nothing when that is not a value of the entry's data type (a file read for one node and used for
 /// another may not fit). The sum is checked: it never overflows.
-std::optional<std::int64_t> value_for_node(const sub_entry& e, int node_id);
+std::optional<std::int64_t> value_for_node(const dictionary::sub_entry& e, int node_id);
 
 }  // namespace cia402::canopen

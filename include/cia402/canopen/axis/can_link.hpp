@@ -38,7 +38,7 @@
 
 #include "cia402/axis/drive_link.hpp"
 #include "cia402/canopen/301/nmt.hpp"
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 #include "cia402/canopen/301/sdo_client.hpp"
 #include "cia402/canopen/402/drive_master.hpp"
 #include "cia402/canopen/can/channel.hpp"
@@ -59,12 +59,12 @@ struct can_link_config {
   const profile* drive_profile = nullptr;
   bool map_position = false;               ///< PDO 3 for a csp stream
   /// The node's objects as an EDS describes them (read_eds), if the user gave one.
-  std::vector<object_entry> eds;
+  std::vector<dictionary::object_entry> eds;
   /// Without an EDS: the objects of the project's virtual drive as a node serves them (the caller's,
   /// e.g. canopen::node_objects(apps::drive_node_config(n))): their CiA 301 objects (0x1000..0x1FFF)
   /// are taken as any node's, their manufacturer objects (0x2000..0x5FFF) only on a node whose 0x1008
   /// names the virtual drive.
-  std::vector<object_entry> known_objects;
+  std::vector<dictionary::object_entry> known_objects;
   /// The clock the master's heartbeat runs on (drive_master_config::heartbeat_clock_us).
   std::function<std::uint64_t()> heartbeat_clock_us;
 };

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <initializer_list>
 
+#include "cia402/data_type.hpp"
+
 namespace cia402::canopen {
 
 struct frame {
@@ -37,16 +39,6 @@ inline constexpr std::uint32_t sdo_tx = 0x580;      ///< server -> client, + nod
 inline constexpr std::uint32_t sdo_rx = 0x600;      ///< client -> server, + node-ID
 inline constexpr std::uint32_t heartbeat = 0x700;   ///< + node-ID (also boot-up)
 }  // namespace cob
-
-/// Little-endian helpers: CANopen puts every multi-byte value least significant byte first.
-inline void put_le(std::uint8_t* p, std::uint64_t v, unsigned bytes) noexcept {
-  for (unsigned i = 0; i < bytes; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-inline std::uint64_t get_le(const std::uint8_t* p, unsigned bytes) noexcept {
-  std::uint64_t v = 0;
-  for (unsigned i = 0; i < bytes; ++i) v |= static_cast<std::uint64_t>(p[i]) << (8 * i);
-  return v;
-}
 
 /// A frame with `len` bytes taken from `bytes`.
 inline frame make_frame(std::uint32_t id, std::initializer_list<std::uint8_t> bytes) noexcept {

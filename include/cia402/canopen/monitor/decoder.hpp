@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 #include "cia402/canopen/can/frame.hpp"
 
 namespace cia402::canopen::monitor {
@@ -83,11 +83,11 @@ class decoder {
   /// Describes node `node_id` (1..127; others are ignored) by its objects: an EDS read with
   /// read_eds (306/eds_reader.hpp), or the dictionary the node serves. Its PDO maps start from the
   /// description's values.
-  void describe_node(std::uint8_t node_id, std::vector<object_entry> objects);
+  void describe_node(std::uint8_t node_id, std::vector<dictionary::object_entry> objects);
   /// Describes every node that describe_node did not, e.g. by the whole table of the project's drive
   /// as a node (canopen::node_objects(apps::drive_node_config(0))), so the predefined PDOs of a
   /// `cia402 bus` decode with no EDS.
-  void describe_other_nodes(std::vector<object_entry> objects);
+  void describe_other_nodes(std::vector<dictionary::object_entry> objects);
 
   decoded_frame decode(const frame& f, std::uint64_t time_us);
 
@@ -101,7 +101,7 @@ class decoder {
   void decode_sdo(decoded_frame& d, bool from_server);
   bool decode_pdo(decoded_frame& d);
 
-  using table = std::shared_ptr<const std::vector<object_entry>>;
+  using table = std::shared_ptr<const std::vector<dictionary::object_entry>>;
   std::map<std::uint8_t, table> described_;
   table others_;
   std::map<std::uint8_t, std::unique_ptr<node_state>> nodes_;

@@ -2,7 +2,7 @@
 // normal and segmented, with complete access), SDO information (object list, object and entry
 // descriptions, fragmented across mailboxes) and emergency messages, over a CANopen object
 // dictionary. The values go through the same object_access the CANopen SDO server uses
-// (canopen/301/dictionary_access.hpp), so a value refused on CAN is refused here with the same abort
+// (dictionary/dictionary_access.hpp), so a value refused on CAN is refused here with the same abort
 // code. Every frame is read and written by the CoE codec (ethercat/coe).
 #pragma once
 
@@ -11,8 +11,8 @@
 #include <span>
 #include <vector>
 
-#include "cia402/canopen/301/object_dictionary.hpp"
-#include "cia402/canopen/301/sdo_server.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
+#include "cia402/dictionary/object_access.hpp"
 #include "cia402/ethercat/coe/mailbox.hpp"
 #include "cia402/ethercat/coe/sdo.hpp"
 #include "cia402/ethercat/coe/sdo_information.hpp"
@@ -27,10 +27,10 @@ class coe_server {
   /// and counted, so a master that never reads cannot grow the queue.
   static constexpr std::size_t max_queued = 16;
   /// Longest value a download may carry (as the CANopen server's).
-  static constexpr std::size_t max_download = canopen::sdo_server::max_download;
+  static constexpr std::size_t max_download = dictionary::max_download;
 
   /// `mailbox_size` is the size of the send and receive mailboxes (SM0/SM1 length).
-  coe_server(canopen::object_access& access, const canopen::object_dictionary& dictionary,
+  coe_server(dictionary::object_access& access, const dictionary::object_dictionary& dictionary,
              std::uint16_t mailbox_size, std::uint16_t station_address = 0);
 
   /// One mailbox the master wrote. Anything that is not a sound CoE request gets a mailbox error
@@ -62,8 +62,8 @@ class coe_server {
   sdo_abort upload_complete(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t>& out);
   sdo_abort download_complete(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data);
 
-  canopen::object_access* access_;
-  const canopen::object_dictionary* dictionary_;
+  dictionary::object_access* access_;
+  const dictionary::object_dictionary* dictionary_;
   std::uint16_t mailbox_size_;
   std::uint16_t station_address_;
   std::uint8_t counter_ = 0;

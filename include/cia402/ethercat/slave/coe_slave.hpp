@@ -1,7 +1,7 @@
-// An EtherCAT CoE slave around a device (canopen/301/device.hpp): an emulated controller (esc), the
+// An EtherCAT CoE slave around a device (dictionary/device.hpp): an emulated controller (esc), the
 // application behind it (the AL state machine, CoE mailboxes, process data) and the device's part of
 // the dictionary, to which it adds the objects of CoE's communication area (ETG.1000.6): 0x1003
-// (CiA 301's pre-defined error field: the last 8 emergencies, canopen/301/error_history.hpp), 0x1600 /
+// (CiA 301's pre-defined error field: the last 8 emergencies, dictionary/error_history.hpp), 0x1600 /
 // 0x1601 RxPDO and 0x1A00 / 0x1A01 TxPDO mappings, 0x1C00 sync manager types, 0x1C12 / 0x1C13 PDO
 // assignment, and 0x1017 (producer heartbeat time: stored and acting on nothing, EtherCAT has no
 // heartbeat, so a master that writes it on every bus is not refused). It knows no device profile:
@@ -51,9 +51,9 @@
 #include <string>
 #include <vector>
 
-#include "cia402/canopen/301/device.hpp"
-#include "cia402/canopen/301/dictionary_access.hpp"
-#include "cia402/canopen/301/object_dictionary.hpp"
+#include "cia402/dictionary/device.hpp"
+#include "cia402/dictionary/dictionary_access.hpp"
+#include "cia402/dictionary/object_dictionary.hpp"
 #include "cia402/ethercat/esc/esc.hpp"
 #include "cia402/ethercat/sii/slave_information.hpp"
 #include "cia402/ethercat/slave/coe_server.hpp"
@@ -112,7 +112,7 @@ inline constexpr int max_pdo_entries = 12;
 struct coe_slave_config {
   /// The device's objects: its identity (0x1000, 0x1008, 0x1018 ...), its profile's objects, its own.
   /// The slave adds its communication objects (coe_communication_objects()).
-  std::vector<canopen::object_entry> objects;
+  std::vector<dictionary::object_entry> objects;
   /// RxPDO 0x1600 and TxPDO 0x1A00 as they start, assigned by 0x1C12 / 0x1C13; 0x1601 and 0x1A01
   /// start empty and unassigned.
   pdo_map rx_pdo{};
@@ -127,20 +127,20 @@ struct coe_slave_config {
 
 /// The objects the slave serves itself: 0x1003, 0x1017, 0x1600, 0x1601, 0x1A00, 0x1A01, 0x1C00, 0x1C12,
 /// 0x1C13, 0x1C32, 0x1C33.
-std::vector<canopen::object_entry> coe_communication_objects(const coe_slave_config& c);
+std::vector<dictionary::object_entry> coe_communication_objects(const coe_slave_config& c);
 /// The whole table of a slave of configuration `c`, by index. Throws std::invalid_argument when the
 /// device's objects hold one of the slave's own.
-std::vector<canopen::object_entry> coe_objects(const coe_slave_config& c);
+std::vector<dictionary::object_entry> coe_objects(const coe_slave_config& c);
 /// The SII / ESI description of a slave of configuration `c`: identity and names from its 0x1018,
 /// 0x1008 and 0x1000 (the device profile number), the PDOs 0x1C12 / 0x1C13 assign by default with their
 /// entries' names and types, mailbox and sync manager layout.
 slave_description coe_slave_description(const coe_slave_config& c);
 
-class coe_slave final : private canopen::dictionary_access, private canopen::device_events {
+class coe_slave final : private dictionary::dictionary_access, private dictionary::device_events {
  public:
   /// The device must outlive the slave; the slave attaches itself to its reports until destroyed.
   /// Throws std::invalid_argument as coe_objects() does.
-  coe_slave(canopen::device& d, const coe_slave_config& c);
+  coe_slave(dictionary::device& d, const coe_slave_config& c);
   ~coe_slave();
   coe_slave(const coe_slave&) = delete;
   coe_slave& operator=(const coe_slave&) = delete;
@@ -151,7 +151,7 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
   void step(std::uint32_t elapsed_us);
   al_state state() const noexcept { return state_; }
   const slave_description& description() const noexcept { return description_; }
-  const canopen::object_dictionary& dictionary() const noexcept { return od_; }
+  const dictionary::object_dictionary& dictionary() const noexcept { return od_; }
   /// Bytes of the assigned RxPDOs (outputs) and TxPDOs (inputs) as the dictionary has them now.
   std::uint16_t output_bytes() const noexcept;
   std::uint16_t input_bytes() const noexcept;
@@ -159,7 +159,7 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
  private:
   /// One PDO entry bound on the way to SAFE-OP.
   struct bound_entry {
-    canopen::object_dictionary::slot* slot = nullptr;
+    dictionary::object_dictionary::slot* slot = nullptr;
     std::uint16_t bit_offset = 0;
     std::uint8_t bits = 0;
     bool is_signed = false;
@@ -169,13 +169,13 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
   void handle_al_control();
   bool to_safe_operational();
   bool choose_sync_mode();
-  sdo_abort write_sync_mode(canopen::object_dictionary::slot& s, std::int64_t v);
+  sdo_abort write_sync_mode(dictionary::object_dictionary::slot& s, std::int64_t v);
   void refuse(std::uint16_t code);
   void enter(al_state s);
   bool mailbox_sync_managers_sound() const;
   bool process_data_sync_manager_sound(int n, std::uint16_t bytes, bool outputs) const;
   bool entry_mappable(std::uint16_t mapping, std::uint32_t entry) const;
-  sdo_abort write_pdo_configuration(canopen::object_dictionary::slot& s, std::int64_t v);
+  sdo_abort write_pdo_configuration(dictionary::object_dictionary::slot& s, std::int64_t v);
   void watch_sync_managers();
   void exchange_process_data();
   void serve_mailbox();
@@ -184,14 +184,14 @@ class coe_slave final : private canopen::dictionary_access, private canopen::dev
   void send_next_as_last_read();
 
   // dictionary_access
-  sdo_abort read_value(const canopen::object_dictionary::slot& s, std::int64_t& v) override;
-  sdo_abort write_value(canopen::object_dictionary::slot& s, std::int64_t v) override;
+  sdo_abort read_value(const dictionary::object_dictionary::slot& s, std::int64_t& v) override;
+  sdo_abort write_value(dictionary::object_dictionary::slot& s, std::int64_t v) override;
   // device_events
   void object_changed(std::uint16_t, std::uint8_t) noexcept override {}
   void error_changed(std::uint16_t code) noexcept override;
 
-  canopen::device* device_;
-  canopen::object_dictionary od_;
+  dictionary::device* device_;
+  dictionary::object_dictionary od_;
   slave_description description_;
   esc esc_;
   coe_server coe_;
