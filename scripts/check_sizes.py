@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
-"""Checks the size rules of the project on its product code (src/, include/, tools/): no source file
-over 600 lines, no function over 150 lines. A function is a brace-delimited body whose opening
-statement has a parameter list, at namespace or class scope; its lines run from the line of its
-opening brace to the line of its closing one. Comments and string literals are left out of the
+"""Checks the size rules of the project on its product code (src/, include/, tools/ and scripts/): no
+source file over 600 lines, no function over 150 lines, in C++, JavaScript (the page's scripts) and
+Python alike. In C++ and JavaScript a function is a brace-delimited body whose opening statement has
+a parameter list, at namespace, class or module scope (a JavaScript arrow function's body too); its
+lines run from the line of its opening brace to the line of its closing one. In Python a function
+runs from its `def` to its body's last line. Comments and string literals are left out of the
 reading, not of the count.
 
 Known breaches, each with its reason, are listed in scripts/size_exceptions.txt as FILE (a file over
@@ -18,8 +20,8 @@ import sys
 
 MAX_FILE_LINES = 600
 MAX_FUNCTION_LINES = 150
-TOPS = ("src", "include", "tools")
-SUFFIXES = (".cpp", ".hpp", ".h")
+TOPS = ("src", "include", "tools", "scripts")
+SUFFIXES = (".cpp", ".hpp", ".h", ".js", ".mjs", ".py")
 
 
 def blanked(text):
@@ -27,6 +29,7 @@ def blanked(text):
     def keep_lines(m):
         return re.sub(r"[^\n]", " ", m.group(0))
     text = re.sub(r'R"([^(\s]*)\(.*?\)\1"', keep_lines, text, flags=re.S)
+    text = re.sub(r"`(\\.|[^`\\])*`", keep_lines, text, flags=re.S)  # JavaScript template literals
     text = re.sub(r"/\*.*?\*/", keep_lines, text, flags=re.S)
     text = re.sub(r"//[^\n]*", keep_lines, text)
     text = re.sub(r'"(\\.|[^"\\\n])*"', keep_lines, text)
@@ -76,6 +79,28 @@ def functions(text):
     return found
 
 
+def python_functions(text):
+    """(name, first line, last line) of every Python function: its `def` line to the last line
+    indented deeper than the `def` (a nested function is counted in its own right too)."""
+    lines = text.split("\n")
+    found = []
+    for i, line in enumerate(lines):
+        m = re.match(r"^(\s*)(async\s+)?def\s+(\w+)", line)
+        if not m:
+            continue
+        indent = len(m.group(1))
+        last = i
+        for j in range(i + 1, len(lines)):
+            body = lines[j]
+            if not body.strip():
+                continue
+            if len(body) - len(body.lstrip()) <= indent:
+                break
+            last = j
+        found.append((m.group(3), i + 1, last + 1))
+    return found
+
+
 def breaches(root):
     found = []  # (key, why)
     for top in TOPS:
@@ -89,7 +114,8 @@ def breaches(root):
                 lines = text.count("\n")
                 if lines > MAX_FILE_LINES:
                     found.append((path, f"{lines} lines, more than {MAX_FILE_LINES}"))
-                for name, first, last in functions(text):
+                reader = python_functions if f.endswith(".py") else functions
+                for name, first, last in reader(text):
                     length = last - first + 1
                     if length > MAX_FUNCTION_LINES:
                         found.append((f"{path}:{name}", f"{length} lines from line {first}, more than {MAX_FUNCTION_LINES}"))
