@@ -27,13 +27,19 @@ if ! diff -u "$consumer/main.cpp" "$work/readme_example.cpp"; then
   exit 1
 fi
 
-say "build and install cia402 into a temporary prefix"
-# Configured for the default prefix and installed elsewhere: the package must be relocatable.
-# shellcheck disable=SC2086  # word splitting of the extra arguments is wanted
-cmake -S "$root" -B "$work/lib" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCIA402_BUILD_TESTS=OFF \
-  ${CIA402_CONSUMER_CMAKE_ARGS:-}
-cmake --build "$work/lib" -j "$jobs"
-cmake --install "$work/lib" --prefix "$prefix"
+# Configured for the default prefix and installed elsewhere, either way: the package must be
+# relocatable.
+if [ -n "${CIA402_CONSUMER_BUILD:-}" ]; then
+  say "install cia402 from $CIA402_CONSUMER_BUILD into a temporary prefix"
+  cmake --install "$CIA402_CONSUMER_BUILD" --prefix "$prefix"
+else
+  say "build and install cia402 into a temporary prefix"
+  # shellcheck disable=SC2086  # word splitting of the extra arguments is wanted
+  cmake -S "$root" -B "$work/lib" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCIA402_BUILD_TESTS=OFF \
+    ${CIA402_CONSUMER_CMAKE_ARGS:-}
+  cmake --build "$work/lib" -j "$jobs"
+  cmake --install "$work/lib" --prefix "$prefix"
+fi
 (cd "$prefix" && find . -type f | sort)
 if [ -e "$prefix/bin/cia402" ]; then
   "$prefix/bin/cia402" --help > /dev/null
