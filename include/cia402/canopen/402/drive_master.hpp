@@ -1,7 +1,9 @@
-// The CANopen master for one CiA 402 drive: it sets the drive up over SDO, starts it with NMT, then
-// steers it over PDOs. The one 402 master of the project: `cia402 master` runs it with SYNC and the
-// core's master step, the instrument page's remote backend (`serve --can`) runs it with PDOs on
-// change and words of its own.
+// The CANopen bus master for one CiA 402 drive: it sets the drive up over SDO, starts it with NMT,
+// then carries words over PDOs. It does not steer: the axis session (cia402/axis/session.hpp) is the
+// one master, and its CAN link (cia402/canopen/axis/can_link.hpp) hands this class the session's
+// control words (send_control_word) and reads the status word back, for `cia402 master --can` and
+// `cia402 serve --can` alike. set_target / set_command below are retired steering of its own, kept
+// for tests and benches only (scripts/layer_exceptions.txt) until they move onto the session.
 //
 // Set-up, in order (each an SDO transfer; the first required one that fails ends it with a clear
 // error: "does not answer" for a timeout, "refused" with the abort code otherwise):
