@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cia402/ethercat/master/ecat_master.hpp"
+#include "enable_words.hpp"
 #include "hostile_line.hpp"
 
 namespace cia402::ethercat {
@@ -152,13 +153,11 @@ TEST(ecat_master_hostile, a_mapping_changed_in_pre_op_is_never_cycled_with_the_o
   ASSERT_FALSE(lrw_lengths.empty());
   for (const std::size_t length : lrw_lengths) EXPECT_EQ(length, image) << "a cycle ran on the image of the mapping before";
   ASSERT_TRUE(m.set_output(0, 0x607A, 12345));
-  // Leaving OP counted as a lost connection (0x6007): reset that fault on the way.
-  for (const state target : {state::switch_on_disabled, state::operation_enabled}) {
-    m.set_target(0, target);
-    for (int i = 0; i < 200 && m.slaves()[0].steering.outcome() != master_outcome::reached; ++i) {
-      (void)m.cycle();
-      line.wait_us(1000);
-    }
+  // Leaving OP counted as a lost connection (0x6007): the words reset that fault on the way.
+  for (int i = 0; i < 400 && (m.slaves()[0].last_status & 0x006F) != 0x0027; ++i) {
+    testing::send_enable_word(m, 0);
+    (void)m.cycle();
+    line.wait_us(1000);
   }
   EXPECT_TRUE(m.slaves()[0].last_status & 0x0004) << "enabled through the new layout: status " << std::hex
                                                    << m.slaves()[0].last_status << " error code " << m.slaves()[0].last_error_code << " " << m.error();

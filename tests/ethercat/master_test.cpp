@@ -1,7 +1,9 @@
 // Our EtherCAT master against a line of virtual drives on the in-process wire, on virtual time:
-// scan and SII, bring-up to OP with the mapping learnt over CoE, the core's master step over the
-// process data (enable, quick stop, an injected fault and its reset), SDO with aborts, the
-// watchdog when the master stops, and a slave that refuses a state.
+// scan and SII, bring-up to OP with the mapping learnt over CoE, each drive's control and status
+// words carried in the process data (the words of enable, quick stop and fault reset, an injected
+// fault's error code and EMCY), SDO with aborts, the watchdog when the master stops, and a slave
+// that refuses a state. The master carries words and steers nothing: the steering of these drives
+// is the axis session's, tested over ecat_link in ecat_session_steering_test.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,6 +15,7 @@
 #include "cia402/ethercat/master/ecat_master.hpp"
 #include "cia402/master.hpp"
 #include "cia402/profile.hpp"
+#include "enable_words.hpp"
 
 namespace cia402::ethercat {
 namespace {
@@ -64,6 +67,26 @@ state shown(const ecat_slave& s) {
   state st = state::start;
   EXPECT_TRUE(decode_status(standard_profile(), s.last_status, st)) << s.last_status;
   return st;
+}
+
+// Cycles with each of `drives` sent the word that leads it towards OPERATION ENABLED
+// (enable_words.hpp) until all show it; the number of cycles, or -1.
+int enable(ecat_master& m, wire_link& link, const std::vector<std::size_t>& drives, int limit = 5000) {
+  for (int i = 1; i <= limit; ++i) {
+    for (const std::size_t d : drives) testing::send_enable_word(m, d);
+    (void)m.cycle();
+    link.wait_us(1000);
+    if (std::all_of(drives.begin(), drives.end(), [&](std::size_t d) { return shown(m.slaves()[d]) == state::operation_enabled; })) {
+      return i;
+    }
+  }
+  return -1;
+}
+
+std::vector<std::size_t> first(std::size_t n) {
+  std::vector<std::size_t> v;
+  for (std::size_t i = 0; i < n; ++i) v.push_back(i);
+  return v;
 }
 
 struct line {
@@ -154,23 +177,19 @@ TEST(ecat_master, a_changed_mapping_is_found_where_the_drive_puts_it) {
   EXPECT_EQ(s.position_actual->bit_offset, 0);
   EXPECT_EQ(s.status_word->bit_offset, 32);
   EXPECT_FALSE(s.error_code) << "0x603F is no longer mapped";
-  m.set_target(0, state::operation_enabled);
-  EXPECT_GT(run_until(m, l.link, [&] { return shown(m.slaves()[0]) == state::operation_enabled; }), 0);
+  EXPECT_GT(enable(m, l.link, {0}), 0) << "the control word out and the status word back where the mapping puts them";
   EXPECT_EQ(m.sdo_write(0, 0x1C13, 0, 0, 1).ok, false) << "PDO assignment is refused outside PRE-OP";
 }
 
-TEST(ecat_master, enables_quick_stops_faults_and_resets_every_drive_over_process_data) {
+TEST(ecat_master, carries_every_drives_words_of_enable_quick_stop_fault_and_reset_over_process_data) {
   line l(16);
   l.up();
-  for (std::size_t i = 0; i < 16; ++i) l.master.set_target(i, state::operation_enabled);
-  EXPECT_GT(run_until(l.master, l.link, [&] { return l.all(state::operation_enabled); }), 0);
-  (void)l.master.cycle();  // the master's step sees the status word the cycle before brought
+  EXPECT_GT(enable(l.master, l.link, first(16)), 0);
   for (std::size_t i = 0; i < 16; ++i) {
-    EXPECT_EQ(l.master.slaves()[i].steering.outcome(), master_outcome::reached);
-    EXPECT_EQ(l.link.slaves[i]->device().drive().view().current(), state::operation_enabled);
+    EXPECT_EQ(l.link.slaves[i]->device().drive().view().current(), state::operation_enabled) << "the drive's own state";
   }
   // Quick stop on every drive: QUICK STOP ACTIVE, then (0x605A = 2) SWITCH ON DISABLED at standstill.
-  for (std::size_t i = 0; i < 16; ++i) l.master.hold_command(i, cia402::command::quick_stop);
+  for (std::size_t i = 0; i < 16; ++i) l.master.send_control_word(i, control_bit::enable_voltage);  // Quick stop
   bool passed_quick_stop = false;
   EXPECT_GT(run_until(l.master, l.link, [&] {
               passed_quick_stop = passed_quick_stop || shown(l.master.slaves()[0]) == state::quick_stop_active;
@@ -179,17 +198,15 @@ TEST(ecat_master, enables_quick_stops_faults_and_resets_every_drive_over_process
             0);
   EXPECT_TRUE(passed_quick_stop);
   // A fault injected in drive 5 (0x2001 over the mailbox): FAULT there alone, its EMCY arrives.
-  for (std::size_t i = 0; i < 16; ++i) l.master.set_target(i, state::operation_enabled);
-  ASSERT_GT(run_until(l.master, l.link, [&] { return l.all(state::operation_enabled); }), 0);
+  ASSERT_GT(enable(l.master, l.link, first(16)), 0);
   ASSERT_TRUE(l.master.sdo_write(5, 0x2001, 0, 0x2310, 2).ok);
   EXPECT_GT(run_until(l.master, l.link, [&] { return shown(l.master.slaves()[5]) == state::fault; }), 0);
-  (void)l.master.cycle();
-  EXPECT_EQ(l.master.slaves()[5].steering.outcome(), master_outcome::fault);
-  EXPECT_EQ(l.master.slaves()[5].last_error_code, 0x2310);
+  EXPECT_EQ(l.master.slaves()[5].last_error_code, 0x2310) << "0x603F in the process data";
   EXPECT_EQ(shown(l.master.slaves()[4]), state::operation_enabled) << "the others run on";
   // Reset once the cause is gone: the fault-reset edge, then SWITCH ON DISABLED.
   ASSERT_TRUE(l.master.sdo_write(5, 0x2001, 0, 0, 2).ok);
-  l.master.set_target(5, state::switch_on_disabled);
+  ASSERT_EQ(l.master.slaves()[5].last_control & control_bit::fault_reset, 0);
+  l.master.send_control_word(5, control_bit::fault_reset);  // bit 7 rising
   EXPECT_GT(run_until(l.master, l.link, [&] { return shown(l.master.slaves()[5]) == state::switch_on_disabled; }), 0);
   EXPECT_EQ(l.master.slaves()[5].last_error_code, 0);
   const auto& emcy = l.master.slaves()[5].emergencies;
@@ -205,8 +222,7 @@ TEST(ecat_master, cyclic_synchronous_position_over_the_process_data_at_1_ms) {
   l.up();
   auto& m = l.master;
   ASSERT_TRUE(m.set_output(1, 0x6060, 8));
-  m.set_target(1, state::operation_enabled);
-  ASSERT_GT(run_until(m, l.link, [&] { return shown(m.slaves()[1]) == state::operation_enabled; }), 0);
+  ASSERT_GT(enable(m, l.link, {1}), 0);
   ASSERT_EQ(m.input(1, 0x6061), 8) << "the mode display in the process data";
   const std::int64_t start = *m.input(1, 0x6064);
   std::int64_t max_error = 0;
@@ -233,10 +249,11 @@ TEST(ecat_master, cyclic_synchronous_position_over_the_process_data_at_1_ms) {
 
 TEST(ecat_master, a_long_run_of_sdo_transfers_keeps_the_process_data_flowing) {
   // Each frame takes 3 ms to come back: 40 SDO uploads in a row take far longer than the drives'
-  // 100 ms watchdog. The master runs its cycles between the mailbox frames, so no drive leaves OP.
+  // 100 ms watchdog. The master runs its cycles between the mailbox frames, so no drive leaves OP,
+  // and a control word sent before the transfers reaches its drive in those cycles.
   line l(4);
   l.up();
-  l.master.set_target(2, state::operation_enabled);
+  l.master.send_control_word(2, control_bit::enable_voltage | control_bit::quick_stop);  // Shutdown
   l.link.exchange_us = 3000;
   for (int k = 0; k < 40; ++k) {
     const ecat_sdo_result r = l.master.sdo_read(static_cast<std::size_t>(k % 4), 0x6083, 0);
@@ -245,7 +262,9 @@ TEST(ecat_master, a_long_run_of_sdo_transfers_keeps_the_process_data_flowing) {
   for (std::size_t i = 0; i < 4; ++i) {
     EXPECT_EQ(l.link.slaves[i]->state(), al_state::operational) << "slave " << i;
   }
-  EXPECT_EQ(shown(l.master.slaves()[2]), state::operation_enabled) << "steered meanwhile";
+  EXPECT_EQ(l.link.slaves[2]->device().drive().view().current(), state::ready_to_switch_on) << "the word went out meanwhile";
+  EXPECT_EQ(shown(l.master.slaves()[2]), state::ready_to_switch_on) << "and its status word came back";
+  EXPECT_EQ(shown(l.master.slaves()[1]), state::switch_on_disabled) << "the others had their own words";
 }
 
 TEST(ecat_master, the_cycle_runs_while_the_line_goes_to_op) {
@@ -331,8 +350,7 @@ TEST(ecat_master, sdo_reads_writes_and_reports_aborts_in_words) {
 TEST(ecat_master, a_master_that_stops_leaves_the_drives_to_their_watchdog) {
   line l(2);
   l.up();
-  l.master.set_target(0, state::operation_enabled);
-  ASSERT_GT(run_until(l.master, l.link, [&] { return shown(l.master.slaves()[0]) == state::operation_enabled; }), 0);
+  ASSERT_GT(enable(l.master, l.link, {0}), 0);
   l.link.wait_us(200'000);  // no frames for 200 ms: past the 100 ms process data watchdog
   EXPECT_EQ(l.link.slaves[0]->state(), al_state::safe_operational);
   (void)l.master.cycle();
@@ -368,8 +386,7 @@ TEST(ecat_master, configures_distributed_clocks_and_runs_the_drives_on_sync0) {
     ASSERT_TRUE(mode.ok) << mode.error;
     EXPECT_EQ(mode.value(false), 2) << "the drive runs DC SYNC0";
   }
-  for (std::size_t i = 0; i < 3; ++i) l.master.set_target(i, state::operation_enabled);
-  EXPECT_GT(run_until(l.master, l.link, [&] { return l.all(state::operation_enabled); }), 0);
+  EXPECT_GT(enable(l.master, l.link, first(3)), 0) << "the drives follow their words on SYNC0";
 }
 
 TEST(ecat_master, a_cycle_shorter_than_a_drive_can_run_leaves_it_free_running) {

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "../ethercat/enable_words.hpp"
 #include "../ethercat/hostile_line.hpp"
 #include "cia402/ethercat/master/ecat_master.hpp"
 #include "cia402/profile.hpp"
@@ -156,8 +157,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!m.scan()) return 0;
   (void)m.sdo_read(0, 0x1018, 1);
   if (!m.bring_to_operational()) return 0;
-  m.set_target(0, state::operation_enabled);
   for (int i = 0; i < 30; ++i) {
+    cia402::ethercat::testing::send_enable_word(m, 0);  // drive 0's words towards OPERATION ENABLED
     (void)m.cycle();
     line.wait_us(1000);
   }

@@ -399,37 +399,12 @@ bool ecat_master::leave_operational() {
   return pre_operational_;
 }
 
-void ecat_master::set_target(std::size_t i, state target) {
-  ecat_slave& s = slaves_.at(i);
-  s.policy = master_policy::make(*profile_, make_axis(*profile_), target);
-  s.steering.set_target(s.policy, link_->now_us(), 2'000'000);
-  s.steered = true;
-  s.held_command.reset();
-}
-
-void ecat_master::hold_command(std::size_t i, cia402::command c) {
-  ecat_slave& s = slaves_.at(i);
-  s.steering.clear_target();
-  s.steered = false;
-  s.held_command = c;
-}
-
-void ecat_master::release(std::size_t i) {
-  ecat_slave& s = slaves_.at(i);
-  s.steering.clear_target();
-  s.steered = false;
-  s.held_command.reset();
-}
-
 void ecat_master::pause(std::uint32_t us) {
   if (cycling_ && link_->now_us() - last_cycle_us_ >= cycle_us_) (void)cycle();
   if (us != 0) link_->wait_us(us);
 }
 
-void ecat_master::send_control_word(std::size_t i, std::uint16_t word) {
-  release(i);
-  slaves_.at(i).last_control = word;
-}
+void ecat_master::send_control_word(std::size_t i, std::uint16_t word) { slaves_.at(i).last_control = word; }
 
 std::optional<std::int64_t> ecat_master::input(std::size_t i, std::uint16_t index, std::uint8_t sub) const {
   const ecat_slave& s = slaves_.at(i);
@@ -482,15 +457,7 @@ bool ecat_master::cycle() {
   last_cycle_us_ = now;
   for (ecat_slave& s : slaves_) {
     if (!s.control_word) continue;
-    std::uint16_t cw = s.last_control;
-    if (s.steered) {
-      cw = s.steering.step(s.last_status, now, s.last_error_code);
-    } else if (s.held_command) {
-      std::uint16_t word = 0;
-      if (encode_command(*profile_, *s.held_command, static_cast<std::uint16_t>(s.last_control & ~0x80u), word)) cw = word;
-    }
-    s.last_control = cw;
-    put_bits(image_, (s.logical_outputs - logical_base) * 8u + s.control_word->bit_offset, 16, cw);
+    put_bits(image_, (s.logical_outputs - logical_base) * 8u + s.control_word->bit_offset, 16, s.last_control);
   }
   frame_builder b(broadcast, master_mac);
   const long lrw = b.add(command::lrw, ++index_, logical_base, image_, static_cast<std::uint16_t>(image_.size()));

@@ -1,8 +1,9 @@
 // An EtherCAT master for CiA 402 drives (ETG.1000.4/.6, ETG.6010): it finds the slaves on a line,
 // addresses them, reads their SII, sets up the mailbox, learns the PDO mapping over CoE (falling
 // back to the SII's default PDOs), maps the process data with FMMUs, brings the line to OP and then
-// runs a cyclic LRW in which the core's master step (`cia402::master`) turns each drive's status
-// word into its control word. SDO upload and download over the mailbox for everything else.
+// runs a cyclic LRW carrying each drive's control word out and its status word back. It carries
+// words and steers nothing: the axis session steers a drive through them (ethercat/axis's
+// ecat_link). SDO upload and download over the mailbox for everything else.
 //
 // It is written for real drives, not only ours: every layout comes from what a slave says about
 // itself (SII sync managers and mailbox, 0x1C12/0x1C13 and the PDOs they assign), 0x6040 and 0x6041
@@ -86,13 +87,8 @@ struct ecat_slave {
   std::string mapping_source;   ///< "CoE 0x1C12/0x1C13" or "SII default PDOs"
   std::uint8_t al_state = 0;    ///< the last AL status read (bits 0..3; bit 4 = error)
   std::uint16_t al_code = 0;
-  // The drive's CiA 402 machine, as the master drives it.
-  master steering;
-  master_policy policy;
-  bool steered = false;         ///< a target is set
-  std::optional<cia402::command> held_command;  ///< a command sent every cycle (quick stop), instead of a target
-  std::uint16_t last_status = 0;
-  std::uint16_t last_control = 0;
+  std::uint16_t last_status = 0;   ///< 0x6041 as the last cycle brought it
+  std::uint16_t last_control = 0;  ///< 0x6040 as every cycle sends it (send_control_word)
   std::uint16_t last_error_code = 0;
   std::vector<std::uint16_t> emergencies;  ///< error codes of the EMCYs the mailbox brought
   bool dc = false;              ///< its ESC has distributed clocks (0x0008 bit 2)
@@ -112,7 +108,8 @@ struct ecat_sdo_result {
 
 class ecat_master {
  public:
-  /// `p` (outliving the master) is the profile the drives' status words are read with.
+  /// `p` (outliving the master) is the drives' profile; the master itself reads no state from a
+  /// status word (drive_profile() gives it to whoever does).
   ecat_master(master_link& link, const profile& p, std::uint32_t cycle_us = 1000);
 
   /// Counts the slaves (BRD), resets them to INIT, gives each the station address 0x1001 + position
@@ -128,17 +125,13 @@ class ecat_master {
   /// Every slave from OP back to PRE-OP (the cycle stops first): how a master leaves the line when
   /// it is done. False with error() when a slave does not get there.
   bool leave_operational();
-  /// One cycle: the LRW of every slave's process data and each AL status; each drive's master step
-  /// runs on what came back. False when the frame did not come back or the working counter was
+  /// One cycle: the LRW of every slave's process data (each control word out, each status word
+  /// back) and each AL status. False when the frame did not come back or the working counter was
   /// short (the cycle still counts; error() says which), and, sending nothing, when no bring-up to
   /// OP has configured the process data since the last scan or PRE-OP.
   bool cycle();
 
-  /// Steer drive `i` (index into slaves()) to a state, or hold a command (quick stop).
-  void set_target(std::size_t i, state target);
-  void hold_command(std::size_t i, cia402::command c);
-  void release(std::size_t i);
-  /// Sends this control word every cycle from now on (no target, no held command).
+  /// Sends this control word to drive `i` (index into slaves()) every cycle from now on.
   void send_control_word(std::size_t i, std::uint16_t word);
 
   /// An input object as the last cycle brought it (signed where the CiA 402 object table says so);
@@ -170,6 +163,7 @@ class ecat_master {
   std::uint64_t cycles() const noexcept { return cycles_; }
   std::uint64_t lost_frames() const noexcept { return lost_frames_; }
   std::uint32_t cycle_us() const noexcept { return cycle_us_; }
+  const profile& drive_profile() const noexcept { return *profile_; }
   /// The slave whose clock is the system time, when the line has distributed clocks.
   std::optional<std::size_t> dc_reference() const noexcept { return dc_reference_; }
   /// Called with every frame exchanged (sent, then answered), for captures.
