@@ -1,7 +1,10 @@
 // The CANopen drive master against virtual drives (the simulator behind CiA 301 slaves) on the
-// in-process bus: configuration over SDO, NMT start, the core's master step over PDOs with SYNC;
-// enable, quick stop with each 0x605A code, fault and reset, heartbeat loss with each 0x6007 code,
-// and the clear failures for a missing node, a refused SDO and a lost drive heartbeat.
+// in-process bus: configuration over SDO, NMT start, the words it carries in RPDO1 and the status
+// word it brings back from TPDO1 with SYNC or on change; EMCY, the guard (0x1016) and heartbeat loss
+// with each 0x6007 code, and the clear failures for a missing node, a refused SDO and a lost drive
+// heartbeat. It does not steer: the words here are the test's own (carried_words.hpp). Steering over
+// CAN (enable, disable, quick stop with each 0x605A code, fault reset, two drives) is the axis
+// session's, tested over a can_link in session_over_can_test.cpp.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -12,9 +15,12 @@
 #include "cia402/manufacturer_objects.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
 #include "cia402/words.hpp"
+#include "carried_words.hpp"
 
 namespace cia402::canopen {
 namespace {
+
+using namespace test;
 
 class bench {
  public:
@@ -46,14 +52,30 @@ class bench {
       }
     }
   }
-  /// Runs until the master has reached its target (or failed), at most `ms`.
-  bool run_until_reached(int ms) {
+  /// Runs until the master has set the drive up (or failed), at most `ms`.
+  bool run_until_running(int ms = 2000) {
+    for (int i = 0; i < ms; ++i) {
+      if (master_->phase() == master_phase::running) return true;
+      run_ms(1);
+    }
+    return master_->phase() == master_phase::running;
+  }
+  /// Carries `word` (with a fault-reset edge if asked) and runs until the status word shows `s` (or
+  /// the master failed), at most `ms`.
+  bool carry_until(std::uint16_t word, state s, bool reset_edge = false, int ms = 500) {
+    master_->send_control_word(word, reset_edge);
     for (int i = 0; i < ms; ++i) {
       run_ms(1);
-      if (master_->outcome() == master_outcome::reached) return true;
+      if (master_->observed() == s && !master_->words_queued()) return true;
       if (master_->phase() == master_phase::failed) return false;
     }
     return false;
+  }
+  /// Set up, then the words of T2, T3 and T4: the drive in OPERATION ENABLED.
+  bool enable_by_words() {
+    return run_until_running() && carry_until(shutdown_word, state::ready_to_switch_on) &&
+           carry_until(switch_on_word, state::switched_on) &&
+           carry_until(enable_operation_word, state::operation_enabled);
   }
   drive_master& master() { return *master_; }
   /// Another master in this one's place (a new `cia402 master` process), the same channel.
@@ -95,13 +117,7 @@ drive_master_config on_change_config() {
   return mc;
 }
 
-bool run_until_running(bench& b, int ms) {
-  for (int i = 0; i < ms; ++i) {
-    b.run_ms(1);
-    if (b.master().phase() == master_phase::running) return true;
-  }
-  return false;
-}
+bool run_until_running(bench& b, int ms) { return b.run_until_running(ms); }
 
 std::vector<std::uint16_t> words_in(const std::vector<frame>& frames, std::uint16_t id) {
   std::vector<std::uint16_t> words;
@@ -111,15 +127,15 @@ std::vector<std::uint16_t> words_in(const std::vector<frame>& frames, std::uint1
   return words;
 }
 
-TEST(drive_master, enable_configures_the_drive_and_reaches_operation_enabled) {
+TEST(drive_master, set_up_maps_the_pdos_and_the_words_it_carries_enable_the_drive) {
   bench b;
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(2000)) << b.master().failure_text();
+  ASSERT_TRUE(b.enable_by_words()) << b.master().failure_text();
   EXPECT_EQ(b.master().phase(), master_phase::running);
   EXPECT_EQ(b.node().state(), nmt_state::operational);
   EXPECT_EQ(b.drive().view().current(), state::operation_enabled);
   EXPECT_EQ(b.master().observed(), state::operation_enabled);
   EXPECT_EQ(b.master().status_word() & 0x6F, 0x27);
+  EXPECT_EQ(b.master().last_sent(), enable_operation_word);
   // The master set up TPDO1 = 0x6041 + 0x603F on every SYNC and RPDO1 = 0x6040 on receipt.
   EXPECT_EQ(b.node().tpdo(0).count, 2);
   EXPECT_EQ(b.node().tpdo(0).transmission_type, 1);
@@ -129,80 +145,33 @@ TEST(drive_master, enable_configures_the_drive_and_reaches_operation_enabled) {
   EXPECT_EQ(hb, 100);
 }
 
-TEST(drive_master, disable_from_operation_enabled_reaches_switch_on_disabled) {
+TEST(drive_master, with_sync_each_word_goes_out_once_in_rpdo1_and_each_sync_brings_a_status_word) {
   bench b;
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(2000));
-  b.master().set_target(state::switch_on_disabled);
-  ASSERT_TRUE(b.run_until_reached(2000));
-  EXPECT_EQ(b.drive().view().current(), state::switch_on_disabled);
+  ASSERT_TRUE(b.run_until_running());
+  (void)b.sent();
+  b.master().send_control_word(shutdown_word);
+  b.run_ms(100);
+  const std::vector<frame> frames = b.sent();
+  EXPECT_EQ(words_in(frames, cob::rpdo1 + 1), (std::vector<std::uint16_t>{shutdown_word}))
+      << "a word is carried when given, not repeated: repeating is the session's link's choice";
+  int syncs = 0;
+  for (const frame& f : frames) syncs += f.id == cob::sync ? 1 : 0;
+  EXPECT_EQ(syncs, 10) << "one SYNC every 10 ms";
+  EXPECT_GE(words_in(frames, cob::tpdo1 + 1).size(), 9u) << "TPDO1 answers each SYNC";
+  EXPECT_EQ(b.master().observed(), state::ready_to_switch_on);
 }
 
-TEST(drive_master, two_drives_on_one_bus_each_follow_their_own_master) {
-  virtual_bus bus;
-  std::vector<std::unique_ptr<apps::virtual_drive_node>> nodes;
-  std::vector<std::unique_ptr<virtual_channel>> chs;
-  std::vector<std::unique_ptr<drive_master>> masters;
-  for (std::uint8_t id : {1, 2}) {
-    nodes.push_back(
-        std::make_unique<apps::virtual_drive_node>(standard_profile(), bus.attach(), apps::drive_node_config(id)));
-    chs.push_back(bus.attach());
-    drive_master_config c;
-    c.node_id = id;
-    masters.push_back(std::make_unique<drive_master>(*chs.back(), c));
-  }
-  masters[0]->set_target(state::operation_enabled);
-  masters[1]->set_target(state::ready_to_switch_on);
-  for (int i = 0; i < 1500; ++i) {
-    for (std::size_t k = 0; k < 2; ++k) masters[k]->poll(*chs[k], 1000);
-    for (auto& n : nodes) n->poll(1000);
-  }
-  EXPECT_EQ(nodes[0]->drive().view().current(), state::operation_enabled);
-  EXPECT_EQ(nodes[1]->drive().view().current(), state::ready_to_switch_on);
-}
-
-class quick_stop_code : public ::testing::TestWithParam<int> {};
-
-TEST_P(quick_stop_code, quick_stop_from_operation_enabled_follows_0x605A) {
-  const int code = GetParam();
+TEST(drive_master, a_fault_is_reported_with_its_emcy_and_a_reset_edge_it_carries_sends_the_emcy_reset) {
   bench b;
-  ASSERT_EQ(b.node().write(0x605A, 0, code), sdo_abort::none);
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(2000)) << b.master().failure_text();
-  b.master().set_command(command::quick_stop);
-  b.run_ms(500);
-  // S5: 1..4 ramp then T12 to SWITCH ON DISABLED; 5..8 stay in QUICK STOP ACTIVE with bit 10 at
-  // standstill; 0 coasts and stays in QUICK STOP ACTIVE.
-  const bool ends = code >= 1 && code <= 4;
-  EXPECT_EQ(b.drive().view().current(), ends ? state::switch_on_disabled : state::quick_stop_active);
-  EXPECT_EQ(b.master().observed(), ends ? state::switch_on_disabled : state::quick_stop_active);
-  if (code >= 5) EXPECT_TRUE(b.master().status_word() & status_bit::target_reached);
-  if (code >= 5) {
-    // T16 on Enable operation: the master's plan for OPERATION ENABLED is one step.
-    b.master().set_target(state::operation_enabled);
-    ASSERT_TRUE(b.run_until_reached(500));
-    EXPECT_EQ(b.drive().view().state_of_axis().core.last_transition, 16);
-  }
-}
-
-INSTANTIATE_TEST_SUITE_P(codes_0_to_8, quick_stop_code, ::testing::Range(0, 9));
-
-TEST(drive_master, fault_is_reported_with_its_emcy_and_a_new_target_resets_it) {
-  bench b;
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(2000));
+  ASSERT_TRUE(b.enable_by_words());
   b.drive().view().inject_fault(0x2310);
   b.run_ms(300);
-  EXPECT_EQ(b.master().outcome(), master_outcome::fault);
   EXPECT_EQ(b.master().observed(), state::fault);
   EXPECT_EQ(b.master().error_code(), 0x2310);
   ASSERT_FALSE(b.emcy.empty());
   EXPECT_EQ(b.emcy.front(), 0x2310);
-  // The cause is gone: a new target is the decision to reset (T15), then T2, T3, T4.
   b.drive().view().clear_faults();
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(2000));
-  EXPECT_EQ(b.drive().view().current(), state::operation_enabled);
+  ASSERT_TRUE(b.carry_until(disable_voltage_word, state::switch_on_disabled, /*reset_edge=*/true));
   EXPECT_EQ(b.emcy.back(), 0x0000) << "EMCY error reset after T15";
 }
 
@@ -214,8 +183,7 @@ TEST_P(master_heartbeat_loss, silent_master_makes_the_drive_apply_0x6007) {
   mc.master_heartbeat_ms = 20;
   bench b(mc);
   ASSERT_EQ(b.node().write(0x6007, 0, code), sdo_abort::none);
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(2000)) << b.master().failure_text();
+  ASSERT_TRUE(b.enable_by_words()) << b.master().failure_text();
   std::int64_t watch = 0;
   b.node().read(0x1016, 1, watch);
   EXPECT_EQ(watch, (127 << 16) | 60);
@@ -242,10 +210,8 @@ TEST(drive_master, a_master_that_disabled_the_drive_then_went_silent_leaves_no_f
   guarded.master_heartbeat_ms = 20;
   bench b(guarded);
   ASSERT_EQ(b.node().write(0x6007, 0, 1), sdo_abort::none);  // 1 = fault
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(2000));
-  b.master().set_target(state::ready_to_switch_on);
-  ASSERT_TRUE(b.run_until_reached(2000));
+  ASSERT_TRUE(b.enable_by_words());
+  ASSERT_TRUE(b.carry_until(shutdown_word, state::ready_to_switch_on));  // T8
   b.run_ms(500, /*master_alive=*/false);
   EXPECT_TRUE(b.node().connection_lost());
   EXPECT_EQ(b.drive().view().current(), state::ready_to_switch_on);
@@ -258,10 +224,8 @@ TEST(drive_master, a_drive_enabled_while_the_heartbeat_is_lost_applies_0x6007_th
   drive_master_config guarded;
   guarded.master_heartbeat_ms = 20;
   bench b(guarded);
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(2000));
-  b.master().set_target(state::switch_on_disabled);
-  ASSERT_TRUE(b.run_until_reached(2000));
+  ASSERT_TRUE(b.enable_by_words());
+  ASSERT_TRUE(b.carry_until(disable_voltage_word, state::switch_on_disabled));  // T9
   b.run_ms(500, /*master_alive=*/false);
   ASSERT_TRUE(b.node().connection_lost());
   ASSERT_EQ(b.drive().view().current(), state::switch_on_disabled);
@@ -281,8 +245,12 @@ TEST_P(nmt_stop_of_a_drive, acts_as_0x6007_says_when_enabled_and_changes_nothing
   const bool enabled = GetParam();
   bench b;
   const state target = enabled ? state::operation_enabled : state::ready_to_switch_on;
-  b.master().set_target(target);
-  ASSERT_TRUE(b.run_until_reached(2000));
+  if (enabled) {
+    ASSERT_TRUE(b.enable_by_words());
+  } else {
+    ASSERT_TRUE(b.run_until_running());
+    ASSERT_TRUE(b.carry_until(shutdown_word, state::ready_to_switch_on));
+  }
   const auto nmt = b.bus().attach();
   (void)nmt->send(nmt_frame(nmt_command::enter_pre_operational, 1));
   b.run_ms(50, /*master_alive=*/false);
@@ -296,19 +264,19 @@ TEST_P(nmt_stop_of_a_drive, acts_as_0x6007_says_when_enabled_and_changes_nothing
 
 INSTANTIATE_TEST_SUITE_P(enabled_or_not, nmt_stop_of_a_drive, ::testing::Bool());
 
-TEST(drive_master, a_master_without_guard_clears_the_guard_a_gone_master_left_and_resets_the_fault) {
+TEST(drive_master, a_master_without_guard_clears_the_guard_a_gone_master_left_and_carries_the_reset) {
   drive_master_config guarded;
   guarded.master_heartbeat_ms = 20;
   bench b(guarded);
   ASSERT_EQ(b.node().write(0x6007, 0, 1), sdo_abort::none);  // 1 = fault
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(2000));
+  ASSERT_TRUE(b.enable_by_words());
   b.run_ms(500, /*master_alive=*/false);
   ASSERT_EQ(b.drive().view().current(), state::fault);
   b.replace_master({});
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(3000)) << b.master().failure_text() << " "
-                                         << state_name(b.master().observed());
+  ASSERT_TRUE(b.run_until_running(3000)) << b.master().failure_text();
+  ASSERT_TRUE(b.carry_until(disable_voltage_word, state::switch_on_disabled, /*reset_edge=*/true))
+      << state_name(b.master().observed());
+  ASSERT_TRUE(b.enable_by_words()) << b.master().failure_text() << " " << state_name(b.master().observed());
   std::int64_t watch = -1;
   b.node().read(0x1016, 1, watch);
   EXPECT_EQ(watch, 0) << "the entry for node 127 is cleared";
@@ -320,8 +288,8 @@ TEST(drive_master, a_master_without_guard_clears_the_guard_a_gone_master_left_an
 TEST(drive_master, a_guard_of_another_master_is_left_alone) {
   bench b;
   ASSERT_EQ(b.node().write(0x1016, 1, (5 << 16) | 1000), sdo_abort::none);  // node 5 watched
-  b.master().set_target(state::switch_on_disabled);
-  ASSERT_TRUE(b.run_until_reached(2000));
+  ASSERT_TRUE(b.run_until_running());
+  b.run_ms(20);
   std::int64_t watch = 0;
   b.node().read(0x1016, 1, watch);
   EXPECT_EQ(watch, (5 << 16) | 1000);
@@ -331,12 +299,13 @@ TEST(drive_master, missing_node_fails_with_no_answer_naming_the_first_request) {
   drive_master_config mc;
   mc.node_id = 9;
   bench b(mc);  // the bus has node 1 only
-  b.master().set_target(state::operation_enabled);
+  b.master().send_control_word(enable_operation_word);  // waits for a set-up that never ends
   b.run_ms(600);
   EXPECT_EQ(b.master().phase(), master_phase::failed);
   EXPECT_EQ(b.master().failure(), master_failure::no_answer);
   EXPECT_EQ(b.master().failed_index(), 0x1000);
   EXPECT_NE(b.master().failure_text().find("node 9 does not answer"), std::string::npos);
+  EXPECT_TRUE(words_in(b.sent(), cob::rpdo1 + 9).empty()) << "no word before the set-up ended";
 }
 
 TEST(drive_master, refused_configuration_fails_with_the_abort_code) {
@@ -345,19 +314,19 @@ TEST(drive_master, refused_configuration_fails_with_the_abort_code) {
   bench b(mc);
   // Another entry already watches node 127: 0x1016 sub 1 for it is refused (0x06040043).
   ASSERT_EQ(b.node().write(0x1016, 2, (127 << 16) | 500), sdo_abort::none);
-  b.master().set_target(state::operation_enabled);
+  b.master().send_control_word(shutdown_word);  // waits for the set-up, which fails
   b.run_ms(300);
   EXPECT_EQ(b.master().failure(), master_failure::sdo_refused);
   EXPECT_EQ(b.master().failed_abort(), sdo_abort::general_parameter_incompatibility);
   EXPECT_EQ(b.master().failed_index(), 0x1016);
   EXPECT_NE(b.master().failure_text().find("0x06040043"), std::string::npos);
   EXPECT_EQ(b.drive().view().current(), state::switch_on_disabled) << "nothing was started";
+  EXPECT_TRUE(words_in(b.sent(), cob::rpdo1 + 1).empty()) << "the word waiting was dropped";
 }
 
 TEST(drive_master, lost_drive_heartbeat_fails_the_master) {
   bench b;
-  b.master().set_target(state::operation_enabled);
-  ASSERT_TRUE(b.run_until_reached(2000));
+  ASSERT_TRUE(b.enable_by_words());
   b.run_ms(200);
   EXPECT_EQ(b.master().phase(), master_phase::running);
   b.remove_drives();

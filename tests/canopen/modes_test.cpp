@@ -9,11 +9,13 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "cia402/canopen/402/drive_master.hpp"
 #include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"
+#include "carried_words.hpp"
 #include "network.hpp"
 
 namespace cia402::canopen {
@@ -260,15 +262,21 @@ struct pdo3_bench {
       m.poll(*ch, 0);
     }
   }
-  // Set up, in OPERATION ENABLED in `mode` with the set-point at 0.
+  // Set up, in OPERATION ENABLED in `mode` with the set-point at 0: the words of T2, T3 and T4,
+  // each carried in RPDO1 (or RPDO3 with a new set-point) until the status word shows its state.
   void enable_in(std::int64_t mode) {
     run_ms(100);
     ASSERT_EQ(m.phase(), master_phase::running) << m.failure_text();
     ASSERT_EQ(drive.drive().write(0x6060, 0, mode), sdo_abort::none);
     m.set_position_set_point(0);
-    m.set_target(state::operation_enabled);
-    for (int i = 0; i < 300 && m.outcome() != master_outcome::reached; ++i) run_ms(1);
-    ASSERT_EQ(m.outcome(), master_outcome::reached);
+    const std::pair<std::uint16_t, state> steps[] = {{test::shutdown_word, state::ready_to_switch_on},
+                                                     {test::switch_on_word, state::switched_on},
+                                                     {test::enable_operation_word, state::operation_enabled}};
+    for (const auto& [word, reached] : steps) {
+      m.send_control_word(word);
+      for (int i = 0; i < 300 && m.observed() != reached; ++i) run_ms(1);
+      ASSERT_EQ(m.observed(), reached) << "after 0x" << std::hex << word;
+    }
   }
   virtual_bus bus;
   apps::virtual_drive_node drive;

@@ -1,5 +1,6 @@
 // socketcand over loopback TCP (free port): the protocol as python-can and socketcand speak it, bad
-// input, limits, and the drive master joining the virtual bus through our own socketcand client.
+// input, limits, and the drive master (carrying the test's words) joining the virtual bus through
+// our own socketcand client. The axis session over socketcand: session_over_can_test.cpp.
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -16,6 +17,7 @@
 #include "cia402/canopen/402/drive_master.hpp"
 #include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/socketcand.hpp"
+#include "carried_words.hpp"
 
 namespace cia402::canopen {
 namespace {
@@ -406,10 +408,11 @@ TEST_F(socketcand_server_test, our_client_channel_joins_and_exchanges_frames) {
   EXPECT_EQ(f.data[0], 7);
 }
 
-// The drive master over socketcand on loopback: the same checks as over the in-process bus.
+// The drive master over socketcand on loopback: the bus checks of the in-process bus
+// (drive_master_test.cpp) with the test's own words carried.
 class master_over_socketcand : public socketcand_server_test {
  protected:
-  std::unique_ptr<drive_master> connect_master(drive_master_config mc = {}) {
+  void connect() {
     std::error_code ec;
     std::string why;
     std::atomic<bool> connected{false};
@@ -417,7 +420,11 @@ class master_over_socketcand : public socketcand_server_test {
     channel_ = socketcand::client_channel::connect("127.0.0.1", srv->port(), "can0", ec, why, 3000);
     connected = true;
     server_loop.join();
-    EXPECT_TRUE(channel_) << why;
+    ASSERT_TRUE(channel_) << why;
+  }
+  std::unique_ptr<drive_master> connect_master(drive_master_config mc = {}) {
+    connect();
+    if (!channel_) return nullptr;
     return std::make_unique<drive_master>(*channel_, mc);
   }
   void run(drive_master& m, int ms, bool alive = true) {
@@ -428,10 +435,12 @@ class master_over_socketcand : public socketcand_server_test {
       spin(1, 0);
     }
   }
-  bool run_until_reached(drive_master& m, int ms) {
+  /// Carries `word` and runs until the status word shows `s` (or the master failed), at most `ms`.
+  bool carry_until(drive_master& m, std::uint16_t word, state s, int ms = 3000) {
+    m.send_control_word(word);
     for (int i = 0; i < ms; ++i) {
       run(m, 1);
-      if (m.outcome() == master_outcome::reached) return true;
+      if (m.observed() == s) return true;
       if (m.phase() == master_phase::failed) return false;
     }
     return false;
@@ -440,44 +449,23 @@ class master_over_socketcand : public socketcand_server_test {
   std::unique_ptr<socketcand::client_channel> channel_;
 };
 
-TEST_F(master_over_socketcand, enable_then_fault_and_reset) {
+TEST_F(master_over_socketcand, the_words_it_carries_enable_the_drive_and_a_fault_comes_with_its_emcy) {
   add_drive(1);
   auto m = connect_master();
+  ASSERT_TRUE(m);
   std::vector<std::uint16_t> emcy;
   m->on_emcy = [&](std::uint16_t code, std::uint8_t, const std::uint8_t*) { emcy.push_back(code); };
-  m->set_target(state::operation_enabled);
-  ASSERT_TRUE(run_until_reached(*m, 3000)) << m->failure_text();
+  ASSERT_TRUE(carry_until(*m, test::shutdown_word, state::ready_to_switch_on)) << m->failure_text();
+  ASSERT_TRUE(carry_until(*m, test::switch_on_word, state::switched_on));
+  ASSERT_TRUE(carry_until(*m, test::enable_operation_word, state::operation_enabled));
   EXPECT_EQ(drive().view().current(), state::operation_enabled);
   drive().view().inject_fault(0x3210);
   run(*m, 300);
-  EXPECT_EQ(m->outcome(), master_outcome::fault);
+  EXPECT_EQ(m->observed(), state::fault);
   EXPECT_EQ(m->error_code(), 0x3210);
   ASSERT_FALSE(emcy.empty());
   EXPECT_EQ(emcy[0], 0x3210);
-  drive().view().clear_faults();
-  m->set_target(state::operation_enabled);
-  ASSERT_TRUE(run_until_reached(*m, 3000));
-  EXPECT_EQ(emcy.back(), 0x0000);
 }
-
-class quick_stop_over_socketcand : public master_over_socketcand,
-                                   public ::testing::WithParamInterface<int> {};
-
-TEST_P(quick_stop_over_socketcand, quick_stop_follows_0x605A) {
-  const int code = GetParam();
-  add_drive(1);
-  ASSERT_EQ(drives[0]->node().write(0x605A, 0, code), sdo_abort::none);
-  auto m = connect_master();
-  m->set_target(state::operation_enabled);
-  ASSERT_TRUE(run_until_reached(*m, 3000)) << m->failure_text();
-  m->set_command(command::quick_stop);
-  run(*m, 500);
-  const bool ends = code >= 1 && code <= 4;
-  EXPECT_EQ(drive().view().current(), ends ? state::switch_on_disabled : state::quick_stop_active);
-  EXPECT_EQ(m->observed(), drive().view().current());
-}
-
-INSTANTIATE_TEST_SUITE_P(codes_0_to_8, quick_stop_over_socketcand, ::testing::Range(0, 9));
 
 class heartbeat_over_socketcand : public master_over_socketcand,
                                   public ::testing::WithParamInterface<int> {};
@@ -489,8 +477,10 @@ TEST_P(heartbeat_over_socketcand, silent_master_makes_the_drive_apply_0x6007) {
   drive_master_config mc;
   mc.master_heartbeat_ms = 20;
   auto m = connect_master(mc);
-  m->set_target(state::operation_enabled);
-  ASSERT_TRUE(run_until_reached(*m, 3000)) << m->failure_text();
+  ASSERT_TRUE(m);
+  ASSERT_TRUE(carry_until(*m, test::shutdown_word, state::ready_to_switch_on)) << m->failure_text();
+  ASSERT_TRUE(carry_until(*m, test::switch_on_word, state::switched_on));
+  ASSERT_TRUE(carry_until(*m, test::enable_operation_word, state::operation_enabled));
   run(*m, 100);
   ASSERT_FALSE(drives[0]->node().connection_lost());
   run(*m, 500, /*alive=*/false);
@@ -501,6 +491,7 @@ TEST_P(heartbeat_over_socketcand, silent_master_makes_the_drive_apply_0x6007) {
 }
 
 INSTANTIATE_TEST_SUITE_P(codes_0_to_3, heartbeat_over_socketcand, ::testing::Range(0, 4));
+
 
 }  // namespace
 }  // namespace cia402::canopen

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "cia402/canopen/301/pdo.hpp"
+#include "cia402/master.hpp"  // decode_status
 #include "cia402/support/text.hpp"
 #include "cia402/words.hpp"
 
@@ -89,7 +90,6 @@ void drive_master::go_running() {
     sync_timer_.start(config_.cycle_us);
     send_sync();
   }
-  if (mode_ == mode::target) master_.set_target(policy_, now_us_, config_.transition_timeout_us);
 }
 
 void drive_master::fail(master_failure f, sdo_abort a, std::uint16_t index, std::uint8_t sub,
@@ -317,17 +317,6 @@ void drive_master::note_status(std::uint16_t sw) {
     observed_ = s;
     if (on_state) on_state(before, s, sw);
   }
-  if (phase_ != master_phase::running) return;
-  switch (mode_) {
-    case mode::idle:
-    case mode::word: break;
-    case mode::target: send_word(master_.step(sw, now_us_, error_code_) | mode_bits_); break;
-    case mode::command: {
-      std::uint16_t cw = 0;
-      if (encode_command(*profile_, command_, 0, cw)) send_word(cw);
-      break;
-    }
-  }
 }
 
 void drive_master::on_frame(const frame& f) {
@@ -379,42 +368,11 @@ void drive_master::on_frame(const frame& f) {
   }
 }
 
-// --- commanding ---------------------------------------------------------------------------------
+// --- the words carried ---------------------------------------------------------------------------
 
-void drive_master::set_target(state target) {
-  mode_ = mode::target;
-  outbox_.clear();
-  policy_ = master_policy::make(*profile_, options_, target);
-  master_.set_target(policy_, now_us_, config_.transition_timeout_us);
-}
-
-void drive_master::set_mode_bits(std::uint16_t bits) {
-  // Only the bits a mode defines: the state machine's own (0..3, 7) stay the master step's.
-  constexpr std::uint16_t mode_specific = 0x0370;
-  bits &= mode_specific;
-  if (bits == mode_bits_) return;
-  mode_bits_ = bits;
-  if (phase_ == master_phase::running && mode_ == mode::target) {
-    send_word(static_cast<std::uint16_t>((last_sent_ & ~mode_specific) | bits));
-  }
-}
-
-void drive_master::set_command(command c) {
-  mode_ = mode::command;
-  outbox_.clear();
-  command_ = c;
-  master_.clear_target();
-}
-
-void drive_master::clear_target() {
-  mode_ = mode::idle;
-  outbox_.clear();
-  master_.clear_target();
-}
+void drive_master::clear_target() { outbox_.clear(); }
 
 void drive_master::send_control_word(std::uint16_t word, bool fault_reset_edge) {
-  if (mode_ != mode::word) master_.clear_target();
-  mode_ = mode::word;
   outbox_.clear();
   if (!fault_reset_edge) {
     outbox_.emplace_back(word, now_us_);

@@ -2,8 +2,7 @@
 // then carries words over PDOs. It does not steer: the axis session (cia402/axis/session.hpp) is the
 // one master, and its CAN link (cia402/canopen/axis/can_link.hpp) hands this class the session's
 // control words (send_control_word) and reads the status word back, for `cia402 master --can` and
-// `cia402 serve --can` alike. set_target / set_command below are retired steering of its own, kept
-// for tests and benches only (scripts/layer_exceptions.txt) until they move onto the session.
+// `cia402 serve --can` alike.
 //
 // Set-up, in order (each an SDO transfer; the first required one that fails ends it with a clear
 // error: "does not answer" for a timeout, "refused" with the abort code otherwise):
@@ -11,8 +10,8 @@
 //   2. read 0x1008, the device name (optional); on a node of `cia402 bus` ("cia402 virtual drive")
 //      read 0x2001 too: "write-only" (0x06010001) says faults may be injected by writing it. No
 //      other drive's 0x2001 is touched: there it is some manufacturer object of unknown meaning;
-//   3. read the option codes 0x605A..0x605E and 0x6007 (absent ones keep the profile's default), so
-//      commands are planned with the drive's own codes, then `read_at_start` (optional reads);
+//   3. read the option codes 0x605A..0x605E and 0x6007 (absent ones keep the profile's default;
+//      option_code() and start_values() say them), then `read_at_start` (optional reads);
 //   4. 0x1017 = drive heartbeat time (the master watches it at 3x; optional unless
 //      `heartbeat_required`: without it a silent node is found by SDO polling);
 //   5. with a master heartbeat: 0x1016 sub 1 = this master's node-ID and 3 x its period, so the drive
@@ -27,16 +26,14 @@
 //      enable;
 //   7. on change only: the present 0x6040, 0x6041, 0x603F, 0x606C, so the master starts from them;
 //   8. NMT start.
-// Running: with `pdo_timing::sync` one SYNC per cycle; the drive answers with TPDO1 and, when a
-// target or a command is set, the master answers with RPDO1 at once. With `map_position` and a
+// Running: with `pdo_timing::sync` one SYNC per cycle; the drive answers with TPDO1 (on_status). With `map_position` and a
 // set-point given (set_position_set_point), RPDO3 (the last control word sent and the set-point) goes
 // out just before each SYNC, after `before_sync` has had the chance to move the set-point on; TPDO3's
 // position is kept (position()) and reported (on_position); a control word given while the set-point
 // has changed since the last RPDO3 goes in the next RPDO3 instead of RPDO1, so a pp handshake's
 // bit 4 and its target take effect at the same SYNC. Words set with
 // `send_control_word` go out when given (a fault-reset edge as bit 7 high for `reset_pulse_us`).
-// Nothing is sent in RPDO1 until a target, command or word is given, so watching a drive never
-// commands it. Requests (`read`, `write`) run one at a time between polls of what no PDO carries
+// Nothing is sent in RPDO1 until a word is given, so watching a drive never commands it. Requests (`read`, `write`) run one at a time between polls of what no PDO carries
 // (0x1001, and 0x606C / 0x603F / 0x6041 when not mapped or watched) every `poll_us`.
 //
 // Any SDO timeout or a lost heartbeat is "does not answer"; with `retry_us` set-up starts again that
@@ -57,7 +54,7 @@
 #include "cia402/canopen/301/nmt.hpp"
 #include "cia402/canopen/301/sdo_client.hpp"
 #include "cia402/canopen/301/timing.hpp"
-#include "cia402/master.hpp"
+#include "cia402/drive.hpp"
 #include "cia402/profile.hpp"
 
 namespace cia402::canopen {
@@ -77,7 +74,6 @@ struct drive_master_config {
   /// whose process() time lags the wall (a held-up host skipping cycles) would otherwise miss.
   std::function<std::uint64_t()> heartbeat_clock_us;
   std::uint32_t sdo_timeout_us = 500000;
-  std::uint64_t transition_timeout_us = 3000000;  ///< per transition, 0 = none
   const profile* drive_profile = nullptr;  ///< the drive's profile; nullptr = the standard one
   pdo_timing timing = pdo_timing::sync;
   bool map_velocity = false;               ///< TPDO2 = 0x606C, on change
@@ -124,21 +120,14 @@ class drive_master {
   /// Every frame waiting on `in`, then process(elapsed).
   std::uint32_t poll(channel& in, std::uint32_t elapsed_us);
 
-  /// Drive towards a state with the core's master step (once running; before, it waits).
-  void set_target(state target);
-  /// Send one fixed command every cycle instead (e.g. Quick stop), encoded for the profile.
-  void set_command(command c);
-  /// Send this word in RPDO1 now (once running). With `fault_reset_edge`, bit 7 rises and falls:
-  /// the word without bit 7 first if the last one had it, then with it, then without, each held
-  /// `reset_pulse_us`, so the drive steps on both levels. Ends a target or command.
+  /// Send this word in RPDO1 now (once running; given before, it waits for the running phase, and
+  /// a failure or a restart of the set-up drops it). With `fault_reset_edge`, bit 7 rises and falls: the word without bit 7 first if the last one
+  /// had it, then with it, then without, each held `reset_pulse_us`, so the drive steps on both
+  /// levels. Words of an earlier call not yet sent are dropped.
   void send_control_word(std::uint16_t word, bool fault_reset_edge = false);
-  /// Stop steering: RPDO1 is no longer sent (words still queued are dropped).
+  /// Stop carrying words: words still queued are dropped, none goes out until the next
+  /// send_control_word. (The name is can_link's; there is no target here.)
   void clear_target();
-  /// Operation-mode bits (4, 5, 6, 8, 9: new set-point, change immediately, relative, halt, change
-  /// on set-point; homing start) ORed into every word the master step sends; sent at once when
-  /// they change while steering.
-  void set_mode_bits(std::uint16_t bits);
-  std::uint16_t mode_bits() const noexcept { return mode_bits_; }
   /// With `map_position`: the target position RPDO3 carries before every SYNC (with the last control
   /// word sent), once a control word has been sent; nullopt stops RPDO3.
   void set_position_set_point(std::optional<std::int32_t> position) noexcept {
@@ -188,9 +177,6 @@ class drive_master {
   std::optional<std::uint8_t> nmt_seen() const noexcept { return nmt_seen_; }
   /// The state the last status word shows (start if none or unreadable).
   state observed() const noexcept { return observed_; }
-  master_outcome outcome() const noexcept { return master_.outcome(); }
-  bool steering() const noexcept { return mode_ != mode::idle; }
-  const cia402::master& core_master() const noexcept { return master_; }
   std::uint64_t now_us() const noexcept { return now_us_; }
   /// The drive's option code as read during configuration (or the profile's default).
   std::int8_t option_code(option o) const noexcept { return options_.options[static_cast<int>(o)]; }
@@ -243,8 +229,6 @@ class drive_master {
     std::function<void(const sdo_result&)> done;  // a request's own callback
     bool nmt_start = false;  // not a transfer: NMT start, then running
   };
-  enum class mode : std::uint8_t { idle, target, command, word };
-
   void build_script();
   void restart(phase_reason why, std::string text);
   void go_running();
@@ -302,13 +286,8 @@ class drive_master {
   std::map<std::uint16_t, std::int64_t> start_values_;
 
   axis options_;  // the drive's option codes, read at set-up
-  master_policy policy_{};
-  cia402::master master_;
-  mode mode_ = mode::idle;
-  command command_ = command::disable_voltage;
   std::deque<std::pair<std::uint16_t, std::uint64_t>> outbox_;  // word, not before (us)
   std::uint16_t last_sent_ = 0;
-  std::uint16_t mode_bits_ = 0;
   bool word_sent_ = false;  // a control word went out since running: RPDO3 may carry it
   std::optional<std::int32_t> position_set_point_;
   // A set-point newer than the last RPDO3: a control word given now waits for that RPDO3, so the
