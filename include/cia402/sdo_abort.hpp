@@ -2,7 +2,10 @@
 // sends them unchanged.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+
+#include "cia402/hex_text.hpp"
 
 namespace cia402 {
 
@@ -34,5 +37,28 @@ enum class sdo_abort : std::uint32_t {
 
 /// A short English reason, e.g. "value range of parameter exceeded"; never null.
 const char* sdo_abort_text(sdo_abort code) noexcept;
+
+/// The text of an abort as every message names it, in a buffer the result carries (no allocation).
+struct sdo_abort_words_text {
+  char chars[112] = {};  ///< the longest line (0x08000022's) is 95 characters and the NUL
+  constexpr const char* c_str() const noexcept { return chars; }
+};
+
+/// "SDO abort 0x06090030 (invalid value for parameter)": the code's 8 hexadecimal digits and its
+/// sdo_abort_text(). The one spelling of an abort in the page, the scenario log, the replay and the
+/// masters' messages.
+inline sdo_abort_words_text sdo_abort_words(sdo_abort code) noexcept {
+  sdo_abort_words_text out;
+  std::size_t n = 0;
+  const auto put = [&](const char* s) {
+    while (*s != '\0' && n + 1 < sizeof out.chars) out.chars[n++] = *s++;
+  };
+  put("SDO abort ");
+  put(to_hex(static_cast<std::uint32_t>(code), 8).c_str());
+  put(" (");
+  put(sdo_abort_text(code));
+  put(")");
+  return out;
+}
 
 }  // namespace cia402

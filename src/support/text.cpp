@@ -6,7 +6,9 @@
 
 namespace cia402::support {
 
-std::string hex(std::uint64_t value, int digits) { return fmt::format("0x{:0{}X}", value, digits); }
+std::string hex(std::uint64_t value, int digits, std::string_view prefix) {
+  return fmt::format("{}{:0{}X}", prefix, value, digits);
+}
 
 std::optional<std::int64_t> parse_integer(std::string_view text, std::int64_t min, std::int64_t max,
                                           leading_zero zero) {

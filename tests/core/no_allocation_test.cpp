@@ -106,6 +106,8 @@ TEST(no_allocation, profile_checks_names_and_custom_profiles_never_allocate) {
     state parsed{};
     sink += parse_state("operation_enabled", parsed);
     sink += sdo_abort_text(sdo_abort::invalid_value)[0];
+    sink += sdo_abort_words(sdo_abort::cannot_store_in_present_state).c_str()[94];  // the closing ')'
+    sink += to_hex(0x6041, 4).c_str()[2];
     for (unsigned code = 0; code <= 0xFFFF; code += 0x0101) {
       sink += error_code_text(static_cast<std::uint16_t>(code))[0];
     }

@@ -20,6 +20,14 @@ TEST(support_text, hex_pads_to_the_digits_and_widens_for_larger_values) {
   EXPECT_EQ(hex(0xFFFFFFFFFFFFFFFFull, 16), "0xFFFFFFFFFFFFFFFF");
 }
 
+TEST(support_text, hex_takes_another_prefix_or_none) {
+  EXPECT_EQ(hex(0x1A00, 4, ""), "1A00") << "an EDS section name";
+  EXPECT_EQ(hex(0x1, 4, "#x"), "#x0001") << "an ESI number";
+  EXPECT_EQ(hex(0x12345678, 8, "#x"), "#x12345678");
+  EXPECT_EQ(hex(0x1ABCD, 4, ""), "1ABCD");
+  EXPECT_EQ(hex(0x7FF, 1), "0x7FF") << "one digit asked: as many as the value needs";
+}
+
 TEST(support_text, integers_in_decimal_and_hex_with_a_sign) {
   constexpr std::int64_t lo = std::numeric_limits<std::int32_t>::min();
   constexpr std::int64_t hi = std::numeric_limits<std::uint32_t>::max();

@@ -11,9 +11,10 @@
 
 namespace cia402::support {
 
-/// "0x" and `digits` upper-case hexadecimal digits (more if the value needs them): hex(0x6041, 4)
-/// is "0x6041".
-std::string hex(std::uint64_t value, int digits);
+/// `prefix` and `digits` upper-case hexadecimal digits (more if the value needs them): hex(0x6041, 4)
+/// is "0x6041", hex(0x6041, 4, "") "6041", hex(1, 4, "#x") "#x0001" (an ESI file's). The layers
+/// that see only the core write the same "0x" text with cia402::to_hex (cia402/hex_text.hpp).
+std::string hex(std::uint64_t value, int digits, std::string_view prefix = "0x");
 
 /// How a leading 0 reads: as decimal (a person typing "010"), or as octal (CiA 306 §4.6.3, EDS files).
 enum class leading_zero { decimal, octal };
