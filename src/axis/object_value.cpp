@@ -3,11 +3,12 @@
 #include <charconv>
 #include <limits>
 
+#include "cia402/hex_text.hpp"
+
 namespace cia402::axes {
 namespace {
 
 constexpr char hex_chars[] = "0123456789abcdef";
-constexpr char upper_hex_chars[] = "0123456789ABCDEF";
 
 int hex_value(char c) noexcept {
   if (c >= '0' && c <= '9') return c - '0';
@@ -39,14 +40,6 @@ bool fits(std::int64_t v, const value_format& f) noexcept {
   }
   if (bits >= 64) return true;  // any bits: a negative number is not a valid input (parse refuses it)
   return v >= 0 && v <= static_cast<std::int64_t>((std::uint64_t{1} << bits) - 1);
-}
-
-std::string hex_number(std::uint64_t v, unsigned digits) {
-  std::string s = "0x";
-  for (int i = static_cast<int>(digits) - 1; i >= 0; --i) {
-    s += upper_hex_chars[(v >> (4 * i)) & 0xF];
-  }
-  return s;
 }
 
 }  // namespace
@@ -273,7 +266,7 @@ std::string value_text(const object_value& v, const std::optional<value_format>&
       const unsigned size = f && f->what == kind::integer ? f->size : smallest_size(v.number);
       const std::uint64_t bits = size >= 8 ? static_cast<std::uint64_t>(v.number)
                                            : static_cast<std::uint64_t>(v.number) & ((std::uint64_t{1} << (8 * size)) - 1);
-      return value_json(v, f) + " (" + hex_number(bits, 2 * size) + ")";
+      return value_json(v, f) + " (" + to_hex(bits, static_cast<int>(2 * size)).c_str() + ")";
     }
     case kind::text: return json_string(v.text);
     case kind::bytes:

@@ -29,11 +29,6 @@ constexpr command_entry commands[] = {
 
 }  // namespace
 
-std::string abort_text(sdo_abort code) {
-  return "SDO abort " + hex(static_cast<std::uint32_t>(code), 8) + " (" + sdo_abort_text(code) +
-         ")";
-}
-
 const command_entry& entry_of(page_command c) noexcept {
   for (const command_entry& e : commands) {
     if (e.id == c) return e;

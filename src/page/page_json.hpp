@@ -21,8 +21,8 @@ using json = nlohmann::ordered_json;
 
 using support::hex;  // "0x605A" with `digits` hex digits
 
-/// "SDO abort 0x06090030 (value range of parameter exceeded)".
-std::string abort_text(sdo_abort code);
+/// "SDO abort 0x06090030 (invalid value for parameter)": the core's sdo_abort_words as a string.
+inline std::string abort_text(sdo_abort code) { return sdo_abort_words(code).c_str(); }
 
 struct command_entry {
   page_command id;

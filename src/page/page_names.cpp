@@ -25,12 +25,12 @@ bit_names bit_names_for(const profile& p) {
 // the profile has and the ramps, named from the one object table ("Quick stop option code" ->
 // "quick stop option code (rpm/s)").
 std::vector<object_name> object_names(const profile& p) {
-  constexpr std::uint16_t listed[] = {object_index::modes_of_operation, object_index::target_position,
-                                      object_index::profile_velocity, object_index::target_torque,
-                                      object_index::homing_method, object_index::home_offset,
-                                      0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007,
-                                      object_index::profile_acceleration, object_index::profile_deceleration,
-                                      object_index::quick_stop_deceleration};
+  std::vector<std::uint16_t> listed = {object_index::modes_of_operation, object_index::target_position,
+                                       object_index::profile_velocity, object_index::target_torque,
+                                       object_index::homing_method, object_index::home_offset};
+  for (int i = 0; i < option_count; ++i) listed.push_back(option_index(static_cast<option>(i)));
+  listed.insert(listed.end(), {object_index::profile_acceleration, object_index::profile_deceleration,
+                               object_index::quick_stop_deceleration});
   std::vector<object_name> out;
   for (const std::uint16_t index : listed) {
     option opt{};

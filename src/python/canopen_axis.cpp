@@ -11,6 +11,7 @@
 
 #include "canopen_bus.hpp"
 #include "cia402/canopen/301/slave.hpp"
+#include "cia402/hex_text.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/state.hpp"
 
@@ -245,7 +246,7 @@ class axis_handle {
         known = axis_->session->format_of(index, sub);
       }
       if (known && known->type_name() != asked->type_name()) {
-        raise_argument_error("0x" + hex4(index) + ":" + std::to_string(sub) + " is " + known->type_name() + ", not " + *type);
+        raise_argument_error(std::string(to_hex(index, 4).c_str()) + ":" + std::to_string(sub) + " is " + known->type_name() + ", not " + *type);
       }
       if (!known) {  // the type given decides the bytes
         std::vector<std::uint8_t> bytes;
@@ -302,12 +303,6 @@ class axis_handle {
   }
 
  private:
-  static std::string hex4(std::uint16_t v) {
-    static const char* d = "0123456789ABCDEF";
-    std::string s;
-    for (int i = 3; i >= 0; --i) s += d[(v >> (4 * i)) & 0xF];
-    return s;
-  }
   static std::optional<axes::value_format> format_named(const std::string& name) {
     for (const unsigned size : {1u, 2u, 4u, 8u}) {
       for (const bool is_signed : {false, true}) {

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <optional>
 #include <set>
-#include <sstream>
 
 #include "canopen_bus.hpp"
+#include "cia402/hex_text.hpp"
 
 namespace cia402::python {
 namespace {
@@ -28,7 +28,7 @@ class bus_port {
 
   void send(std::uint32_t id, const std::string& data, bool extended, bool rtr, int dlc) {
     if (id > (extended ? canopen::max_extended_id : canopen::max_base_id)) {
-      raise_argument_error("CAN identifier 0x" + hex(id) + " beyond " + (extended ? "29" : "11") + " bits");
+      raise_argument_error("CAN identifier " + std::string(to_hex(id, 1).c_str()) + " beyond " + (extended ? "29" : "11") + " bits");
     }
     if (data.size() > 8) raise_argument_error("a classic CAN frame carries at most 8 data bytes");
     if (rtr && (dlc < 0 || dlc > 8)) raise_argument_error("a remote frame's DLC is 0..8");
@@ -109,12 +109,6 @@ class bus_port {
   }
 
  private:
-  static std::string hex(std::uint32_t v) {
-    std::ostringstream s;
-    s << std::hex << std::uppercase << v;
-    return s.str();
-  }
-
   std::shared_ptr<bus_core> core_;
   std::unique_ptr<canopen::virtual_channel> channel_;
 };

@@ -20,11 +20,6 @@ std::optional<std::int64_t> parse_number(std::string_view text) {
                                 std::numeric_limits<std::uint32_t>::max());
 }
 
-std::string abort_text(sdo_abort code) {
-  return "SDO abort " + hex(static_cast<std::uint32_t>(code), 8) + " (" + sdo_abort_text(code) +
-         ")";
-}
-
 bool same_outputs(const drive_outputs& a, const drive_outputs& b) {
   return a.current == b.current && a.status_word == b.status_word && a.ramp == b.ramp &&
          a.torque == b.torque && a.brake_released == b.brake_released &&
@@ -159,7 +154,7 @@ std::string replay_session::handle_set(const std::vector<std::string_view>& word
                                         static_cast<std::int32_t>(*value));
   if (result != sdo_abort::none) {
     return error("set " + hex(static_cast<std::uint32_t>(*index), 4) + " " +
-                     std::to_string(*value) + " refused: " + abort_text(result),
+                     std::to_string(*value) + " refused: " + sdo_abort_words(result).c_str(),
                  line_number);
   }
   return settle_line();

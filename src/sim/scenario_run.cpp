@@ -3,6 +3,7 @@
 #include <string>
 
 #include "cia402/objects.hpp"
+#include "cia402/sdo_abort.hpp"
 #include "cia402/sim/scenario.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 #include "cia402/support/text.hpp"
@@ -16,10 +17,6 @@ using support::hex;
 std::string short_seconds(std::uint64_t us) {
   const std::string full = format_seconds(us);  // "1.250000"
   return us % 1000 == 0 ? full.substr(0, full.size() - 3) : full;
-}
-
-std::string abort_text(sdo_abort a) {
-  return "SDO abort " + hex(static_cast<std::uint32_t>(a), 8) + " (" + sdo_abort_text(a) + ")";
 }
 
 std::string describe_control_word(const profile& p, std::uint16_t cw) {
@@ -227,23 +224,22 @@ class runner {
       case scenario_event::kind::write: {
         const sdo_abort r = v.write(e.index, e.sub, e.value);
         std::string text = describe_write(p_, e.index, e.value);
+        const std::string got = sdo_abort_words(r).c_str();
+        const std::string expected = sdo_abort_words(e.expected_abort).c_str();
         bool failed = false;
         if (e.expected_abort != sdo_abort::none) {
           ++result_.checks;
           if (r == e.expected_abort) {
-            text += ": refused as expected, " + abort_text(r);
+            text += ": refused as expected, " + got;
           } else {
             failed = true;
-            text += r == sdo_abort::none ? ": accepted, but the scenario expects " +
-                                               abort_text(e.expected_abort)
-                                         : ": refused with " + abort_text(r) +
-                                               ", but the scenario expects " +
-                                               abort_text(e.expected_abort);
+            text += r == sdo_abort::none ? ": accepted, but the scenario expects " + expected
+                                         : ": refused with " + got + ", but the scenario expects " + expected;
           }
         } else if (r != sdo_abort::none) {
           ++result_.checks;
           failed = true;
-          text += ": refused, " + abort_text(r);
+          text += ": refused, " + got;
         }
         if (failed) ++result_.failures;
         log(t, log_entry::kind::event, failed, text + at_line);

@@ -7,19 +7,13 @@
 #include <string>
 
 #include "cia402/dictionary/error_history.hpp"
+#include "cia402/hex_text.hpp"
 #include "cia402/dictionary/object_builders.hpp"
 #include "cia402/canopen/301/slave.hpp"
 #include "cia402/canopen/can/frame.hpp"
 
 namespace cia402::canopen {
 namespace {
-
-std::string hex4(std::uint16_t v) {
-  static const char* digits = "0123456789ABCDEF";
-  std::string s = "0x";
-  for (int shift = 12; shift >= 0; shift -= 4) s += digits[(v >> shift) & 0xF];
-  return s;
-}
 
 void add_pdos(std::vector<dictionary::object_entry>& t, const slave_config& c) {
   for (const bool transmit : {false, true}) {
@@ -76,7 +70,7 @@ std::vector<dictionary::object_entry> node_objects(const slave_config& c) {
   std::vector<dictionary::object_entry> t = communication_objects(c);
   for (const dictionary::object_entry& o : c.objects) {
     if (std::any_of(t.begin(), t.end(), [&](const dictionary::object_entry& mine) { return mine.index == o.index; })) {
-      throw std::invalid_argument("the device's table has " + hex4(o.index) +
+      throw std::invalid_argument("the device's table has " + std::string(to_hex(o.index, 4).c_str()) +
                                   ", a communication object the CiA 301 node serves itself");
     }
   }

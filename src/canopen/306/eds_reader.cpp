@@ -279,7 +279,7 @@ class reader {
     std::optional<std::int64_t> compact;
     if (!number_key(s, "CompactSubObj", compact)) return false;
     if (compact && *compact > 0) return compact_subs(s, *compact, o);
-    const std::string prefix = lower(hex_name(index)) + "sub";
+    const std::string prefix = lower(support::hex(index, 4, "")) + "sub";
     for (const auto& [name, sub_section] : sections_) {
       if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
       const auto sub = hex_number(std::string_view(name).substr(prefix.size()), 2);
@@ -314,13 +314,6 @@ class reader {
       o.subs.push_back(std::move(sub));
     }
     return true;
-  }
-
-  static std::string hex_name(std::uint16_t index) {
-    static constexpr char digits[] = "0123456789ABCDEF";
-    std::string s(4, '0');
-    for (int i = 3; i >= 0; --i, index = static_cast<std::uint16_t>(index >> 4)) s[static_cast<std::size_t>(i)] = digits[index & 0xF];
-    return s;
   }
 
   std::string_view text_;

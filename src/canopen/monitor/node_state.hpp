@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cia402/canopen/301/pdo.hpp"
+#include "cia402/hex_text.hpp"
 #include "cia402/canopen/monitor/decoder.hpp"
 
 namespace cia402::canopen::monitor {
@@ -73,7 +74,8 @@ using object_table = std::vector<dictionary::object_entry>;
 
 /// "0x6041:0".
 std::string object_ref(std::uint16_t index, std::uint8_t sub);
-/// "0x" and `digits` upper-case hexadecimal digits (more if the value needs them).
+/// "0x" and `digits` upper-case hexadecimal digits (more if the value needs them): the core's to_hex
+/// (cia402/hex_text.hpp) as a string.
 std::string hex(std::uint64_t value, int digits);
 /// The value of index:sub carried by `bytes`, named and typed by `table` (may be null), else by
 /// the CiA 402 object table.

@@ -78,11 +78,7 @@ std::string meaning_of(std::uint16_t index, std::uint8_t sub, std::int64_t v) {
 
 }  // namespace
 
-std::string hex(std::uint64_t value, int digits) {
-  char buf[24];
-  std::snprintf(buf, sizeof buf, "0x%0*llX", digits, static_cast<unsigned long long>(value));
-  return buf;
-}
+std::string hex(std::uint64_t value, int digits) { return to_hex(value, digits).c_str(); }
 
 std::string object_ref(std::uint16_t index, std::uint8_t sub) {
   return hex(index, 4) + ":" + std::to_string(sub);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "cia402/hex_text.hpp"
 #include "cia402/manufacturer_objects.hpp"
 #include "cia402/master.hpp"
 #include "cia402/objects.hpp"
@@ -23,13 +24,6 @@ constexpr std::uint64_t stop_limit_us = 3'000'000;
 // acts; SWITCHED ON carries torque in some profiles).
 bool carries_torque(state s) {
   return s == state::switched_on || s == state::operation_enabled || s == state::quick_stop_active;
-}
-
-std::string hex4(std::uint32_t v) {
-  static const char* d = "0123456789ABCDEF";
-  std::string s = "0x";
-  for (int i = 3; i >= 0; --i) s += d[(v >> (4 * i)) & 0xF];
-  return s;
 }
 
 // The types of ETG.1000.6's CoE communication objects (table 59 ff.), by index and sub-index.
@@ -157,7 +151,7 @@ std::string ecat_link::short_name() const { return "slave " + std::to_string(pos
 
 std::string ecat_link::what() const {
   const auto& slaves = line_->master().slaves();
-  const std::string station = position_ < slaves.size() ? " (station " + hex4(slaves[position_].station) + ")" : "";
+  const std::string station = position_ < slaves.size() ? " (station " + std::string(to_hex(slaves[position_].station, 4).c_str()) + ")" : "";
   return short_name() + station + " on " + line_->name();
 }
 
@@ -209,7 +203,7 @@ void ecat_link::after_cycle(bool ok) {
   if (ok) ++status_count_;
   if (ok && (s.al_state & 0x0F) != static_cast<std::uint8_t>(line_state::operational)) {
     std::string why = what() + " left OP: AL state " + line_state_name(s.al_state);
-    if (s.al_code != 0) why += ", AL status code " + hex4(s.al_code) + " (" + al_status_code_text(s.al_code) + ")";
+    if (s.al_code != 0) why += ", AL status code " + std::string(to_hex(s.al_code, 4).c_str()) + " (" + al_status_code_text(s.al_code) + ")";
     return fail(why);
   }
   for (; emergencies_seen_ < s.emergencies.size(); ++emergencies_seen_) {

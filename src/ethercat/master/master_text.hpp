@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cia402/ethercat/master/ecat_master.hpp"
+#include "cia402/hex_text.hpp"
 
 namespace cia402::ethercat::detail {
 
@@ -26,12 +27,8 @@ inline void put_le(std::vector<std::uint8_t>& v, std::uint64_t value, unsigned b
   for (unsigned i = 0; i < bytes; ++i) v.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
 }
 
-inline std::string hex(std::uint32_t v, int digits) {
-  static const char* d = "0123456789ABCDEF";
-  std::string s = "0x";
-  for (int i = digits - 1; i >= 0; --i) s += d[(v >> (4 * i)) & 0xF];
-  return s;
-}
+/// "0x0001": the core's to_hex as a string.
+inline std::string hex(std::uint32_t v, int digits) { return to_hex(v, digits).c_str(); }
 
 inline std::string slave_text(const ecat_slave& s) {
   return "slave " + std::to_string(s.position) + " (station " + hex(s.station, 4) + ")";

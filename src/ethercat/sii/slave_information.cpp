@@ -112,11 +112,8 @@ std::vector<std::uint8_t> pdo_category(const std::vector<pdo_description>& pdos,
   return b;
 }
 
-std::string hex(std::uint32_t v, int digits) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "#x%0*X", digits, v);
-  return buf;
-}
+// ESI numbers are written "#x0001" (ETG.2000).
+std::string hex(std::uint32_t v, int digits) { return support::hex(v, digits, "#x"); }
 
 // ESI data type names (ETG.2000) of the CiA 301 data type indices.
 const char* esi_type(std::uint16_t t) {

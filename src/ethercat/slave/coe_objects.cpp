@@ -7,6 +7,7 @@
 #include "cia402/dictionary/error_history.hpp"
 #include "cia402/dictionary/object_builders.hpp"
 #include "cia402/ethercat/slave/coe_slave.hpp"
+#include "cia402/hex_text.hpp"
 
 namespace cia402::ethercat {
 namespace {
@@ -64,13 +65,6 @@ std::int64_t default_of(const std::vector<object_entry>& t, std::uint16_t index,
   return e != nullptr ? e->default_value : 0;
 }
 
-std::string hex4(std::uint16_t v) {
-  static const char* digits = "0123456789ABCDEF";
-  std::string s = "0x";
-  for (int shift = 12; shift >= 0; shift -= 4) s += digits[(v >> shift) & 0xF];
-  return s;
-}
-
 // The PDO a mapping object's defaults describe, entry names and types from the dictionary.
 pdo_description pdo_of(const std::vector<object_entry>& t, std::uint16_t index, std::uint8_t sm) {
   pdo_description p;
@@ -125,7 +119,7 @@ std::vector<object_entry> coe_objects(const coe_slave_config& c) {
   std::vector<object_entry> t = coe_communication_objects(c);
   for (const object_entry& o : c.objects) {
     if (find(t, o.index) != nullptr) {
-      throw std::invalid_argument("the device's table has " + hex4(o.index) +
+      throw std::invalid_argument("the device's table has " + std::string(to_hex(o.index, 4).c_str()) +
                                   ", a communication object the CoE slave serves itself");
     }
   }
