@@ -354,8 +354,11 @@ void coe_slave::step(std::uint32_t elapsed_us) {
   if (esc_.take_al_control_event()) handle_al_control();
   watch_sync_managers();
   serve_mailbox();
-  exchange_process_data();
+  // As SOES runs its application: the outputs in, the device's step on them, then the inputs out,
+  // so the inputs a master reads next answer the outputs it wrote before this step (no cycle more).
+  outputs_in();
   device_->step(elapsed_us);
+  inputs_out();
   esc_.advance(std::uint64_t{elapsed_us} * 1000);
   if (esc_.take_watchdog_event() && state_ == al_state::operational) {
     // The master stopped sending outputs: SAFE-OP with the watchdog's code, and the device's

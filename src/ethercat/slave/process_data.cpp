@@ -1,6 +1,7 @@
 // The CoE slave's process data: each assigned PDO entry bound to its dictionary slot on the way to
 // SAFE-OP, then every cycle a copy of bytes between those slots and the sync managers' buffers, with
-// no lookup and no allocation (SOES fills its sync manager maps the same way).
+// no lookup and no allocation (SOES fills its sync manager maps the same way): outputs in before the
+// device's step, inputs out after it (coe_slave::step).
 #include <array>
 #include <span>
 
@@ -66,7 +67,7 @@ bool coe_slave::bind(std::uint16_t assignment, std::vector<bound_entry>& out, un
   return bits <= 8u * max_process_data;
 }
 
-void coe_slave::exchange_process_data() {
+void coe_slave::outputs_in() {
   if (state_ != al_state::safe_operational && state_ != al_state::operational) return;
   // Whole buffers through the sync managers checked on the way to SAFE-OP, whose lengths hold the
   // bound entries: the application reaches process RAM only, in the buffer the controller gives it.
@@ -84,6 +85,8 @@ void coe_slave::exchange_process_data() {
     }
     if (sync0) outputs_waiting_ = false;
   }
+  // In SAFE-OP the events are taken (so a pulse or a buffer of then is not applied later) but the
+  // outputs stay unapplied.
   const std::size_t out_bytes = outputs_checked_.enabled ? outputs_checked_.length : 0;
   if (state_ == al_state::operational && take_outputs && out_bytes <= buffer.size() &&
       output_bits_ <= 8 * out_bytes && esc_.read_buffer(sm_outputs, std::span(buffer.data(), out_bytes))) {
@@ -95,10 +98,14 @@ void coe_slave::exchange_process_data() {
       (void)write(*e.slot, value);
     }
   }
-  // Inputs: every cycle, so the master always reads the present values.
+}
+
+void coe_slave::inputs_out() {
+  // Every cycle in SAFE-OP and OP, so the master always reads the present values.
+  if (state_ != al_state::safe_operational && state_ != al_state::operational) return;
+  std::array<std::uint8_t, max_process_data> buffer{};
   const std::size_t in_bytes = inputs_checked_.enabled ? inputs_checked_.length : 0;
   if (in_bytes == 0 || in_bytes > buffer.size() || input_bits_ > 8 * in_bytes) return;
-  buffer.fill(0);
   for (const bound_entry& e : inputs_) {
     std::int64_t value = 0;
     (void)read(*e.slot, value);

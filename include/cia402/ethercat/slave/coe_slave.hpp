@@ -23,7 +23,8 @@
 // Process data: each assigned PDO entry is bound once, on the way to SAFE-OP (as SOES fills its sync
 // manager maps then), to its dictionary slot, bit offset, length and sign. Each cycle then copies
 // bytes between those slots and the sync managers' buffers, with no lookup and no allocation: in
-// SAFE-OP and OP the inputs (SM3) every cycle, in OP the outputs (SM2) when a whole buffer arrived. A
+// OP the outputs (SM2) when a whole buffer arrived, before the device's step, and in SAFE-OP and OP
+// the inputs (SM3) every cycle after it, so a master reads the state its outputs brought. A
 // value the outputs carry goes through the dictionary's rules as an SDO write does
 // (dictionary_access). PDO mappings and assignments are written in PRE-OP only (0x08000022
 // otherwise), and only with objects that are PDO mappable the right way, of their own length and
@@ -146,8 +147,9 @@ class coe_slave final : private dictionary::dictionary_access, private dictionar
   coe_slave& operator=(const coe_slave&) = delete;
 
   esc& controller() noexcept { return esc_; }
-  /// The application's cycle: AL requests, mailboxes, process data, then `elapsed_us` of the device
-  /// and of the watchdog.
+  /// The application's cycle: AL requests, mailboxes, the outputs to the device, `elapsed_us` of the
+  /// device, the inputs from it (so they answer this cycle's outputs, as SOES runs its application
+  /// between the two), then `elapsed_us` of the controller and the watchdog.
   void step(std::uint32_t elapsed_us);
   al_state state() const noexcept { return state_; }
   const slave_description& description() const noexcept { return description_; }
@@ -177,7 +179,10 @@ class coe_slave final : private dictionary::dictionary_access, private dictionar
   bool entry_mappable(std::uint16_t mapping, std::uint32_t entry) const;
   sdo_abort write_pdo_configuration(dictionary::object_dictionary::slot& s, std::int64_t v);
   void watch_sync_managers();
-  void exchange_process_data();
+  // The cycle's process data, either side of the device's step: the outputs (SM2) to the device in
+  // OP, then the inputs (SM3) from it in SAFE-OP and OP.
+  void outputs_in();
+  void inputs_out();
   void serve_mailbox();
   void send_reply(std::vector<std::uint8_t>& reply);
   void repeat_last_reply();
