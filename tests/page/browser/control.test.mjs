@@ -128,7 +128,9 @@ async function lostSignOfLife(axis, fromMs, lease) {
 }
 
 runChecks(async () => {
-  const server = await startServer(['--nodes', '3']);
+  // A lease of 2 s, not the default 1 s: the test times every check from it, and a browser on a
+  // loaded 2-core machine can miss a 1 s lease between two probes without any fault of the page.
+  const server = await startServer(['--nodes', '3', '--lease', '2000']);
   base = server.url.split('?')[0];
   const info = await (await fetch(`${base}api/info`)).json();
   const lease = info.lease_ms;

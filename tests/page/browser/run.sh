@@ -24,7 +24,10 @@ command -v npm >/dev/null || skip "npm is not installed (apt-get install npm)"
 [ -x "$chromium" ] || skip "$chromium is missing (apt-get install chromium)"
 
 mkdir -p "$work"
-# Reinstall only when the lock file changed.
+# Reinstall only when the lock file changed. Each script is a CTest of its own and they run side by
+# side: the first installs, under this lock, and the others wait for it.
+exec 9>"$work/.install.lock"
+flock 9
 if ! cmp -s "$here/package-lock.json" "$work/package-lock.json" || [ ! -d "$work/node_modules/playwright-core" ]; then
   cp "$here/package.json" "$here/package-lock.json" "$work/"
   if ! (cd "$work" && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error); then
@@ -32,6 +35,7 @@ if ! cmp -s "$here/package-lock.json" "$work/package-lock.json" || [ ! -d "$work
     skip "npm ci could not install playwright-core (no access to the npm registry?)"
   fi
 fi
+flock -u 9
 
 # The screenshot in docs/ changes only when asked for (CIA402_UPDATE_SCREENSHOT=1), so a test run
 # leaves the source tree as it was; otherwise it goes beside the other outputs.
@@ -41,8 +45,12 @@ fi
 
 export CIA402_NODE_MODULES="$work/node_modules"
 export CIA402_CHROMIUM="$chromium"
-# CIA402_BROWSER_ONLY=control.test.mjs: that script alone (a CTest entry of its own).
+# CIA402_BROWSER_ONLY=control.test.mjs: that script alone (how CTest runs each, see
+# tests/page/CMakeLists.txt); the instrument page's script also takes the screenshot's path.
 if [ -n "${CIA402_BROWSER_ONLY:-}" ]; then
+  if [ "$CIA402_BROWSER_ONLY" = instrument_page.test.mjs ]; then
+    exec node "$here/$CIA402_BROWSER_ONLY" "$cia402" "$work/output" "$screenshot"
+  fi
   exec node "$here/$CIA402_BROWSER_ONLY" "$cia402" "$work/output"
 fi
 node "$here/instrument_page.test.mjs" "$cia402" "$work/output" "$screenshot"
