@@ -29,8 +29,8 @@ LAYERS = [
     ("sim", "src/sim/"),
     ("drive402", "include/cia402/drive402/"),
     ("drive402", "src/drive402/"),
-    ("canopen/402", "include/cia402/canopen/402/"),
-    ("canopen/402", "src/canopen/402/"),
+    ("canopen/master", "include/cia402/canopen/master/"),
+    ("canopen/master", "src/canopen/master/"),
     ("canopen/306", "include/cia402/canopen/306/"),
     ("canopen/306", "src/canopen/306/"),
     ("canopen/can", "include/cia402/canopen/can/"),
@@ -83,7 +83,7 @@ ALLOWED = {
     "canopen/306": {"core", "support", "dictionary", "canopen/can", "canopen/301"},
     "canopen/transport": {"core", "support", "canopen/can"},
     "canopen/monitor": {"core", "dictionary", "canopen/can", "canopen/301"},
-    "canopen/402": {"core", "support", "canopen/can", "canopen/301", "canopen/306"},
+    "canopen/master": {"core", "support", "canopen/can", "canopen/301", "canopen/306"},
     "drive402": {"core", "motion", "sim", "dictionary"},
     "ethercat/esc": set(),
     "ethercat/sii": {"support"},
@@ -92,22 +92,22 @@ ALLOWED = {
     "ethercat/master": {"core", "ethercat/esc", "ethercat/sii", "ethercat/coe"},
     # The axis session and its links: the session sees the core only; each link its own fieldbus.
     "axis": {"core"},
-    "canopen/axis": {"core", "axis", "support", "dictionary", "canopen/can", "canopen/301", "canopen/306", "canopen/402"},
+    "canopen/axis": {"core", "axis", "support", "dictionary", "canopen/can", "canopen/301", "canopen/306", "canopen/master"},
     "ethercat/axis": {"core", "axis", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/master"},
     # The compositions: canopen/axis for the CiA 301 types' value formats the local link shares.
     "apps": {"axis", "dictionary", "canopen/axis", "ethercat/master", "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/slave", "drive402", "sim", "motion", "support",
-             "core", "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+             "core", "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/master",
              "canopen/monitor"},
     # The page is a client of the axis session; `cia402 serve` (tools) builds the link.
     "page": {"core", "motion", "support", "profile_file", "diagram", "sim", "axis"},
     # The Python binding: the core, profile files, the replay, the simulator, and the fieldbuses as
     # the apps layer composes them (the virtual CAN bus with its drives, the axis session).
     "python": {"core", "motion", "support", "profile_file", "replay", "sim", "apps", "drive402", "dictionary",
-               "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+               "canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/master",
                "canopen/monitor", "axis", "canopen/axis", "ethercat/esc", "ethercat/sii",
                "ethercat/coe", "ethercat/slave", "ethercat/master", "ethercat/axis"},
     "tools": {"core", "motion", "support", "profile_file", "diagram", "replay", "sim", "dictionary", "canopen/can",
-              "canopen/301", "canopen/306", "canopen/transport", "canopen/402", "canopen/monitor",
+              "canopen/301", "canopen/306", "canopen/transport", "canopen/master", "canopen/monitor",
               "drive402", "apps", "page", "axis", "canopen/axis", "ethercat/axis",
               "ethercat/esc", "ethercat/sii", "ethercat/coe", "ethercat/slave", "ethercat/master"},
 }
@@ -123,18 +123,18 @@ NEVER = [
     ("ethercat/", {"sim", "motion", "drive402", "apps", "page"}),
     ("ethercat/coe", {"canopen/can", "canopen/301"}),
     ("ethercat/master", {"ethercat/slave"}),
-    ("page", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+    ("page", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/master",
               "canopen/monitor", "canopen/axis", "ethercat/esc", "ethercat/sii", "ethercat/coe",
               "ethercat/slave", "ethercat/master", "ethercat/axis", "apps", "drive402"}),
-    ("drive402", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+    ("drive402", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/master",
                   "canopen/monitor", "canopen/axis", "ethercat/esc", "ethercat/sii", "ethercat/coe",
                   "ethercat/slave", "ethercat/master", "ethercat/axis"}),
     # The object dictionary is fieldbus-neutral, and no EtherCAT layer sees CANopen: the CoE slave
     # mounts the same dictionary the CANopen node does.
-    ("dictionary", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+    ("dictionary", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/master",
                     "canopen/monitor", "canopen/axis", "ethercat/esc", "ethercat/sii", "ethercat/coe",
                     "ethercat/slave", "ethercat/master", "ethercat/axis"}),
-    ("ethercat/", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/402",
+    ("ethercat/", {"canopen/can", "canopen/301", "canopen/306", "canopen/transport", "canopen/master",
                    "canopen/monitor", "canopen/axis"}),
 ]
 

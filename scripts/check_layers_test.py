@@ -41,18 +41,18 @@ def main():
     steering["src/ethercat/master/ecat_master.cpp"] = "// frames, not cia402::master steering\n"
     code, out = run(steering)
     checks.append(("the axis session may steer, a comment naming the master step is no steering", code == 0))
-    steering["src/canopen/402/drive_master.cpp"] = "  s.policy = master_policy::make(p, a, t);\n"
+    steering["src/canopen/master/drive_master.cpp"] = "  s.policy = master_policy::make(p, a, t);\n"
     code, out = run(steering)
-    checks.append(("a bus master that steers fails", code == 1 and "canopen/402 steers a drive" in out))
-    code, out = run(steering, "src/canopen/402/drive_master.cpp -> steering  # why\n")
+    checks.append(("a bus master that steers fails", code == 1 and "canopen/master steers a drive" in out))
+    code, out = run(steering, "src/canopen/master/drive_master.cpp -> steering  # why\n")
     checks.append(("a listed steering breach passes", code == 0))
     fieldbus = dict(sound)
     fieldbus["include/cia402/sim/virtual_drive.hpp"] = "#pragma once\n"
-    fieldbus["src/canopen/402/drive_master.cpp"] = '#include "cia402/sim/virtual_drive.hpp"\n'
+    fieldbus["src/canopen/master/drive_master.cpp"] = '#include "cia402/sim/virtual_drive.hpp"\n'
     fieldbus["src/ethercat/slave/coe_slave.cpp"] = '#include "cia402/sim/virtual_drive.hpp"\n'
     code, out = run(fieldbus)
     checks.append(("canopen or ethercat including sim fails",
-                   code == 1 and "canopen/402 may not include sim" in out and "ethercat/slave may not include sim" in out))
+                   code == 1 and "canopen/master may not include sim" in out and "ethercat/slave may not include sim" in out))
     codec = dict(sound)
     codec["include/cia402/canopen/301/slave.hpp"] = "#pragma once\n"
     codec["src/ethercat/coe/sdo.cpp"] = '#include "cia402/canopen/301/slave.hpp"\n'
@@ -75,11 +75,11 @@ def main():
                    "dictionary may not include canopen/301" in out))
     import check_layers
     widened = {layer: set(seen) for layer, seen in check_layers.ALLOWED.items()}
-    widened["canopen/402"].add("sim")
+    widened["canopen/master"].add("sim")
     widened["ethercat/master"].add("ethercat/slave")
     checks.append(("the rule table itself may not let a fieldbus see the simulator",
                    check_layers.check_rules(check_layers.ALLOWED) == [] and
-                   ("canopen/402", "sim") in check_layers.check_rules(widened) and
+                   ("canopen/master", "sim") in check_layers.check_rules(widened) and
                    ("ethercat/master", "ethercat/slave") in check_layers.check_rules(widened)))
     return report(checks)
 

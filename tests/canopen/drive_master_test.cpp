@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/canopen/master/drive_master.hpp"
 #include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/manufacturer_objects.hpp"
 #include "cia402/canopen/transport/virtual_bus.hpp"

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "cia402/apps/bus_host.hpp"
-#include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/canopen/master/drive_master.hpp"
 #include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/transport/socketcand.hpp"
 #include "carried_words.hpp"

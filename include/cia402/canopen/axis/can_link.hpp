@@ -1,6 +1,6 @@
 // The axis session's link to a CiA 402 drive on a CAN bus (axis/drive_link.hpp): a CANopen node
 // reached by SDO, and from start_cyclic() on by PDOs with SYNC through the project's CANopen 402
-// master (canopen/402/drive_master.hpp).
+// master (canopen/master/drive_master.hpp).
 //
 // Stages:
 // - acyclic, from the start: SDO transfers only (its own client), nothing set up, the node's NMT
@@ -40,7 +40,7 @@
 #include "cia402/canopen/301/nmt.hpp"
 #include "cia402/dictionary/object_dictionary.hpp"
 #include "cia402/canopen/301/sdo_client.hpp"
-#include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/canopen/master/drive_master.hpp"
 #include "cia402/canopen/can/channel.hpp"
 #include "cia402/profile.hpp"
 

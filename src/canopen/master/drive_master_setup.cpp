@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <iterator>
 
-#include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/canopen/master/drive_master.hpp"
 #include "cia402/canopen/301/pdo.hpp"
 #include "cia402/manufacturer_objects.hpp"
 #include "cia402/objects.hpp"

@@ -1,4 +1,4 @@
-#include "cia402/canopen/402/drive_master.hpp"
+#include "cia402/canopen/master/drive_master.hpp"
 
 #include <algorithm>
 
