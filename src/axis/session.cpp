@@ -87,6 +87,15 @@ std::uint32_t session::poll(std::uint32_t elapsed_us) {
   return std::min(link_next, next_deadline());
 }
 
+bool session::poll_until_idle() {
+  // A transfer answered in one round may queue the next (a read whose completion asks for more),
+  // and the session hands the link one transfer at a time: so the rounds go on while either says so.
+  const auto work_left = [this] { return !deferred_.empty() || link_->work_now(); };
+  (void)poll(0);
+  for (int round = 1; round < max_zero_time_polls && work_left(); ++round) (void)poll(0);
+  return !work_left();
+}
+
 void session::on_link_event(link_event e, const std::string& text) {
   switch (e) {
     case link_event::running:

@@ -102,7 +102,8 @@ void axis_page::impl::start_session(const profile& p) {
   }
   drive.link->start_cyclic();
   // A drive in this process is read at start without time passing: the page opens on it prepared.
-  for (int i = 0; i < 20 && drive.plant != nullptr && !session->prepared(); ++i) session->poll(0);
+  // On a bus the start-up reads come with the cycle thread's polls.
+  (void)session->poll_until_idle();
 }
 
 void axis_page::impl::advance(std::uint32_t elapsed_us) {

@@ -104,7 +104,7 @@ std::optional<axes::result> axis_page::impl::await(std::unique_lock<std::mutex>&
   });
   // A drive in this process answers without time passing, and a request refused before anything is
   // sent at once; the rest comes with the cycle thread's polls.
-  for (int i = 0; i < 8 && !*out; ++i) session->poll(0);
+  if (!*out) (void)session->poll_until_idle();
   answered.wait_for(lock, config.request_timeout, [&] { return out->has_value() || board.closed(); });
   return *out;
 }
@@ -255,9 +255,8 @@ reply axis_page::jog(std::int64_t velocity_rpm, std::uint64_t time_to_live_us) {
     } else {
       m.session->renew_jog(0);  // the session's dead-man ends it in its next poll: 0x60FF = 0
     }
-    if (m.drive.plant != nullptr) {
-      for (int i = 0; i < 4; ++i) m.session->poll(0);
-    }
+    // A drive in this process has 0x60FF = 0 before the reply; on a bus it goes with the next cycle.
+    (void)m.session->poll_until_idle();
     // Reported at once, as the button's release is: the session ramps the shaft to rest meanwhile.
     if (m.jogging) m.end_jog(axes::result{});
     return accepted{id};

@@ -267,7 +267,8 @@ reply axis_page::read_error_field() {
     m.error_field.stale = false;
     m.read_error_field(0, {});
   }
-  for (int i = 0; i < 300 && !done; ++i) m.session->poll(0);
+  // A drive in this process answers the whole chain of reads without time passing.
+  if (!done) (void)m.session->poll_until_idle();
   m.answered.wait_for(lock, m.config.request_timeout, [&] { return done || m.board.closed(); });
   if (!done) {
     m.error_field.waiting.clear();

@@ -111,10 +111,9 @@ std::vector<std::optional<axes::result>> axis_page::impl::read_entries(std::uniq
       if (--*left == 0) answered.notify_all();
     });
   }
-  // A drive in this process answers each at once (a few polls apiece); on a bus the cycle thread's
+  // A drive in this process answers them all without time passing; on a bus the cycle thread's
   // polls bring them.
-  const std::size_t polls = drive.plant != nullptr ? 8 + 4 * entries.size() : 8;
-  for (std::size_t k = 0; k < polls && *left > 0; ++k) session->poll(0);
+  if (*left > 0) (void)session->poll_until_idle();
   answered.wait_for(lock, config.request_timeout, [&] { return *left == 0 || board.closed(); });
   return *results;
 }

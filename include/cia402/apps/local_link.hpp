@@ -5,9 +5,9 @@
 // - one cycle per cycle of the simulator (1 ms by default): the control word and the cyclic outputs
 //   (0x6040, 0x6060, 0x607A, 0x60FF, 0x6071, as EtherCAT's RxPDO 0x1600) go in before the step,
 //   and every mappable object the drive can read is a cyclic input of that cycle;
-// - a transfer (upload, download) ends at the next poll, by the dictionary rules both buses apply
-//   (dictionary::dictionary_access over drive402::drive_objects()), so a value refused here is refused
-//   on a bus with the same abort code;
+// - a transfer (upload, download) ends at the next poll, even poll(0) (work_now() says one waits),
+//   by the dictionary rules both buses apply (dictionary::dictionary_access over
+//   drive402::drive_objects()), so a value refused here is refused on a bus with the same abort code;
 // - 0x1003, the pre-defined error field (CiA 301 §7.5.2.5), kept as a CiA 301 node keeps it: each new
 //   error code the drive raises goes in at sub-index 1, the older ones move down, at most
 //   `error_history` kept; sub-index 0 is their number, and writing 0 to it empties the list;
@@ -42,6 +42,8 @@ class local_link final : public axes::link_base {
   local_link& operator=(const local_link&) = delete;
 
   std::uint32_t poll(std::uint32_t elapsed_us) override;
+  /// A transfer queued: the next poll(0) answers it.
+  bool work_now() const override { return !closed_ && !transfers_.empty(); }
   axes::link_phase phase() const override;
   std::string phase_text() const override { return closed_ ? "closed" : std::string(); }
   std::string what() const override { return "the virtual drive in this process"; }

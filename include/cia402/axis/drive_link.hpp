@@ -87,6 +87,10 @@ class drive_link {
   /// The link's work for `elapsed_us` of time: frames, set-up, the cyclic exchange. Returns the
   /// microseconds until it next wants to run.
   virtual std::uint32_t poll(std::uint32_t elapsed_us) = 0;
+  /// Work the next poll(0) does without time passing: a transfer a drive in this process answers
+  /// at once. On a bus nothing is answered before time passes (a frame must go and come back), so
+  /// a bus's link keeps this false; session::poll_until_idle() asks it whether to poll again.
+  virtual bool work_now() const { return false; }
   virtual link_phase phase() const = 0;
   /// Why it is connecting or failed, in words; empty while running.
   virtual std::string phase_text() const = 0;

@@ -141,6 +141,17 @@ class session {
   /// The session's work for `elapsed_us`: the link's poll, then the jobs, the operation, the lease
   /// and the control word. Returns the microseconds until it next wants to run.
   std::uint32_t poll(std::uint32_t elapsed_us);
+  /// Does what needs no time: poll(0), and poll(0) again while a completion waits to be said or
+  /// the link has work_now() (a drive in this process answers a chain of transfers this way, one
+  /// a round), at most `max_zero_time_polls` rounds. True once nothing is left that needs no time
+  /// (an operation may still wait for time: a state change takes the drive's cycles); false at the
+  /// bound, with the rest left to the timed polls. On a bus it polls once.
+  bool poll_until_idle();
+  /// The bound of poll_until_idle(), so a link whose work never ends (a fault of the link) cannot
+  /// hold its caller. Each round answers a transfer; the longest chains a client runs without time,
+  /// 0x1003 (sub 0, then up to 254 entries) and the page's parameter panel (a read per object), are
+  /// far below it. Past it nothing is lost: what is left runs in the timed polls, as on a bus.
+  static constexpr int max_zero_time_polls = 4096;
 
   // --- requests: each returns its id; `done` is called from a later poll() ---------------------
   /// The state, status word and error code (over SDO when the link has no cyclic status yet).

@@ -1,0 +1,156 @@
+// session::poll_until_idle(): what needs no time runs at once over a drive in this process
+// (apps::local_link), stops at its bound over a link whose work never ends, and polls once over a
+// bus, where nothing is answered before time passes.
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <memory>
+
+#include "cia402/apps/local_link.hpp"
+#include "cia402/axis/session.hpp"
+#include "cia402/objects.hpp"
+#include "sim_link.hpp"
+
+namespace cia402::axes::test {
+namespace {
+
+// A bus-like link around sim_link that counts its polls and says work_now() as a test sets it:
+// false as a bus's link does, true as a broken link that always claims more.
+class counting_link final : public drive_link {
+ public:
+  explicit counting_link(bool busy) : busy_(busy) {
+    inner.on_event = [this](link_event e, const std::string& t) { if (on_event) on_event(e, t); };
+    inner.before_cycle = [this] { if (before_cycle) before_cycle(); };
+  }
+  sim_link inner;
+  int polls = 0;
+
+  std::uint32_t poll(std::uint32_t elapsed_us) override {
+    ++polls;
+    return inner.poll(elapsed_us);
+  }
+  bool work_now() const override { return busy_; }
+  link_phase phase() const override { return inner.phase(); }
+  std::string phase_text() const override { return inner.phase_text(); }
+  std::string what() const override { return inner.what(); }
+  std::string short_name() const override { return inner.short_name(); }
+  bool cyclic() const override { return inner.cyclic(); }
+  void start_cyclic() override { inner.start_cyclic(); }
+  std::uint32_t cycle_us() const override { return inner.cycle_us(); }
+  bool status_known() const override { return inner.status_known(); }
+  std::uint16_t status_word() const override { return inner.status_word(); }
+  std::uint64_t status_count() const override { return inner.status_count(); }
+  std::optional<std::uint16_t> error_code() const override { return inner.error_code(); }
+  void set_control_word(std::uint16_t w) override { inner.set_control_word(w); }
+  const std::vector<cyclic_object>& cyclic_inputs() const override { return inner.cyclic_inputs(); }
+  const std::vector<cyclic_object>& cyclic_outputs() const override { return inner.cyclic_outputs(); }
+  std::optional<std::int64_t> cyclic_input(std::uint16_t i, std::uint8_t s) const override { return inner.cyclic_input(i, s); }
+  bool set_cyclic_output(std::uint16_t i, std::uint8_t s, std::int64_t v) override { return inner.set_cyclic_output(i, s, v); }
+  bool upload(std::uint16_t i, std::uint8_t s, transfer_done d) override { return inner.upload(i, s, std::move(d)); }
+  bool download(std::uint16_t i, std::uint8_t s, std::vector<std::uint8_t> b, transfer_done d) override {
+    return inner.download(i, s, std::move(b), std::move(d));
+  }
+  std::optional<value_format> describe(std::uint16_t i, std::uint8_t s) const override { return inner.describe(i, s); }
+  void close() override { inner.close(); }
+  const close_report& closing() const override { return inner.closing(); }
+
+ private:
+  bool busy_;
+};
+
+TEST(poll_until_idle, a_drive_in_this_process_is_prepared_at_start_without_time_passing) {
+  apps::local_link link(standard_profile());
+  session s(link);
+  ASSERT_FALSE(s.prepared());
+  EXPECT_TRUE(s.poll_until_idle());
+  EXPECT_TRUE(s.prepared());
+  EXPECT_FALSE(link.work_now());
+  EXPECT_EQ(s.now_us(), 0u);
+  EXPECT_EQ(link.status_count(), 0u) << "no cycle of the drive ran";
+}
+
+TEST(poll_until_idle, a_drive_in_this_process_answers_every_read_queued_at_once) {
+  apps::local_link link(standard_profile());
+  session s(link);
+  ASSERT_TRUE(s.poll_until_idle());
+  std::size_t asked = 0, answered = 0;
+  for (std::size_t i = 0; i < drive_object_count(); ++i) {
+    const object_description& o = drive_object(i);
+    if (o.access == object_access::write_only) continue;
+    ++asked;
+    s.read_object(o.index, o.sub, [&](const result& r) {
+      EXPECT_TRUE(r.ok()) << r.error;
+      ++answered;
+    });
+  }
+  ASSERT_GT(asked, 8u) << "more reads than the page's old guess of 8 polls";
+  EXPECT_TRUE(s.poll_until_idle());
+  EXPECT_EQ(answered, asked);
+  EXPECT_EQ(s.now_us(), 0u);
+}
+
+TEST(poll_until_idle, a_chain_of_reads_each_asking_the_next_ends_without_time_passing) {
+  apps::local_link link(standard_profile());
+  session s(link);
+  ASSERT_TRUE(s.poll_until_idle());
+  // Longer than the 300 polls the page used to give 0x1003.
+  constexpr int chain = 400;
+  int done = 0;
+  std::function<void()> next = [&] {
+    s.read_object(device_name_index, 0, [&](const result& r) {
+      EXPECT_TRUE(r.ok()) << r.error;
+      if (++done < chain) next();
+    });
+  };
+  next();
+  EXPECT_TRUE(s.poll_until_idle());
+  EXPECT_EQ(done, chain);
+  EXPECT_EQ(s.now_us(), 0u);
+}
+
+TEST(poll_until_idle, a_link_whose_work_never_ends_is_polled_no_more_than_the_bound) {
+  counting_link link(true);
+  session s(link);
+  EXPECT_FALSE(s.poll_until_idle()) << "it did not come to rest";
+  EXPECT_EQ(link.polls, session::max_zero_time_polls);
+  EXPECT_EQ(s.now_us(), 0u);
+}
+
+TEST(poll_until_idle, a_bus_is_polled_once_and_its_answer_comes_with_time) {
+  counting_link link(false);
+  session s(link);
+  ASSERT_TRUE(s.poll_until_idle());  // the start-up reads go as on a bus: with time
+  link.polls = 0;
+  bool answered = false;
+  s.read_object(object_index::modes_of_operation, 0, [&](const result&) { answered = true; });
+  EXPECT_TRUE(s.poll_until_idle()) << "nothing on a bus is answered without time: at rest at once";
+  EXPECT_EQ(link.polls, 1);
+  EXPECT_EQ(s.now_us(), 0u);
+  for (int i = 0; i < 100 && !answered; ++i) s.poll(1000);
+  EXPECT_TRUE(answered) << "the timed polls bring it";
+}
+
+TEST(poll_until_idle, a_completion_that_asks_again_is_said_in_the_next_round_even_on_a_bus) {
+  counting_link link(false);
+  session s(link);
+  ASSERT_TRUE(s.poll_until_idle());
+  link.polls = 0;
+  // Text into an integer object is refused before anything is sent; its answer comes from the
+  // next poll, and the second refusal, asked from the first's completion, from the one after.
+  int refusals = 0;
+  const object_value text = object_value::of_text("x");
+  s.write_object(object_index::target_velocity, 0, text, [&](const result& r) {
+    EXPECT_TRUE(r.bad_input);
+    ++refusals;
+    s.write_object(object_index::target_velocity, 0, text, [&](const result& r2) {
+      EXPECT_TRUE(r2.bad_input);
+      ++refusals;
+    });
+  });
+  EXPECT_TRUE(s.poll_until_idle());
+  EXPECT_EQ(refusals, 2);
+  EXPECT_EQ(link.polls, 2);
+}
+
+}  // namespace
+}  // namespace cia402::axes::test
