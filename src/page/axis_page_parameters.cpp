@@ -58,19 +58,11 @@ std::vector<parameter_entry> catalog(const std::vector<parameter_entry>& beyond)
   return out;
 }
 
+// As the core's data types read it (CiA 301 §7.1.6); a type code it does not know has no format.
 std::optional<axes::value_format> format_of(const parameter_entry& e) {
-  switch (e.data_type) {
-    case 0x0002: return axes::value_format::integer(1, true);
-    case 0x0003: return axes::value_format::integer(2, true);
-    case 0x0004: return axes::value_format::integer(4, true);
-    case 0x0005: return axes::value_format::integer(1, false);
-    case 0x0006: return axes::value_format::integer(2, false);
-    case 0x0007: return axes::value_format::integer(4, false);
-    case 0x0015: return axes::value_format::integer(8, true);
-    case 0x001B: return axes::value_format::integer(8, false);
-    case 0x0009: return axes::value_format::text();
-    default: return std::nullopt;
-  }
+  const auto t = static_cast<data_type>(e.data_type);
+  if (type_size(t) == 0 && t != data_type::visible_string) return std::nullopt;
+  return axes::format_of(t);
 }
 
 std::string key_of(std::uint16_t index, std::uint8_t sub) { return hex(index, 4) + ":" + std::to_string(sub); }
