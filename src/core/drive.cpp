@@ -70,13 +70,10 @@ std::int8_t stop_code_of_row(const axis& a, unsigned stop) noexcept {
   return option_value(a, (stop & stop_bits::code_605c) ? option::disable_operation : option::shutdown);
 }
 
-// The ramp a row's stop runs before its state change, given the code read when it started; none
-// means the change is immediate.
-stop_ramp ramp_of_row(const axis& a, unsigned stop, int code) noexcept {
-  if ((stop & stop_bits::if_code_is_1) && code != 1) return stop_ramp::none;
-  const unsigned ramp = stop & stop_bits::ramp;
-  return ramp == stop_bits::halt_ramp_live ? ramp_of_code(option_value(a, option::halt))
-                                           : static_cast<stop_ramp>(ramp);
+// Whether a row's stop runs a ramp before its state change, given the code read when it started;
+// else the change is immediate. A ramp 0x605D picks is never none, so its code is not read here.
+bool stop_ramps(unsigned stop, int code) noexcept {
+  return (stop & stop_bits::ramp) != 0 && !((stop & stop_bits::if_code_is_1) && code != 1);
 }
 
 // What the present state (or the pending row's stop) asks of the motion side, and whether that stop
@@ -89,40 +86,41 @@ constexpr unsigned ramp = 0xFFu;
 }  // namespace activity
 
 unsigned activity_of(const profile& p, const axis& a, bool halt) noexcept {
+  // The option code is chosen first so that ramp_of_code() is compiled once, not per case (the
+  // Cortex-M4 firmware: bench/cortex_m4). Torque is "wanted" in every state but an idle one, also
+  // where the stop coasts: the outputs turn a coast's torque off all the same.
+  unsigned ends = 0;
+  int code;
   if (a.pending_row != no_row) {
     const stored_row& r = p.rows[a.pending_row];
+    const unsigned stop = stop_of(r.stop);
     // A stop into a state that holds torque (SWITCHED ON of seeds 003/004) keeps the brake open.
-    return static_cast<unsigned>(ramp_of_row(a, stop_of(r.stop), a.stop_code)) |
-           activity::torque_wanted | (p.torque_allowed(r.to) ? 0u : activity::stop_ends_torque);
+    ends = p.torque_allowed(r.to) ? 0u : activity::stop_ends_torque;
+    const unsigned ramp = stop & stop_bits::ramp;
+    if ((stop & stop_bits::if_code_is_1) && a.stop_code != 1) return activity::torque_wanted | ends;
+    if (ramp != stop_bits::halt_ramp_live) return ramp | activity::torque_wanted | ends;
+    code = option_value(a, option::halt);
+  } else {
+    const state_activity act = p.info(a.current).activity;
+    if (act == state_activity::idle) return 0;
+    code = a.stop_code;
+    if (act == state_activity::hold || act == state_activity::run) {
+      if (!halt || act != state_activity::run) return activity::torque_wanted;
+      code = option_value(a, option::halt);
+    } else if (act == state_activity::fault_reaction) {
+      // 0x605E as it was when the reaction started (S16), unless the drive turned it into a coast.
+      ends = activity::stop_ends_torque;
+      if (a.flags & axis_flag::coast_reaction) code = 0;
+    } else if (code >= 1 && code <= 4) {  // 0x605A as it was when the quick stop started (S16)
+      ends = activity::stop_ends_torque;
+    }
   }
-  const state_activity act = p.info(a.current).activity;
-  if (act == state_activity::hold || act == state_activity::run) {
-    return activity::torque_wanted |
-           (halt && act == state_activity::run
-                ? static_cast<unsigned>(ramp_of_code(option_value(a, option::halt)))
-                : 0u);
-  }
-  if (act == state_activity::quick_stop || act == state_activity::fault_reaction) {
-    // The code of 0x605A or 0x605E as it was when the stop started (S16); a fault reaction the
-    // drive turned into a coast coasts.
-    const int code = a.stop_code;
-    const bool fault_reaction = act == state_activity::fault_reaction;
-    const stop_ramp ramp = fault_reaction && (a.flags & axis_flag::coast_reaction)
-                               ? stop_ramp::coast
-                               : ramp_of_code(code);
-    return static_cast<unsigned>(ramp) | (ramp != stop_ramp::coast ? activity::torque_wanted : 0u) |
-           (fault_reaction || (code >= 1 && code <= 4) ? activity::stop_ends_torque : 0u);
-  }
-  return 0;
+  return static_cast<unsigned>(ramp_of_code(code)) | activity::torque_wanted | ends;
 }
 
 bool raised_by_drive(std::uint16_t code) noexcept {
   return (code == error_code::safe_torque_off) | (code == error_code::dc_link_undervoltage) |
          (code == error_code::heartbeat);
-}
-
-void set_flag(axis& a, std::uint8_t flag, bool on) noexcept {
-  a.flags = static_cast<std::uint8_t>(on ? (a.flags | flag) : (a.flags & ~flag));
 }
 
 // The fault facts an error class raises (fault, fault_quick_stop, fault_present, fault_immediate:
@@ -275,7 +273,7 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   if (take != no_row) {
     const unsigned stop = stop_of(p.rows[take].stop);
     const std::int8_t code = stop_code_of_row(a, stop);  // read as the stop starts (S16)
-    if (torque_was_on && !in.sto && ramp_of_row(a, stop, code) != stop_ramp::none) {
+    if (torque_was_on && !in.sto && stop_ramps(stop, code)) {
       a.pending_row = take;
       a.stop_code = code;
     } else {
@@ -304,17 +302,20 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
     a.last_transition = r.number;
     out.transition = r.number;
     out.clear_setpoints = (r.flags & row_flag::clears_setpoints) != 0;
-    set_flag(a, axis_flag::entered_by_fault, (why & fault_facts) && !(why & command_facts));
+    // Built in a register and stored once: a store per flag made the Cortex-M4 firmware larger.
+    unsigned flags = a.flags & ~static_cast<unsigned>(axis_flag::entered_by_fault);
+    if ((why & fault_facts) && !(why & command_facts)) flags |= axis_flag::entered_by_fault;
     if (why & fault_facts) a.error_code = fault_code;
-    if (why & bits(fact::fault)) {
+    if (why & (bits(fact::fault) | bits(fact::fault_reset))) {
+      flags &= ~static_cast<unsigned>(axis_flag::coast_reaction);
       // A fault reaction has nothing to ramp when torque is already off, or cannot (S14). The
-      // drive's own faults have class 3.
-      set_flag(a, axis_flag::coast_reaction, fault_class >= 3 || !torque_was_on || in.sto);
+      // drive's own faults have class 3. A fault reset ends the coast.
+      if (!(why & bits(fact::fault_reset)) && (fault_class >= 3 || !torque_was_on || in.sto)) {
+        flags |= axis_flag::coast_reaction;
+      }
     }
-    if (why & bits(fact::fault_reset)) {
-      a.error_code = 0;
-      set_flag(a, axis_flag::coast_reaction, false);
-    }
+    if (why & bits(fact::fault_reset)) a.error_code = 0;
+    a.flags = static_cast<std::uint8_t>(flags);
   }
   const unsigned now = activity_of(p, a, halt);
 
