@@ -8,23 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "cli/app.hpp"
+#include "../support/cli_run.hpp"
 
 namespace cia402::cli {
 namespace {
-
-struct result {
-  int status;
-  std::string out;
-  std::string err;
-};
-
-result run_tool(std::vector<std::string> args) {
-  std::istringstream in;
-  std::ostringstream out, err;
-  const int status = run(args, in, out, err);
-  return {status, out.str(), err.str()};
-}
 
 std::vector<nlohmann::json> lines_of(const std::string& out) {
   std::vector<nlohmann::json> v;

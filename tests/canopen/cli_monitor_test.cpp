@@ -10,23 +10,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli/app.hpp"
+#include "../support/cli_run.hpp"
 
 namespace cia402::cli {
 namespace {
-
-struct result {
-  int status;
-  std::string out;
-  std::string err;
-};
-
-result run_tool(std::vector<std::string> args, const std::string& input = "") {
-  std::istringstream in(input);
-  std::ostringstream out, err;
-  const int status = run(args, in, out, err);
-  return {status, out.str(), err.str()};
-}
 
 // A session on node 3 as `cia402 bus --log` writes it.
 const std::string session =

@@ -6,24 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "cli/app.hpp"
+#include "../support/cli_run.hpp"
 #include "cli/bus.hpp"
 
 namespace cia402::cli {
 namespace {
-
-struct result {
-  int status;
-  std::string out;
-  std::string err;
-};
-
-result run_tool(std::vector<std::string> args) {
-  std::istringstream in;
-  std::ostringstream out, err;
-  const int status = run(args, in, out, err);
-  return {status, out.str(), err.str()};
-}
 
 TEST(cli_master, enable_on_the_virtual_bus_reaches_operation_enabled) {
   const result r = run_tool({"master", "--can", "virtual", "--node", "5", "enable"});
