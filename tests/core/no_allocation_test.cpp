@@ -26,14 +26,7 @@ struct lcg {
 
 TEST(no_allocation, counter_sees_a_heap_allocation) {
   // So the zero counts below can mean something.
-  int* volatile p = nullptr;
-  const long calls = heap_calls_during([&] {
-    p = new int(7);
-    delete p;
-    p = new (std::nothrow) int[3];
-    delete[] p;
-  });
-  EXPECT_EQ(calls, 4);
+  EXPECT_EQ(test::heap_calls_of_two_known_allocations(), 4);
 }
 
 TEST(no_allocation, stepping_every_profile_never_allocates) {

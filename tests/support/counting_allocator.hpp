@@ -89,4 +89,16 @@ long heap_calls_during(Body body) {
   return (allocations.load() - a0) + (deallocations.load() - d0);
 }
 
+/// The counter's own check, so that a zero count can mean something: the heap calls seen around a
+/// new and delete of one int and a nothrow new[] and delete[] of three. 4 when the counting works.
+inline long heap_calls_of_two_known_allocations() {
+  int* volatile p = nullptr;
+  return heap_calls_during([&] {
+    p = new int(7);
+    delete p;
+    p = new (std::nothrow) int[3];
+    delete[] p;
+  });
+}
+
 }  // namespace cia402::test
