@@ -12,6 +12,7 @@
 
 #include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/coe/mailbox.hpp"
+#include "register_bytes.hpp"
 
 namespace cia402::ethercat::testing {
 
@@ -60,9 +61,7 @@ struct bench {
     return read16(reg::al_status);
   }
   void sync_manager(int n, const sync_manager_description& d) {
-    std::vector<std::uint8_t> s{static_cast<std::uint8_t>(d.start), static_cast<std::uint8_t>(d.start >> 8),
-                                static_cast<std::uint8_t>(d.length), static_cast<std::uint8_t>(d.length >> 8),
-                                d.control, 0, 1, 0};
+    const std::vector<std::uint8_t> s = register_bytes::sync_manager(d);
     EXPECT_EQ(send(command::fpwr, fp(static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n)), s).wkc, 1);
   }
   void to_pre_op() {
@@ -107,15 +106,7 @@ struct bench {
     return r[8] == 0x60 ? 0 : static_cast<std::uint32_t>(r[12] | (r[13] << 8) | (r[14] << 16) | (r[15] << 24));
   }
   void fmmu(int i, std::uint32_t log, std::uint16_t len, std::uint16_t phys, std::uint8_t type) {
-    std::vector<std::uint8_t> f(16, 0);
-    for (int k = 0; k < 4; ++k) f[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(log >> (8 * k));
-    f[4] = static_cast<std::uint8_t>(len);
-    f[5] = static_cast<std::uint8_t>(len >> 8);
-    f[7] = 7;
-    f[8] = static_cast<std::uint8_t>(phys);
-    f[9] = static_cast<std::uint8_t>(phys >> 8);
-    f[11] = type;
-    f[12] = 1;
+    const std::vector<std::uint8_t> f = register_bytes::fmmu(log, len, phys, type);
     EXPECT_EQ(send(command::fpwr, fp(static_cast<std::uint16_t>(reg::fmmu0 + 16 * i)), f).wkc, 1);
   }
   void to_op() {

@@ -11,6 +11,7 @@
 
 #include "cia402/ethercat/esc/esc.hpp"
 #include "cia402/ethercat/sii/slave_information.hpp"
+#include "register_bytes.hpp"
 
 namespace cia402::ethercat::esc_bus {
 
@@ -69,28 +70,14 @@ struct bus {
 // FMMU i: logical start, length, start bit, end bit, physical start, physical bit, type, active.
 inline void fmmu(bus& b, int slave, int i, std::uint32_t log, std::uint16_t len, std::uint8_t sbit, std::uint8_t ebit,
           std::uint16_t phys, std::uint8_t pbit, std::uint8_t type) {
-  std::vector<std::uint8_t> f(16, 0);
-  f[0] = static_cast<std::uint8_t>(log);
-  f[1] = static_cast<std::uint8_t>(log >> 8);
-  f[2] = static_cast<std::uint8_t>(log >> 16);
-  f[3] = static_cast<std::uint8_t>(log >> 24);
-  f[4] = static_cast<std::uint8_t>(len);
-  f[5] = static_cast<std::uint8_t>(len >> 8);
-  f[6] = sbit;
-  f[7] = ebit;
-  f[8] = static_cast<std::uint8_t>(phys);
-  f[9] = static_cast<std::uint8_t>(phys >> 8);
-  f[10] = pbit;
-  f[11] = type;
-  f[12] = 1;
+  const std::vector<std::uint8_t> f = register_bytes::fmmu(log, len, phys, type, sbit, ebit, pbit);
   EXPECT_EQ(b.send(command::apwr, ap(static_cast<std::uint16_t>(slave), static_cast<std::uint16_t>(reg::fmmu0 + 16 * i)), f).wkc, 1);
 }
 
 // SM n: start, length, control, enabled.
 inline void sync_manager(bus& b, int n, std::uint16_t start, std::uint16_t len, std::uint8_t control) {
-  std::vector<std::uint8_t> s{static_cast<std::uint8_t>(start), static_cast<std::uint8_t>(start >> 8),
-                              static_cast<std::uint8_t>(len), static_cast<std::uint8_t>(len >> 8), control, 0, 1, 0};
-  EXPECT_EQ(b.send(command::apwr, ap(0, static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n)), s).wkc, 1);
+  EXPECT_EQ(b.send(command::apwr, ap(0, static_cast<std::uint16_t>(reg::sync_manager0 + 8 * n)),
+                   register_bytes::sync_manager(start, len, control)).wkc, 1);
 }
 
 }  // namespace cia402::ethercat::esc_bus
