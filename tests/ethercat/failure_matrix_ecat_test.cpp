@@ -28,43 +28,10 @@
 #include "cia402/ethercat/slave/coe_slave.hpp"
 #include "cia402/objects.hpp"
 #include "failure_matrix.hpp"
+#include "refusing_device.hpp"
 
 namespace cia402::ethercat {
 namespace {
-
-// A device in front of the virtual drive's that refuses writes of the objects in `refused` with
-// 0x06090030 (invalid value for parameter); everything else, the drive's reports too, passes through.
-class refusing_device final : public dictionary::device {
- public:
-  explicit refusing_device(drive402::sim_device& inner) : inner_(&inner), relay_{this} { inner.attach(&relay_); }
-  ~refusing_device() override { inner_->attach(nullptr); }
-
-  sdo_abort read(std::uint16_t index, std::uint8_t sub, std::int64_t& value) noexcept override {
-    return inner_->read(index, sub, value);
-  }
-  sdo_abort write(std::uint16_t index, std::uint8_t sub, std::int64_t value) noexcept override {
-    if (refused.count(index) != 0) return sdo_abort::invalid_value;
-    return inner_->write(index, sub, value);
-  }
-  std::uint32_t step(std::uint32_t elapsed_us) noexcept override { return inner_->step(elapsed_us); }
-  void set_connection_lost(bool lost) noexcept override { inner_->set_connection_lost(lost); }
-  void reset() noexcept override { inner_->reset(); }
-  std::array<std::uint8_t, 5> manufacturer_error_field() const noexcept override {
-    return inner_->manufacturer_error_field();
-  }
-
-  std::set<std::uint16_t> refused;
-
- private:
-  struct relay final : dictionary::device_events {
-    explicit relay(refusing_device* d) : owner(d) {}
-    void object_changed(std::uint16_t index, std::uint8_t sub) noexcept override { owner->changed(index, sub); }
-    void error_changed(std::uint16_t code) noexcept override { owner->device::error_changed(code); }
-    refusing_device* owner;
-  };
-  drive402::sim_device* inner_;
-  relay relay_;
-};
 
 // The in-process wire with the one slave; cut, no frame comes back.
 class wire final : public master_link {
@@ -80,7 +47,7 @@ class wire final : public master_link {
     slave.step(us);
   }
   drive402::sim_device drive_device{standard_profile()};
-  refusing_device dev{drive_device};
+  failure_matrix::refusing_device dev{drive_device};
   coe_slave slave{dev, apps::drive_slave_config(1, 1000)};
   chain line;
   std::uint64_t now = 0;
@@ -88,7 +55,7 @@ class wire final : public master_link {
 };
 
 // The drive on the wire, a line brought to OP, a link and a session on slave 0, run in steps of 1 ms.
-struct bench {
+struct bench : failure_matrix::ms_clock<bench> {
   wire w;
   ecat_line line{w, standard_profile(), 1000, "test-line"};
   std::unique_ptr<ecat_link> link;
@@ -108,36 +75,10 @@ struct bench {
     (void)s->poll(1000);
     w.wait_us(1000);
   }
-  bool run_until(const std::function<bool()>& done, int ms) {
-    for (int i = 0; i < ms; ++i) {
-      tick();
-      if (done()) return true;
-    }
-    return false;
-  }
-  void run_ms(int ms) {
-    for (int i = 0; i < ms; ++i) tick();
-  }
-  axes::result finish(const std::function<void(axes::completion)>& request, int ms = 20000) {
-    std::optional<axes::result> got;
-    request([&got](const axes::result& r) { got = r; });
-    if (!run_until([&] { return got.has_value(); }, ms)) {
-      axes::result r;
-      r.end = axes::outcome::failed;
-      r.error = "no end within the test's time";
-      return r;
-    }
-    return *got;
-  }
+  void clear_refusals() { w.dev.refused.clear(); }
 };
 
 using namespace failure_matrix;
-
-// How this bus says a lost link.
-const std::string link_lost_words = "the line does not answer";
-
-// The command of kind `k` on this bench's session.
-void start(bench& b, kind k, axes::completion done) { failure_matrix::start(*b.s, k, std::move(done)); }
 
 void inject(bench& b, failure f) {
   switch (f) {
@@ -155,42 +96,13 @@ void inject(bench& b, failure f) {
   }
 }
 
-// One run: the command, the failure after `at_ms`, then the checks.
+// The drive's sync manager watchdog sees the frames gone and it stops as 0x6007 says.
+const bus_traits ecat_bus{"the line does not answer", 2000, 200, true};
+
 void run_one(kind k, failure f, int at_ms) {
-  SCOPED_TRACE(std::string(name(k)) + ", " + name(f) + " at " + std::to_string(at_ms) + " ms");
+  SCOPED_TRACE(where(k, f, at_ms));
   bench b;
-  std::optional<axes::result> got;
-  start(b, k, [&](const axes::result& res) { got = res; });
-  b.run_ms(at_ms);
-  const bool ended_before = got.has_value();
-  const bool enabled = b.view().current() == state::operation_enabled;
-  inject(b, f);
-  // The bound: the failure stop's three stages, and the time to say it.
-  ASSERT_TRUE(b.run_until([&] { return got.has_value(); }, 3 * 10'000 + 2000)) << "the request never ended";
-  if (ended_before || got->ok()) return;  // the failure came after the end, or changed nothing the command needed
-  EXPECT_TRUE(names_one(got->error, cause_words(f, link_lost_words))) << got->error;
-  if (f == failure::link_lost) {
-    if (enabled) EXPECT_NE(got->error.find("0x6007"), std::string::npos) << got->error;
-    // Out of the session's hands; the drive's sync manager watchdog sees the frames gone and it
-    // stops as 0x6007 says.
-    if (enabled) {
-      EXPECT_TRUE(b.run_until([&] { return std::abs(b.view().velocity_rpm()) <= 1; }, 30'000))
-          << got->error << " (" << b.view().velocity_rpm() << " rpm)";
-    }
-    return;
-  }
-  // At standstill: at once where the session stopped it; after the drive's own fault reaction (or a
-  // coast under STO) where the drive took over.
-  const bool stands = b.run_until([&] { return std::abs(b.view().velocity_rpm()) <= 1; },
-                                  f == failure::cancel || f == failure::refused_sdo ? 200 : 30'000);
-  EXPECT_TRUE(stands) << got->error << " (" << b.view().velocity_rpm() << " rpm)";
-  if (f == failure::cancel || f == failure::refused_sdo) {
-    EXPECT_NE(b.view().current(), state::fault) << got->error;
-    b.w.dev.refused.clear();
-    // The next command runs without a reset.
-    const axes::result next = b.finish([&](axes::completion d) { b.s->velocity(100, std::move(d)); });
-    EXPECT_TRUE(next.ok()) << next.error;
-  }
+  check_run(b, k, f, at_ms, ecat_bus, inject);
 }
 
 // The moments: every 10 ms of the first 60 ms, where the session reads the option codes and limits
@@ -204,11 +116,7 @@ std::vector<int> moments() {
 }
 
 TEST(failure_matrix_ecat, every_motion_command_every_failure_at_every_moment_of_its_first_400_ms) {
-  for (const kind k : kinds) {
-    for (const failure f : failures) {
-      for (const int at : moments()) run_one(k, f, at);
-    }
-  }
+  for_every_case(moments(), run_one);
 }
 
 // A gap the matrix found (issue 42): a wire cut while a CoE SDO waits to hand its request to the
