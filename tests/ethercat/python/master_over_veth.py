@@ -8,11 +8,13 @@ skips (exit 77) without root. Usage: master_over_veth.py CIA402_BINARY [KEEP_DIR
 import json
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
 import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import veth_session  # noqa: E402  the veth pair with `cia402 ecat-slave` and tshark on it
 
 SKIP = 77
 
@@ -20,25 +22,8 @@ SKIP = 77
 def run_line(cia402, drives, workdir):
     tag = "%d%d" % (os.getpid() % 1000, drives)
     m, s = "c4em" + tag, "c4es" + tag
-    subprocess.run(["ip", "link", "add", m, "type", "veth", "peer", "name", s], check=True)
-    slave = capture = None
     pcap = os.path.join(workdir, "line-%d.pcapng" % drives)
-    try:
-        for name in (m, s):
-            subprocess.run(["ip", "link", "set", name, "up"], check=True)
-        slave = subprocess.Popen([cia402, "ecat-slave", "--iface", s, "--nodes", str(drives)],
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        first = slave.stdout.readline()
-        assert "%d drive(s) on %s" % (drives, s) in first, first + slave.stderr.read()
-        capture = subprocess.Popen(["tshark", "-i", m, "-f", "ether proto 0x88a4", "-w", pcap, "-q"], stdout=subprocess.DEVNULL,
-                                   stderr=subprocess.PIPE, text=True)
-        # tshark says "Capturing on" once it captures: nothing before that is lost.
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            line = capture.stderr.readline()
-            if "Capturing on" in line:
-                break
-            assert line or capture.poll() is None, "tshark did not start"
+    with veth_session.slave_line(cia402, m, s, drives, pcap):
         steps = ["state", "enable", "quick-stop", "enable", "sdo", "write", "0x2001", "0x2310", "wait", "50",
                  "sdo", "write", "0x2001", "0", "reset", "state"]
         master = subprocess.run([cia402, "master", "--ecat", m, "--json"] + steps, capture_output=True,
@@ -46,14 +31,6 @@ def run_line(cia402, drives, workdir):
         assert master.returncode == 0, master.stdout + master.stderr
         events = [json.loads(line) for line in master.stdout.splitlines()]
         time.sleep(0.5)  # the last answers into the capture
-    finally:
-        if capture is not None:
-            capture.send_signal(signal.SIGINT)
-            capture.wait(timeout=30)
-        if slave is not None:
-            slave.send_signal(signal.SIGTERM)
-            slave.wait(timeout=10)
-        subprocess.run(["ip", "link", "del", m], capture_output=True)
     check_session(events, drives)
     check_capture(pcap, drives)
     return events

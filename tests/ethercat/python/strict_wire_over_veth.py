@@ -19,7 +19,6 @@ Usage: strict_wire_over_veth.py CIA402_BINARY [KEEP_DIR]."""
 import json
 import os
 import shutil
-import signal
 import struct
 import subprocess
 import sys
@@ -34,18 +33,6 @@ APRD, APWR, FPRD, FPWR, BRD, BWR, LRW, ARMW, FRMW = 1, 2, 4, 5, 7, 8, 12, 13, 14
 LOGICAL = (10, 11, LRW)
 STATION = 0x1001  # drive 0 as our master addresses it (0x1001 + position)
 ABORT_READ_ONLY, ABORT_NO_OBJECT = 0x06010002, 0x06020000
-
-
-def start_capture(iface, pcap):
-    capture = subprocess.Popen(["tshark", "-i", iface, "-f", "ether proto 0x88a4", "-w", pcap, "-q"],
-                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 30
-    while time.monotonic() < deadline:  # tshark says "Capturing on" once it captures
-        line = capture.stderr.readline()
-        if "Capturing on" in line:
-            return capture
-        assert line or capture.poll() is None, "tshark did not start"
-    raise AssertionError("tshark did not start capturing within 30 s")
 
 
 def master(cia402, iface, steps):
@@ -230,29 +217,12 @@ def check_al_and_repeat(frames, seen, first, again):
 def run(cia402, workdir):
     tag = "%d" % (os.getpid() % 10000)
     m, s = "c4xm" + tag, "c4xs" + tag
-    subprocess.run(["ip", "link", "add", m, "type", "veth", "peer", "name", s], check=True)
-    slave = capture = None
     pcap = os.path.join(workdir, "strict.pcapng")
-    try:
-        for name in (m, s):
-            subprocess.run(["ip", "link", "set", name, "up"], check=True)
-        slave = subprocess.Popen([cia402, "ecat-slave", "--iface", s, "--nodes", "2"],
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        first = slave.stdout.readline()
-        assert "2 drive(s) on %s" % s in first, first + slave.stderr.read()
-        capture = start_capture(m, pcap)
+    with veth_session.slave_line(cia402, m, s, 2, pcap):
         refused_sdos(cia402, m)
         set_points = csp_on_sync0(cia402, m)
         seen, reply, again = al_error_and_repeat(m)
         time.sleep(0.3)  # the last answers into the capture
-    finally:
-        if capture is not None:
-            capture.send_signal(signal.SIGINT)
-            capture.wait(timeout=30)
-        if slave is not None:
-            slave.send_signal(signal.SIGTERM)
-            slave.wait(timeout=10)
-        subprocess.run(["ip", "link", "del", m], capture_output=True)
     frames = decode(pcap)
     aborts = check_aborts(frames)
     cycles = check_distributed_clocks(datagrams(frames))

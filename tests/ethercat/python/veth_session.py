@@ -1,7 +1,9 @@
 """`cia402 ecat-slave` on one end of a veth pair, a raw-socket master written here on the other:
 the frames a master sends at start-up (ETG.1000.4/.6 numbers written out here, not taken from our
 code) travel through the kernel and come back answered. Needs root (CI runs as root) and iproute2;
-skips (exit 77) saying why otherwise. Usage: veth_session.py CIA402_BINARY."""
+skips (exit 77) saying why otherwise. Usage: veth_session.py CIA402_BINARY. Also the line the
+tshark tests (master_over_veth.py, strict_wire_over_veth.py) run on: slave_line()."""
+import contextlib
 import os
 import signal
 import socket
@@ -45,6 +47,44 @@ class master:
             wkc = struct.unpack("<H", raw[16 + 10 + n:16 + 12 + n])[0]
             return payload, wkc
         raise AssertionError("no answer from the slaves")
+
+
+def start_capture(iface, pcap):
+    """tshark capturing the EtherCAT frames on IFACE into PCAP, once it says it captures."""
+    capture = subprocess.Popen(["tshark", "-i", iface, "-f", "ether proto 0x88a4", "-w", pcap, "-q"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:  # tshark says "Capturing on" once it captures
+        line = capture.stderr.readline()
+        if "Capturing on" in line:
+            return capture
+        assert line or capture.poll() is None, "tshark did not start"
+    raise AssertionError("tshark did not start capturing within 30 s")
+
+
+@contextlib.contextmanager
+def slave_line(cia402, m, s, drives, pcap):
+    """A veth pair M-S: `cia402 ecat-slave` with DRIVES drives on S, and tshark capturing M into PCAP
+    while the block runs; the pair is gone after it."""
+    subprocess.run(["ip", "link", "add", m, "type", "veth", "peer", "name", s], check=True)
+    slave = capture = None
+    try:
+        for name in (m, s):
+            subprocess.run(["ip", "link", "set", name, "up"], check=True)
+        slave = subprocess.Popen([cia402, "ecat-slave", "--iface", s, "--nodes", str(drives)],
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        first = slave.stdout.readline()
+        assert "%d drive(s) on %s" % (drives, s) in first, first + slave.stderr.read()
+        capture = start_capture(m, pcap)
+        yield
+    finally:
+        if capture is not None:
+            capture.send_signal(signal.SIGINT)
+            capture.wait(timeout=30)
+        if slave is not None:
+            slave.send_signal(signal.SIGTERM)
+            slave.wait(timeout=10)
+        subprocess.run(["ip", "link", "del", m], capture_output=True)
 
 
 def main():
