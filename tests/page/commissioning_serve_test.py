@@ -19,7 +19,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from serve_can_test import Process, request, wait_state, settled_result  # noqa: E402
+from serve_can_test import Process, bus_and_serve, request, wait_state, settled_result  # noqa: E402
 
 SKIP = 77
 JOG_RPM = 300
@@ -74,22 +74,11 @@ def check(base, label):
 
 
 def over_can(cia402):
-    bus = serve = None
-    try:
-        bus = Process([cia402, 'bus', '--listen', '127.0.0.1:0', '--nodes', '1'])
-        port = int(bus.wait_for(r'socketcand on 127\.0\.0\.1:(\d+)').group(1))
-        serve = Process([cia402, 'serve', '--can', f'socketcand://127.0.0.1:{port}/can0', '--node', '1',
-                         '--port', '0'])
-        base = serve.wait_for(r'instrument page at (http://\S+/)').group(1)
+    with bus_and_serve(cia402, '1', ('--node', '1')) as (_, serve, base):
         wait_state(base, lambda s: s['remote']['status'] == 'running', 'set-up of node 1')
         check(base, 'serve --can')
         assert serve.stop() == 0, serve.output
-        serve = None
-        return 0
-    finally:
-        for p in (serve, bus):
-            if p is not None:
-                p.stop()
+    return 0
 
 
 def veth_pair():

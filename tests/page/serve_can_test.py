@@ -11,6 +11,7 @@ cause is gone SWITCH ON DISABLED by 15; STO is refused with the reason; node 2 i
 own; the recorder holds the inferred transitions; when the bus goes away the
 page says so and the server keeps answering. Both processes are stopped by their PIDs.
 """
+import contextlib
 import json
 import os
 import re
@@ -65,6 +66,22 @@ class Process:
         return self.proc.returncode
 
 
+@contextlib.contextmanager
+def bus_and_serve(cia402, nodes, serve_args):
+    """`cia402 bus --listen 127.0.0.1:0 --nodes NODES` and `cia402 serve --can` on the port it printed,
+    with SERVE_ARGS: (bus, serve, the page's base URL) while the block runs; both stopped after."""
+    bus = serve = None
+    try:
+        bus = Process([cia402, 'bus', '--listen', '127.0.0.1:0', '--nodes', nodes])
+        port = int(bus.wait_for(r'socketcand on 127\.0\.0\.1:(\d+)').group(1))
+        serve = Process([cia402, 'serve', '--can', f'socketcand://127.0.0.1:{port}/can0', *serve_args, '--port', '0'])
+        yield bus, serve, serve.wait_for(r'instrument page at (http://\S+/)').group(1)
+    finally:
+        for p in (serve, bus):
+            if p is not None:
+                p.stop()
+
+
 def request(url, body=None):
     data = None if body is None else json.dumps(body).encode()
     req = urllib.request.Request(url, data=data, method='GET' if body is None else 'POST')
@@ -111,15 +128,8 @@ def main():
         print('usage: serve_can_test.py CIA402_BINARY', file=sys.stderr)
         return 2
     cia402 = sys.argv[1]
-    bus = serve = None
     checks = 0
-    try:
-        bus = Process([cia402, 'bus', '--listen', '127.0.0.1:0', '--nodes', '1-2'])
-        port = int(bus.wait_for(r'socketcand on 127\.0\.0\.1:(\d+)').group(1))
-        serve = Process([cia402, 'serve', '--can', f'socketcand://127.0.0.1:{port}/can0',
-                         '--node', '1', '--node', '2', '--port', '0'])
-        base = serve.wait_for(r'instrument page at (http://\S+/)').group(1)
-
+    with bus_and_serve(cia402, '1-2', ('--node', '1', '--node', '2')) as (bus, serve, base):
         s = wait_state(base, lambda s: s['remote']['status'] == 'running', 'set-up of node 1')
         assert s['state'] == 'SWITCH_ON_DISABLED', s['state']
         assert s['remote']['device_name'] == 'cia402 virtual drive', s['remote']
@@ -199,10 +209,6 @@ def main():
         assert serve.stop() == 0, serve.output
         print(f'{checks} checks passed')
         return 0
-    finally:
-        for p in (serve, bus):
-            if p is not None:
-                p.stop()
 
 
 if __name__ == '__main__':

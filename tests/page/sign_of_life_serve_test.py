@@ -20,7 +20,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from serve_can_test import Process, request, wait_state, settled_result  # noqa: E402
+from serve_can_test import Process, bus_and_serve, request, wait_state, settled_result  # noqa: E402
 from commissioning_serve_test import over_ecat  # noqa: E402
 
 LEASE_MS = 500
@@ -112,31 +112,20 @@ def main():
     cia402 = sys.argv[1]
     if len(sys.argv) == 3:
         return over_ecat(cia402, check, ('--lease', str(LEASE_MS)))
-    bus = serve = None
+    serve = Process([cia402, 'serve', '--port', '0', '--lease', str(LEASE_MS)])
     try:
-        serve = Process([cia402, 'serve', '--port', '0', '--lease', str(LEASE_MS)])
-        base = serve.wait_for(r'instrument page at (http://\S+/)').group(1)
-        check(base, 'virtual drive')
+        check(serve.wait_for(r'instrument page at (http://\S+/)').group(1), 'virtual drive')
         assert serve.stop() == 0, serve.output
-        serve = None
+    finally:
+        serve.stop()
 
-        bus = Process([cia402, 'bus', '--listen', '127.0.0.1:0', '--nodes', '1'])
-        port = int(bus.wait_for(r'socketcand on 127\.0\.0\.1:(\d+)').group(1))
-        serve = Process([cia402, 'serve', '--can', f'socketcand://127.0.0.1:{port}/can0', '--node', '1',
-                         '--port', '0', '--lease', str(LEASE_MS)])
-        base = serve.wait_for(r'instrument page at (http://\S+/)').group(1)
+    with bus_and_serve(cia402, '1', ('--node', '1', '--lease', str(LEASE_MS))) as (bus, serve, base):
         wait_state(base, lambda s: s['remote']['status'] == 'running', 'set-up of node 1')
         check(base, 'serve --can')
         assert serve.stop() == 0, serve.output
-        serve = None
         assert bus.stop() == 0, bus.output
-        bus = None
-        print('2 checks passed')
-        return 0
-    finally:
-        for p in (serve, bus):
-            if p is not None:
-                p.stop()
+    print('2 checks passed')
+    return 0
 
 
 if __name__ == '__main__':
