@@ -25,11 +25,7 @@ void expect_refused(std::string_view text, int line, int column, std::string_vie
 
 std::string rows(int n) {
   std::string text = "base = \"cia402\"\n";
-  for (int i = 0; i < n; ++i) {
-    text +=
-        "[[rows]]\nnumber = 0\nfrom = [\"start\"]\nto = \"not_ready_to_switch_on\"\n"
-        "any = [\"automatic\"]\n";
-  }
+  for (int i = 0; i < n; ++i) text += test::t0_row;
   return text;
 }
 

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <initializer_list>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -33,24 +34,37 @@ inline profile_file_error load_error(std::string_view text) {
 
 namespace cia402::test {
 
-/// A complete profile without base: the smallest file that passes (T0, T1, T2, T13, T14, T15).
-/// Line numbers matter to the error tests that append to it: it is 78 lines long.
-inline constexpr std::string_view minimal_profile = R"(name = "minimal"
-[[decoder]]
-mask = 0x02
-value = 0x00
-command = "disable_voltage"
-[[rows]]
+/// Pieces of a profile file, joined into its text.
+inline std::string toml(std::initializer_list<std::string_view> pieces) {
+  std::string text;
+  for (const std::string_view p : pieces) text += p;
+  return text;
+}
+
+/// The power-up rows every table begins with, 5 lines each: T0 (START to NOT READY TO SWITCH ON)
+/// and T1 (on to SWITCH ON DISABLED), both automatic. A based file needs T0 at least.
+inline constexpr std::string_view t0_row = R"([[rows]]
 number = 0
 from = ["start"]
 to = "not_ready_to_switch_on"
 any = ["automatic"]
-[[rows]]
+)";
+inline constexpr std::string_view t1_row = R"([[rows]]
 number = 1
 from = ["not_ready_to_switch_on"]
 to = "switch_on_disabled"
 any = ["automatic"]
-[[rows]]
+)";
+
+/// A complete profile without base: the smallest file that passes (T0, T1, T2, T13, T14, T15).
+/// Line numbers matter to the error tests that append to it: it is 78 lines long, the name and
+/// the decoder on lines 1 to 5, T0 and T1 on 6 to 15, T2 from line 16 on.
+inline const std::string minimal_profile = toml({R"(name = "minimal"
+[[decoder]]
+mask = 0x02
+value = 0x00
+command = "disable_voltage"
+)", t0_row, t1_row, R"([[rows]]
 number = 2
 from = ["switch_on_disabled"]
 to = "ready_to_switch_on"
@@ -113,6 +127,6 @@ default = 0
 [options.0x6007]
 supported = [0, 1]
 default = 1
-)";
+)"});
 
 }  // namespace cia402::test

@@ -114,13 +114,7 @@ command = "disable_voltage"
 }
 
 TEST(profile_file_load, rows_in_a_based_file_replace_the_whole_base_table) {
-  const custom_profile c = load_ok(R"(base = "cia402"
-[[rows]]
-number = 0
-from = ["start"]
-to = "not_ready_to_switch_on"
-any = ["automatic"]
-)");
+  const custom_profile c = load_ok(test::toml({"base = \"cia402\"\n", test::t0_row}));
   ASSERT_EQ(c.get().row_count, 1);
   EXPECT_EQ(c.get().row(0).to, state::not_ready_to_switch_on);
 }
@@ -149,13 +143,7 @@ TEST(profile_file_load, row_optional_keys_default_to_immediate_no_flags_no_guard
 }
 
 TEST(profile_file_load, every_row_key_is_read_into_the_row) {
-  const custom_profile c = load_ok(R"(base = "cia402"
-[[rows]]
-number = 0
-from = ["start"]
-to = "not_ready_to_switch_on"
-any = ["automatic"]
-[[rows]]
+  const custom_profile c = load_ok(test::toml({"base = \"cia402\"\n", test::t0_row, R"([[rows]]
 number = 17
 from = ["operation_enabled", "quick_stop_active"]
 to = "switch_on_disabled"
@@ -165,7 +153,7 @@ none = ["sto", "halt"]
 stop = "quick_stop_ramp"
 interrupts_stop = true
 clears_setpoints = true
-)");
+)"}));
   ASSERT_EQ(c.get().row_count, 2);
   const transition_row r = c.get().row(1);
   EXPECT_EQ(r.number, 17);

@@ -391,19 +391,8 @@ TEST(replay, profile_and_profile_file_together_are_refused) {
 
 TEST(replay, settling_is_bounded_when_a_profile_never_comes_to_rest) {
   // Two automatic rows that undo each other: the drive never settles, replay must still end.
-  const custom_profile restless = test::load_ok(R"(base = "cia402"
-name = "restless"
-[[rows]]
-number = 0
-from = ["start"]
-to = "not_ready_to_switch_on"
-any = ["automatic"]
-[[rows]]
-number = 1
-from = ["not_ready_to_switch_on"]
-to = "switch_on_disabled"
-any = ["automatic"]
-[[rows]]
+  const custom_profile restless = test::load_ok(test::toml({"base = \"cia402\"\nname = \"restless\"\n",
+                                                           test::t0_row, test::t1_row, R"([[rows]]
 number = 2
 from = ["switch_on_disabled"]
 to = "ready_to_switch_on"
@@ -413,7 +402,7 @@ number = 7
 from = ["ready_to_switch_on"]
 to = "switch_on_disabled"
 any = ["automatic"]
-)");
+)"}));
   ASSERT_FALSE(::testing::Test::HasFailure()) << "the restless profile was refused";
   std::istringstream in("cw 0x06\n");
   std::ostringstream out;
