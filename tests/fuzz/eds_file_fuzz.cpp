@@ -12,6 +12,7 @@
 #include <string_view>
 #include <variant>
 
+#include "../canopen/eds_round_trip.hpp"
 #include "cia402/canopen/306/eds.hpp"
 #include "cia402/canopen/306/eds_reader.hpp"
 
@@ -27,22 +28,6 @@ using namespace cia402::dictionary;
 }
 
 bool in_type(data_type t, std::int64_t v) { return v >= type_min(t) && v <= type_max(t); }
-
-// Every field of every entry, so two readings compare as texts.
-std::string fields(const eds_contents& c) {
-  std::ostringstream out;
-  out << "node " << int{c.node_id} << "\n";
-  for (const object_entry& o : c.objects) {
-    out << o.index << " '" << o.name << "' " << int(o.code) << " " << int(o.category) << "\n";
-    for (const sub_entry& e : o.subs) {
-      out << " " << int{e.sub} << " '" << e.name << "' " << int(e.type) << " " << int(e.acc) << " "
-          << e.pdo_mappable << " " << int(e.where) << " " << e.default_value << " " << e.plus_node_id
-          << " '" << e.default_text << "' " << e.capacity << " " << e.has_limits << " " << e.low << ".."
-          << e.high << " " << e.parameter_value << "\n";
-    }
-  }
-  return out.str();
-}
 
 // The reader's promise on what it accepted: numbers of their types, sums that fit.
 void check_types(const eds_contents& c) {
@@ -60,20 +45,6 @@ void check_types(const eds_contents& c) {
       if (!fits) fail("a $NODEID+X that leaves its type");
     }
   }
-}
-
-std::string dcf_of(const eds_contents& c) {
-  dcf_values values;
-  for (const object_entry& o : c.objects) {
-    for (const sub_entry& e : o.subs) {
-      if (e.parameter_value) values[{o.index, e.sub}] = dcf_entry_text(e);
-    }
-  }
-  eds_info info;
-  info.node_id = c.node_id;
-  std::ostringstream out;
-  write_dcf(c.objects, values, info, out);
-  return out.str();
 }
 
 }  // namespace
@@ -94,7 +65,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     fail(("the written DCF is refused at line " + std::to_string(e->line) + ": " + e->reason).c_str(), dcf);
   }
   const eds_contents& again = std::get<eds_contents>(second);
-  if (fields(again) != fields(accepted)) fail("the DCF reads back to other entries", fields(accepted), fields(again));
+  if (entry_fields(again) != entry_fields(accepted)) {
+    fail("the DCF reads back to other entries", entry_fields(accepted), entry_fields(again));
+  }
   if (dcf_of(again) != dcf) fail("the DCF writes again to another text", dcf, dcf_of(again));
   return 0;
 }

@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "../ethercat/register_bytes.hpp"
 #include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/coe/mailbox.hpp"
 
@@ -57,11 +58,6 @@ std::vector<std::uint8_t> take_mailbox(chain& wire, drive_slave& s) {
   return std::vector<std::uint8_t>(f.begin() + at, f.begin() + at + mailbox_size);
 }
 
-std::vector<std::uint8_t> sm_bytes(const sync_manager_description& d) {
-  return {static_cast<std::uint8_t>(d.start), static_cast<std::uint8_t>(d.start >> 8),
-          static_cast<std::uint8_t>(d.length), static_cast<std::uint8_t>(d.length >> 8), d.control, 0, 1, 0};
-}
-
 void request(chain& wire, drive_slave& s, std::uint8_t state) {
   send(wire, command::apwr, ap(reg::al_control), {state, 0});
   s.step(1000);
@@ -77,26 +73,20 @@ void bring_up(chain& wire, drive_slave& s, std::uint8_t target) {
   s.step(1000);
   if (target < 2) return;
   const slave_description& d = s.description();
-  for (int n = 0; n < 2; ++n) send(wire, command::apwr, ap(reg::sync_manager0 + 8 * n), sm_bytes(d.sync_managers[static_cast<std::size_t>(n)]));
+  for (int n = 0; n < 2; ++n) {
+    send(wire, command::apwr, ap(reg::sync_manager0 + 8 * n),
+         register_bytes::sync_manager(d.sync_managers[static_cast<std::size_t>(n)]));
+  }
   request(wire, s, 0x12);
   if (target < 4) return;
   const auto out = static_cast<std::uint16_t>(s.output_bytes());
   const auto in = static_cast<std::uint16_t>(s.input_bytes());
   const sync_manager_description& sm2 = d.sync_managers[2];
   const sync_manager_description& sm3 = d.sync_managers[3];
-  send(wire, command::apwr, ap(reg::sync_manager0 + 16), sm_bytes({sm2.start, out, sm2.control, 1, sm2.type}));
-  send(wire, command::apwr, ap(reg::sync_manager0 + 24), sm_bytes({sm3.start, in, sm3.control, 1, sm3.type}));
+  send(wire, command::apwr, ap(reg::sync_manager0 + 16), register_bytes::sync_manager(sm2.start, out, sm2.control));
+  send(wire, command::apwr, ap(reg::sync_manager0 + 24), register_bytes::sync_manager(sm3.start, in, sm3.control));
   const auto fmmu = [&](int i, std::uint32_t log, std::uint16_t len, std::uint16_t phys, std::uint8_t type) {
-    std::vector<std::uint8_t> f(16, 0);
-    for (int k = 0; k < 4; ++k) f[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(log >> (8 * k));
-    f[4] = static_cast<std::uint8_t>(len);
-    f[5] = static_cast<std::uint8_t>(len >> 8);
-    f[7] = 7;
-    f[8] = static_cast<std::uint8_t>(phys);
-    f[9] = static_cast<std::uint8_t>(phys >> 8);
-    f[11] = type;
-    f[12] = 1;
-    send(wire, command::apwr, ap(static_cast<std::uint16_t>(reg::fmmu0 + 16 * i)), f);
+    send(wire, command::apwr, ap(static_cast<std::uint16_t>(reg::fmmu0 + 16 * i)), register_bytes::fmmu(log, len, phys, type));
   };
   fmmu(0, outputs_logical, out, sm2.start, 2);
   fmmu(1, inputs_logical, in, sm3.start, 1);
