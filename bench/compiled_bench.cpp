@@ -9,6 +9,7 @@
 
 #include "cia402/compiled.hpp"
 #include "cia402/master.hpp"
+#include "core_setup.hpp"
 #include "lookup_table.hpp"
 
 namespace {
@@ -91,9 +92,7 @@ void compiled_axes(benchmark::State& st) {
 // The master in OPERATION ENABLED, its status word XORed with `toggle` every cycle: 0 repeats the
 // word, the warning bit 7 gives a new word in the same state each time.
 void master_words(benchmark::State& st, std::uint16_t toggle) {
-  const cia402::profile& p = cia402::standard_profile();
-  const auto policy =
-      cia402::master_policy::make(p, cia402::make_axis(p), cia402::state::operation_enabled);
+  const cia402::master_policy policy = bench::enabled_policy();
   cia402::master m;
   m.set_target(policy, 0, 0);
   std::uint64_t now = 0;
@@ -113,14 +112,9 @@ void master_new_word(benchmark::State& st) { master_words(st, cia402::status_bit
 const bool registered = [] {
   benchmark::RegisterBenchmark("lookup_quiet", lookup_quiet);
   benchmark::RegisterBenchmark("lookup_transitions", lookup_transitions);
-  for (std::size_t i = 0; i < cia402::builtin_profile_count(); ++i) {
-    const cia402::profile* p = &cia402::builtin_profile(i);
-    benchmark::RegisterBenchmark((std::string("compiled_quiet/") + p->name).c_str(), compiled_quiet, p);
-    benchmark::RegisterBenchmark((std::string("compiled_transitions/") + p->name).c_str(),
-                                 compiled_transitions, p);
-    benchmark::RegisterBenchmark((std::string("profile_transitions/") + p->name).c_str(),
-                                 profile_transitions, p);
-  }
+  bench::register_per_profile({{"compiled_quiet", compiled_quiet},
+                               {"compiled_transitions", compiled_transitions},
+                               {"profile_transitions", profile_transitions}});
   benchmark::RegisterBenchmark("lookup_axes", lookup_axes);
   benchmark::RegisterBenchmark("compiled_axes", compiled_axes);
   benchmark::RegisterBenchmark("master_repeated_word", master_repeated_word);

@@ -5,6 +5,7 @@
 
 #include "baseline_switch.hpp"
 #include "cia402/drive.hpp"
+#include "core_setup.hpp"
 #include "inputs.hpp"
 
 namespace {
@@ -103,13 +104,7 @@ void baseline_cycle_axes(benchmark::State& st) {
 }
 
 const bool registered = [] {
-  for (std::size_t i = 0; i < cia402::builtin_profile_count(); ++i) {
-    const cia402::profile* p = &cia402::builtin_profile(i);
-    benchmark::RegisterBenchmark((std::string("drive_step_steady/") + p->name).c_str(),
-                                 drive_step_steady, p);
-    benchmark::RegisterBenchmark((std::string("drive_step_mixed/") + p->name).c_str(),
-                                 drive_step_mixed, p);
-  }
+  bench::register_per_profile({{"drive_step_steady", drive_step_steady}, {"drive_step_mixed", drive_step_mixed}});
   benchmark::RegisterBenchmark("baseline_step_steady", baseline_step_steady);
   benchmark::RegisterBenchmark("baseline_step_mixed", baseline_step_mixed);
   for (int n : {1, 100, 10000}) {

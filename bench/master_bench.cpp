@@ -5,6 +5,7 @@
 
 #include "baseline_switch.hpp"
 #include "cia402/master.hpp"
+#include "core_setup.hpp"
 
 namespace {
 
@@ -15,9 +16,7 @@ std::vector<std::uint16_t> status_trace() {
 }
 
 void master_step_steady(benchmark::State& st) {
-  const cia402::profile& p = cia402::standard_profile();
-  const auto policy =
-      cia402::master_policy::make(p, cia402::make_axis(p), cia402::state::operation_enabled);
+  const cia402::master_policy policy = bench::enabled_policy();
   cia402::master m;
   m.set_target(policy, 0, 0);
   std::uint64_t now = 0;
@@ -28,9 +27,7 @@ void master_step_steady(benchmark::State& st) {
 }
 
 void master_step_trace(benchmark::State& st) {
-  const cia402::profile& p = cia402::standard_profile();
-  const auto policy =
-      cia402::master_policy::make(p, cia402::make_axis(p), cia402::state::operation_enabled);
+  const cia402::master_policy policy = bench::enabled_policy();
   const auto trace = status_trace();
   cia402::master m;
   std::uint64_t now = 0;
