@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "cia402/master.hpp"
+#include "fsa_states.hpp"
 
 namespace {
 
@@ -12,11 +13,7 @@ using cia402::command;
 using cia402::master_outcome;
 using cia402::state;
 
-constexpr state fsa_states[] = {
-    state::not_ready_to_switch_on, state::switch_on_disabled, state::ready_to_switch_on,
-    state::switched_on,            state::operation_enabled,  state::quick_stop_active,
-    state::fault_reaction_active,  state::fault,
-};
+using cia402::test::fsa_states;
 
 // Runs the master from `from` towards `target` and on for 40 cycles at the target: no word sent to a
 // target other than OPERATION ENABLED is Enable operation, and a drive that can stand at the target

@@ -7,6 +7,7 @@
 
 #include "cia402/drive.hpp"
 #include "cia402/master.hpp"
+#include "fsa_states.hpp"
 #include "cia402/profile.hpp"
 
 #include "counting_allocator.hpp"
@@ -16,11 +17,7 @@ namespace {
 
 using test::heap_calls_during;
 
-constexpr state fsa_states[] = {
-    state::not_ready_to_switch_on, state::switch_on_disabled, state::ready_to_switch_on,
-    state::switched_on,            state::operation_enabled,  state::quick_stop_active,
-    state::fault_reaction_active,  state::fault,
-};
+using test::fsa_states;
 
 TEST(master_no_allocation, counter_sees_a_heap_allocation) {
   // So the zero counts below can mean something.

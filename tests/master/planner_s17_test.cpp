@@ -7,16 +7,13 @@
 #include <string>
 
 #include "cia402/master.hpp"
+#include "fsa_states.hpp"
 
 namespace {
 
 using cia402::state;
 
-constexpr state fsa_states[] = {
-    state::not_ready_to_switch_on, state::switch_on_disabled, state::ready_to_switch_on,
-    state::switched_on,            state::operation_enabled,  state::quick_stop_active,
-    state::fault_reaction_active,  state::fault,
-};
+using cia402::test::fsa_states;
 
 // Every option value of 0x605A the profile supports (the one that decides T16 and T12).
 std::vector<int> quick_stop_codes(const cia402::profile& p) {
