@@ -128,15 +128,8 @@ void run_one(kind k, failure f, int at_ms) {
 // The moments: every 10 ms of the first 150 ms, where the link reads the drive, sets up its PDOs and
 // starts the node, the session reads the option codes and limits and enables the drive (by SDO, at
 // one SYNC every 10 ms); then every 50 ms to 400 ms, where the command runs.
-std::vector<int> moments() {
-  std::vector<int> at;
-  for (int ms = 0; ms <= 150; ms += 10) at.push_back(ms);
-  for (int ms = 200; ms <= 400; ms += 50) at.push_back(ms);
-  return at;
-}
-
 TEST(failure_matrix_can, every_motion_command_every_failure_at_every_moment_of_its_first_400_ms) {
-  for_every_case(moments(), run_one);
+  for_every_case(moments(150, 200), run_one);
 }
 
 // A gap the matrix found (issue 42): the link writes the drive's guard (0x1016 on the master's

@@ -81,6 +81,16 @@ inline void start(axes::session& s, kind k, axes::completion done) {
   }
 }
 
+// The moments of a run over a real bus: every 10 ms to `set_up_until_ms`, where the link and the
+// session set the drive up and enable it, then every 50 ms from `running_from_ms` to 400 ms, where
+// the command runs.
+inline std::vector<int> moments(int set_up_until_ms, int running_from_ms) {
+  std::vector<int> at;
+  for (int ms = 0; ms <= set_up_until_ms; ms += 10) at.push_back(ms);
+  for (int ms = running_from_ms; ms <= 400; ms += 50) at.push_back(ms);
+  return at;
+}
+
 // The whole matrix: every command of every kind against every failure at every moment.
 template <typename Run>
 void for_every_case(const std::vector<int>& moments, Run run_one) {
