@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <initializer_list>
 #include <string>
 
 #include "cia402/drive.hpp"
@@ -12,11 +13,20 @@
 namespace cia402 {
 namespace {
 
+struct code_text {
+  std::uint16_t code;
+  const char* text;
+};
+
+// Each code has its text.
+void expect_texts(std::initializer_list<code_text> expected) {
+  for (const code_text& e : expected) {
+    EXPECT_STREQ(error_code_text(e.code), e.text) << std::hex << e.code;
+  }
+}
+
 TEST(error_codes, the_generic_codes_of_cia_301_table_21_have_their_texts) {
-  const struct {
-    std::uint16_t code;
-    const char* text;
-  } expected[] = {
+  expect_texts({
       {0x0000, "error reset or no error"},   {0x1000, "generic error"},
       {0x2000, "current"},                   {0x3000, "voltage"},
       {0x3210, "DC link over-voltage"},      {0x3220, "DC link under-voltage"},
@@ -26,17 +36,16 @@ TEST(error_codes, the_generic_codes_of_cia_301_table_21_have_their_texts) {
       {0x8120, "CAN in error passive mode"}, {0x8130, "life guard error or heartbeat error"},
       {0x8140, "recovered from bus off"},    {0x8210, "PDO not processed due to length error"},
       {0x9000, "external error"},            {0xFF00, "device specific"},
-  };
-  for (const auto& e : expected) {
-    EXPECT_STREQ(error_code_text(e.code), e.text) << std::hex << e.code;
-  }
+  });
 }
 
 TEST(error_codes, the_cia_402_codes_a_drive_reports_have_their_texts) {
-  EXPECT_STREQ(error_code_text(0x2310), "continuous over-current");
-  EXPECT_STREQ(error_code_text(0x4310), "excess drive temperature");
-  EXPECT_STREQ(error_code_text(0x8611), "following error");
-  EXPECT_STREQ(error_code_text(0x7121), "motor blocked");
+  expect_texts({
+      {0x2310, "continuous over-current"},
+      {0x4310, "excess drive temperature"},
+      {0x8611, "following error"},
+      {0x7121, "motor blocked"},
+  });
 }
 
 TEST(error_codes, every_code_the_projects_drive_raises_has_an_entry_of_its_own) {
@@ -53,19 +62,23 @@ TEST(error_codes, every_code_the_projects_drive_raises_has_an_entry_of_its_own) 
 }
 
 TEST(error_codes, a_code_without_an_entry_takes_the_text_of_its_class_then_of_its_group) {
-  EXPECT_STREQ(error_code_text(0x2315), "current, device output side");  // class 0x2300
-  EXPECT_STREQ(error_code_text(0x8131), "communication");                // class 0x8100
-  EXPECT_STREQ(error_code_text(0x8FFF), "monitoring");                   // group 0x8000
-  EXPECT_STREQ(error_code_text(0x2A17), "current");                      // group 0x2000
-  EXPECT_STREQ(error_code_text(0xFF42), "device specific");              // class 0xFF00
-  EXPECT_STREQ(error_code_text(0xF0AB), "additional functions");         // class 0xF000
+  expect_texts({
+      {0x2315, "current, device output side"},  // class 0x2300
+      {0x8131, "communication"},                // class 0x8100
+      {0x8FFF, "monitoring"},                   // group 0x8000
+      {0x2A17, "current"},                      // group 0x2000
+      {0xFF42, "device specific"},              // class 0xFF00
+      {0xF0AB, "additional functions"},         // class 0xF000
+  });
 }
 
 TEST(error_codes, a_code_in_no_class_is_unknown_not_no_error) {
-  EXPECT_STREQ(error_code_text(0x0001), "unknown error code");
-  EXPECT_STREQ(error_code_text(0x0FFF), "unknown error code");
-  EXPECT_STREQ(error_code_text(0xA000), "unknown error code");
-  EXPECT_STREQ(error_code_text(0xE123), "unknown error code");
+  expect_texts({
+      {0x0001, "unknown error code"},
+      {0x0FFF, "unknown error code"},
+      {0xA000, "unknown error code"},
+      {0xE123, "unknown error code"},
+  });
 }
 
 TEST(error_codes, the_table_is_ascending_and_every_code_finds_its_own_entry) {
