@@ -64,28 +64,33 @@ TEST(profile_rows, no_quick_stop_t8_ramps_to_standstill_then_closes_brake_then_d
   EXPECT_FALSE(b.out.torque);
 }
 
-// 003_83442f2f4b0b2bb9.txt T3: "Output stage is switched on (enabled). Drive has torque." T6:
-// "Output stage is switched off (disabled). Drive has no torque." 004 likewise ("Motor has torque").
-TEST(profile_rows, profibus_switched_on_has_torque_and_t6_removes_it) {
+// The PROFIBUS drives of seeds 003 and 004, each on a bench of its own brought to `s`, then `check`.
+template <typename Check>
+void on_each_profibus_drive_in(S s, Check check) {
   for (const char* name : {"s300-profibus", "ax2000-profibus"}) {
     SCOPED_TRACE(name);
     bench b(test::builtin(name));
-    ASSERT_TRUE(test::reach(b, S::switched_on));
+    ASSERT_TRUE(test::reach(b, s));
+    check(b);
+  }
+}
+
+// 003_83442f2f4b0b2bb9.txt T3: "Output stage is switched on (enabled). Drive has torque." T6:
+// "Output stage is switched off (disabled). Drive has no torque." 004 likewise ("Motor has torque").
+TEST(profile_rows, profibus_switched_on_has_torque_and_t6_removes_it) {
+  on_each_profibus_drive_in(S::switched_on, [](bench& b) {
     EXPECT_EQ(int(b.out.transition), 3);
     EXPECT_TRUE(b.out.torque);
     b.in.control_word = words_for(b.p).shutdown;
     b.step();
     EXPECT_EQ(int(b.out.transition), 6);
     EXPECT_FALSE(b.out.torque);
-  }
+  });
 }
 
 // 003 / 004 T11: "The output stage remains enabled. Setpoints are canceled."
 TEST(profile_rows, profibus_fast_stop_keeps_the_output_stage_and_cancels_setpoints) {
-  for (const char* name : {"s300-profibus", "ax2000-profibus"}) {
-    SCOPED_TRACE(name);
-    bench b(test::builtin(name));
-    ASSERT_TRUE(test::reach(b, S::operation_enabled));
+  on_each_profibus_drive_in(S::operation_enabled, [](bench& b) {
     b.in.standstill = false;
     b.in.control_word = words_for(b.p).quick_stop;
     b.step();
@@ -93,7 +98,7 @@ TEST(profile_rows, profibus_fast_stop_keeps_the_output_stage_and_cancels_setpoin
     EXPECT_TRUE(b.out.torque);
     EXPECT_TRUE(b.out.clear_setpoints);
     EXPECT_EQ(b.out.ramp, stop_ramp::quick_stop) << "the emergency ramp";
-  }
+  });
 }
 
 // 004_e07fd68605b3a8c6.txt T17: "Switch-on inhibited, output stage disabled".
