@@ -18,6 +18,7 @@
 #include "cia402/ethercat/master/ecat_master.hpp"
 #include "cia402/master.hpp"
 #include "cia402/profile.hpp"
+#include "../tests/ethercat/drive_line.hpp"
 
 namespace {
 
@@ -71,25 +72,7 @@ void lrw_through_chain(benchmark::State& st) {
 }
 BENCHMARK(lrw_through_chain)->Arg(1)->Arg(64);
 
-// Frames pass every controller at once; waiting runs every slave's application.
-class wire_link final : public master_link {
- public:
-  explicit wire_link(std::size_t drives) {
-    for (std::size_t i = 0; i < drives; ++i) {
-      slaves.push_back(std::make_unique<cia402::apps::virtual_drive_slave>(cia402::standard_profile(), static_cast<std::uint32_t>(i + 1)));
-      wire.add(slaves.back()->controller());
-    }
-  }
-  bool exchange(std::vector<std::uint8_t>& frame) override { return wire.pass(frame) == frame_error::none; }
-  std::uint64_t now_us() override { return now; }
-  void wait_us(std::uint32_t us) override {
-    now += us;
-    for (auto& s : slaves) s->step(us);
-  }
-  std::vector<std::unique_ptr<cia402::apps::virtual_drive_slave>> slaves;
-  chain wire;
-  std::uint64_t now = 0;
-};
+using wire_link = cia402::ethercat::testing::drive_line;
 
 void drive_line_1ms_cycle(benchmark::State& st) {
   const auto n = static_cast<std::size_t>(st.range(0));

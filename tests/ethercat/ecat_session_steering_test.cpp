@@ -17,28 +17,12 @@
 #include "cia402/axis/session.hpp"
 #include "cia402/ethercat/axis/ecat_link.hpp"
 #include "cia402/master.hpp"
+#include "drive_line.hpp"
 
 namespace cia402::ethercat {
 namespace {
 
-class wire final : public master_link {
- public:
-  explicit wire(int drives) {
-    for (int i = 0; i < drives; ++i) {
-      slaves.push_back(std::make_unique<apps::virtual_drive_slave>(standard_profile(), static_cast<std::uint32_t>(i + 1)));
-      line.add(slaves.back()->controller());
-    }
-  }
-  bool exchange(std::vector<std::uint8_t>& frame) override { return line.pass(frame) == frame_error::none; }
-  std::uint64_t now_us() override { return now; }
-  void wait_us(std::uint32_t us) override {
-    now += us;
-    for (auto& s : slaves) s->step(us);
-  }
-  std::vector<std::unique_ptr<apps::virtual_drive_slave>> slaves;
-  chain line;
-  std::uint64_t now = 0;
-};
+using wire = testing::drive_line;
 
 struct sessions {
   explicit sessions(int drives) : w(drives), line(w, standard_profile(), 1000, "test-line") {

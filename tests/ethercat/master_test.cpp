@@ -15,42 +15,13 @@
 #include "cia402/ethercat/master/ecat_master.hpp"
 #include "cia402/master.hpp"
 #include "cia402/profile.hpp"
+#include "drive_line.hpp"
 #include "enable_words.hpp"
 
 namespace cia402::ethercat {
 namespace {
 
-using drive_slave = apps::virtual_drive_slave;
-
-// The line: frames pass every controller in order at once; waiting runs the drives' applications.
-class wire_link final : public master_link {
- public:
-  explicit wire_link(int drives) {
-    for (int i = 0; i < drives; ++i) {
-      slaves.push_back(std::make_unique<drive_slave>(standard_profile(), static_cast<std::uint32_t>(i + 1)));
-      wire.add(slaves.back()->controller());
-    }
-  }
-  bool exchange(std::vector<std::uint8_t>& frame) override {
-    if (cut) return false;
-    ++frames;
-    const bool ok = wire.pass(frame) == frame_error::none;
-    if (exchange_us != 0) wait_us(exchange_us);  // a slow line: the drives run while the frame travels
-    return ok;
-  }
-  std::uint64_t now_us() override { return now; }
-  void wait_us(std::uint32_t us) override {
-    now += us;
-    for (auto& s : slaves) s->step(us);
-  }
-
-  std::vector<std::unique_ptr<drive_slave>> slaves;
-  chain wire;
-  std::uint64_t now = 0;
-  std::uint64_t frames = 0;
-  bool cut = false;
-  std::uint32_t exchange_us = 0;
-};
+using wire_link = testing::drive_line;
 
 // Cycles (1 ms each) until `done` or the limit; the number of cycles, or -1.
 template <typename F>
