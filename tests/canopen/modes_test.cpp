@@ -77,9 +77,8 @@ class modes_test : public ::testing::Test {
   }
   /// An expedited SDO download; the abort code, 0 when done.
   std::uint32_t sdo_write(std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes) {
-    static constexpr std::uint8_t commands[5] = {0, 0x2F, 0x2B, 0x27, 0x23};
     received.clear();
-    send(sdo_request(id, commands[bytes], index, sub, static_cast<std::uint32_t>(value)));
+    send(test::sdo_download(id, index, sub, static_cast<std::uint32_t>(value), bytes));
     settle();
     for (const frame& f : received) {
       if (f.id == cob::sdo_tx + id) return f.data[0] == 0x60 ? 0 : abort_code_of(f);

@@ -142,12 +142,7 @@ class monitor_on_a_node : public ::testing::Test {
     return out;
   }
   std::uint32_t write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, unsigned bytes) {
-    static constexpr std::uint8_t commands[5] = {0, 0x2F, 0x2B, 0x27, 0x23};
-    net.received.clear();
-    net.send(sdo_request(id, commands[bytes], index, sub, value));
-    net.settle();
-    const auto r = net.with_id(cob::sdo_tx + id);
-    return r.empty() ? 0xFFFFFFFFu : test::abort_code_of(r.back());
+    return test::sdo_answer(net, id, test::sdo_download(id, index, sub, value, bytes));
   }
 
   static constexpr std::uint8_t id = 4;

@@ -100,4 +100,21 @@ inline std::uint32_t abort_code_of(const frame& f) {
   return static_cast<std::uint32_t>(get_le(&f.data[4], 4));
 }
 
+/// An expedited SDO download of `bytes` (1..4) bytes of `value` to `node`.
+inline frame sdo_download(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t value,
+                          unsigned bytes) {
+  static constexpr std::uint8_t commands[5] = {0, 0x2F, 0x2B, 0x27, 0x23};
+  return sdo_request(node, commands[bytes], index, sub, value);
+}
+
+/// The tester sends an SDO request to `node` and lets it settle: the abort code of the node's last
+/// answer (0 when that is no abort), 0xFFFFFFFF when it gave none. `net.received` holds what came.
+inline std::uint32_t sdo_answer(network& net, std::uint8_t node, const frame& request) {
+  net.received.clear();
+  net.send(request);
+  net.settle();
+  const auto r = net.with_id(cob::sdo_tx + node);
+  return r.empty() ? 0xFFFFFFFFu : abort_code_of(r.back());
+}
+
 }  // namespace cia402::canopen::test

@@ -16,11 +16,7 @@ std::uint16_t emcy_code(const frame& f) { return static_cast<std::uint16_t>(get_
 class nmt_test : public ::testing::Test {
  protected:
   std::uint32_t write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::uint8_t command) {
-    net.received.clear();
-    net.send(sdo_request(id, command, index, sub, value));
-    net.settle();
-    const auto r = net.with_id(cob::sdo_tx + id);
-    return r.empty() ? 0xFFFFFFFFu : abort_code_of(r.back());
+    return sdo_answer(net, id, sdo_request(id, command, index, sub, value));
   }
   network net;
 };

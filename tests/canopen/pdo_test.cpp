@@ -23,13 +23,9 @@ class pdo_test : public ::testing::Test {
     net.settle();
   }
   std::uint32_t write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, unsigned bytes) {
-    static constexpr std::uint8_t commands[5] = {0, 0x2F, 0x2B, 0x27, 0x23};
-    net.received.clear();
-    net.send(sdo_request(id, commands[bytes], index, sub, value));
-    net.settle();
-    const auto r = net.with_id(cob::sdo_tx + id);
-    EXPECT_EQ(r.size(), 1u);
-    return r.empty() ? 0xFFFFFFFFu : abort_code_of(r.back());
+    const std::uint32_t code = sdo_answer(net, id, sdo_download(id, index, sub, value, bytes));
+    EXPECT_EQ(net.with_id(cob::sdo_tx + id).size(), 1u);
+    return code;
   }
   void start() {
     net.send(nmt_frame(nmt_command::start, id));
@@ -425,9 +421,8 @@ class pdo_sub_index_test : public ::testing::Test {
     while (tester->receive(f)) received.push_back(f);
   }
   std::uint32_t write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, unsigned bytes) {
-    static constexpr std::uint8_t commands[5] = {0, 0x2F, 0x2B, 0x27, 0x23};
     received.clear();
-    EXPECT_FALSE(tester->send(sdo_request(id, commands[bytes], index, sub, value)));
+    EXPECT_FALSE(tester->send(sdo_download(id, index, sub, value, bytes)));
     settle();
     for (const frame& f : received) {
       if (f.id == cob::sdo_tx + id) return abort_code_of(f);
