@@ -1,11 +1,12 @@
-// The ordinary-cycle table (profile::ordinary_rows) of the standard profile, written from seed 002's
-// table: which transitions an ordinary cycle takes at once, which it leaves to the full step, and
-// that the step taking them does what the full step does. The model check proves the equality on
+// The ordinary cycles of the standard profile (profile::ordinary_entry, and the tables compiled from
+// it, profile::ordinary), written from seed 002's table: which transitions an ordinary cycle takes at
+// once, which it leaves to the full step, and that the step taking them does what the full step does. The model check proves the equality on
 // every reachable pair; these pin the table's reading of the rows, which it cannot see.
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cstring>
+#include <initializer_list>
 
 #include "cia402/drive.hpp"
 #include "cia402/profile.hpp"
@@ -15,13 +16,30 @@ namespace cia402 {
 namespace {
 
 std::uint8_t entry(const profile& p, state s, command c) {
-  return p.ordinary_rows[profile::ordinary_index(static_cast<int>(s), static_cast<unsigned>(c))];
+  return p.ordinary_entry(static_cast<int>(s), static_cast<unsigned>(c));
 }
 
 // The transition number of the row an entry fires, or no_transition for a quiet entry.
 int fired_transition(const profile& p, state s, command c) {
   const unsigned row = entry(p, s, c) & ordinary::row;
   return row == 0 ? no_transition : p.rows[row - 1].number;
+}
+
+// Steps two axes through `words`, one by step() on `p`, the other by the full step on `full`: the
+// outputs and the axes are the same after every word. The axis step() left.
+axis expect_step_is_full_step(const profile& p, const profile& full,
+                              std::initializer_list<std::uint16_t> words) {
+  axis a = make_axis(p);
+  axis b = a;
+  drive_inputs in;
+  for (const std::uint16_t cw : words) {
+    in.control_word = cw;
+    const drive_outputs x = step(p, a, in);
+    const drive_outputs y = detail::full_step(full, b, in);
+    EXPECT_TRUE(test::same_outputs(x, y)) << "control word 0x" << std::hex << cw;
+    EXPECT_EQ(std::memcmp(&a, &b, sizeof(axis)), 0) << "control word 0x" << std::hex << cw;
+  }
+  return a;
 }
 
 TEST(ordinary_rows, the_standard_profile_fires_the_immediate_transitions_from_its_table) {
@@ -75,17 +93,70 @@ TEST(ordinary_rows, a_profile_with_a_changed_row_gets_a_changed_table_at_finaliz
 
 TEST(ordinary_rows, an_ordinary_transition_through_the_profile_equals_the_full_step) {
   const profile& p = standard_profile();
-  axis a = make_axis(p);
-  axis b = a;
-  drive_inputs in;
-  for (const std::uint16_t cw : {0x00, 0x00, 0x06, 0x07, 0x0F, 0x80, 0x06, 0x0F, 0x02}) {
-    in.control_word = cw;
-    const drive_outputs x = step(p, a, in);
-    const drive_outputs y = detail::full_step(p, b, in);
-    EXPECT_TRUE(test::same_outputs(x, y)) << "control word 0x" << std::hex << cw;
-    EXPECT_EQ(std::memcmp(&a, &b, sizeof(axis)), 0) << "control word 0x" << std::hex << cw;
-  }
+  const axis a = expect_step_is_full_step(p, p, {0x00, 0x00, 0x06, 0x07, 0x0F, 0x80, 0x06, 0x0F, 0x02});
   EXPECT_EQ(a.current, state::switch_on_disabled);  // the last word, Quick stop in SWITCHED ON: T10
+}
+
+// The compiled entry of a key: the state, a control word (its command and bit 7) and the axis's
+// flags fault_reset_bit and torque_on.
+struct compiled_entry {
+  std::uint32_t keep, set;
+  std::uint64_t image;
+};
+compiled_entry compiled(const profile& p, state s, std::uint16_t cw, bool reset_before, bool torque_before) {
+  const unsigned axis_key = static_cast<unsigned>(s) | (reset_before ? 1u << 8 : 0u) | (torque_before ? 1u << 9 : 0u);
+  const std::size_t at = ordinary_tables::offset_of(axis_key) + p.ordinary->row_offset[cw & 0xFFu];
+  return {p.ordinary->axis_words[at / 4], p.ordinary->axis_words[at / 4 + 1], p.ordinary->images[at / 8]};
+}
+bool to_full_step(const compiled_entry& e) {
+  return ((e.keep >> detail::byte_shift<4>(2)) & ordinary_action::full) != 0;
+}
+
+TEST(ordinary_tables, every_built_in_profile_has_them_compiled_with_it) {
+  for (std::size_t i = 0; i < builtin_profile_count(); ++i) {
+    const profile& p = builtin_profile(i);
+    ASSERT_NE(p.ordinary, nullptr) << p.name;
+    ordinary_tables again{};
+    p.compile_ordinary(again);
+    EXPECT_EQ(std::memcmp(&again, p.ordinary, sizeof again), 0) << p.name << ": compiled anew at run time";
+  }
+}
+
+TEST(ordinary_tables, a_stop_with_torque_on_and_a_reset_edge_where_a_row_reads_it_go_to_the_full_step) {
+  const profile& p = standard_profile();
+  // T5 (Switch on in OPERATION ENABLED) ramps first where torque was on (S7), else fires at once.
+  EXPECT_TRUE(to_full_step(compiled(p, state::operation_enabled, 0x07, false, true)));
+  const compiled_entry t5 = compiled(p, state::operation_enabled, 0x07, false, false);
+  ASSERT_FALSE(to_full_step(t5));
+  EXPECT_EQ((t5.set >> detail::byte_shift<4>(1)) & 0xFFu, static_cast<unsigned>(state::switched_on));
+  EXPECT_EQ((t5.image >> detail::byte_shift<8>(4)) & 0xFFu, 5u) << "the image's transition";
+  // FAULT: bit 7 rising is T15's fault reset; bit 7 held (its flag set before) is quiet.
+  EXPECT_TRUE(to_full_step(compiled(p, state::fault, 0x80, false, false)));
+  const compiled_entry held = compiled(p, state::fault, 0x80, true, false);
+  ASSERT_FALSE(to_full_step(held));
+  EXPECT_EQ((held.set >> detail::byte_shift<4>(0)) & axis_flag::fault_reset_bit, axis_flag::fault_reset_bit)
+      << "bit 7 kept for the next cycle's edge";
+  // QUICK STOP ACTIVE stops by 0x605A in every cycle.
+  EXPECT_TRUE(to_full_step(compiled(p, state::quick_stop_active, 0x0F, false, true)));
+}
+
+TEST(ordinary_tables, a_profile_finalized_without_tables_steps_by_the_full_step_alone) {
+  profile p = standard_profile();
+  p.finalize();
+  EXPECT_EQ(p.ordinary, nullptr);
+  expect_step_is_full_step(p, standard_profile(), {0x00, 0x00, 0x06, 0x07, 0x0F, 0x07, 0x0F, 0x0B, 0x00});
+}
+
+TEST(ordinary_tables, a_copied_custom_profile_points_at_its_own_tables) {
+  custom_profile c(standard_profile());
+  ASSERT_NE(c.get().ordinary, nullptr);
+  const custom_profile copy = c;
+  EXPECT_NE(copy.get().ordinary, c.get().ordinary);
+  EXPECT_EQ(std::memcmp(copy.get().ordinary, c.get().ordinary, sizeof(ordinary_tables)), 0);
+  custom_profile assigned;
+  assigned = c;
+  EXPECT_NE(assigned.get().ordinary, c.get().ordinary);
+  EXPECT_EQ(std::memcmp(assigned.get().ordinary, standard_profile().ordinary, sizeof(ordinary_tables)), 0);
 }
 
 }  // namespace
