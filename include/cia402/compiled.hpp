@@ -160,59 +160,6 @@ class compiled_profile {
 
 namespace detail {
 
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
-inline constexpr bool little_endian = false;
-#else
-inline constexpr bool little_endian = true;
-#endif
-
-/// Where byte `i` of an object of `Size` bytes sits in an integer read from it, in bits.
-template <unsigned Size>
-constexpr unsigned byte_shift(unsigned i) noexcept {
-  return little_endian ? 8u * i : 8u * (Size - 1u - i);
-}
-
-/// A condition the ordinary cycle does not meet: its code is laid out away from the table's path.
-inline constexpr bool seldom(bool condition) noexcept {
-#if defined(__GNUC__)
-  return __builtin_expect(condition, false);
-#else
-  return condition;
-#endif
-}
-
-/// Where the status word's lowest bit sits in the outputs' first 8 bytes read as one integer.
-inline constexpr unsigned status_shift = little_endian ? 16u : 32u;
-
-/// The outputs from their first 8 bytes (`head`: all an entry decides) and what fills the second:
-/// 0x603F (bytes 8, 9) and its 0x1001 (byte 10). Two whole words, no field stores.
-inline drive_outputs outputs_of(std::uint64_t head, std::uint16_t code) noexcept {
-  static_assert(sizeof(drive_outputs) == 16 && offsetof(drive_outputs, clear_setpoints) == 1 &&
-                    offsetof(drive_outputs, status_word) == 2 && offsetof(drive_outputs, ramp) == 5 &&
-                    offsetof(drive_outputs, error_code) == 8 && offsetof(drive_outputs, error_register) == 10,
-                "the outputs are two 8-byte words");
-  std::uint64_t tail = std::uint64_t{code} << (little_endian ? 0u : 48u);
-  // No error is the rule: its register (0) costs no branch the ordinary cycle takes.
-  if (seldom(code != 0)) tail |= std::uint64_t{error_register_of(code)} << byte_shift<8>(2);
-#if defined(__GNUC__)
-  // One register for both ways: GCC would otherwise build the no-error tail (0) in memory and
-  // load it back into the vector register that carries the outputs.
-  __asm__("" : "+r"(tail));
-#endif
-  drive_outputs out;
-  std::memcpy(static_cast<void*>(&out), &head, 8);
-  std::memcpy(reinterpret_cast<unsigned char*>(&out) + 8, &tail, 8);
-  return out;
-}
-
-/// The motion side's reported status bits an entry with these actions shows: target reached only
-/// where the state runs (compiled_profile::runs).
-inline unsigned reported_bits(unsigned status_bits, unsigned actions) noexcept {
-  static_assert(compiled_profile::runs << 8 == status_bit::target_reached, "runs passes bit 10");
-  return status_bits & ((status_bit::reported & ~unsigned{status_bit::target_reached}) |
-                        ((actions & compiled_profile::runs) << 8));
-}
-
 /// The first 8 bytes of drive_inputs as an ordinary cycle has them: no fault code, DC link, no STO,
 /// remote, link up, no local request. One compare tells an ordinary cycle from one the table does
 /// not hold.
@@ -226,6 +173,9 @@ inline std::uint64_t ordinary_head() noexcept {
 }
 
 }  // namespace detail
+
+static_assert(compiled_profile::runs == ordinary_action::runs,
+              "detail::reported_bits reads both tables' runs bit");
 
 inline unsigned compiled_profile::axis_key(std::uint32_t word) noexcept {
   const unsigned flags = (word >> detail::byte_shift<4>(0)) & 0xFFu;

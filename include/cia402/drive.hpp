@@ -61,17 +61,7 @@ struct alignas(8) drive_outputs {
   std::uint8_t error_register = 0;          ///< 0x1001
 };
 
-/// Bits of `axis::flags`: what the drive remembers from the previous cycle. The two that every
-/// cycle reads are bits 3 and 4, so that with the state in the next byte they are a multiple of 8:
-/// the compiled step (compiled.hpp) indexes its table of 8-byte entries with the axis word and one
-/// mask, and no scaling.
-namespace axis_flag {
-inline constexpr std::uint8_t entered_by_fault = 1u << 0;  ///< the state came from a fault fact
-inline constexpr std::uint8_t coast_reaction = 1u << 1;    ///< the running fault reaction coasts
-inline constexpr std::uint8_t fault_latched = 1u << 2;     ///< class-4 error: only power-off clears
-inline constexpr std::uint8_t fault_reset_bit = 1u << 3;   ///< bit 7 of the previous control word (S2)
-inline constexpr std::uint8_t torque_on = 1u << 4;         ///< torque was on in the previous cycle
-}  // namespace axis_flag
+// The bits of axis::flags (axis_flag) are in profile.hpp: the profile's ordinary cycles rewrite them.
 
 /// One axis's state between cycles: 16 bytes. The profile is passed to each call, so many axes
 /// share one profile. Aligned to 4: the compiled step (compiled.hpp) reads and writes the first
@@ -129,16 +119,20 @@ inline constexpr std::uint16_t heartbeat = 0x8130;             ///< S10: 0x6007 
 axis make_axis(const profile& p) noexcept;
 
 namespace detail {
+inline bool quiet_cycle(const profile& p, axis& a, const drive_inputs& in, std::uint64_t& head) noexcept;
+inline drive_outputs outputs_of(std::uint64_t head, std::uint16_t code) noexcept;
 inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_outputs& out) noexcept;
 drive_outputs full_step(const profile& p, axis& a, const drive_inputs& in) noexcept;
 }  // namespace detail
 
-/// Runs one cycle. A build optimised for size (-Os, a firmware) takes the full step every cycle:
-/// the inline quiet path trades about 500 bytes of flash for speed (bench/cortex_m4/size.sh).
+/// Runs one cycle: the profile's compiled ordinary cycle where it answers, else the full step. A
+/// build optimised for size (-Os, a firmware) takes the full step every cycle, and its built-in
+/// profiles carry no compiled cycles: the inline path and its tables cost flash a firmware lacks
+/// (bench/cortex_m4/size.sh).
 inline drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noexcept {
 #if !defined(__OPTIMIZE_SIZE__)
-  drive_outputs out;
-  if (detail::quiet_step(p, a, in, out)) return out;
+  std::uint64_t head;
+  if (detail::quiet_cycle(p, a, in, head)) return detail::outputs_of(head, a.error_code);
   // The full step on a copy: the only place the inputs' address is taken, so a caller's inputs
   // built in locals stay in registers on the ordinary path instead of being stored every cycle
   // for a call that seldom comes (97 instructions a quiet step where the copy makes it fewer,
@@ -155,7 +149,11 @@ inline drive_outputs step(const profile& p, axis& a, const drive_inputs& in) noe
 /// back wider, which stalls store forwarding.
 inline void step(const profile& p, axis& a, const drive_inputs& in, drive_outputs& out) noexcept {
 #if !defined(__OPTIMIZE_SIZE__)
-  if (detail::quiet_step(p, a, in, out)) return;
+  std::uint64_t head;
+  if (detail::quiet_cycle(p, a, in, head)) {
+    out = detail::outputs_of(head, a.error_code);
+    return;
+  }
   const drive_inputs copy = in;  // as above
   out = detail::full_step(p, a, copy);
 #else

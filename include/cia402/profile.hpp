@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <string_view>
 
+#include "cia402/detail/byte_order.hpp"
+#include "cia402/detail/ordinary_tables.hpp"
 #include "cia402/state.hpp"
 #include "cia402/words.hpp"
 
@@ -232,7 +234,21 @@ struct option_spec {
 
 inline constexpr std::size_t max_rows = 32;
 
-/// The values of profile::ordinary_rows: bits 0..5 the row that fires plus 1 (0: none, quiet).
+/// Bits of `axis::flags`: what the drive remembers from the previous cycle. The two that every
+/// cycle reads are bits 3 and 4, so that with the state in the next byte they are a multiple of 8:
+/// the compiled step (compiled.hpp) indexes its table of 8-byte entries with the axis word and one
+/// mask, and no scaling.
+namespace axis_flag {
+inline constexpr std::uint8_t entered_by_fault = 1u << 0;  ///< the state came from a fault fact
+inline constexpr std::uint8_t coast_reaction = 1u << 1;    ///< the running fault reaction coasts
+inline constexpr std::uint8_t fault_latched = 1u << 2;     ///< class-4 error: only power-off clears
+inline constexpr std::uint8_t fault_reset_bit = 1u << 3;   ///< bit 7 of the previous control word (S2)
+inline constexpr std::uint8_t torque_on = 1u << 4;         ///< torque was on in the previous cycle
+}  // namespace axis_flag
+
+
+/// What profile::ordinary_entry() says of a state under a command: bits 0..5 the row that fires
+/// plus 1 (0: none, quiet).
 namespace ordinary {
 inline constexpr std::uint8_t quiet = 0;
 inline constexpr std::uint8_t row = 0x3F;
@@ -305,14 +321,11 @@ struct profile {
   // rows that leave it (bit i = rows[i]), so a step that can fire nothing costs one AND.
   std::array<std::uint8_t, 32> command_of_bits{};
   std::array<std::uint32_t, state_count> rows_from{};
-  /// What an ordinary cycle (detail/quiet_step.hpp: default inputs, no stop running, |speed| below
-  /// the limit) does in each state under each decoded command, at ordinary_index(state, command):
-  /// ordinary::quiet, a row that fires at once (its index + 1), or ordinary::full when the facts
-  /// an ordinary cycle does not fix (halt, stop complete, 0x605A's facts, the axis's fault flags)
-  /// could change the outcome, or the state stops by an option code, or the row goes to one that
-  /// does. 54 bytes (a firmware's flash: bench/cortex_m4); the full step stays the reference for
-  /// everything else. The decoder yields commands below command_count (check_profile).
-  std::array<std::uint8_t, state_count * command_count> ordinary_rows{};
+  /// The ordinary cycles compiled from the rows (ordinary_tables), or nullptr: then every cycle
+  /// takes the full step. The built-in profiles point at tables compiled with them at compile time,
+  /// except in a build for size (a firmware, bench/cortex_m4, whose step is the full step); a
+  /// custom_profile compiles its own at finalize().
+  const ordinary_tables* ordinary = nullptr;
 
   /// Points the profile at stored rows (stored_rows<...>) that outlive it.
   template <std::size_t NRows, std::size_t NSets>
@@ -323,8 +336,10 @@ struct profile {
     fact_set_count = static_cast<std::uint8_t>(NSets);
   }
 
-  /// Recomputes the derived tables from the data above. Call after any change to it.
-  constexpr void finalize() noexcept {
+  /// Recomputes the derived tables from the data above. Call after any change to it. The ordinary
+  /// cycles are compiled into `tables` where they are given (they must outlive the profile's use);
+  /// without them the profile has none, and its step is the full step every cycle.
+  constexpr void finalize(ordinary_tables* tables = nullptr) noexcept {
     for (unsigned bits = 0; bits < 32; ++bits) {
       std::uint8_t result = static_cast<std::uint8_t>(command::enable_operation);
       for (std::size_t r = 0; r < decoder_size; ++r) {
@@ -340,9 +355,65 @@ struct profile {
       for (std::size_t r = 0; r < row_count && r < max_rows; ++r) {
         if ((rows[r].from() >> s) & 1u) rows_from[s] |= 1u << r;
       }
-      for (unsigned c = 0; c < static_cast<unsigned>(command_count); ++c) {
-        ordinary_rows[ordinary_index(s, c)] = ordinary_entry(s, c);
+    }
+    ordinary = nullptr;
+    if (tables != nullptr) {
+      compile_ordinary(*tables);
+      ordinary = tables;
+    }
+  }
+
+  /// Compiles the ordinary cycles (ordinary_tables) from ordinary_entry() of each state and command
+  /// (rows_from and the decoder as finalize() leaves them).
+  constexpr void compile_ordinary(ordinary_tables& t) const noexcept {
+    using detail::byte_shift;
+    constexpr std::uint32_t to_full_step = std::uint32_t{ordinary_action::full} << byte_shift<4>(2);
+    for (unsigned key = 0; key < ordinary_tables::entry_count; ++key) {
+      const std::size_t at = ordinary_tables::offset_of(key);
+      t.axis_words[at / 4] = to_full_step;
+      t.axis_words[at / 4 + 1] = 0;
+      t.images[at / 8] = 0;
+      const unsigned s = key & 0xFu, c = (key >> 4) & 7u;
+      if (s >= static_cast<unsigned>(state_count) || c >= static_cast<unsigned>(command_count)) continue;
+      const bool bit7 = ((key >> 7) & 1u) != 0, reset_before = ((key >> 8) & 1u) != 0,
+                 torque_before = ((key >> 9) & 1u) != 0;
+      const std::uint8_t code = ordinary_entry(static_cast<int>(s), c);
+      // A fault-reset edge where a row reads it, or torque on where the row stops first (S7): the
+      // full step decides.
+      if (code == ordinary::full || (bit7 && !reset_before && (code & ordinary::reset_reads) != 0) ||
+          (torque_before && (code & ordinary::stops) != 0)) {
+        continue;
       }
+      const unsigned fired = code & ordinary::row;
+      const stored_row* r = fired != 0 ? &rows[fired - 1] : nullptr;
+      const unsigned to = r != nullptr ? static_cast<unsigned>(r->to) : s;
+      const state_activity act = states[to].activity;
+      const bool torque = act != state_activity::idle;
+      const unsigned actions =
+          (options[static_cast<int>(option::halt)].exists() ? ordinary_action::has_halt : 0u) |
+          (act == state_activity::run ? ordinary_action::runs : 0u) |
+          (speed_limit_rpm > 0 ? ordinary_action::speed_limit : 0u);
+      // Bit 7's flag and torque's are set anew each cycle; a row that fires clears entered_by_fault.
+      const unsigned flags_kept =
+          0xFFu & ~static_cast<unsigned>(axis_flag::torque_on | axis_flag::fault_reset_bit) &
+          (r != nullptr ? ~static_cast<unsigned>(axis_flag::entered_by_fault) : 0xFFu);
+      const unsigned flags_set = (torque ? unsigned{axis_flag::torque_on} : 0u) |
+                                 (bit7 ? unsigned{axis_flag::fault_reset_bit} : 0u);
+      t.axis_words[at / 4] = (flags_kept << byte_shift<4>(0)) | (actions << byte_shift<4>(2)) |
+                             ((r != nullptr ? 0u : 0xFFu) << byte_shift<4>(3));
+      t.axis_words[at / 4 + 1] = (flags_set << byte_shift<4>(0)) | (to << byte_shift<4>(1)) |
+                                 (0xFFu << byte_shift<4>(2)) |
+                                 ((r != nullptr ? unsigned{r->number} : 0u) << byte_shift<4>(3));
+      const bool clear = r != nullptr && (r->flags & row_flag::clears_setpoints) != 0;
+      const unsigned transition = r != nullptr ? r->number : no_transition;
+      t.images[at / 8] = (std::uint64_t{to} << byte_shift<8>(0)) | (std::uint64_t{clear} << byte_shift<8>(1)) |
+                         (std::uint64_t{states[to].status_pattern | 0x0210u} << detail::status_shift) |
+                         (std::uint64_t{transition} << byte_shift<8>(4)) |
+                         (std::uint64_t{torque} << byte_shift<8>(6)) | (std::uint64_t{torque} << byte_shift<8>(7));
+    }
+    for (unsigned bits = 0; bits < 256; ++bits) {
+      t.row_offset[bits] = static_cast<std::uint16_t>(
+          ordinary_tables::offset_of((unsigned{command_of_bits[bits & 0x1Fu]} << 4) | (bits & 0x80u)));
     }
   }
 
@@ -427,6 +498,7 @@ class custom_profile {
   custom_profile& operator=(const custom_profile& o) noexcept {
     name_ = o.name_; seed_ = o.seed_; title_ = o.title_;
     decoder_ = o.decoder_; rows_ = o.rows_; fact_sets_ = o.fact_sets_; view_ = o.view_;
+    ordinary_ = o.ordinary_;
     repoint();
     return *this;
   }
@@ -446,7 +518,7 @@ class custom_profile {
   /// The rest of the profile (states, options, flags); tables and names are kept.
   profile& settings() noexcept { return view_; }
   /// Recompute the derived tables; call after any change.
-  void finalize() noexcept { repoint(); view_.finalize(); }
+  void finalize() noexcept { repoint(); view_.finalize(&ordinary_); }
 
  private:
   template <std::size_t N>
@@ -458,6 +530,8 @@ class custom_profile {
   void repoint() noexcept {
     view_.name = name_.data(); view_.seed = seed_.data(); view_.title = title_.data();
     view_.decoder = decoder_.data(); view_.rows = rows_.data(); view_.fact_sets = fact_sets_.data();
+    // Its own compiled cycles where it has them: a copy must not point at the other's.
+    if (view_.ordinary != nullptr) view_.ordinary = &ordinary_;
   }
   std::array<char, 40> name_{};
   std::array<char, 64> seed_{};
@@ -465,6 +539,7 @@ class custom_profile {
   std::array<decoder_rule, max_decoder_rules> decoder_{};
   std::array<stored_row, max_rows> rows_{};
   std::array<std::uint32_t, 3 * max_rows> fact_sets_{};
+  ordinary_tables ordinary_{};
   profile view_{};
 };
 

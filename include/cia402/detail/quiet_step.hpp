@@ -2,13 +2,15 @@
 // it in place. Most cycles of a running drive are ordinary: no fault, voltage on, no STO, remote
 // control, no stop running, and the control word either asks for the state the drive is in or for
 // a transition that takes effect at once (T2, T3, T4, T6, T7, T9, T10, ...). This path handles
-// exactly those, by one lookup in the profile's ordinary_rows (computed from the rows by finalize():
-// at compile time for the built-in profiles, at load for a profile file), and returns false,
-// touching nothing, whenever anything else might happen; detail::full_step (src/core/drive.cpp)
-// then does the whole work. The model check (tests/core/model_check.hpp) holds the two equal on
-// every reachable pair of every built-in profile.
+// exactly those, by one entry of the profile's compiled ordinary cycles (profile::ordinary, which
+// finalize() compiles from the rows: at compile time for the built-in profiles, at load for a
+// profile file), and returns false, touching nothing, whenever anything else might happen;
+// detail::full_step (src/core/drive.cpp) then does the whole work. The model check
+// (tests/core/model_check.hpp) holds the two equal on every reachable pair of every built-in profile.
 #pragma once
 
+#include <cstddef>
+#include <cstring>
 
 namespace cia402::detail {
 
@@ -20,71 +22,117 @@ constexpr std::uint32_t quick_stop_facts(std::int8_t code) noexcept {
                         : 0u;
 }
 
-inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_outputs& out) noexcept {
+/// A condition the ordinary cycle does not meet: its code is laid out away from the table's path.
+inline constexpr bool seldom(bool condition) noexcept {
+#if defined(__GNUC__)
+  return __builtin_expect(condition, false);
+#else
+  return condition;
+#endif
+}
+
+/// The outputs from their first 8 bytes (`head`: all an entry decides) and what fills the second:
+/// 0x603F (bytes 8, 9) and its 0x1001 (byte 10). Two whole words, no field stores.
+inline drive_outputs outputs_of(std::uint64_t head, std::uint16_t code) noexcept {
+  static_assert(sizeof(drive_outputs) == 16 && offsetof(drive_outputs, clear_setpoints) == 1 &&
+                    offsetof(drive_outputs, status_word) == 2 && offsetof(drive_outputs, ramp) == 5 &&
+                    offsetof(drive_outputs, error_code) == 8 && offsetof(drive_outputs, error_register) == 10,
+                "the outputs are two 8-byte words");
+  std::uint64_t tail = std::uint64_t{code} << (little_endian ? 0u : 48u);
+  // No error is the rule: its register (0) costs no branch the ordinary cycle takes.
+  if (seldom(code != 0)) tail |= std::uint64_t{error_register_of(code)} << byte_shift<8>(2);
+#if defined(__GNUC__)
+  // One register for both ways: GCC would otherwise build the no-error tail (0) in memory and
+  // load it back into the vector register that carries the outputs.
+  __asm__("" : "+r"(tail));
+#endif
+  drive_outputs out;
+  std::memcpy(static_cast<void*>(&out), &head, 8);
+  std::memcpy(reinterpret_cast<unsigned char*>(&out) + 8, &tail, 8);
+  return out;
+}
+
+/// The motion side's reported status bits an entry with these actions shows: target reached only
+/// where the state runs (ordinary_action::runs).
+inline unsigned reported_bits(unsigned status_bits, unsigned actions) noexcept {
+  static_assert(ordinary_action::runs << 8 == status_bit::target_reached, "runs passes bit 10");
+  return status_bits & ((status_bit::reported & ~unsigned{status_bit::target_reached}) |
+                        ((actions & ordinary_action::runs) << 8));
+}
+
+/// The ordinary cycle: false, touching nothing, where anything else might happen; else the axis
+/// stepped and `head` the outputs' first 8 bytes (outputs_of adds the error code). The same path
+/// as the compiled step's (compiled.hpp), on the profile's own tables.
+inline bool quiet_cycle(const profile& p, axis& a, const drive_inputs& in, std::uint64_t& head) noexcept {
+  static_assert(offsetof(axis, flags) == 0 && offsetof(axis, current) == 1 &&
+                    offsetof(axis, pending_row) == 2 && offsetof(axis, last_transition) == 3 &&
+                    alignof(axis) >= 4,
+                "an ordinary cycle rewrites the axis's first four bytes as one aligned word");
+  static_assert(offsetof(drive_outputs, current) == 0 && offsetof(drive_outputs, transition) == 4 &&
+                    offsetof(drive_outputs, torque) == 6 && offsetof(drive_outputs, brake_released) == 7,
+                "an image is the outputs' first 8 bytes");
+  static_assert(axis_flag::fault_reset_bit == 1u << 3 && axis_flag::torque_on == 1u << 4,
+                "the key's flags lie where offset_of puts them: the word & 0xF18");
+  const ordinary_tables* const tables = p.ordinary;
   // Field by field rather than one 8-byte load: callers fill inputs field by field, and a wide
   // load over narrow stores stalls store forwarding. Bitwise ORs keep it to one branch.
   const bool unusual_inputs = (in.fault_code != 0) | !in.dc_link | in.sto | !in.remote |
                               in.connection_lost | in.local_enable | in.local_disable;
-  const std::uint16_t cw = in.control_word;
-  // Bit 7 as the axis keeps it (axis_flag::fault_reset_bit), and its 0->1 edge (S2).
-  const unsigned reset_bit = (cw >> 4) & axis_flag::fault_reset_bit;
-  const unsigned flags = a.flags;
-  const unsigned edge = reset_bit & ~flags;
-  // Not |speed| < limit (seed 001's T2/T7 watch it): speed + limit - 1 in [0, 2 limit - 2], one
-  // unsigned compare that no speed or limit can overflow (mod 2^32 it is a shift of the interval).
-  const std::int32_t limit = p.speed_limit_rpm;
-  const std::uint32_t span = static_cast<std::uint32_t>(limit) - 1u;
-  const bool beyond_limit =
-      limit > 0 && static_cast<std::uint32_t>(in.actual_speed_rpm) + span > 2u * span;
-  // Halt (S8) ramps by 0x605D; a value outside 1..4 is the full step's to decide.
-  const bool halt_asked = (cw & 0x100u) && p.options[3].supported != 0;
-  const bool odd_halt = halt_asked && static_cast<std::uint8_t>(a.options[3] - 1) >= 4u;
-  const std::uint8_t entry = p.ordinary_rows[profile::ordinary_index(static_cast<int>(a.current),
-                                                                    p.command_of_bits[cw & 0x1Fu])];
-  const bool torque_was_on = (flags & axis_flag::torque_on) != 0;
-  if (unusual_inputs | (a.pending_row != 0xFF) | beyond_limit | odd_halt | (entry == ordinary::full) |
-      ((edge != 0) & ((entry & ordinary::reset_reads) != 0)) |
-      (torque_was_on & ((entry & ordinary::stops) != 0))) {
-    return false;
+  if (seldom(unusual_inputs | (tables == nullptr))) return false;  // no tables: finalize()
+  const unsigned cw = in.control_word;
+  // The axis's first four bytes as one word, read and written back whole: a row that fires costs
+  // no branch and no field stores.
+  std::uint32_t word;
+  std::memcpy(&word, &a, 4);
+  const std::size_t axis_offset =
+      (little_endian ? word : (((word >> 24) & 0xFFu) | ((word >> 8) & 0xFF00u))) & 0xF18u;
+  const unsigned char* row = reinterpret_cast<const unsigned char*>(tables) + tables->row_offset[cw & 0xFFu];
+  std::uint32_t keep;
+  std::memcpy(&keep, row + axis_offset, sizeof keep);
+  std::uint32_t set;
+  std::memcpy(&set, row + axis_offset + 4, sizeof set);
+  std::uint64_t image;
+  std::memcpy(&image, row + sizeof(ordinary_tables::axis_words) + axis_offset, sizeof image);
+  constexpr unsigned actions_shift = byte_shift<4>(2);
+  const unsigned actions = (keep >> actions_shift) & 0xFFu;
+  head = image | (std::uint64_t{reported_bits(in.status_bits, actions)} << status_shift);
+  // A stop runs (the pending row is not 0xFF: adding one to its byte leaves it nonzero).
+  if (seldom(((word + (1u << actions_shift)) & (0xFFu << actions_shift)) != 0)) return false;
+  // A profile that watches |speed| (seed 001's T2/T7): speed + limit - 1 in [0, 2 limit - 2] is
+  // |speed| < limit, one unsigned compare that no speed or limit can overflow (mod 2^32 it is a
+  // shift of the interval). Its own test: in the one below, lexium32's every cycle took the rare path.
+  if (seldom(keep & (std::uint32_t{ordinary_action::speed_limit} << actions_shift))) {
+    const std::uint32_t span = static_cast<std::uint32_t>(p.speed_limit_rpm) - 1u;
+    if (static_cast<std::uint32_t>(in.actual_speed_rpm) + span > 2u * span) return false;
   }
-
-  unsigned kept = flags;
-  std::uint8_t transition = no_transition;
-  bool clear = false;
-  const unsigned fired = entry & ordinary::row;
-  if (fired != 0) {
-    // A row that fires at once, with no fault fact and no fault reset among its reasons.
-    const stored_row& r = p.rows[fired - 1];
-    a.current = r.to;
-    a.stop_code = 0;  // the new state stops by no option code
-    a.last_transition = r.number;
-    transition = r.number;
-    clear = (r.flags & row_flag::clears_setpoints) != 0;
-    kept &= ~static_cast<unsigned>(axis_flag::entered_by_fault);
+  // One test of the keep word for the rare entries: the full step decides, or the control word
+  // halts (bit 8) where the profile has 0x605D.
+  if (seldom(keep & ((((cw >> 8) & 1u) | ordinary_action::full) << actions_shift))) {
+    if (actions & ordinary_action::full) return false;
+    if ((actions & ordinary_action::has_halt) && (cw & control_bit::halt)) {
+      // Halt (S8) ramps by 0x605D: 1 slow-down, 2 quick-stop, 3 current limit, 4 voltage limit
+      // (stop_ramp's values); bit 10 then says standstill. A value outside 1..4 is the full step's.
+      const auto ramp = static_cast<std::uint8_t>(a.options[static_cast<int>(option::halt)]);
+      if (static_cast<std::uint8_t>(ramp - 1u) >= 4u) return false;
+      if (actions & ordinary_action::runs) {
+        const unsigned standstill = static_cast<unsigned>(in.standstill) << 10;
+        head = (head & ~(std::uint64_t{status_bit::target_reached} << status_shift)) |
+               (std::uint64_t{standstill} << status_shift) | (std::uint64_t{ramp} << byte_shift<8>(5));
+      }
+    }
   }
+  // A committed row's stop code needs no clearing: outside a stop it is 0 (S16; the model check
+  // holds every reachable axis to it).
+  const std::uint32_t after = (word & keep) | set;
+  std::memcpy(static_cast<void*>(&a), &after, 4);
+  return true;
+}
 
-  // The state is idle, holding or running: only outputs remain.
-  const state_info info = p.states[static_cast<std::size_t>(a.current)];
-  const bool torque = info.activity != state_activity::idle;
-  const bool run = info.activity == state_activity::run;
-  const bool halt = run && halt_asked;
-  a.flags = static_cast<std::uint8_t>((kept & ~(axis_flag::torque_on | axis_flag::fault_reset_bit)) |
-                                      (torque ? axis_flag::torque_on : 0u) | reset_bit);
-  out.current = a.current;
-  out.transition = transition;
-  // 605D: 1 slow-down, 2 quick-stop, 3 current limit, 4 voltage limit (stop_ramp's values).
-  out.ramp = halt ? static_cast<stop_ramp>(a.options[3]) : stop_ramp::none;
-  out.torque = torque;
-  out.brake_released = torque;
-  out.clear_setpoints = clear;
-  const bool target =
-      run && (halt ? in.standstill : (in.status_bits & status_bit::target_reached) != 0);
-  out.status_word = static_cast<std::uint16_t>(
-      info.status_pattern | 0x0210u /* voltage enabled, remote */ |
-      (in.status_bits & (status_bit::reported & ~status_bit::target_reached)) |
-      (static_cast<unsigned>(target) << 10));
-  out.error_code = a.error_code;
-  out.error_register = a.error_code ? error_register_of(a.error_code) : std::uint8_t{0};
+/// The ordinary cycle with its outputs: false, touching nothing, where the full step must decide.
+inline bool quiet_step(const profile& p, axis& a, const drive_inputs& in, drive_outputs& out) noexcept {
+  std::uint64_t head = 0;
+  if (!quiet_cycle(p, a, in, head)) return false;
+  out = outputs_of(head, a.error_code);
   return true;
 }
 

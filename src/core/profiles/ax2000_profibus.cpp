@@ -77,8 +77,10 @@ constexpr profile make() noexcept {
   return p;
 }
 
+constexpr profile base = make();
+
 }  // namespace
 
-const profile ax2000_profibus_profile = make();
+const profile ax2000_profibus_profile = with_ordinary_cycles<base>();
 
 }  // namespace cia402::detail

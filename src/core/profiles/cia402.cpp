@@ -53,12 +53,14 @@ constexpr std::array<option_spec, option_count> options = {{
     {value_range(0, 3), 1},  // 0x6007 abort connection (S10)
 }};
 
-}  // namespace
-
-const profile cia402_profile = make_profile(
+constexpr profile base = make_profile(
     "cia402", "002_522d2c0bb8f5a5f8.txt",
     "CiA 402 standard (CoE table 7.8)",
     standard_decoder, stored_rows<rows>,
     standard_states(state_activity::idle), options);
+
+}  // namespace
+
+const profile cia402_profile = with_ordinary_cycles<base>();
 
 }  // namespace cia402::detail

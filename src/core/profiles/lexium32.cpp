@@ -83,8 +83,10 @@ constexpr profile make() noexcept {
   return p;
 }
 
+constexpr profile base = make();
+
 }  // namespace
 
-const profile lexium32_profile = make();
+const profile lexium32_profile = with_ordinary_cycles<base>();
 
 }  // namespace cia402::detail

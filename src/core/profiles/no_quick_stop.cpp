@@ -53,11 +53,13 @@ constexpr std::array<option_spec, option_count> options = {{
     {value_range(0, 3), 1},  // 0x6007: the standard's
 }};
 
-}  // namespace
-
-const profile no_quick_stop_profile = make_profile(
+constexpr profile base = make_profile(
     "no-quick-stop", "000_44b471b7401b86be.txt",
     "CANopen drive without quick stop; ramped T5/T8 on 0x221E, coasting T9", standard_decoder, stored_rows<rows>,
     standard_states(state_activity::idle), options);
+
+}  // namespace
+
+const profile no_quick_stop_profile = with_ordinary_cycles<base>();
 
 }  // namespace cia402::detail

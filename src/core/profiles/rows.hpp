@@ -89,4 +89,25 @@ constexpr profile make_profile(const char* name, const char* seed, const char* t
   return p;
 }
 
+/// A built-in profile's ordinary cycles (profile::ordinary), compiled with it at compile time.
+template <const profile& Base>
+inline constexpr ordinary_tables ordinary_cycles_of = [] {
+  ordinary_tables t{};
+  profile p = Base;
+  p.finalize(&t);
+  return t;
+}();
+
+/// The built-in profile, pointed at its compiled ordinary cycles. A build for size (-Os: a firmware)
+/// leaves them out, so its step is the full step every cycle (as drive.hpp's step() is there) and
+/// the 16.5 KiB a profile stay out of its flash (bench/cortex_m4).
+template <const profile& Base>
+constexpr profile with_ordinary_cycles() noexcept {
+  profile p = Base;
+#if !defined(__OPTIMIZE_SIZE__)
+  p.ordinary = &ordinary_cycles_of<Base>;
+#endif
+  return p;
+}
+
 }  // namespace cia402::detail

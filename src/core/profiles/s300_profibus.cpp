@@ -65,8 +65,10 @@ constexpr profile make() noexcept {
   return p;
 }
 
+constexpr profile base = make();
+
 }  // namespace
 
-const profile s300_profibus_profile = make();
+const profile s300_profibus_profile = with_ordinary_cycles<base>();
 
 }  // namespace cia402::detail
