@@ -10,6 +10,7 @@
 #include <string>
 #include <variant>
 
+#include "page_steps.hpp"
 #include "virtual_axis_page.hpp"
 #include "cia402/profile.hpp"
 
@@ -22,15 +23,12 @@ using cia402::page::plant_change;
 using cia402::page::refused;
 using cia402::page::reply;
 using json = nlohmann::json;
+using cia402::page::testing::steps::id_of;
+using cia402::page::testing::steps::run;
+using cia402::page::testing::steps::snapshot;
 
 constexpr std::uint64_t ttl_us = 300000;  // 300 cycles of 1 ms
 constexpr std::int64_t jog_rpm = 300;
-
-json snapshot(const virtual_axis_page& inst) { return json::parse(inst.snapshot_json()); }
-
-void run(virtual_axis_page& inst, int cycles) {
-  for (int i = 0; i < cycles; ++i) inst.step();
-}
 
 json result_of(const virtual_axis_page& inst, std::uint64_t id) {
   const json s = snapshot(inst);
@@ -39,11 +37,6 @@ json result_of(const virtual_axis_page& inst, std::uint64_t id) {
   }
   ADD_FAILURE() << "no result " << id << " in " << s["results"];
   return json::object({{"outcome", nullptr}, {"text", ""}, {"transitions", json::array({0})}});
-}
-
-std::uint64_t id_of(const reply& r) {
-  EXPECT_TRUE(std::holds_alternative<accepted>(r)) << (std::holds_alternative<refused>(r) ? std::get<refused>(r).reason : "");
-  return std::holds_alternative<accepted>(r) ? std::get<accepted>(r).id : 0;
 }
 
 std::string refusal_of(const reply& r) {

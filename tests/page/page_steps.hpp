@@ -30,9 +30,10 @@ inline json settled_result(virtual_axis_page& inst) {
   return s["results"].empty() ? json::object() : s["results"][0];
 }
 
+// The id of an accepted command; a refused one fails the test with its reason.
 inline std::uint64_t id_of(const cia402::page::reply& r) {
   const auto* ok = std::get_if<accepted>(&r);
-  EXPECT_NE(ok, nullptr);
+  EXPECT_NE(ok, nullptr) << (std::holds_alternative<refused>(r) ? std::get<refused>(r).reason : "");
   return ok != nullptr ? ok->id : 0;
 }
 
@@ -55,6 +56,5 @@ inline json run_until_status_bit(virtual_axis_page& inst, int bit, int limit) {
   }
   return s;
 }
-
 
 }  // namespace cia402::page::testing::steps

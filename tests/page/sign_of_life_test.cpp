@@ -35,19 +35,25 @@ void run(virtual_axis_page& inst, int cycles, int every = 0) {
   }
 }
 
+// Enable operation with the three command buttons, then set the plant turning at `turning_rpm`;
+// renewals every `every` cycles as in run().
+void enable_and_turn(virtual_axis_page& inst, int every) {
+  for (page_command cmd : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
+    inst.command(cmd);
+    run(inst, 100, every);
+  }
+  plant_change v;
+  v.target_velocity = turning_rpm;
+  inst.change_plant(v);
+}
+
 std::unique_ptr<virtual_axis_page> turning_drive(std::int64_t abort_connection) {
   axis_page_config c;
   c.lease_us = lease_ms * 1000;
   auto inst = std::make_unique<virtual_axis_page>(cia402::standard_profile(), c);
   run(*inst, 10, 50);
   EXPECT_TRUE(std::holds_alternative<cia402::page::accepted>(inst->write_object(0x6007, abort_connection)));
-  for (page_command cmd : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
-    inst->command(cmd);
-    run(*inst, 100, 50);
-  }
-  plant_change v;
-  v.target_velocity = turning_rpm;
-  inst->change_plant(v);
+  enable_and_turn(*inst, 50);
   // Longer than the lease, renewed all along: it keeps turning.
   run(*inst, 5 * lease_ms, 50);
   const json s = snapshot(*inst);
@@ -124,13 +130,7 @@ TEST(sign_of_life, a_page_that_comes_back_rearms_the_lease) {
   run(*inst, lease_ms + 1000);
   ASSERT_EQ(snapshot(*inst)["state"], "SWITCH_ON_DISABLED");
   // Back: enabled again, turning again, then silent again: stopped again.
-  for (page_command cmd : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
-    inst->command(cmd);
-    run(*inst, 100, 50);
-  }
-  plant_change v;
-  v.target_velocity = turning_rpm;
-  inst->change_plant(v);
+  enable_and_turn(*inst, 50);
   run(*inst, 1000, 50);
   ASSERT_EQ(snapshot(*inst)["state"], "OPERATION_ENABLED");
   ASSERT_EQ(snapshot(*inst)["velocity"], turning_rpm);
@@ -142,13 +142,7 @@ TEST(sign_of_life, a_page_that_comes_back_rearms_the_lease) {
 TEST(sign_of_life, without_a_lease_a_silent_page_changes_nothing) {
   virtual_axis_page inst(cia402::standard_profile());  // lease_us = 0, the library's default
   run(inst, 10);
-  for (page_command cmd : {page_command::shutdown, page_command::switch_on, page_command::enable_operation}) {
-    inst.command(cmd);
-    run(inst, 100);
-  }
-  plant_change v;
-  v.target_velocity = turning_rpm;
-  inst.change_plant(v);
+  enable_and_turn(inst, 0);
   run(inst, 3000);
   EXPECT_EQ(snapshot(inst)["state"], "OPERATION_ENABLED");
   EXPECT_EQ(snapshot(inst)["velocity"], turning_rpm);
