@@ -126,11 +126,19 @@ std::vector<row_case> sto_cases(bool switched_on_is_idle) {
   return c;
 }
 
+// A profile's cases: the common ones, the STO ones (SWITCHED ON idle or not), then its own.
+std::vector<row_case> profile_cases(bool switched_on_is_idle, const std::vector<row_case>& own) {
+  std::vector<row_case> c = common_cases();
+  const std::vector<row_case> sto = sto_cases(switched_on_is_idle);
+  c.insert(c.end(), sto.begin(), sto.end());
+  c.insert(c.end(), own.begin(), own.end());
+  return c;
+}
+
 // ---------------------------------------------------------------------------------------------
 // cia402: seed 002_522d2c0bb8f5a5f8.txt (CoE table 7.8) with semantics.md.
 std::vector<row_case> cia402_cases() {
-  std::vector<row_case> c = common_cases();
-  const std::vector<row_case> own = {
+  return profile_cases(true, {
       {"T2: Shutdown", S::switch_on_disabled, F::shutdown, 2, S::ready_to_switch_on, nullptr,
        cw_shutdown},
       {"T2 with bit 7 held: bit 7 is ignored outside FAULT (S2)", S::switch_on_disabled,
@@ -178,11 +186,7 @@ std::vector<row_case> cia402_cases() {
        no_transition, S::quick_stop_active, quick_stop_code_6, cw_shutdown},
       {"605A = 6: Switch on stays in QUICK STOP ACTIVE (S6)", S::quick_stop_active, F::switch_on,
        no_transition, S::quick_stop_active, quick_stop_code_6, cw_switch_on},
-  };
-  const std::vector<row_case> sto = sto_cases(true);
-  c.insert(c.end(), sto.begin(), sto.end());
-  c.insert(c.end(), own.begin(), own.end());
-  return c;
+  });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -255,8 +259,7 @@ void quick_stop_by_class_1(bench& b) {
 }
 
 std::vector<row_case> lexium32_cases() {
-  std::vector<row_case> c = common_cases();
-  const std::vector<row_case> own = {
+  return profile_cases(true, {
       {"T2 3->4: no undervoltage, velocity < 1000 RPM, STO = +24V, Shutdown",
        S::switch_on_disabled, F::shutdown, 2, S::ready_to_switch_on, nullptr,
        [](bench& b) {
@@ -379,18 +382,13 @@ std::vector<row_case> lexium32_cases() {
          fault_reset_edge(b);
        },
        S::operation_enabled, quick_stop_by_class_1},
-  };
-  const std::vector<row_case> sto = sto_cases(true);
-  c.insert(c.end(), sto.begin(), sto.end());
-  c.insert(c.end(), own.begin(), own.end());
-  return c;
+  });
 }
 
 // ---------------------------------------------------------------------------------------------
 // s300-profibus: seed 003_83442f2f4b0b2bb9.txt, transitions as control-word bit changes.
 std::vector<row_case> s300_cases() {
-  std::vector<row_case> c = common_cases();
-  const std::vector<row_case> own = {
+  return profile_cases(false, {
       {"T2: bit 1 and bit 2 set (shutdown), DC-link voltage present", S::switch_on_disabled,
        F::shutdown, 2, S::ready_to_switch_on, nullptr,
        [](bench& b) { b.in.control_word = 0x06; }},
@@ -440,19 +438,14 @@ std::vector<row_case> s300_cases() {
       {"T16: bit 2 is set (fast stop -> operation enabled)", S::quick_stop_active,
        F::enable_operation, 16, S::operation_enabled, nullptr,
        [](bench& b) { b.in.control_word = 0x0F; }},
-  };
-  const std::vector<row_case> sto = sto_cases(false);
-  c.insert(c.end(), sto.begin(), sto.end());
-  c.insert(c.end(), own.begin(), own.end());
-  return c;
+  });
 }
 
 // ---------------------------------------------------------------------------------------------
 // ax2000-profibus: seed 004_e07fd68605b3a8c6.txt. Fast stop is bit 4; bit 2 cleared is T17. The
 // master keeps bit 4 set except to ask for the fast stop.
 std::vector<row_case> ax2000_cases() {
-  std::vector<row_case> c = common_cases();
-  const std::vector<row_case> own = {
+  return profile_cases(false, {
       {"T2: bit 1 and bit 2 set (shutdown), DC bus link voltage present", S::switch_on_disabled,
        F::shutdown, 2, S::ready_to_switch_on, nullptr,
        [](bench& b) { b.in.control_word = 0x16; }},
@@ -508,11 +501,7 @@ std::vector<row_case> ax2000_cases() {
        17, S::switch_on_disabled, nullptr, [](bench& b) { b.in.control_word = 0x1B; }},
       {"T17: bit 2 is canceled in QUICK STOP ACTIVE", S::quick_stop_active, F::stop_and_inhibit,
        17, S::switch_on_disabled, nullptr, [](bench& b) { b.in.control_word = 0x0B; }},
-  };
-  const std::vector<row_case> sto = sto_cases(false);
-  c.insert(c.end(), sto.begin(), sto.end());
-  c.insert(c.end(), own.begin(), own.end());
-  return c;
+  });
 }
 
 std::vector<row_case> cases_for(const profile& p) {
