@@ -26,18 +26,13 @@ SWITCH_STATE_S = 0.4     # BaseNode402.TIMEOUT_SWITCH_STATE_SINGLE
 PDO_NOT_VALID = 0x80000000
 
 
+# The states BaseNode402 names, by their status word bits (mask, value).
+STATES = ((0x4F, 0x40, "SWITCH ON DISABLED"), (0x6F, 0x21, "READY TO SWITCH ON"), (0x6F, 0x23, "SWITCHED ON"),
+          (0x6F, 0x27, "OPERATION ENABLED"), (0x4F, 0x08, "FAULT"))
+
+
 def state_of(word):
-    if word & 0x4F == 0x40:
-        return "SWITCH ON DISABLED"
-    if word & 0x6F == 0x21:
-        return "READY TO SWITCH ON"
-    if word & 0x6F == 0x23:
-        return "SWITCHED ON"
-    if word & 0x6F == 0x27:
-        return "OPERATION ENABLED"
-    if word & 0x4F == 0x08:
-        return "FAULT"
-    return f"0x{word:04X}"
+    return next((name for mask, value, name in STATES if word & mask == value), f"0x{word:04X}")
 
 
 class Node402:

@@ -50,23 +50,15 @@ def wait_for_state(bus, state, timeout=3.0):
                     and status_state(int.from_bytes(m.data[0:2], "little")) == state, timeout)
 
 
+# CiA 402 states by their status word bits (mask, value), as the standard's table gives them.
+STATES = ((0x4F, 0x40, "SWITCH_ON_DISABLED"), (0x6F, 0x21, "READY_TO_SWITCH_ON"), (0x6F, 0x23, "SWITCHED_ON"),
+          (0x6F, 0x27, "OPERATION_ENABLED"), (0x6F, 0x07, "QUICK_STOP_ACTIVE"),
+          (0x4F, 0x0F, "FAULT_REACTION_ACTIVE"), (0x4F, 0x08, "FAULT"))
+
+
 def status_state(word):
     """CiA 402 state from a status word (masks 0x4F / 0x6F)."""
-    if word & 0x4F == 0x40:
-        return "SWITCH_ON_DISABLED"
-    if word & 0x6F == 0x21:
-        return "READY_TO_SWITCH_ON"
-    if word & 0x6F == 0x23:
-        return "SWITCHED_ON"
-    if word & 0x6F == 0x27:
-        return "OPERATION_ENABLED"
-    if word & 0x6F == 0x07:
-        return "QUICK_STOP_ACTIVE"
-    if word & 0x4F == 0x0F:
-        return "FAULT_REACTION_ACTIVE"
-    if word & 0x4F == 0x08:
-        return "FAULT"
-    return "NOT_READY_TO_SWITCH_ON"
+    return next((name for mask, value, name in STATES if word & mask == value), "NOT_READY_TO_SWITCH_ON")
 
 
 def test_sdo_upload_reads_device_type_of_a_cia402_servo(client):
