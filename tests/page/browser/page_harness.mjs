@@ -1,5 +1,6 @@
 // What the instrument page's browser tests share (instrument_page.test.mjs,
-// instrument_page_servers.test.mjs): Debian's chromium launched headless through playwright-core,
+// instrument_page_servers.test.mjs and the others; scope.test.mjs takes its start and server from
+// here, and launches its own browser): Debian's chromium launched headless through playwright-core,
 // `cia402 serve` and `cia402 bus` started and stopped as processes, and the page read as a person
 // sees it (the present state black, the others gray, the last transition number accented).
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
@@ -91,63 +92,45 @@ export function runChecks(main) {
 
 // --- cia402 serve ----------------------------------------------------------------------------
 
-export function startServer(extraArgs) {
+// `cia402 COMMAND ...args`, kept in run.servers: resolves with it once its output matches `pattern`
+// (`url` is the first group), rejects when it exits before that or says nothing for 15 s.
+function startProcess(command, args, pattern, what) {
   return new Promise((resolve, reject) => {
-    const proc = spawn(run.cia402, ['serve', '--port', '0', ...extraArgs], {
+    const proc = spawn(run.cia402, [command, ...args], {
       stdio: ['ignore', 'pipe', 'pipe'],
     });
-    const server = { proc, output: '', url: null, exit: null };
-    run.servers.push(server);
-    const timer = setTimeout(() => reject(new Error(`no URL from cia402 serve:\n${server.output}`)),
+    const child = { proc, output: '', url: null, exit: null };
+    run.servers.push(child);
+    const timer = setTimeout(() => reject(new Error(`no ${what} from cia402 ${command}:\n${child.output}`)),
       15000);
     proc.stdout.on('data', (d) => {
-      server.output += d;
-      const m = /(http:\/\/\S+)/.exec(server.output);
-      if (m && !server.url) {
-        server.url = m[1];
+      child.output += d;
+      const m = pattern.exec(child.output);
+      if (m && !child.url) {
+        child.url = m[1];
         clearTimeout(timer);
-        resolve(server);
+        resolve(child);
       }
     });
-    proc.stderr.on('data', (d) => { server.output += d; });
+    proc.stderr.on('data', (d) => { child.output += d; });
     proc.on('exit', (code, signal) => {
-      server.exit = { code, signal };
-      if (!server.url) {
+      child.exit = { code, signal };
+      if (!child.url) {
         clearTimeout(timer);
-        reject(new Error(`cia402 serve exited (${code}, ${signal}):\n${server.output}`));
+        reject(new Error(`cia402 ${command} exited (${code}, ${signal}):\n${child.output}`));
       }
     });
   });
 }
 
+// `cia402 serve --port 0`: resolves with the page's URL it printed.
+export function startServer(extraArgs) {
+  return startProcess('serve', ['--port', '0', ...extraArgs], /(http:\/\/\S+)/, 'URL');
+}
+
 // `cia402 bus --listen 127.0.0.1:0`: resolves with the socketcand port it printed.
 export function startBus(extraArgs) {
-  return new Promise((resolve, reject) => {
-    const proc = spawn(run.cia402, ['bus', '--listen', '127.0.0.1:0', ...extraArgs], {
-      stdio: ['ignore', 'pipe', 'pipe'],
-    });
-    const bus = { proc, output: '', url: null, exit: null };
-    run.servers.push(bus);
-    const timer = setTimeout(() => reject(new Error(`no port from cia402 bus:\n${bus.output}`)),
-      15000);
-    proc.stdout.on('data', (d) => {
-      bus.output += d;
-      const m = /socketcand on (127\.0\.0\.1:\d+)/.exec(bus.output);
-      if (m && !bus.url) {
-        bus.url = m[1];
-        clearTimeout(timer);
-        resolve(bus);
-      }
-    });
-    proc.stderr.on('data', (d) => { bus.output += d; });
-    proc.on('exit', (code, signal) => {
-      bus.exit = { code, signal };
-      if (!bus.url) {
-        clearTimeout(timer);
-        reject(new Error(`cia402 bus exited (${code}, ${signal}):\n${bus.output}`));
-      }
-    });
-  });
+  return startProcess('bus', ['--listen', '127.0.0.1:0', ...extraArgs], /socketcand on (127\.0\.0\.1:\d+)/, 'port');
 }
 
 // Ctrl-C: the server must stop cleanly, exit status 0.

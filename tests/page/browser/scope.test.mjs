@@ -12,22 +12,17 @@
 //
 //   node scope.test.mjs CIA402_BINARY OUTPUT_DIR
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
-import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import { createRequire } from 'node:module';
 import os from 'node:os';
 import path from 'node:path';
 import { arm as armOn, cursorMs as cursorOf, cursorsFromTrigger, cyclesFilling, cycleMs as cycleOf, dataset as datasetOf,
   recording as recordingOf } from './scope_harness.mjs';
+import { startRun, startServer } from './page_harness.mjs';
 
-const [cia402, outDir] = process.argv.slice(2).map((a) => path.resolve(a));
-if (!cia402 || !outDir) {
-  console.error('usage: node scope.test.mjs CIA402_BINARY OUTPUT_DIR');
-  process.exit(2);
-}
+const [, outDir] = startRun('scope.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
 const modules = path.resolve(process.env.CIA402_NODE_MODULES || 'node_modules');
 const { chromium } = createRequire(path.join(modules, 'resolve-from-here.js'))('playwright-core');
-fs.mkdirSync(outDir, { recursive: true });
 
 // Generous: a wait ends as soon as its condition holds, so only a failing check pays for it.
 const patience = 30000;
@@ -44,25 +39,6 @@ async function check(name, fn) {
   await fn();
   passed += 1;
   console.log(`ok ${passed} - scope: ${name}`);
-}
-
-function startServer() {
-  return new Promise((resolve, reject) => {
-    const proc = spawn(cia402, ['serve', '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
-    const s = { proc, output: '', url: null };
-    const timer = setTimeout(() => reject(new Error(`no URL from cia402 serve:\n${s.output}`)), 15000);
-    proc.stdout.on('data', (d) => {
-      s.output += d;
-      const m = /(http:\/\/\S+)/.exec(s.output);
-      if (m && !s.url) {
-        s.url = m[1];
-        clearTimeout(timer);
-        resolve(s);
-      }
-    });
-    proc.stderr.on('data', (d) => { s.output += d; });
-    proc.on('exit', (code) => { if (!s.url) reject(new Error(`cia402 serve exited ${code}:\n${s.output}`)); });
-  });
 }
 
 // The helpers of scope_harness.mjs on this script's page.
@@ -87,7 +63,7 @@ async function download(id) {
 }
 
 async function main() {
-  server = await startServer();
+  server = await startServer([]);
   const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'cia402-scope-'));
   context = await chromium.launchPersistentContext(userDataDir, {
     executablePath: process.env.CIA402_CHROMIUM || '/usr/bin/chromium',
