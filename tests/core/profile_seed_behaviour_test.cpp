@@ -21,6 +21,14 @@ void fault_class(bench& b, std::uint8_t cls) {
   b.in.fault_class = cls;
 }
 
+// A Fault Reset edge: a step with control word 0x00, then one with bit 7 set (0x80).
+void send_fault_reset(bench& b) {
+  b.in.control_word = 0x00;
+  b.step();
+  b.in.control_word = 0x80;
+  b.step();
+}
+
 // 000_44b471b7401b86be.txt T9: "Power output stage is immediately disabled and the motor coasts.
 // If available, the motor holding brake is closed immediately."
 TEST(profile_rows, no_quick_stop_t9_coasts_and_closes_the_brake_in_the_same_step) {
@@ -147,15 +155,9 @@ TEST(profile_rows, lexium32_class_4_needs_a_power_cycle) {
   b.settle();
   ASSERT_EQ(b.a.current, S::fault);
   b.in.fault_code = 0;  // the cause is corrected
-  b.in.control_word = 0x00;
-  b.step();
-  b.in.control_word = 0x80;
-  b.step();
+  send_fault_reset(b);
   EXPECT_EQ(b.out.current, S::fault) << "Fault Reset does not clear a class-4 error";
-  b.in.control_word = 0x00;
-  b.step();
-  b.in.control_word = 0x80;
-  b.step();
+  send_fault_reset(b);
   EXPECT_EQ(b.out.current, S::fault);
   // Power cycle: a new axis.
   bench fresh(p);
@@ -172,10 +174,7 @@ TEST(profile_rows, lexium32_class_2_is_cleared_by_fault_reset) {
   b.settle();
   ASSERT_EQ(b.a.current, S::fault);
   b.in.fault_code = 0;
-  b.in.control_word = 0x00;
-  b.step();
-  b.in.control_word = 0x80;
-  b.step();
+  send_fault_reset(b);
   EXPECT_EQ(int(b.out.transition), 15);
   EXPECT_EQ(b.out.current, S::switch_on_disabled);
 }
