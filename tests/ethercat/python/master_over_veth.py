@@ -7,16 +7,12 @@ warning or error. Needs root (CI runs as root), iproute2 and tshark (scripts/ins
 skips (exit 77) without root. Usage: master_over_veth.py CIA402_BINARY [KEEP_DIR]."""
 import json
 import os
-import shutil
 import subprocess
 import sys
-import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import veth_session  # noqa: E402  the veth pair with `cia402 ecat-slave` and tshark on it
-
-SKIP = 77
 
 
 def run_line(cia402, drives, workdir):
@@ -89,23 +85,13 @@ def check_capture(pcap, drives):
     print("line of %d: %d EtherCAT frames, %d CoE SDO frames, none malformed or flagged" % (drives, frames, sdo))
 
 
+def run(cia402, workdir):
+    for drives in (1, 16):
+        run_line(cia402, drives, workdir)
+
+
 def main():
-    if os.geteuid() != 0:
-        print("SKIPPED: a raw socket and a veth pair need root")
-        return SKIP
-    for tool in ("ip", "tshark"):
-        if shutil.which(tool) is None:
-            print("FAILED: %s is missing (scripts/install-deps.sh installs it)" % tool)
-            return 1
-    keep = sys.argv[2] if len(sys.argv) > 2 else None
-    workdir = keep or tempfile.mkdtemp(prefix="cia402-ecat-")
-    try:
-        for drives in (1, 16):
-            run_line(sys.argv[1], drives, workdir)
-    finally:
-        if keep is None:
-            shutil.rmtree(workdir, ignore_errors=True)
-    return 0
+    return veth_session.captured_main(run, "cia402-ecat-", missing_tool=1)
 
 
 if __name__ == "__main__":

@@ -18,17 +18,14 @@ Needs root and tshark (scripts/install-deps.sh); skips (exit 77) without root or
 Usage: strict_wire_over_veth.py CIA402_BINARY [KEEP_DIR]."""
 import json
 import os
-import shutil
 import struct
 import subprocess
 import sys
-import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import veth_session  # noqa: E402  the raw-socket master and its frame writer
 
-SKIP = 77
 APRD, APWR, FPRD, FPWR, BRD, BWR, LRW, ARMW, FRMW = 1, 2, 4, 5, 7, 8, 12, 13, 14
 LOGICAL = (10, 11, LRW)
 STATION = 0x1001  # drive 0 as our master addresses it (0x1001 + position)
@@ -232,21 +229,7 @@ def run(cia402, workdir):
 
 
 def main():
-    if os.geteuid() != 0:
-        print("SKIPPED: a raw socket and a veth pair need root")
-        return SKIP
-    for tool in ("ip", "tshark"):
-        if shutil.which(tool) is None:
-            print("SKIPPED: %s is missing (scripts/install-deps.sh installs it)" % tool)
-            return SKIP
-    keep = sys.argv[2] if len(sys.argv) > 2 else None
-    workdir = keep or tempfile.mkdtemp(prefix="cia402-strict-")
-    try:
-        run(sys.argv[1], workdir)
-    finally:
-        if keep is None:
-            shutil.rmtree(workdir, ignore_errors=True)
-    return 0
+    return veth_session.captured_main(run, "cia402-strict-")
 
 
 if __name__ == "__main__":

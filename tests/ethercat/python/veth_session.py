@@ -5,11 +5,13 @@ skips (exit 77) saying why otherwise. Usage: veth_session.py CIA402_BINARY. Also
 tshark tests (master_over_veth.py, strict_wire_over_veth.py) run on: slave_line()."""
 import contextlib
 import os
+import shutil
 import signal
 import socket
 import struct
 import subprocess
 import sys
+import tempfile
 import time
 
 SKIP = 77
@@ -85,6 +87,28 @@ def slave_line(cia402, m, s, drives, pcap):
             slave.send_signal(signal.SIGTERM)
             slave.wait(timeout=10)
         subprocess.run(["ip", "link", "del", m], capture_output=True)
+
+
+def captured_main(run, prefix, missing_tool=SKIP):
+    """The tshark tests' main, SCRIPT CIA402_BINARY [KEEP_DIR]: run(cia402, workdir) in KEEP_DIR, or
+    in a temporary folder (PREFIX...) removed after. Without root: SKIP; without ip or tshark:
+    `missing_tool` (SKIP, or 1 for a test that must not pass by skipping)."""
+    if os.geteuid() != 0:
+        print("SKIPPED: a raw socket and a veth pair need root")
+        return SKIP
+    for tool in ("ip", "tshark"):
+        if shutil.which(tool) is None:
+            print("%s: %s is missing (scripts/install-deps.sh installs it)"
+                  % ("SKIPPED" if missing_tool == SKIP else "FAILED", tool))
+            return missing_tool
+    keep = sys.argv[2] if len(sys.argv) > 2 else None
+    workdir = keep or tempfile.mkdtemp(prefix=prefix)
+    try:
+        run(sys.argv[1], workdir)
+    finally:
+        if keep is None:
+            shutil.rmtree(workdir, ignore_errors=True)
+    return 0
 
 
 def main():
