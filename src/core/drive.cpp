@@ -139,6 +139,122 @@ constexpr std::uint32_t fault_facts_of_class = [] {
 }();
 static_assert((fault_facts | bits(fact::fault_present) | bits(fact::fault_immediate)) == 0xF00u);
 
+// The fault the drive acts on in a cycle: an event of its own (STO or undervoltage while torque was
+// on, S13/S14), a cause from outside, or a lost connection with 0x6007 = 1, which is a fault even
+// beside a mere warning (class 0 or 1). The drive's own faults have class 3.
+struct cycle_fault {
+  std::uint16_t code = 0;
+  unsigned error_class = 0;
+  bool internal = false;  ///< raised by the drive itself
+};
+
+cycle_fault fault_of(const profile& p, const drive_inputs& in, bool torque_was_on, bool link_fault) noexcept {
+  cycle_fault f;
+  const unsigned input_class = p.error_classes ? in.fault_class : 2u;
+  if (torque_was_on && (in.sto || !in.dc_link)) {
+    f.code = in.sto ? error_code::safe_torque_off : error_code::dc_link_undervoltage;
+    f.error_class = 3;
+    f.internal = true;
+  } else if (in.fault_code != 0 && (input_class >= 2 || !link_fault)) {
+    f.code = in.fault_code;
+    f.error_class = input_class;
+  } else if (link_fault) {
+    f.code = error_code::heartbeat;
+    f.error_class = 2;
+  }
+  return f;
+}
+
+// Seed 001: T2 needs "< 1000 RPM", T7 fires on "> 1000 RPM"; exactly 1000 does neither.
+std::uint32_t speed_facts(const profile& p, const drive_inputs& in) noexcept {
+  const std::int32_t limit = p.speed_limit_rpm;
+  const std::int32_t speed = in.actual_speed_rpm;
+  const std::uint32_t magnitude = speed < 0 ? 0u - static_cast<std::uint32_t>(speed)
+                                            : static_cast<std::uint32_t>(speed);
+  if (limit <= 0) return bits(fact::below_speed_limit);
+  if (magnitude > static_cast<std::uint32_t>(limit)) return bits(fact::overspeed);
+  if (magnitude < static_cast<std::uint32_t>(limit)) return bits(fact::below_speed_limit);
+  return 0;
+}
+
+// The first row leaving state `from` whose facts hold, or no_row.
+std::uint8_t first_row(const profile& p, int from, std::uint32_t f) noexcept {
+  for (std::uint32_t rows = p.rows_from[from]; rows != 0; rows &= rows - 1) {
+    const std::uint8_t i = static_cast<std::uint8_t>(detail::lowest_bit(rows));
+    const stored_row& r = p.rows[i];
+    const std::uint32_t all = p.fact_sets[r.all];
+    if ((p.fact_sets[r.any] & f) && (all & f) == all && !(p.fact_sets[r.none] & f)) return i;
+  }
+  return no_row;
+}
+
+// The state change of a row whose stop (if any) is done: the new state, its stop code (S16), the
+// axis flags and the error code its reasons call for.
+void commit_row(const profile& p, axis& a, const stored_row& r, std::uint32_t f, const cycle_fault& fault,
+                bool torque_was_on, bool sto, drive_outputs& out) noexcept {
+  const std::uint32_t why = p.fact_sets[r.any] & f;
+  a.current = r.to;
+  a.pending_row = no_row;
+  // S16: the quick stop and the fault reaction run by the code they find as they start.
+  const state_activity act = p.info(r.to).activity;
+  a.stop_code = act == state_activity::quick_stop       ? option_value(a, option::quick_stop)
+                : act == state_activity::fault_reaction ? option_value(a, option::fault_reaction)
+                                                        : std::int8_t{0};
+  a.last_transition = r.number;
+  out.transition = r.number;
+  out.clear_setpoints = (r.flags & row_flag::clears_setpoints) != 0;
+  // Built in a register and stored once: a store per flag made the Cortex-M4 firmware larger.
+  unsigned flags = a.flags & ~static_cast<unsigned>(axis_flag::entered_by_fault);
+  if ((why & fault_facts) && !(why & command_facts)) flags |= axis_flag::entered_by_fault;
+  if (why & fault_facts) a.error_code = fault.code;
+  if (why & (bits(fact::fault) | bits(fact::fault_reset))) {
+    flags &= ~static_cast<unsigned>(axis_flag::coast_reaction);
+    // A fault reaction has nothing to ramp when torque is already off, or cannot (S14). A fault
+    // reset ends the coast.
+    if (!(why & bits(fact::fault_reset)) && (fault.error_class >= 3 || !torque_was_on || sto)) {
+      flags |= axis_flag::coast_reaction;
+    }
+  }
+  if (why & bits(fact::fault_reset)) a.error_code = 0;
+  a.flags = static_cast<std::uint8_t>(flags);
+}
+
+// The outputs of the state the drive is in now (or of the stop it runs), and torque_on for the next
+// cycle.
+void state_outputs(const profile& p, axis& a, const drive_inputs& in, bool halt, drive_outputs& out) noexcept {
+  const unsigned now = activity_of(p, a, halt);
+  const state s = a.current;
+  out.current = s;
+  const bool torque_wanted = (now & activity::torque_wanted) != 0;
+  const auto ramp = static_cast<stop_ramp>(now & activity::ramp);
+  const bool torque = torque_wanted && !in.sto && ramp != stop_ramp::coast;
+  out.ramp = in.sto && torque_wanted ? stop_ramp::coast : ramp;
+  out.torque = torque;
+  out.brake_released = torque && !((now & activity::stop_ends_torque) && in.standstill);
+  a.flags = static_cast<std::uint8_t>((a.flags & ~axis_flag::torque_on) |
+                                      (torque ? axis_flag::torque_on : 0u));
+
+  const state_info info = p.info(s);
+  std::uint32_t sw = info.status_pattern | (static_cast<std::uint32_t>(in.dc_link) << 4) |
+                     (static_cast<std::uint32_t>(in.sto) << 7) |
+                     (static_cast<std::uint32_t>(in.remote) << 9) |
+                     (in.status_bits & (status_bit::reported & ~status_bit::target_reached));
+  sw |= static_cast<std::uint32_t>(p.error_classes & (in.fault_code != 0) & (in.fault_class <= 1))
+        << 7;  // status_bit::warning
+  bool target;
+  if (info.activity == state_activity::run) {
+    target = halt ? in.standstill : (in.status_bits & status_bit::target_reached) != 0;
+  } else {
+    const int qs_code = a.stop_code;
+    target = info.activity == state_activity::quick_stop && qs_code >= 5 && qs_code <= 8 &&
+             in.standstill;
+  }
+  if (target && a.pending_row == no_row) sw |= status_bit::target_reached;
+  out.status_word = static_cast<std::uint16_t>(sw);
+  out.error_code = a.error_code;
+  out.error_register = error_register_of(a.error_code);
+}
+
 }  // namespace
 
 axis make_axis(const profile& p) noexcept {
@@ -190,26 +306,9 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   const bool halt = in.remote && (cw & control_bit::halt) && p.spec(option::halt).exists();
   if (halt) f |= bits(fact::halt);
 
-  // The fault the drive acts on: an event of its own (STO or undervoltage while torque was on,
-  // S13/S14), a cause from outside, or a lost connection with 0x6007 = 1, which is a fault even
-  // beside a mere warning (class 0 or 1).
-  std::uint16_t fault_code = 0;
-  unsigned fault_class = 0;
-  bool internal = false;
-  const unsigned input_class = p.error_classes ? in.fault_class : 2u;
-  if (torque_was_on && (in.sto || !in.dc_link)) {
-    fault_code = in.sto ? error_code::safe_torque_off : error_code::dc_link_undervoltage;
-    fault_class = 3;
-    internal = true;
-  } else if (in.fault_code != 0 && (input_class >= 2 || !link_fault)) {
-    fault_code = in.fault_code;
-    fault_class = input_class;
-  } else if (link_fault) {
-    fault_code = error_code::heartbeat;
-    fault_class = 2;
-  }
-  f |= ((fault_facts_of_class >> (4 * (fault_class < 5 ? fault_class : 5u))) & 0xFu) << 8;
-  if (fault_class == 4) {  // only with error classes
+  const cycle_fault fault = fault_of(p, in, torque_was_on, link_fault);
+  f |= ((fault_facts_of_class >> (4 * (fault.error_class < 5 ? fault.error_class : 5u))) & 0xFu) << 8;
+  if (fault.error_class == 4) {  // only with error classes
     a.flags |= axis_flag::fault_latched;
     f |= bits(fact::fault_latched);
   }
@@ -219,18 +318,7 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
       (f & (bits(fact::sto) | bits(fact::undervoltage) | bits(fact::fault_immediate)))) {
     a.flags |= axis_flag::coast_reaction;
   }
-  // Seed 001: T2 needs "< 1000 RPM", T7 fires on "> 1000 RPM"; exactly 1000 does neither.
-  const std::int32_t limit = p.speed_limit_rpm;
-  const std::int32_t speed = in.actual_speed_rpm;
-  const std::uint32_t magnitude = speed < 0 ? 0u - static_cast<std::uint32_t>(speed)
-                                            : static_cast<std::uint32_t>(speed);
-  if (limit <= 0) {
-    f |= bits(fact::below_speed_limit);
-  } else if (magnitude > static_cast<std::uint32_t>(limit)) {
-    f |= bits(fact::overspeed);
-  } else if (magnitude < static_cast<std::uint32_t>(limit)) {
-    f |= bits(fact::below_speed_limit);
-  }
+  f |= speed_facts(p, in);
 
   // A stop is complete at standstill with the brake engaged (when it ends with torque off), or at
   // once when it coasts.
@@ -245,18 +333,7 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   }
   if (complete) f |= bits(fact::stop_complete);
 
-  // The first row leaving the present state whose facts hold.
-  const int from = static_cast<int>(a.current);
-  std::uint8_t match = no_row;
-  for (std::uint32_t rows = p.rows_from[from]; rows != 0; rows &= rows - 1) {
-    const std::uint8_t i = static_cast<std::uint8_t>(detail::lowest_bit(rows));
-    const stored_row& r = p.rows[i];
-    const std::uint32_t all = p.fact_sets[r.all];
-    if ((p.fact_sets[r.any] & f) && (all & f) == all && !(p.fact_sets[r.none] & f)) {
-      match = i;
-      break;
-    }
-  }
+  const std::uint8_t match = first_row(p, static_cast<int>(a.current), f);
 
   // S7: while a row's stop runs, only rows that interrupt stops may take over; otherwise the
   // pending row completes when its stop does. A row with a ramp of its own runs it first, also
@@ -285,71 +362,12 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   // cause that is still present, so that cause does not write over it.
   if ((f & bits(fact::fault)) &&
       ((a.current == state::fault_reaction_active) | (a.current == state::fault)) &&
-      (internal || !raised_by_drive(a.error_code))) {
-    a.error_code = fault_code;
+      (fault.internal || !raised_by_drive(a.error_code))) {
+    a.error_code = fault.code;
   }
 
-  if (commit != no_row) {
-    const stored_row& r = p.rows[commit];
-    const std::uint32_t why = p.fact_sets[r.any] & f;
-    a.current = r.to;
-    a.pending_row = no_row;
-    // S16: the quick stop and the fault reaction run by the code they find as they start.
-    const state_activity act = p.info(r.to).activity;
-    a.stop_code = act == state_activity::quick_stop       ? option_value(a, option::quick_stop)
-                  : act == state_activity::fault_reaction ? option_value(a, option::fault_reaction)
-                                                          : std::int8_t{0};
-    a.last_transition = r.number;
-    out.transition = r.number;
-    out.clear_setpoints = (r.flags & row_flag::clears_setpoints) != 0;
-    // Built in a register and stored once: a store per flag made the Cortex-M4 firmware larger.
-    unsigned flags = a.flags & ~static_cast<unsigned>(axis_flag::entered_by_fault);
-    if ((why & fault_facts) && !(why & command_facts)) flags |= axis_flag::entered_by_fault;
-    if (why & fault_facts) a.error_code = fault_code;
-    if (why & (bits(fact::fault) | bits(fact::fault_reset))) {
-      flags &= ~static_cast<unsigned>(axis_flag::coast_reaction);
-      // A fault reaction has nothing to ramp when torque is already off, or cannot (S14). The
-      // drive's own faults have class 3. A fault reset ends the coast.
-      if (!(why & bits(fact::fault_reset)) && (fault_class >= 3 || !torque_was_on || in.sto)) {
-        flags |= axis_flag::coast_reaction;
-      }
-    }
-    if (why & bits(fact::fault_reset)) a.error_code = 0;
-    a.flags = static_cast<std::uint8_t>(flags);
-  }
-  const unsigned now = activity_of(p, a, halt);
-
-  // Outputs of the state the drive is in now.
-  const state s = a.current;
-  out.current = s;
-  const bool torque_wanted = (now & activity::torque_wanted) != 0;
-  const auto ramp = static_cast<stop_ramp>(now & activity::ramp);
-  const bool torque = torque_wanted && !in.sto && ramp != stop_ramp::coast;
-  out.ramp = in.sto && torque_wanted ? stop_ramp::coast : ramp;
-  out.torque = torque;
-  out.brake_released = torque && !((now & activity::stop_ends_torque) && in.standstill);
-  a.flags = static_cast<std::uint8_t>((a.flags & ~axis_flag::torque_on) |
-                                      (torque ? axis_flag::torque_on : 0u));
-
-  const state_info info = p.info(s);
-  std::uint32_t sw = info.status_pattern | (static_cast<std::uint32_t>(in.dc_link) << 4) |
-                     (static_cast<std::uint32_t>(in.sto) << 7) |
-                     (static_cast<std::uint32_t>(in.remote) << 9) |
-                     (in.status_bits & (status_bit::reported & ~status_bit::target_reached));
-  sw |= static_cast<std::uint32_t>(p.error_classes & (in.fault_code != 0) & (in.fault_class <= 1))
-        << 7;  // status_bit::warning
-  bool target;
-  if (info.activity == state_activity::run) {
-    target = halt ? in.standstill : (in.status_bits & status_bit::target_reached) != 0;
-  } else {
-    const int qs_code = a.stop_code;
-    target = info.activity == state_activity::quick_stop && qs_code >= 5 && qs_code <= 8 &&
-             in.standstill;
-  }
-  if (target && a.pending_row == no_row) sw |= status_bit::target_reached;
-  out.status_word = static_cast<std::uint16_t>(sw);
-  out.error_code = a.error_code;
-  out.error_register = error_register_of(a.error_code);
+  if (commit != no_row) commit_row(p, a, p.rows[commit], f, fault, torque_was_on, in.sto, out);
+  state_outputs(p, a, in, halt, out);
   return out;
 }
 
