@@ -69,11 +69,9 @@ sdo_abort dictionary_access::download(std::uint16_t index, std::uint8_t sub,
   if (!size_indicated && data.size() > type_size(e.type)) data = data.first(type_size(e.type));
   a = check_download(index, sub, data.size(), true);
   if (a != sdo_abort::none) return a;
-  const std::int64_t v = decode_value(e.type, data);
-  if (v > type_max(e.type)) return sdo_abort::value_too_high;  // BOOLEAN above 1
-  if (e.has_limits && v < e.low) return sdo_abort::value_too_low;
-  if (e.has_limits && v > e.high) return sdo_abort::value_too_high;
-  return write_value(*s, v);
+  // The value's checks are write()'s: the type's range (a BOOLEAN above 1) and the entry's limits,
+  // in one place for an SDO download, a PDO's mapped entry and a local write alike.
+  return write(*s, decode_value(e.type, data));
 }
 
 sdo_abort dictionary_access::upload(std::uint16_t index, std::uint8_t sub,
