@@ -90,6 +90,13 @@ void replace_row(custom_profile& c, int i, transition_row r) {
   c.finalize();
 }
 
+// Sets option `o` to `supported` and `default_value` (both unchecked) and finalizes.
+template <option o, std::uint16_t supported, std::int8_t default_value>
+void set_option(custom_profile& c) {
+  c.settings().options[static_cast<int>(o)] = {supported, default_value};
+  c.finalize();
+}
+
 void replace_decoder_rule(custom_profile& c, int i, decoder_rule d) {
   decoder_rule rules[max_decoder_rules];
   const profile& v = c.get();
@@ -170,30 +177,12 @@ const malformation malformations[] = {
        replace_decoder_rule(c, 2, {0x01, 0x00, static_cast<command>(6)});
      }},
     {"option default the profile does not support", "default", -1,
-     [](custom_profile& c) {
-       c.settings().options[static_cast<int>(option::quick_stop)] = {0x0003, 5};
-       c.finalize();
-     }},
-    {"fixed option value out of range", "out of range", -1,
-     [](custom_profile& c) {
-       c.settings().options[static_cast<int>(option::halt)] = {0, 40};
-       c.finalize();
-     }},
+     set_option<option::quick_stop, 0x0003, 5>},
+    {"fixed option value out of range", "out of range", -1, set_option<option::halt, 0, 40>},
     {"halt code 0, which the standard reserves", "does not define", -1,
-     [](custom_profile& c) {
-       c.settings().options[static_cast<int>(option::halt)] = {0x0003, 1};
-       c.finalize();
-     }},
-    {"quick stop code 9", "does not define", -1,
-     [](custom_profile& c) {
-       c.settings().options[static_cast<int>(option::quick_stop)] = {0x0204, 2};
-       c.finalize();
-     }},
-    {"fixed fault reaction 7", "out of range", -1,
-     [](custom_profile& c) {
-       c.settings().options[static_cast<int>(option::fault_reaction)] = {0, 7};
-       c.finalize();
-     }},
+     set_option<option::halt, 0x0003, 1>},
+    {"quick stop code 9", "does not define", -1, set_option<option::quick_stop, 0x0204, 2>},
+    {"fixed fault reaction 7", "out of range", -1, set_option<option::fault_reaction, 0, 7>},
     {"status pattern with bit 4", "status pattern", -1,
      [](custom_profile& c) {
        c.settings().states[static_cast<int>(state::switched_on)].status_pattern = 0x33;
