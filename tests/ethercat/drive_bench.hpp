@@ -12,14 +12,13 @@
 
 #include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/coe/mailbox.hpp"
+#include "one_datagram.hpp"
 #include "register_bytes.hpp"
 
 namespace cia402::ethercat::testing {
 
 using drive_slave = apps::virtual_drive_slave;
 
-constexpr std::array<std::uint8_t, 6> broadcast{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
-constexpr std::array<std::uint8_t, 6> master_mac{0x02, 0, 0, 0, 0, 1};
 constexpr std::uint16_t station = 0x1001;
 
 struct bench {
@@ -28,20 +27,9 @@ struct bench {
   std::uint8_t counter = 0;
   bench() { wire.add(slave.controller()); }
 
-  struct answer {
-    std::vector<std::uint8_t> data;
-    std::uint16_t wkc = 0;
-  };
+  using answer = datagram_answer;
   answer send(command c, std::uint32_t address, std::vector<std::uint8_t> data) {
-    frame_builder b(broadcast, master_mac);
-    const long at = b.add(c, 0, address, data, static_cast<std::uint16_t>(data.size()));
-    std::vector<std::uint8_t> f = b.finish();
-    EXPECT_EQ(wire.pass(f), frame_error::none);
-    answer a;
-    a.data.assign(f.begin() + at, f.begin() + at + static_cast<long>(data.size()));
-    a.wkc = static_cast<std::uint16_t>(f[static_cast<std::size_t>(at) + data.size()] |
-                                       (f[static_cast<std::size_t>(at) + data.size() + 1] << 8));
-    return a;
+    return one_datagram(wire, c, 0, address, data);
   }
   std::uint32_t fp(std::uint16_t offset) const { return station | (static_cast<std::uint32_t>(offset) << 16); }
   std::uint16_t read16(std::uint16_t offset) {

@@ -11,12 +11,13 @@
 
 #include "cia402/ethercat/esc/esc.hpp"
 #include "cia402/ethercat/sii/slave_information.hpp"
+#include "one_datagram.hpp"
 #include "register_bytes.hpp"
 
 namespace cia402::ethercat::esc_bus {
 
-inline constexpr std::array<std::uint8_t, 6> broadcast{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF};
-inline constexpr std::array<std::uint8_t, 6> master_mac{0x02, 0, 0, 0, 0, 1};
+using testing::broadcast;
+using testing::master_mac;
 
 inline std::vector<std::uint8_t> eeprom() {
   slave_description d;
@@ -33,12 +34,8 @@ inline std::uint32_t fp(std::uint16_t station, std::uint16_t offset) {
   return station | (static_cast<std::uint32_t>(offset) << 16);
 }
 
-// One datagram through the chain: its data and working counter as they came back.
-struct result {
-  std::vector<std::uint8_t> data;
-  std::uint16_t wkc = 0;
-  std::uint16_t adp = 0;
-};
+// One datagram through the chain: its data, working counter and ADP as they came back.
+using result = testing::datagram_answer;
 
 struct bus {
   std::vector<esc> escs;
@@ -49,16 +46,7 @@ struct bus {
     for (esc& e : escs) wire.add(e);
   }
   result send(command c, std::uint32_t address, std::vector<std::uint8_t> data) {
-    frame_builder b(broadcast, master_mac);
-    const long at = b.add(c, 1, address, data, static_cast<std::uint16_t>(data.size()));
-    std::vector<std::uint8_t> f = b.finish();
-    EXPECT_EQ(wire.pass(f), frame_error::none);
-    result r;
-    const auto* p = f.data() + at;
-    r.data.assign(p, p + data.size());
-    r.wkc = static_cast<std::uint16_t>(p[data.size()] | (p[data.size() + 1] << 8));
-    r.adp = static_cast<std::uint16_t>(f[static_cast<std::size_t>(at) - 8] | (f[static_cast<std::size_t>(at) - 7] << 8));
-    return r;
+    return testing::one_datagram(wire, c, 1, address, data);
   }
   result write16(command c, std::uint32_t address, std::uint16_t v) {
     return send(c, address, {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8)});
