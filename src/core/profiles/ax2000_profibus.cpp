@@ -18,10 +18,9 @@ constexpr decoder_rule decoder[] = {
 };
 
 constexpr transition_row rows[] = {
-    row(13, every_state_but_fault, S::fault_reaction_active, facts(F::fault), {}, {},
-        row_stop::immediate, interrupts),
-    row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic)),
-    row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
+    t13_fault(),
+    t0_power_on,
+    t1_initialised,
     // T2: bits 1 and 2 set, DC bus link voltage present (seed lines 14..16).
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown),
         facts(F::dc_link), facts(F::sto)),

@@ -9,10 +9,9 @@ namespace {
 // Rows are tried in this order and the first match wins: T13 comes first because faults win over
 // any command (S12); the others follow the seed's numbering.
 constexpr transition_row rows[] = {
-    row(13, every_state_but_fault, S::fault_reaction_active, facts(F::fault), {}, {},
-        row_stop::immediate, interrupts),
-    row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic)),
-    row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
+    t13_fault(),
+    t0_power_on,
+    t1_initialised,
     // S14: SWITCH ON DISABLED is not left while STO is active.
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown), {}, facts(F::sto)),
     // S3: Enable operation here runs T3, then T4 in the next step. S13/S14: voltage, no STO.

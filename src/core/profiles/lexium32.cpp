@@ -10,10 +10,9 @@ namespace {
 // First match wins. T13 (error classes 2..4) first; T7 before T3 so that an undervoltage, STO or
 // overspeed in READY TO SWITCH ON drops to SWITCH ON DISABLED even while Switch on is commanded.
 constexpr transition_row rows[] = {
-    row(13, every_state_but_fault, S::fault_reaction_active, facts(F::fault), {}, {},
-        row_stop::immediate, interrupts),
-    row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic)),
-    row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
+    t13_fault(),
+    t0_power_on,
+    t1_initialised,
     // T2: no undervoltage, actual velocity < 1000 rpm, STO = +24 V, Shutdown (seed lines 6..10).
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown),
         facts(F::dc_link, F::below_speed_limit), facts(F::sto)),

@@ -14,10 +14,9 @@ constexpr std::uint16_t every_state_it_has_but_fault =
     every_state_but_fault & static_cast<std::uint16_t>(~state_bit(S::quick_stop_active));
 
 constexpr transition_row rows[] = {
-    row(13, every_state_it_has_but_fault, S::fault_reaction_active, facts(F::fault), {}, {},
-        row_stop::immediate, interrupts),
-    row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic)),
-    row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
+    t13_fault(every_state_it_has_but_fault),
+    t0_power_on,
+    t1_initialised,
     // S14: SWITCH ON DISABLED is not left while STO is active.
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown), {}, facts(F::sto)),
     // "System checks if power supply is switched on" (seed line 49).

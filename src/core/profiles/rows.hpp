@@ -67,6 +67,18 @@ constexpr std::uint16_t value_range(int lo, int hi) noexcept {
   return m;
 }
 
+/// The rows every seed prints alike. T13 from the states it leaves (every state but the two fault
+/// states, S4), first in every table because faults win over any command (S12).
+constexpr transition_row t13_fault(std::uint16_t from_states = every_state_but_fault) noexcept {
+  return row(13, from_states, S::fault_reaction_active, facts(F::fault), {}, {}, row_stop::immediate,
+             interrupts);
+}
+/// T0 and T1: power on, then the drive's own initialisation, each by itself.
+inline constexpr transition_row t0_power_on =
+    row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic));
+inline constexpr transition_row t1_initialised =
+    row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic));
+
 /// Puts the pieces together and derives the lookup tables.
 template <std::size_t NDecoder, std::size_t NRows, std::size_t NSets>
 constexpr profile make_profile(const char* name, const char* seed, const char* title,

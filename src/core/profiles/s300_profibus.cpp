@@ -10,10 +10,9 @@ namespace {
 // First match wins; T13 first. The output stage is on from T3 ("Drive has torque", seed line 88),
 // so SWITCHED ON holds torque, and T6, T8, T9, T10, T12 switch it off at once ("motor loses torque").
 constexpr transition_row rows[] = {
-    row(13, every_state_but_fault, S::fault_reaction_active, facts(F::fault), {}, {},
-        row_stop::immediate, interrupts),
-    row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic)),
-    row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic)),
+    t13_fault(),
+    t0_power_on,
+    t1_initialised,
     // T2: bits 1 and 2 set (shutdown), DC-link voltage present (seed lines 73..74).
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown),
         facts(F::dc_link), facts(F::sto)),
