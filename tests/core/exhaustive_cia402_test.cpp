@@ -303,16 +303,6 @@ struct sweep_logs {
   mismatch_log error_code;
 };
 
-std::string describe(const expectation& e) {
-  std::ostringstream os;
-  os << state_name(e.current) << " T"
-     << (e.transition == no_transition ? std::string("-") : std::to_string(e.transition))
-     << " sw=" << hex(e.status_word) << " torque=" << e.torque << " brake_released="
-     << e.brake_released << " ramp=" << stop_ramp_name(e.ramp) << " clear_setpoints="
-     << e.clear_setpoints << " error=" << hex(e.error_code) << " reg=" << hex(e.error_register, 2);
-  return os.str();
-}
-
 bool behaviour_matches(const expectation& e, const drive_outputs& o) {
   return e.current == o.current && e.transition == o.transition && e.status_word == o.status_word &&
          e.torque == o.torque && e.brake_released == o.brake_released && e.ramp == o.ramp &&
@@ -331,7 +321,7 @@ bool compare(const expectation& e, const drive_outputs& o, Context context, swee
   ++logs.error_code.checked;
   const bool behaviour = behaviour_matches(e, o);
   if (behaviour && error_code_matches(e, o)) return true;
-  const std::string both = context() + ":\n    expected " + describe(e) + "\n    actual   " +
+  const std::string both = context() + ":\n    expected " + test::describe(e) + "\n    actual   " +
                            test::describe(o);
   (behaviour ? logs.error_code : logs.behaviour).add(both);
   return behaviour;

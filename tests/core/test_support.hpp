@@ -75,7 +75,9 @@ inline std::string hex(std::uint32_t v, int width = 4) {
   return os.str();
 }
 
-inline std::string describe(const drive_outputs& o) {
+/// One line of a step's outputs, or of anything with their fields (an oracle's expectation).
+template <typename Outputs>
+std::string describe(const Outputs& o) {
   std::ostringstream os;
   os << state_name(o.current) << " T"
      << (o.transition == no_transition ? std::string("-") : std::to_string(o.transition))
