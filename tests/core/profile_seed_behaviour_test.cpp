@@ -146,16 +146,22 @@ TEST(profile_rows, lexium32_class_3_reaches_fault_at_once_class_2_after_its_stop
   }
 }
 
-// Lexium 32 eSM table (cia402-reference.md §6.3): class 4 is reset by a power cycle only.
-TEST(profile_rows, lexium32_class_4_needs_a_power_cycle) {
-  const profile& p = test::builtin("lexium32");
-  bench b(p);
+// From OPERATION ENABLED, a fault of class `cls` until the drive stands in FAULT, the cause
+// corrected, then one Fault Reset edge.
+void fault_corrected_then_reset(bench& b, std::uint8_t cls) {
   ASSERT_TRUE(test::reach(b, S::operation_enabled));
-  fault_class(b, 4);
+  fault_class(b, cls);
   b.settle();
   ASSERT_EQ(b.a.current, S::fault);
   b.in.fault_code = 0;  // the cause is corrected
   send_fault_reset(b);
+}
+
+// Lexium 32 eSM table (cia402-reference.md §6.3): class 4 is reset by a power cycle only.
+TEST(profile_rows, lexium32_class_4_needs_a_power_cycle) {
+  const profile& p = test::builtin("lexium32");
+  bench b(p);
+  ASSERT_NO_FATAL_FAILURE(fault_corrected_then_reset(b, 4));
   EXPECT_EQ(b.out.current, S::fault) << "Fault Reset does not clear a class-4 error";
   send_fault_reset(b);
   EXPECT_EQ(b.out.current, S::fault);
@@ -169,12 +175,7 @@ TEST(profile_rows, lexium32_class_4_needs_a_power_cycle) {
 // The same fault with class 2: Fault Reset clears it (T15), the comparison case for class 4.
 TEST(profile_rows, lexium32_class_2_is_cleared_by_fault_reset) {
   bench b(test::builtin("lexium32"));
-  ASSERT_TRUE(test::reach(b, S::operation_enabled));
-  fault_class(b, 2);
-  b.settle();
-  ASSERT_EQ(b.a.current, S::fault);
-  b.in.fault_code = 0;
-  send_fault_reset(b);
+  ASSERT_NO_FATAL_FAILURE(fault_corrected_then_reset(b, 2));
   EXPECT_EQ(int(b.out.transition), 15);
   EXPECT_EQ(b.out.current, S::switch_on_disabled);
 }
