@@ -19,7 +19,7 @@
 import { createRequire } from 'node:module';
 import path from 'node:path';
 import {
-  patience, run, startRun, fail, expect, check, runChecks, startServer, stopServer, waitPresent,
+  patience, run, startRun, fail, expect, check, runChecks, startServer, waitPresent, stopCleanly, pageProblems,
 } from './page_harness.mjs';
 
 startRun('control.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
@@ -70,9 +70,7 @@ async function serverWait(fromMs, ms, each = async () => {}) {
 async function openPage(context, axis) {
   const page = await context.newPage();
   run.currentPage = page;
-  const errors = [];
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  page.on('pageerror', (e) => errors.push(String(e)));
+  const errors = pageProblems(page);
   page.errors = errors;
   await page.goto(`${base}?axis=${axis}`);
   await page.waitForSelector('#diagram .present', { timeout: patience });
@@ -315,8 +313,7 @@ runChecks(async () => {
 
   await browser.close();
   run.context = null;
-  const exit = await stopServer(server);
-  expect(exit.code === 0, `cia402 serve exit ${JSON.stringify(exit)}`);
+  await stopCleanly(server, 'cia402 serve');
   console.log(`1..${run.passed}`);
 });
 

@@ -10,7 +10,7 @@
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
 import {
   patience, run, startRun, expect, check, launchBrowser, closeBrowser, runChecks, startServer, startBus,
-  stopServer, waitPresent, click,
+  stopServer, waitPresent, click, stopCleanly,
 } from './page_harness.mjs';
 
 startRun('homing.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
@@ -88,8 +88,7 @@ runChecks(async () => {
   await homingChecks(lp, 'local drive', local);
   await errorChecks(lp, 'local drive');
   await lp.close();
-  const l = await stopServer(local);
-  expect(l.code === 0, `local server exit ${JSON.stringify(l)}`);
+  await stopCleanly(local, 'local server');
 
   const bus = await startBus(['--nodes', '1']);
   const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);

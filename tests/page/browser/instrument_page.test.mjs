@@ -20,7 +20,6 @@ import {
   closeBrowser,
   runChecks,
   startServer,
-  stopServer,
   waitResult,
   expectPresentState,
   expectAccented,
@@ -28,6 +27,9 @@ import {
   click,
   driveState,
   untilDrive,
+  stopCleanly,
+  pageProblems,
+  enableByClicks,
 } from './page_harness.mjs';
 
 const [, outDir, screenshotPath] = startRun('instrument_page.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR', 'SCREENSHOT_PNG']);
@@ -41,9 +43,7 @@ async function main() {
   const context = await launchBrowser();
   const page = context.pages()[0] || await context.newPage();
   run.currentPage = page;
-  const problems = [];
-  page.on('console', (m) => { if (m.type() === 'error') problems.push(m.text()); });
-  page.on('pageerror', (e) => problems.push(String(e)));
+  const problems = pageProblems(page);
 
   await page.goto(main.url);
 
@@ -302,12 +302,7 @@ async function main() {
     expect(await page.textContent('#status-bits li[data-bit="10"] .name') === 'Target reached', 'status bit 10');
     expect(await visible('position-form') && await visible('pp-options') && !(await visible('target-form')),
       'pp: target position, relative and immediate instead of the target velocity');
-    await click(page, 'shutdown');
-    await expectPresentState(page, 'READY_TO_SWITCH_ON');
-    await click(page, 'switch_on');
-    await expectPresentState(page, 'SWITCHED_ON');
-    await click(page, 'enable_operation');
-    await expectPresentState(page, 'OPERATION_ENABLED');
+    await enableByClicks(page, expectPresentState);
     await page.fill('#position-input', '20000');
     await page.click('#position-go');
     await waitResult(page, 'NEW SET-POINT: done: 0x607A = 20000');
@@ -403,8 +398,7 @@ async function main() {
   });
 
   await check('Ctrl-C stops cia402 serve cleanly with exit status 0', async () => {
-    const r = await stopServer(main);
-    expect(r.code === 0, `exit ${JSON.stringify(r)}:\n${main.output}`);
+    await stopCleanly(main, 'cia402 serve');
     expect(main.output.includes('stopping (SIGINT)'), 'it says it stops');
   });
 

@@ -19,11 +19,13 @@ import {
   runChecks,
   startServer,
   startBus,
-  stopServer,
   waitPresent,
   expectPresentState,
   expectAccented,
   click,
+  stopCleanly,
+  pageProblems,
+  enableByClicks,
 } from './page_harness.mjs';
 
 const [, outDir] = startRun('instrument_page_servers.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
@@ -68,8 +70,7 @@ async function main() {
     await click(viewer, 'disable_voltage');
     await expectPresentState(viewer, 'SWITCH_ON_DISABLED');
   });
-  const r = await stopServer(guarded);
-  expect(r.code === 0, `guarded server exit ${JSON.stringify(r)}`);
+  await stopCleanly(guarded, 'guarded server');
   await viewer.close();
 
   // --- a PROFIBUS profile: the seed's names, no Halt -------------------------------------------
@@ -106,8 +107,7 @@ async function main() {
     expect(words.summary === 'Switch-on inhibited', `summary '${words.summary}'`);
     expect(!/\.txt|semantics\.md|S1\.\./.test(words.header), `header '${words.header}'`);
   });
-  const pr = await stopServer(profibus);
-  expect(pr.code === 0, `profibus server exit ${JSON.stringify(pr)}`);
+  await stopCleanly(profibus, 'profibus server');
   await pb.close();
 
   // --- several axes, and choosing the profile on the page ----------------------------------------
@@ -146,8 +146,7 @@ async function main() {
     const r = await (await fetch(`${multi.url.split('?')[0]}api/state?axis=1`)).json();
     expect(r.profile === 'cia402', `axis 1 runs ${r.profile}`);
   });
-  const mr = await stopServer(multi);
-  expect(mr.code === 0, `--nodes server exit ${JSON.stringify(mr)}`);
+  await stopCleanly(multi, '--nodes server');
   await mp.close();
 
   // --- a drive on a CAN bus: cia402 serve --can against a cia402 bus node ----------------------
@@ -156,9 +155,7 @@ async function main() {
   const rp = await context.newPage();
   run.currentPage = rp;
   // Its own list: the earlier pages keep retrying their stopped servers.
-  const remoteProblems = [];
-  rp.on('console', (m) => { if (m.type() === 'error') remoteProblems.push(m.text()); });
-  rp.on('pageerror', (e) => remoteProblems.push(String(e)));
+  const remoteProblems = pageProblems(rp);
   await rp.setViewportSize({ width: 1280, height: 800 });
   await check('--can: the page shows node 1 of the bus, its state, and says numbers are inferred', async () => {
     await rp.goto(remote.url);
@@ -182,15 +179,10 @@ async function main() {
     expect((await rp.textContent('#lamp-sto b')) === 'unknown', 'STO lamp says unknown');
   });
   await check('--can: Shutdown, Switch on, Enable operation: T2, T3, T4 accented, inferred', async () => {
-    await click(rp, 'shutdown');
-    await expectPresentState(rp, 'READY_TO_SWITCH_ON');
-    await expectAccented(rp, 2);
-    await click(rp, 'switch_on');
-    await expectPresentState(rp, 'SWITCHED_ON');
-    await expectAccented(rp, 3);
-    await click(rp, 'enable_operation');
-    await expectPresentState(rp, 'OPERATION_ENABLED');
-    await expectAccented(rp, 4);
+    await enableByClicks(rp, async (p, state, transition) => {
+      await expectPresentState(p, state);
+      await expectAccented(p, transition);
+    });
     const last = await rp.textContent('#last-transition');
     expect(last.includes('inferred'), `last transition "${last}"`);
     expect((await rp.textContent('#cw-hex')) === '0x000F', 'control word 0x000F');
@@ -211,8 +203,7 @@ async function main() {
     await expectAccented(rp, 15);
   });
   await check('--can: when the bus goes away the page says so and shows no present state', async () => {
-    const b = await stopServer(bus);
-    expect(b.code === 0, `cia402 bus exit ${JSON.stringify(b)}`);
+    await stopCleanly(bus, 'cia402 bus');
     await rp.waitForSelector('#remote:not([data-status="running"])', { timeout: patience });
     const text = await rp.textContent('#remote');
     expect(text.includes('bus connection failed'), `banner: "${text}"`);
@@ -222,8 +213,7 @@ async function main() {
   await rp.screenshot({ path: path.join(outDir, 'remote-bus-gone-1280x800.png') });
   await check('--can: no console errors; Ctrl-C stops the server with exit status 0', async () => {
     expect(remoteProblems.length === 0, `console errors: ${JSON.stringify(remoteProblems)}`);
-    const x = await stopServer(remote);
-    expect(x.code === 0, `exit ${JSON.stringify(x)}:\n${remote.output}`);
+    await stopCleanly(remote, 'cia402 serve');
   });
 
 

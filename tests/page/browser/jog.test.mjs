@@ -12,8 +12,8 @@
 //   node jog.test.mjs CIA402_BINARY OUTPUT_DIR
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
 import {
-  patience, run, startRun, fail, expect, check, launchBrowser, closeBrowser, runChecks, startServer,
-  startBus, stopServer, waitPresent, driveState, untilDrive,
+  patience, run, startRun, fail, expect, check, launchBrowser, closeBrowser, runChecks, startServer, startBus,
+  stopServer, waitPresent, driveState, untilDrive, stopCleanly,
 } from './page_harness.mjs';
 import net from 'node:net';
 
@@ -246,8 +246,7 @@ runChecks(async () => {
   const context = await launchBrowser();
   const local = await startServer([]);
   await jogChecks(context, local, 'local drive', false);
-  const l = await stopServer(local);
-  expect(l.code === 0, `local server exit ${JSON.stringify(l)}`);
+  await stopCleanly(local, 'local server');
 
   const bus = await startBus(['--nodes', '1']);
   const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);

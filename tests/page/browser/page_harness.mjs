@@ -147,6 +147,21 @@ export async function stopServer(server) {
   return result;
 }
 
+// Stops `server` (a server or a bus) as stopServer does; it must have exited with status 0.
+export async function stopCleanly(server, what) {
+  const exit = await stopServer(server);
+  expect(exit.code === 0, `${what} exit ${JSON.stringify(exit)}:\n${server.output}`);
+  return exit;
+}
+
+// The errors `page` reports (console errors, uncaught exceptions), gathered as they come.
+export function pageProblems(page) {
+  const problems = [];
+  page.on('console', (m) => { if (m.type() === 'error') problems.push(m.text()); });
+  page.on('pageerror', (e) => problems.push(String(e)));
+  return problems;
+}
+
 // --- reading the page ------------------------------------------------------------------------
 
 export async function waitPresent(page, state, timeout = patience) {
@@ -252,6 +267,17 @@ export async function statusWord(page) {
 
 export async function click(page, command) {
   await page.click(`button[data-command="${command}"]`);
+}
+
+// Shutdown, Switch on and Enable operation clicked in turn, each once `until(page, state, transition)`
+// saw the state the one before led to (waitPresent by default).
+export async function enableByClicks(page, until = (p, state) => waitPresent(p, state)) {
+  const steps = [['shutdown', 'READY_TO_SWITCH_ON', 2], ['switch_on', 'SWITCHED_ON', 3],
+    ['enable_operation', 'OPERATION_ENABLED', 4]];
+  for (const [command, state, transition] of steps) {
+    await click(page, command);
+    await until(page, state, transition);
+  }
 }
 
 // The drive's snapshot as a script sees it (GET /api/state from here, not from the page).

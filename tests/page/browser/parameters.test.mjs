@@ -20,7 +20,7 @@ import {
   runChecks,
   startServer,
   startBus,
-  stopServer,
+  stopCleanly,
 } from './page_harness.mjs';
 
 const [, outDir] = startRun('parameters.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
@@ -128,16 +128,13 @@ async function main() {
   const context = await launchBrowser();
   const local = await startServer([]);
   await checks(context, 'local', local);
-  const l = await stopServer(local);
-  expect(l.code === 0, `local server exit ${JSON.stringify(l)}`);
+  await stopCleanly(local, 'local server');
 
   const bus = await startBus(['--nodes', '1']);
   const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
   await checks(context, 'can', remote);
-  const r = await stopServer(remote);
-  expect(r.code === 0, `--can server exit ${JSON.stringify(r)}`);
-  const b = await stopServer(bus);
-  expect(b.code === 0, `cia402 bus exit ${JSON.stringify(b)}`);
+  await stopCleanly(remote, '--can server');
+  await stopCleanly(bus, 'cia402 bus');
 
   await closeBrowser();
   console.log(`# ${run.passed} checks passed`);

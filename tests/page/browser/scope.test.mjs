@@ -18,7 +18,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { arm as armOn, cursorMs as cursorOf, cursorsFromTrigger, cyclesFilling, cycleMs as cycleOf, dataset as datasetOf,
   recording as recordingOf } from './scope_harness.mjs';
-import { startRun, startServer } from './page_harness.mjs';
+import { enableByClicks, pageProblems, startRun, startServer } from './page_harness.mjs';
 
 const [, outDir] = startRun('scope.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
 const modules = path.resolve(process.env.CIA402_NODE_MODULES || 'node_modules');
@@ -74,9 +74,7 @@ async function main() {
     acceptDownloads: true,
   });
   page = context.pages()[0] || await context.newPage();
-  const problems = [];
-  page.on('console', (m) => { if (m.type() === 'error') problems.push(m.text()); });
-  page.on('pageerror', (e) => problems.push(String(e)));
+  const problems = pageProblems(page);
   // The first request for one module fails, as Chromium fails the requests in flight when the
   // machine's network interfaces change: the page must load anyway (boot.js reloads it).
   let aborted = 0;
@@ -104,12 +102,7 @@ async function main() {
   let t4 = null;
   await check('single shot on transition 4 captures the samples around it, the trigger at the pre-trigger fraction', async () => {
     await arm({ mode: 'single', type: 'transition', transition: 4, pre: 50, div: 20 });
-    await command('shutdown');
-    await waitState('READY_TO_SWITCH_ON');
-    await command('switch_on');
-    await waitState('SWITCHED_ON');
-    await command('enable_operation');
-    await waitState('OPERATION_ENABLED');
+    await enableByClicks(page, (p, state) => waitState(state));
     await page.waitForSelector('#scope-status[data-state="stopped"]', { timeout: patience });
     const rec = await recording();
     const fired = rec.transitions.filter((t) => t.number === 4);

@@ -12,7 +12,7 @@
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
 import {
   patience, run, startRun, expect, check, launchBrowser, closeBrowser, runChecks, startServer, startBus,
-  stopServer, waitPresent, click,
+  stopServer, waitPresent, stopCleanly, pageProblems, enableByClicks,
 } from './page_harness.mjs';
 import { arm, cursorMs, cursorsFromTrigger, cycleMs, cyclesFilling, dataset, recording } from './scope_harness.mjs';
 
@@ -32,9 +32,7 @@ runChecks(async () => {
   const server = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
   const page = await context.newPage();
   run.currentPage = page;
-  const problems = [];
-  page.on('console', (m) => { if (m.type() === 'error') problems.push(m.text()); });
-  page.on('pageerror', (e) => problems.push(String(e)));
+  const problems = pageProblems(page);
   await page.goto(server.url);
   await page.waitForSelector('#remote[data-status="running"]', { timeout: patience });
   await waitPresent(page, 'SWITCH_ON_DISABLED');
@@ -55,12 +53,7 @@ runChecks(async () => {
   let t3 = null;
   await check('--can: single shot on transition 4 captures around the inferred T4, the trigger at the pre-trigger fraction', async () => {
     await arm(page, capture);
-    await click(page, 'shutdown');
-    await waitPresent(page, 'READY_TO_SWITCH_ON');
-    await click(page, 'switch_on');
-    await waitPresent(page, 'SWITCHED_ON');
-    await click(page, 'enable_operation');
-    await waitPresent(page, 'OPERATION_ENABLED');
+    await enableByClicks(page);
     await page.waitForSelector('#scope-status[data-state="stopped"]', { timeout: patience });
     const rec = await recording(page);
     const fired = rec.transitions.filter((t) => t.number === 4);
@@ -104,8 +97,7 @@ runChecks(async () => {
     expect(problems.length === 0, `console errors: ${JSON.stringify(problems)}`);
   });
   await page.close();
-  const s = await stopServer(server);
-  expect(s.code === 0, `serve exit ${JSON.stringify(s)}`);
+  await stopCleanly(server, 'serve');
   await stopServer(bus);
   await closeBrowser();
   console.log(`1..${run.passed}`);
