@@ -1,7 +1,6 @@
 // The drive master's set-up script: the SDO transfers that make a CiA 402 drive ready for PDOs,
 // in the order drive_master.hpp gives, built once from the configuration.
 #include <algorithm>
-#include <iterator>
 
 #include "cia402/canopen/master/drive_master.hpp"
 #include "cia402/canopen/301/pdo.hpp"
@@ -13,58 +12,66 @@
 namespace cia402::canopen {
 namespace {
 
-constexpr std::uint16_t option_indices[] = {0x605A, 0x605B, 0x605C, 0x605D, 0x605E, 0x6007};
-
 bool is_signed_object(std::uint16_t index) {
   const object_description* o = find_drive_object(index);
   return o != nullptr && type_is_signed(o->type);
 }
 
+template <typename Job>
+Job read_job(std::uint16_t index, bool optional) {
+  Job j;
+  j.index = index;
+  j.optional = optional;
+  j.is_signed = is_signed_object(index);
+  return j;
+}
+
+// A write of `v` in `bytes`; one of a group (group != 0) is optional, and its refusal skips the
+// rest of the group.
+template <typename Job>
+Job write_job(std::uint16_t index, std::uint8_t sub, std::int64_t v, unsigned bytes, int group = 0) {
+  Job j;
+  j.write = true;
+  j.index = index;
+  j.sub = sub;
+  j.value = [v] { return v; };
+  j.bytes = bytes;
+  j.group = group;
+  j.optional = group != 0;
+  return j;
+}
+
+// CiA 301's order for a new mapping: sub-index 0 to 0, the entries, then their number.
+template <typename Job>
+void push_mapping(std::vector<Job>& script, std::uint16_t map_index, const pdo_map& m) {
+  script.push_back(write_job<Job>(map_index, 0, 0, 1));
+  for (std::uint8_t e = 0; e < m.count; ++e) {
+    script.push_back(write_job<Job>(map_index, static_cast<std::uint8_t>(e + 1), m.entries[e].word(), 4));
+  }
+  script.push_back(write_job<Job>(map_index, 0, m.count, 1));
+}
+
+// A transfer's `then` that records whether it was done.
+auto note_done(bool& worked) {
+  return [&worked](const sdo_client& c) { worked = c.state() == sdo_client::status::done; };
+}
+
 }  // namespace
 
 void drive_master::build_script() {
-  const std::uint8_t node = config_.node_id;
-  const auto read = [](std::uint16_t index, bool optional) {
-    sdo_job j;
-    j.index = index;
-    j.optional = optional;
-    j.is_signed = is_signed_object(index);
-    return j;
-  };
-  const auto write = [](std::uint16_t index, std::uint8_t sub, std::int64_t v, unsigned bytes,
-                        int group = 0) {
-    sdo_job j;
-    j.write = true;
-    j.index = index;
-    j.sub = sub;
-    j.value = [v] { return v; };
-    j.bytes = bytes;
-    j.group = group;
-    j.optional = group != 0;
-    return j;
-  };
-  // CiA 301's order for a new mapping: sub-index 0 to 0, the entries, then their number.
-  const auto write_mapping = [this, &write](std::uint16_t map_index, const pdo_map& m) {
-    script_.push_back(write(map_index, 0, 0, 1));
-    for (std::uint8_t e = 0; e < m.count; ++e) {
-      script_.push_back(write(map_index, static_cast<std::uint8_t>(e + 1), m.entries[e].word(), 4));
-    }
-    script_.push_back(write(map_index, 0, m.count, 1));
-  };
-  const auto note_done = [](bool& worked) {
-    return [&worked](const sdo_client& c) { worked = c.state() == sdo_client::status::done; };
-  };
-  const auto keep_value = [this](std::uint16_t index, bool is_signed) {
-    return [this, index, is_signed](const sdo_client& c) {
-      if (c.state() == sdo_client::status::done) {
-        start_values_[index] = c.value(is_signed);
-      } else {
-        start_values_.erase(index);
-      }
-    };
-  };
+  script_identity();
+  script_start_values();
+  script_error_control();
+  script_pdos();
+  script_present_values();
+  sdo_job start;
+  start.nmt_start = true;
+  script_.push_back(start);
+}
 
-  sdo_job type = read(0x1000, false);
+// 0x1000 (a CiA 402 drive or none), 0x1008, and whether it is our virtual drive with 0x2001.
+void drive_master::script_identity() {
+  sdo_job type = read_job<sdo_job>(0x1000, false);
   type.then = [this](const sdo_client& c) {
     if ((c.value() & 0xFFFF) != 0x0192) {
       fail(master_failure::not_a_drive, sdo_abort::none, 0x1000, 0,
@@ -74,7 +81,7 @@ void drive_master::build_script() {
   };
   script_.push_back(type);
 
-  sdo_job name = read(0x1008, true);
+  sdo_job name = read_job<sdo_job>(0x1008, true);
   name.then = [this](const sdo_client& c) {
     if (c.state() != sdo_client::status::done) return;
     device_name_.assign(c.data().begin(), c.data().end());
@@ -83,16 +90,30 @@ void drive_master::build_script() {
   script_.push_back(name);
 
   // 0x2001 exists on a `cia402 bus` node as write-only: reading it says so and changes nothing.
-  sdo_job probe = read(fault_injection_index, true);
+  sdo_job probe = read_job<sdo_job>(fault_injection_index, true);
   probe.wanted = [this] { return device_name_ == virtual_drive_device_name; };
   probe.then = [this](const sdo_client& c) {
     fault_injection_ = c.state() == sdo_client::status::aborted &&
                        c.abort_code() == sdo_abort::write_only_object;
   };
   script_.push_back(probe);
+}
 
-  for (const std::uint16_t index : option_indices) {
-    sdo_job s = read(index, true);
+// The option codes (the core's list, 0x605A..0x605E and 0x6007) and what the configuration reads at
+// start, each kept as the drive had it.
+void drive_master::script_start_values() {
+  const auto keep_value = [this](std::uint16_t index, bool is_signed) {
+    return [this, index, is_signed](const sdo_client& c) {
+      if (c.state() == sdo_client::status::done) {
+        start_values_[index] = c.value(is_signed);
+      } else {
+        start_values_.erase(index);
+      }
+    };
+  };
+  for (int o = 0; o < option_count; ++o) {
+    const std::uint16_t index = option_index(static_cast<option>(o));
+    sdo_job s = read_job<sdo_job>(index, true);
     const auto keep = keep_value(index, true);
     s.then = [this, index, keep](const sdo_client& c) {
       keep(c);
@@ -103,24 +124,25 @@ void drive_master::build_script() {
     script_.push_back(s);
   }
   for (const std::uint16_t index : config_.read_at_start) {
-    if (std::find(std::begin(option_indices), std::end(option_indices), index) !=
-        std::end(option_indices)) {
-      continue;  // read above
-    }
-    sdo_job s = read(index, true);
+    option already_read;
+    if (option_of_index(index, already_read)) continue;  // read above
+    sdo_job s = read_job<sdo_job>(index, true);
     s.then = keep_value(index, s.is_signed);
     script_.push_back(s);
   }
+}
 
+// The drive's heartbeat (0x1017) and its watch of ours (0x1016).
+void drive_master::script_error_control() {
   if (config_.drive_heartbeat_ms != 0) {
-    sdo_job hb = write(0x1017, 0, config_.drive_heartbeat_ms, 2, config_.heartbeat_required ? 0 : 1);
+    sdo_job hb = write_job<sdo_job>(0x1017, 0, config_.drive_heartbeat_ms, 2, config_.heartbeat_required ? 0 : 1);
     hb.then = note_done(heartbeat_watched_);
     script_.push_back(hb);
   }
   if (config_.master_heartbeat_ms == 0) {
     // A master of ours that asked to be watched and went away leaves the drive watching a silent
     // node (and faulting on it, 0x6007): clear its entry, and only its.
-    sdo_job guard = read(0x1016, true);
+    sdo_job guard = read_job<sdo_job>(0x1016, true);
     guard.sub = 1;
     guard.then = [this](const sdo_client& c) {
       const auto v = static_cast<std::uint32_t>(c.value());
@@ -128,16 +150,22 @@ void drive_master::build_script() {
                      ((v >> 16) & 0x7F) == config_.master_node_id;
     };
     script_.push_back(guard);
-    sdo_job clear = write(0x1016, 1, 0, 4);
+    sdo_job clear = write_job<sdo_job>(0x1016, 1, 0, 4);
     clear.wanted = [this] { return stale_guard_; };
     script_.push_back(clear);
   }
   if (config_.master_heartbeat_ms != 0) {
     const std::uint32_t watch = std::min<std::uint32_t>(3u * config_.master_heartbeat_ms, 0xFFFF);
-    script_.push_back(write(0x1016, 1, (static_cast<std::int64_t>(config_.master_node_id) << 16) | watch,
-                            4, config_.heartbeat_required ? 0 : 4));
+    script_.push_back(write_job<sdo_job>(0x1016, 1, (static_cast<std::int64_t>(config_.master_node_id) << 16) | watch,
+                                         4, config_.heartbeat_required ? 0 : 4));
   }
+}
 
+void drive_master::script_pdos() {
+  const std::uint8_t node = config_.node_id;
+  const auto write = [](std::uint16_t index, std::uint8_t sub, std::int64_t v, unsigned bytes, int group = 0) {
+    return write_job<sdo_job>(index, sub, v, bytes, group);
+  };
   // TPDO1: status word (+ error code), at each SYNC or on every change.
   const bool on_change = config_.timing == pdo_timing::on_change;
   const std::int64_t tpdo1 = cob::tpdo1 + node;
@@ -173,8 +201,7 @@ void drive_master::build_script() {
   // RPDO1: the control word, acting on receipt.
   const std::int64_t rpdo1 = cob::rpdo1 + node;
   script_.push_back(write(0x1400, 1, pdo_cob_invalid | rpdo1, 4));
-  const pdo_map& control = pdo_maps::can_rpdo[0];  // the control word alone: CiA 402's RPDO1
-  write_mapping(0x1600, control);
+  push_mapping(script_, 0x1600, pdo_maps::can_rpdo[0]);  // the control word alone: CiA 402's RPDO1
   script_.push_back(write(0x1400, 2, 255, 1));
   script_.push_back(write(0x1400, 1, rpdo1, 4));
 
@@ -186,45 +213,42 @@ void drive_master::build_script() {
     const std::int64_t rpdo3_id = cob::rpdo1 + 0x200 + node;
     script_.push_back(write(0x1402, 1, pdo_cob_invalid | rpdo3_id, 4));
     const pdo_map& rpdo3 = pdo_maps::can_rpdo[2];
-    write_mapping(0x1602, rpdo3);
+    push_mapping(script_, 0x1602, rpdo3);
     script_.push_back(write(0x1402, 2, rpdo3.transmission_type, 1));
     script_.push_back(write(0x1402, 1, rpdo3_id, 4));
     const std::int64_t tpdo3_id = cob::tpdo1 + 0x200 + node;
     script_.push_back(write(0x1802, 1, pdo_cob_invalid | tpdo3_id, 4));
     const pdo_map& tpdo3 = pdo_maps::can_tpdo[2];
-    write_mapping(0x1A02, tpdo3);
+    push_mapping(script_, 0x1A02, tpdo3);
     script_.push_back(write(0x1802, 2, tpdo3.transmission_type, 1));
     sdo_job enable3 = write(0x1802, 1, tpdo3_id, 4);
     enable3.then = note_done(position_mapped_);
     script_.push_back(enable3);
   }
+}
 
-  if (on_change) {
-    // The drive's present values last, just before NMT start, so the master starts from them:
-    // no TPDO says them until they change.
-    sdo_job cw = read(0x6040, true);
-    cw.then = [this](const sdo_client& c) {
-      if (c.state() == sdo_client::status::done) last_sent_ = static_cast<std::uint16_t>(c.value());
-    };
-    script_.push_back(cw);
-    sdo_job sw = read(0x6041, false);
-    sw.then = [this](const sdo_client& c) { note_status(static_cast<std::uint16_t>(c.value())); };
-    script_.push_back(sw);
-    sdo_job err = read(0x603F, true);
-    err.then = [this](const sdo_client& c) {
-      if (c.state() == sdo_client::status::done) error_code_ = static_cast<std::uint16_t>(c.value());
-    };
-    script_.push_back(err);
-    sdo_job vel = read(0x606C, true);
-    vel.then = [this](const sdo_client& c) {
-      if (c.state() == sdo_client::status::done) note_velocity(static_cast<std::int32_t>(c.value(true)));
-    };
-    script_.push_back(vel);
-  }
-
-  sdo_job start;
-  start.nmt_start = true;
-  script_.push_back(start);
+// With TPDOs on change, the drive's present values last, just before NMT start, so the master
+// starts from them: no TPDO says them until they change.
+void drive_master::script_present_values() {
+  if (config_.timing != pdo_timing::on_change) return;
+  sdo_job cw = read_job<sdo_job>(0x6040, true);
+  cw.then = [this](const sdo_client& c) {
+    if (c.state() == sdo_client::status::done) last_sent_ = static_cast<std::uint16_t>(c.value());
+  };
+  script_.push_back(cw);
+  sdo_job sw = read_job<sdo_job>(0x6041, false);
+  sw.then = [this](const sdo_client& c) { note_status(static_cast<std::uint16_t>(c.value())); };
+  script_.push_back(sw);
+  sdo_job err = read_job<sdo_job>(0x603F, true);
+  err.then = [this](const sdo_client& c) {
+    if (c.state() == sdo_client::status::done) error_code_ = static_cast<std::uint16_t>(c.value());
+  };
+  script_.push_back(err);
+  sdo_job vel = read_job<sdo_job>(0x606C, true);
+  vel.then = [this](const sdo_client& c) {
+    if (c.state() == sdo_client::status::done) note_velocity(static_cast<std::int32_t>(c.value(true)));
+  };
+  script_.push_back(vel);
 }
 
 }  // namespace cia402::canopen

@@ -229,7 +229,14 @@ class drive_master {
     std::function<void(const sdo_result&)> done;  // a request's own callback
     bool nmt_start = false;  // not a transfer: NMT start, then running
   };
+  /// The set-up script (build_script), in the order drive_master.hpp gives: who the drive is,
+  /// the values read at start, error control, the PDOs, the present values, NMT start.
   void build_script();
+  void script_identity();
+  void script_start_values();
+  void script_error_control();
+  void script_pdos();
+  void script_present_values();
   void restart(phase_reason why, std::string text);
   void go_running();
   void fail(master_failure f, sdo_abort a, std::uint16_t index, std::uint8_t sub, std::string text);
