@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <functional>
 #include <random>
 
 #include "bench.hpp"
@@ -17,41 +18,46 @@ bool has(const std::string& text, const std::string& part) { return text.find(pa
 
 // --- limits before motion -----------------------------------------------------------------------
 
+// The request is refused as bad input before anything moves: its error names `why` and no control
+// word went out. The result.
+result expect_refused_before_motion(bench& b, const std::function<std::uint64_t(completion)>& request,
+                                    const std::string& why) {
+  const result r = b.finish(request);
+  EXPECT_TRUE(r.bad_input);
+  EXPECT_TRUE(has(r.error, why)) << r.error;
+  EXPECT_TRUE(b.link.words.empty()) << "no control word went out";
+  return r;
+}
+
 TEST(limits, a_velocity_beyond_0x607F_is_refused_naming_it_and_nothing_moves) {
   bench b;
-  const result r = b.finish([&](completion d) { return b.s->velocity(99999, std::move(d)); });
+  const result r =
+      expect_refused_before_motion(b, [&](completion d) { return b.s->velocity(99999, std::move(d)); },
+                                   "velocity 99999 rpm is beyond 0x607F (max profile velocity) = 6000 rpm");
   EXPECT_FALSE(r.ok());
-  EXPECT_TRUE(r.bad_input);
-  EXPECT_TRUE(has(r.error, "velocity 99999 rpm is beyond 0x607F (max profile velocity) = 6000 rpm")) << r.error;
-  EXPECT_TRUE(b.link.words.empty()) << "no control word went out";
   EXPECT_EQ(b.link.drive.view().current(), state::switch_on_disabled);
 }
 
 TEST(limits, a_velocity_within_0x607F_but_beyond_0x6080_names_0x6080) {
   bench b;
   ASSERT_EQ(b.link.drive.write(object_index::max_motor_speed, 0, 2000), sdo_abort::none);
-  const result r = b.finish([&](completion d) { return b.s->velocity(-3000, std::move(d)); });
-  EXPECT_TRUE(r.bad_input);
-  EXPECT_TRUE(has(r.error, "velocity -3000 rpm is beyond 0x6080 (max motor speed) = 2000 rpm")) << r.error;
-  EXPECT_TRUE(b.link.words.empty());
+  expect_refused_before_motion(b, [&](completion d) { return b.s->velocity(-3000, std::move(d)); },
+                               "velocity -3000 rpm is beyond 0x6080 (max motor speed) = 2000 rpm");
 }
 
 TEST(limits, a_torque_beyond_0x6072_is_refused) {
   bench b;
-  const result r = b.finish([&](completion d) { return b.s->torque(5000, std::move(d)); });
-  EXPECT_TRUE(r.bad_input);
-  EXPECT_TRUE(has(r.error, "torque 5000 permille is beyond 0x6072 (max torque) = 3000 permille")) << r.error;
-  EXPECT_TRUE(b.link.words.empty());
+  expect_refused_before_motion(b, [&](completion d) { return b.s->torque(5000, std::move(d)); },
+                               "torque 5000 permille is beyond 0x6072 (max torque) = 3000 permille");
 }
 
 TEST(limits, a_move_beyond_0x607D_is_refused_absolute_and_relative) {
   bench b;
   ASSERT_EQ(b.link.drive.write(object_index::software_position_limit, 1, -1000), sdo_abort::none);
   ASSERT_EQ(b.link.drive.write(object_index::software_position_limit, 2, 10000), sdo_abort::none);
-  const result far = b.finish([&](completion d) { return b.s->move({20000, false, std::nullopt}, std::move(d)); });
-  EXPECT_TRUE(far.bad_input);
-  EXPECT_TRUE(has(far.error, "target position 20000 is beyond 0x607D:02 (max position limit) = 10000")) << far.error;
-  EXPECT_TRUE(b.link.words.empty());
+  expect_refused_before_motion(
+      b, [&](completion d) { return b.s->move({20000, false, std::nullopt}, std::move(d)); },
+      "target position 20000 is beyond 0x607D:02 (max position limit) = 10000");
   ASSERT_TRUE(b.finish([&](completion d) { return b.s->move({8000, false, std::nullopt}, std::move(d)); }).ok());
   const result more = b.finish([&](completion d) { return b.s->move({3000, true, std::nullopt}, std::move(d)); });
   EXPECT_TRUE(more.bad_input);
@@ -71,10 +77,8 @@ TEST(limits, a_profile_velocity_beyond_0x607F_refuses_the_move) {
 TEST(limits, a_mode_0x6502_does_not_announce_is_refused_before_the_limits_are_read) {
   bench b;
   b.link.own[{object_index::supported_drive_modes, 0}] = {0x01, 0x00, 0x00, 0x00};  // pp only
-  const result r = b.finish([&](completion d) { return b.s->velocity(100, std::move(d)); });
-  EXPECT_TRUE(r.bad_input);
-  EXPECT_TRUE(has(r.error, "pv (3) is not among the modes 0x6502")) << r.error;
-  EXPECT_TRUE(b.link.words.empty());
+  expect_refused_before_motion(b, [&](completion d) { return b.s->velocity(100, std::move(d)); },
+                               "pv (3) is not among the modes 0x6502");
 }
 
 TEST(limits, a_drive_without_the_limit_objects_is_not_judged) {
