@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "mode_support.hpp"
@@ -82,22 +83,33 @@ TEST(interpolation, csp_moves_evenly_whatever_the_cycle_in_the_period_the_master
   }
 }
 
+// What `sample` reads after each of `cycles` steps.
+std::vector<std::int64_t> samples(virtual_drive& d, int cycles, const std::function<std::int64_t()>& sample) {
+  std::vector<std::int64_t> v;
+  for (int c = 0; c < cycles; ++c) {
+    d.step();
+    v.push_back(sample());
+  }
+  return v;
+}
+
+// The period under way when a set-point was written still runs towards 0; the next one goes from 0
+// to the set-point in ten equal steps of `step`, then it holds.
+void expect_ramp_over_the_next_period(const std::vector<std::int64_t>& v, std::int64_t step) {
+  const auto first = std::find_if(v.begin(), v.end(), [](std::int64_t x) { return x != 0; });
+  ASSERT_NE(first, v.end());
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(*(first + i), step * (i + 1)) << i;
+  EXPECT_EQ(v.back(), 10 * step);
+}
+
 TEST(interpolation, csv_ramps_a_step_of_0x60FF_over_the_period) {
   virtual_drive d(standard_profile());
   set_period_ms(d, 10);
   enable_in_mode(d, cia402::mode::cyclic_synchronous_velocity);
   write(d, 0x60FF, 500);
-  std::vector<std::int64_t> v;
-  for (int c = 0; c < 25; ++c) {
-    d.step();
-    v.push_back(d.view().velocity_micro_rpm());
-  }
-  // The period under way when it was written still runs towards 0; the next one goes from 0 to 500
-  // rpm in ten equal steps of 50 rpm (below the motor's 100 rpm a cycle), then it holds.
-  const auto first = std::find_if(v.begin(), v.end(), [](std::int64_t x) { return x != 0; });
-  ASSERT_NE(first, v.end());
-  for (int i = 0; i < 10; ++i) EXPECT_EQ(*(first + i), 50 * micro * (i + 1)) << i;
-  EXPECT_EQ(v.back(), 500 * micro);
+  // 0 to 500 rpm in ten equal steps of 50 rpm (below the motor's 100 rpm a cycle).
+  expect_ramp_over_the_next_period(samples(d, 25, [&] { return d.view().velocity_micro_rpm(); }),
+                                   50 * micro);
 }
 
 TEST(interpolation, cst_ramps_a_step_of_0x6071_over_the_period) {
@@ -105,15 +117,7 @@ TEST(interpolation, cst_ramps_a_step_of_0x6071_over_the_period) {
   set_period_ms(d, 10);
   enable_in_mode(d, cia402::mode::cyclic_synchronous_torque);
   write(d, 0x6071, 500);
-  std::vector<std::int64_t> torque;
-  for (int c = 0; c < 25; ++c) {
-    d.step();
-    torque.push_back(read(d, 0x6077));
-  }
-  const auto first = std::find_if(torque.begin(), torque.end(), [](std::int64_t x) { return x != 0; });
-  ASSERT_NE(first, torque.end());
-  for (int i = 0; i < 10; ++i) EXPECT_EQ(*(first + i), 50 * (i + 1)) << i;
-  EXPECT_EQ(torque.back(), 500);
+  expect_ramp_over_the_next_period(samples(d, 25, [&] { return read(d, 0x6077); }), 50);
 }
 
 }  // namespace
