@@ -19,7 +19,7 @@
 import { createRequire } from 'node:module';
 import path from 'node:path';
 import {
-  patience, run, startRun, fail, expect, check, runChecks, startServer, waitPresent, stopCleanly, pageProblems,
+  patience, run, startRun, fail, expect, check, runChecks, startServer, waitPresent, stopCleanly, pageProblems, newTab,
 } from './page_harness.mjs';
 
 startRun('control.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
@@ -68,8 +68,7 @@ async function serverWait(fromMs, ms, each = async () => {}) {
 }
 
 async function openPage(context, axis) {
-  const page = await context.newPage();
-  run.currentPage = page;
+  const page = await newTab(context);
   const errors = pageProblems(page);
   page.errors = errors;
   await page.goto(`${base}?axis=${axis}`);

@@ -10,7 +10,7 @@
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
 import {
   patience, run, startRun, expect, check, launchBrowser, closeBrowser, runChecks, startServer, startBus,
-  stopServer, waitPresent, click, stopCleanly,
+  stopServer, waitPresent, click, stopCleanly, newTab,
 } from './page_harness.mjs';
 
 startRun('homing.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
@@ -81,8 +81,7 @@ async function errorChecks(page, where) {
 runChecks(async () => {
   const context = await launchBrowser();
   const local = await startServer([]);
-  const lp = await context.newPage();
-  run.currentPage = lp;
+  const lp = await newTab(context);
   await lp.goto(local.url);
   await waitPresent(lp, 'SWITCH_ON_DISABLED');
   await homingChecks(lp, 'local drive', local);
@@ -92,8 +91,7 @@ runChecks(async () => {
 
   const bus = await startBus(['--nodes', '1']);
   const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
-  const rp = await context.newPage();
-  run.currentPage = rp;
+  const rp = await newTab(context);
   await rp.goto(remote.url);
   await rp.waitForSelector('#remote[data-status="running"]', { timeout: patience });
   await waitPresent(rp, 'SWITCH_ON_DISABLED');

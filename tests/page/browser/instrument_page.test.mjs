@@ -276,6 +276,20 @@ async function main() {
     { timeout: patience });
   const positionIs = (value) => page.waitForFunction(
     (v) => document.getElementById('position').textContent === v, value, { timeout: patience });
+  // The operation mode chosen in the select, once the page shows it.
+  const selectMode = async (mode) => {
+    await page.selectOption('#mode-select', mode);
+    await page.waitForFunction((m) => document.getElementById('mode').textContent.startsWith(`${m} `), mode,
+      { timeout: patience });
+  };
+  // The names the page gives the control or status bits, by number.
+  const expectBitNames = async (list, names) => {
+    const item = list === 'control' ? '#control-bits button' : '#status-bits li';
+    for (const [bit, name] of Object.entries(names)) {
+      const shown = await page.textContent(`${item}[data-bit="${bit}"] .name`);
+      expect(shown === name, `${list} bit ${bit} is named "${shown}", not "${name}"`);
+    }
+  };
 
   await check('operation modes: the select offers the modes 0x6502 announces, by name', async () => {
     const options = await page.$$eval('#mode-select option', (os) => os.map((o) => `${o.value} ${o.textContent}`));
@@ -284,22 +298,13 @@ async function main() {
       '10 Cyclic synchronous torque (cst)', `modes offered: ${options.join('|')}`);
     expect(await page.textContent('#mode') === '3 Profile velocity (pv)', 'pv at power-up');
     expect(await visible('target-form') && !(await visible('position-form')), 'pv: the target velocity');
-    expect(await page.textContent('#status-bits li[data-bit="12"] .name') === 'Speed = 0', 'status bit 12 in pv');
+    await expectBitNames('status', { 12: 'Speed = 0' });
   });
 
   await check('pp: a target and the new set-point handshake move the drive; the bits take pp names', async () => {
-    await page.selectOption('#mode-select', '1');
-    await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('1 '),
-      null, { timeout: patience });
-    expect(await page.textContent('#control-bits button[data-bit="4"] .name') === 'New set-point',
-      'control bit 4 named for pp');
-    expect(await page.textContent('#control-bits button[data-bit="5"] .name') === 'Change set immediately',
-      'control bit 5 named for pp');
-    expect(await page.textContent('#control-bits button[data-bit="6"] .name') === 'Relative (0 absolute)',
-      'control bit 6 named for pp');
-    expect(await page.textContent('#status-bits li[data-bit="12"] .name') === 'Set-point acknowledge',
-      'status bit 12 named for pp');
-    expect(await page.textContent('#status-bits li[data-bit="10"] .name') === 'Target reached', 'status bit 10');
+    await selectMode('1');
+    await expectBitNames('control', { 4: 'New set-point', 5: 'Change set immediately', 6: 'Relative (0 absolute)' });
+    await expectBitNames('status', { 10: 'Target reached', 12: 'Set-point acknowledge' });
     expect(await visible('position-form') && await visible('pp-options') && !(await visible('target-form')),
       'pp: target position, relative and immediate instead of the target velocity');
     await enableByClicks(page, expectPresentState);
@@ -325,15 +330,9 @@ async function main() {
   });
 
   await check('hm: homing method 37 and homing start set the position to the home offset', async () => {
-    await page.selectOption('#mode-select', '6');
-    await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('6 '),
-      null, { timeout: patience });
-    expect(await page.textContent('#status-bits li[data-bit="12"] .name') === 'Homing attained',
-      'status bit 12 named for homing');
-    expect(await page.textContent('#status-bits li[data-bit="13"] .name') === 'Homing error',
-      'status bit 13 named for homing');
-    expect(await page.textContent('#control-bits button[data-bit="4"] .name') === 'Homing operation start',
-      'control bit 4 named for homing');
+    await selectMode('6');
+    await expectBitNames('status', { 12: 'Homing attained', 13: 'Homing error' });
+    await expectBitNames('control', { 4: 'Homing operation start' });
     expect(await visible('homing-form') && !(await visible('position-form')), 'hm: the homing inputs');
     await page.selectOption('#object-index', '0x607C');
     await page.fill('#object-value', '777');
@@ -352,11 +351,8 @@ async function main() {
       null, { timeout: patience });
     await click(page, 'disable_voltage');
     await expectPresentState(page, 'SWITCH_ON_DISABLED');
-    await page.selectOption('#mode-select', '3');
-    await page.waitForFunction(() => document.getElementById('mode').textContent.startsWith('3 '),
-      null, { timeout: patience });
-    expect(await page.textContent('#control-bits button[data-bit="4"] .name') === 'Reserved in pv',
-      'control bit 4 back to pv');
+    await selectMode('3');
+    await expectBitNames('control', { 4: 'Reserved in pv' });
   });
 
   await check('the recording exports position and torque as its last columns', async () => {

@@ -26,6 +26,7 @@ import {
   stopCleanly,
   pageProblems,
   enableByClicks,
+  newTab,
 } from './page_harness.mjs';
 
 const [, outDir] = startRun('instrument_page_servers.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
@@ -38,9 +39,7 @@ async function main() {
   await check('--token-required prints a URL with ?token=', async () => {
     expect(/\?token=[0-9a-f]{32}$/.test(guarded.url), `URL ${guarded.url}`);
   });
-  const viewer = await context.newPage();
-  run.currentPage = viewer;
-  await viewer.setViewportSize({ width: 1280, height: 800 });
+  const viewer = await newTab(context, { width: 1280, height: 800 });
   await check('without the token the page is view-only: banner shown, controls disabled', async () => {
     await viewer.goto(guarded.url.replace(/\?token=.*$/, ''));
     await waitPresent(viewer, 'SWITCH_ON_DISABLED');
@@ -75,9 +74,7 @@ async function main() {
 
   // --- a PROFIBUS profile: the seed's names, no Halt -------------------------------------------
   const profibus = await startServer(['--profile', 's300-profibus']);
-  const pb = await context.newPage();
-  run.currentPage = pb;
-  await pb.setViewportSize({ width: 1280, height: 800 });
+  const pb = await newTab(context, { width: 1280, height: 800 });
   await check('s300-profibus: no Halt button (bit 8 is Jog there), bits named as STW/ZSW', async () => {
     await pb.goto(profibus.url);
     await waitPresent(pb, 'SWITCH_ON_DISABLED');
@@ -112,9 +109,7 @@ async function main() {
 
   // --- several axes, and choosing the profile on the page ----------------------------------------
   const multi = await startServer(['--nodes', '3']);
-  const mp = await context.newPage();
-  run.currentPage = mp;
-  await mp.setViewportSize({ width: 1280, height: 800 });
+  const mp = await newTab(context, { width: 1280, height: 800 });
   const cardState = (k) => mp.textContent(`.axis-card[data-axis="${k}"] .axis-state`);
   await check('--nodes 3: an overview card per axis, the one shown marked', async () => {
     await mp.goto(multi.url);
@@ -152,8 +147,7 @@ async function main() {
   // --- a drive on a CAN bus: cia402 serve --can against a cia402 bus node ----------------------
   const bus = await startBus(['--nodes', '1']);
   const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
-  const rp = await context.newPage();
-  run.currentPage = rp;
+  const rp = await newTab(context);
   // Its own list: the earlier pages keep retrying their stopped servers.
   const remoteProblems = pageProblems(rp);
   await rp.setViewportSize({ width: 1280, height: 800 });

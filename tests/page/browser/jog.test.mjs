@@ -13,7 +13,7 @@
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
 import {
   patience, run, startRun, fail, expect, check, launchBrowser, closeBrowser, runChecks, startServer, startBus,
-  stopServer, waitPresent, driveState, untilDrive, stopCleanly,
+  stopServer, waitPresent, driveState, untilDrive, stopCleanly, newTab,
 } from './page_harness.mjs';
 import net from 'node:net';
 
@@ -124,8 +124,7 @@ function startRelay(serverUrl) {
 }
 
 async function openPage(context, server, remote, pageUrl = server.url) {
-  const page = await context.newPage();
-  run.currentPage = page;
+  const page = await newTab(context);
   await page.goto(pageUrl);
   if (remote) await page.waitForSelector('#remote[data-status="running"]', { timeout: patience });
   await page.waitForSelector('#diagram .present', { timeout: patience });

@@ -67,6 +67,14 @@ export async function launchBrowser() {
   return run.context;
 }
 
+// A new tab in `context`, the one a failure's screenshot shows; at `viewport` when given.
+export async function newTab(context, viewport = null) {
+  const page = await context.newPage();
+  run.currentPage = page;
+  if (viewport) await page.setViewportSize(viewport);
+  return page;
+}
+
 export async function closeBrowser() {
   await run.context.close();
   run.context = null;

@@ -21,6 +21,7 @@ import {
   startServer,
   startBus,
   stopCleanly,
+  newTab,
 } from './page_harness.mjs';
 
 const [, outDir] = startRun('parameters.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
@@ -44,8 +45,7 @@ async function writeInline(page, key, value) {
 }
 
 async function checks(context, name, server) {
-  const page = await context.newPage();
-  run.currentPage = page;
+  const page = await newTab(context);
   const problems = [];
   page.on('pageerror', (e) => problems.push(String(e)));
   await check(`${name}: the Parameters panel lists the drive's entries with type, unit, limits and default`, async () => {

@@ -12,7 +12,7 @@
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
 import {
   patience, run, startRun, expect, check, launchBrowser, closeBrowser, runChecks, startServer, startBus,
-  stopServer, waitPresent, stopCleanly, pageProblems, enableByClicks,
+  stopServer, waitPresent, stopCleanly, pageProblems, enableByClicks, newTab,
 } from './page_harness.mjs';
 import { arm, cursorMs, cursorsFromTrigger, cycleMs, cyclesFilling, dataset, recording } from './scope_harness.mjs';
 
@@ -30,8 +30,7 @@ runChecks(async () => {
   const context = await launchBrowser();
   const bus = await startBus(['--nodes', '1']);
   const server = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
-  const page = await context.newPage();
-  run.currentPage = page;
+  const page = await newTab(context);
   const problems = pageProblems(page);
   await page.goto(server.url);
   await page.waitForSelector('#remote[data-status="running"]', { timeout: patience });
