@@ -241,47 +241,38 @@ TEST(quick_stop_exit, lexium32_fieldbus_quick_stop_is_left_by_enable_operation) 
 // ---------------------------------------------------------------------------------------------
 // Error codes the drive raises itself (S13, S14; docs/semantics.md choices 5 and 16).
 
-// S14: STO while torque is on is a fault (T13) with a documented code: 0xFF01, in the manufacturer
-// range. 0x1001 (CiA 301, cia402-reference.md §5): bit 0 generic + bit 7 manufacturer = 0x81.
-TEST(fault_codes, sto_while_torque_is_on_records_0xff01_and_error_register_0x81) {
+// In every built-in, from OPERATION ENABLED with torque on and no error: `cause` takes T13 in the
+// next step with the torque off, 0x603F = `code` and 0x1001 = `reg`, and FAULT keeps both.
+void expect_fault_recorded(void (*cause)(bench&), std::uint16_t code, std::uint8_t reg) {
   for (const profile* p : test::all_builtins()) {
     SCOPED_TRACE(p->name);
     bench b(*p);
     ASSERT_TRUE(test::reach(b, S::operation_enabled));
     ASSERT_TRUE(b.out.torque);
     ASSERT_EQ(b.out.error_code, 0);
-    b.in.sto = true;
+    cause(b);
     b.step();
     EXPECT_EQ(int(b.out.transition), 13) << test::describe(b.out);
     EXPECT_FALSE(b.out.torque);
-    EXPECT_EQ(b.out.error_code, 0xFF01);
-    EXPECT_EQ(b.out.error_register, 0x81);
+    EXPECT_EQ(b.out.error_code, code);
+    EXPECT_EQ(b.out.error_register, reg);
     b.settle();
     EXPECT_EQ(b.a.current, S::fault);
-    EXPECT_EQ(b.out.error_code, 0xFF01) << "0x603F keeps the code in FAULT";
-    EXPECT_EQ(b.out.error_register, 0x81);
+    EXPECT_EQ(b.out.error_code, code) << "0x603F keeps the code in FAULT";
+    EXPECT_EQ(b.out.error_register, reg);
   }
+}
+
+// S14: STO while torque is on is a fault (T13) with a documented code: 0xFF01, in the manufacturer
+// range. 0x1001 (CiA 301, cia402-reference.md §5): bit 0 generic + bit 7 manufacturer = 0x81.
+TEST(fault_codes, sto_while_torque_is_on_records_0xff01_and_error_register_0x81) {
+  expect_fault_recorded([](bench& b) { b.in.sto = true; }, 0xFF01, 0x81);
 }
 
 // S13: losing the DC link while torque is on is a fault (T13, 0x3220). 0x1001: bit 0 generic + bit
 // 2 voltage = 0x05.
 TEST(fault_codes, dc_link_lost_while_torque_is_on_records_0x3220_and_error_register_0x05) {
-  for (const profile* p : test::all_builtins()) {
-    SCOPED_TRACE(p->name);
-    bench b(*p);
-    ASSERT_TRUE(test::reach(b, S::operation_enabled));
-    ASSERT_TRUE(b.out.torque);
-    b.in.dc_link = false;
-    b.step();
-    EXPECT_EQ(int(b.out.transition), 13) << test::describe(b.out);
-    EXPECT_FALSE(b.out.torque);
-    EXPECT_EQ(b.out.error_code, 0x3220);
-    EXPECT_EQ(b.out.error_register, 0x05);
-    b.settle();
-    EXPECT_EQ(b.a.current, S::fault);
-    EXPECT_EQ(b.out.error_code, 0x3220);
-    EXPECT_EQ(b.out.error_register, 0x05);
-  }
+  expect_fault_recorded([](bench& b) { b.in.dc_link = false; }, 0x3220, 0x05);
 }
 
 // S14 elsewhere: STO where torque is off raises the warning bit 7; no fault, no code. S11 gives the
