@@ -41,19 +41,15 @@ TEST(diagnostics, the_snapshot_says_what_blocks_enable_and_nothing_once_it_is_go
   why = snapshot(inst)["enable_blocker"];
   ASSERT_TRUE(why.is_string());
   EXPECT_NE(why.get<std::string>().find("DC-link"), std::string::npos) << why;
-  plant_change fault;
+  plant_change fault = fault_of(0x2310);
   fault.dc_link = true;
-  fault.fault = true;
-  fault.fault_code = 0x2310;
   inst.change_plant(fault);
   run(inst, 300);
   why = snapshot(inst)["enable_blocker"];
   ASSERT_TRUE(why.is_string());
   EXPECT_NE(why.get<std::string>().find("0x2310"), std::string::npos) << why;
   EXPECT_NE(why.get<std::string>().find("over-current"), std::string::npos) << why;
-  plant_change gone;
-  gone.fault = false;
-  inst.change_plant(gone);
+  inst.change_plant(no_fault());
   inst.command(page_command::fault_reset);
   run(inst, 300);
   EXPECT_EQ(snapshot(inst)["state"], "SWITCH_ON_DISABLED");
@@ -88,14 +84,9 @@ TEST(diagnostics, the_snapshot_lists_each_error_the_drive_showed_newest_first_wi
   run(inst, 10);
   EXPECT_TRUE(snapshot(inst)["error_history"].empty());
   const auto fault = [&inst](std::uint16_t code) {
-    plant_change c;
-    c.fault = true;
-    c.fault_code = code;
-    inst.change_plant(c);
+    inst.change_plant(fault_of(code));
     run(inst, 100);
-    plant_change gone;
-    gone.fault = false;
-    inst.change_plant(gone);
+    inst.change_plant(no_fault());
     inst.command(page_command::fault_reset);
     run(inst, 100);
   };

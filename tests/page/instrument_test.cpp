@@ -129,19 +129,14 @@ TEST(instrument, halt_is_not_offered_where_bit_8_is_not_a_halt) {
 TEST(instrument, fault_reset_is_one_edge_of_bit_7_and_leads_fault_to_switch_on_disabled_by_t15) {
   virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
-  plant_change fault;
-  fault.fault = true;
-  fault.fault_code = 0x2310;
-  inst.change_plant(fault);
+  inst.change_plant(fault_of(0x2310));
   const json fr = settled_result(inst);
   EXPECT_EQ(fr["transitions"], json::array({13, 14}));
   EXPECT_EQ(snapshot(inst)["state"], "FAULT");
   EXPECT_EQ(snapshot(inst)["error_code"], "0x2310");
   EXPECT_EQ(snapshot(inst)["error_text"], "continuous over-current");  // CiA 402's error code table
 
-  plant_change clear;
-  clear.fault = false;
-  inst.change_plant(clear);
+  inst.change_plant(no_fault());
   run(inst, 100);
   inst.command(page_command::fault_reset);
   inst.step();
@@ -158,13 +153,9 @@ TEST(instrument, fault_reset_after_bit_7_was_left_set_still_makes_an_edge) {
   virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
   inst.toggle_control_bit(7);
-  plant_change fault;
-  fault.fault = true;
-  inst.change_plant(fault);
+  inst.change_plant(fault_of());
   run(inst, 300);
-  plant_change clear;
-  clear.fault = false;
-  inst.change_plant(clear);
+  inst.change_plant(no_fault());
   run(inst, 100);
   ASSERT_EQ(snapshot(inst)["state"], "FAULT");
   inst.command(page_command::fault_reset);
@@ -174,10 +165,7 @@ TEST(instrument, fault_reset_after_bit_7_was_left_set_still_makes_an_edge) {
 TEST(instrument, fault_reset_while_the_cause_persists_is_refused_and_names_the_cause) {
   virtual_axis_page inst(cia402::standard_profile());
   run(inst, 10);
-  plant_change fault;
-  fault.fault = true;
-  fault.fault_code = 0x4310;
-  inst.change_plant(fault);
+  inst.change_plant(fault_of(0x4310));
   run(inst, 300);
   inst.command(page_command::fault_reset);
   const json r = settled_result(inst);

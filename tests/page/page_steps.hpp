@@ -47,6 +47,20 @@ inline void enable(virtual_axis_page& inst) {
   }
 }
 
+// The plant change that makes a fault cause appear, with error code `code` (0x603F), and the one
+// that takes every cause away.
+inline plant_change fault_of(std::uint16_t code = plant_change{}.fault_code) {
+  plant_change c;
+  c.fault = true;
+  c.fault_code = code;
+  return c;
+}
+inline plant_change no_fault() {
+  plant_change c;
+  c.fault = false;
+  return c;
+}
+
 // Steps until the snapshot shows status bit `bit` set (or `limit` cycles passed).
 inline json run_until_status_bit(virtual_axis_page& inst, int bit, int limit) {
   json s = snapshot(inst);
