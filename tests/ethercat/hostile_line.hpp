@@ -31,6 +31,16 @@ class hostile_line final : public master_link {
   struct master_did_not_end : std::runtime_error {
     master_did_not_end() : std::runtime_error("the master was still waiting on the line past the time limit") {}
   };
+  /// Runs `f` (a call of the master on this line): false when it had not ended by the time limit.
+  template <typename F>
+  static bool ends(F f) {
+    try {
+      f();
+      return true;
+    } catch (const master_did_not_end&) {
+      return false;
+    }
+  }
 
   explicit hostile_line(int drives) {
     for (int i = 0; i < drives; ++i) {
