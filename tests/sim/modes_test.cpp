@@ -27,12 +27,17 @@ int offer_setpoint(virtual_drive& d, std::int64_t target, std::uint16_t bits = 0
   return ack;
 }
 
+// Profile position mode with the same acceleration (0x6083) and deceleration (0x6084), rpm/s.
+void enable_pp_with_ramps(virtual_drive& d, std::int64_t rpm_s) {
+  enable_in_mode(d, cia402::mode::profile_position);
+  write(d, 0x6083, rpm_s);
+  write(d, 0x6084, rpm_s);
+}
+
 TEST(profile_position, a_move_takes_the_time_the_trapezoid_says_and_sets_bit_12_then_bit_10) {
   virtual_drive d(standard_profile());
-  enable_in_mode(d, cia402::mode::profile_position);
-  write(d, 0x6081, 1000);   // rpm
-  write(d, 0x6083, 10000);  // rpm/s
-  write(d, 0x6084, 10000);
+  enable_pp_with_ramps(d, 10000);
+  write(d, 0x6081, 1000);  // rpm
   // 10 revolutions at 1000 rpm: 0.1 s up (0.8333 rev), 0.1 s down, 8.3333 rev at 16.667 rev/s in
   // between: 0.7 s in all.
   const int ack = offer_setpoint(d, 100000);
@@ -69,9 +74,7 @@ TEST(profile_position, a_relative_move_adds_to_the_previous_target) {
 
 TEST(profile_position, change_on_setpoint_passes_the_first_target_at_speed) {
   virtual_drive d(standard_profile());
-  enable_in_mode(d, cia402::mode::profile_position);
-  write(d, 0x6083, 10000);
-  write(d, 0x6084, 10000);
+  enable_pp_with_ramps(d, 10000);
   offer_setpoint(d, 50000);
   EXPECT_GE(offer_setpoint(d, 100000, 0x200), 1) << "queued behind the running one, acknowledged";
   std::int64_t slowest_after_start = 1 << 30;
@@ -356,9 +359,7 @@ TEST(profile_position, bit_10_waits_for_the_position_window_time) {
 
 TEST(profile_position, change_immediately_replaces_the_running_set_point) {
   virtual_drive d(standard_profile());
-  enable_in_mode(d, cia402::mode::profile_position);
-  write(d, 0x6083, 10000);
-  write(d, 0x6084, 10000);
+  enable_pp_with_ramps(d, 10000);
   offer_setpoint(d, 100000);
   for (int i = 0; i < 150; ++i) d.step();
   ASSERT_GT(d.view().position(), 0);
