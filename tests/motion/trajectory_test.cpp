@@ -42,6 +42,14 @@ pp_status offer(profile_position& pp, pp_command& cmd, const pp_parameters& par,
   return st;
 }
 
+// From rest at 0: offers `target` and runs on for `cycles` more cycles.
+void start_from_rest(profile_position& pp, pp_command& cmd, const pp_parameters& par, std::int64_t target,
+                     int cycles) {
+  pp.reset(0);
+  offer(pp, cmd, par, target);
+  for (int c = 0; c < cycles; ++c) pp.step(cmd, par, cycle_us);
+}
+
 struct run_result {
   int cycles_to_reach = -1;     // first cycle whose status shows target reached
   int cycles_to_ack = -1;
@@ -140,10 +148,8 @@ TEST(profile_position, a_relative_move_adds_to_the_previous_target) {
 TEST(profile_position, the_queue_and_change_immediately) {
   pp_parameters par = profile_of(600, 6000, 6000);
   profile_position pp;
-  pp.reset(0);
   pp_command cmd;
-  offer(pp, cmd, par, 10000);
-  for (int c = 0; c < 50; ++c) pp.step(cmd, par, cycle_us);
+  start_from_rest(pp, cmd, par, 10000, 50);
   EXPECT_TRUE(offer(pp, cmd, par, 20000).setpoint_acknowledge) << "queued behind 10000";
   EXPECT_TRUE(pp.step(cmd, par, cycle_us).setpoint_acknowledge) << "still queued";
   EXPECT_EQ(pp.target(), 10000);
@@ -175,10 +181,8 @@ TEST(profile_position, the_queue_and_change_immediately) {
 TEST(profile_position, change_on_setpoint_blends_into_the_next_target) {
   pp_parameters par = profile_of(600, 6000, 6000);
   profile_position pp;
-  pp.reset(0);
   pp_command cmd;
-  offer(pp, cmd, par, 20000);
-  pp.step(cmd, par, cycle_us);
+  start_from_rest(pp, cmd, par, 20000, 1);
   cmd.change_on_setpoint = true;
   offer(pp, cmd, par, 40000);
   bool passed_at_speed = false;
@@ -196,10 +200,8 @@ TEST(profile_position, change_on_setpoint_blends_into_the_next_target) {
 TEST(profile_position, halt_stops_on_the_deceleration_ramp_and_clearing_it_resumes) {
   pp_parameters par = profile_of(600, 6000, 3000);
   profile_position pp;
-  pp.reset(0);
   pp_command cmd;
-  offer(pp, cmd, par, 100000);
-  for (int c = 0; c < 200; ++c) pp.step(cmd, par, cycle_us);
+  start_from_rest(pp, cmd, par, 100000, 200);
   ASSERT_EQ(pp.state().velocity, 600 * 1000000);
   cmd.halt = true;
   int cycles = 0;
