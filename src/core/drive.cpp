@@ -8,6 +8,15 @@ namespace {
 
 constexpr std::uint8_t no_row = 0xFF;
 
+// The pieces of the full step (commit_row, state_outputs) are compiled into it: g++ -O3 called them,
+// and then an ordinary cycle's constant inputs (ordinary_full_step) did not reach them. A build
+// for size leaves the choice to the compiler, which keeps the firmware smaller (bench/cortex_m4).
+#if defined(__OPTIMIZE_SIZE__) || !defined(__GNUC__)
+#define step_piece
+#else
+#define step_piece [[gnu::always_inline]] inline
+#endif
+
 constexpr std::uint32_t bits(fact f) noexcept { return static_cast<std::uint32_t>(f); }
 
 constexpr std::uint32_t command_facts = bits(fact::disable_voltage) | bits(fact::quick_stop) |
@@ -190,7 +199,7 @@ std::uint8_t first_row(const profile& p, int from, std::uint32_t f) noexcept {
 
 // The state change of a row whose stop (if any) is done: the new state, its stop code (S16), the
 // axis flags and the error code its reasons call for.
-void commit_row(const profile& p, axis& a, const stored_row& r, std::uint32_t f, const cycle_fault& fault,
+step_piece void commit_row(const profile& p, axis& a, const stored_row& r, std::uint32_t f, const cycle_fault& fault,
                 bool torque_was_on, bool sto, drive_outputs& out) noexcept {
   const std::uint32_t why = p.fact_sets[r.any] & f;
   a.current = r.to;
@@ -221,7 +230,7 @@ void commit_row(const profile& p, axis& a, const stored_row& r, std::uint32_t f,
 
 // The outputs of the state the drive is in now (or of the stop it runs), and torque_on for the next
 // cycle.
-void state_outputs(const profile& p, axis& a, const drive_inputs& in, bool halt, drive_outputs& out) noexcept {
+step_piece void state_outputs(const profile& p, axis& a, const drive_inputs& in, bool halt, drive_outputs& out) noexcept {
   const unsigned now = activity_of(p, a, halt);
   const state s = a.current;
   out.current = s;
@@ -265,7 +274,24 @@ axis make_axis(const profile& p) noexcept {
 
 // Everything but the ordinary cycle (detail/quiet_step.hpp): facts, the first matching row, pending
 // stops (S7), outputs.
-drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& in) noexcept {
+namespace {
+
+// The full step; with Ordinary the inputs an ordinary cycle has (no fault code, DC link, no STO,
+// remote, link up, no local request) are constants the compiler folds away.
+template <bool Ordinary>
+drive_outputs full_step_of(const profile& p, axis& a, const drive_inputs& given) noexcept {
+  drive_inputs ordinary;
+  if constexpr (Ordinary) {
+    ordinary = given;
+    ordinary.fault_code = 0;
+    ordinary.dc_link = true;
+    ordinary.sto = false;
+    ordinary.remote = true;
+    ordinary.connection_lost = false;
+    ordinary.local_enable = false;
+    ordinary.local_disable = false;
+  }
+  const drive_inputs& in = Ordinary ? ordinary : given;
   drive_outputs out;
   // Facts of this cycle.
   const std::uint16_t cw = in.control_word;
@@ -288,7 +314,7 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
                     (static_cast<std::uint32_t>(in.local_enable && !in.remote) << 19) |
                     (static_cast<std::uint32_t>(in.local_disable) << 20) |
                     // S16: in QUICK STOP ACTIVE the code read when the quick stop started.
-                    quick_stop_facts(act_before == state_activity::quick_stop
+                    detail::quick_stop_facts(act_before == state_activity::quick_stop
                                          ? a.stop_code
                                          : a.options[static_cast<int>(option::quick_stop)]) |
                     ((static_cast<std::uint32_t>(a.flags) & axis_flag::entered_by_fault) << 18) |
@@ -369,6 +395,22 @@ drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& i
   if (commit != no_row) commit_row(p, a, p.rows[commit], f, fault, torque_was_on, in.sto, out);
   state_outputs(p, a, in, halt, out);
   return out;
+}
+
+}  // namespace
+
+drive_outputs detail::full_step(const profile& p, axis& a, const drive_inputs& in) noexcept {
+  return full_step_of<false>(p, a, in);
+}
+
+// A build for size has the one full step: a second instance would call the pieces (commit_row,
+// state_outputs) from two places, so they would no longer be compiled into it (bench/cortex_m4).
+drive_outputs detail::ordinary_full_step(const profile& p, axis& a, const drive_inputs& in) noexcept {
+#if defined(__OPTIMIZE_SIZE__)
+  return detail::full_step(p, a, in);
+#else
+  return full_step_of<true>(p, a, in);
+#endif
 }
 
 sdo_abort write_option(const profile& p, axis& a, std::uint16_t index, std::int32_t value) noexcept {

@@ -60,6 +60,14 @@ inline unsigned reported_bits(unsigned status_bits, unsigned actions) noexcept {
                         ((actions & ordinary_action::runs) << 8));
 }
 
+/// The inputs of an ordinary cycle: no fault code, DC link, no STO, remote, link up, no local
+/// request. Field by field rather than one 8-byte load: callers fill inputs field by field, and a
+/// wide load over narrow stores stalls store forwarding. Bitwise ORs keep it to one branch.
+inline bool ordinary_inputs(const drive_inputs& in) noexcept {
+  return !((in.fault_code != 0) | !in.dc_link | in.sto | !in.remote | in.connection_lost |
+           in.local_enable | in.local_disable);
+}
+
 /// The ordinary cycle: false, touching nothing, where anything else might happen; else the axis
 /// stepped and `head` the outputs' first 8 bytes (outputs_of adds the error code). The same path
 /// as the compiled step's (compiled.hpp), on the profile's own tables.
@@ -74,11 +82,7 @@ inline bool quiet_cycle(const profile& p, axis& a, const drive_inputs& in, std::
   static_assert(axis_flag::fault_reset_bit == 1u << 3 && axis_flag::torque_on == 1u << 4,
                 "the key's flags lie where offset_of puts them: the word & 0xF18");
   const ordinary_tables* const tables = p.ordinary;
-  // Field by field rather than one 8-byte load: callers fill inputs field by field, and a wide
-  // load over narrow stores stalls store forwarding. Bitwise ORs keep it to one branch.
-  const bool unusual_inputs = (in.fault_code != 0) | !in.dc_link | in.sto | !in.remote |
-                              in.connection_lost | in.local_enable | in.local_disable;
-  if (seldom(unusual_inputs | (tables == nullptr))) return false;  // no tables: finalize()
+  if (seldom(!ordinary_inputs(in) | (tables == nullptr))) return false;  // no tables: finalize()
   const unsigned cw = in.control_word;
   // The axis's first four bytes as one word, read and written back whole: a row that fires costs
   // no branch and no field stores.
