@@ -143,6 +143,18 @@ class socketcand_server_test : public ::testing::Test {
   void serve_until(const std::atomic<bool>& done) {
     while (!done) (void)host.cycle(1000, 5);
   }
+  /// Our client channel joined to the server on `bus` (null, with `ec` and `why`, when it could
+  /// not). Its connect() blocks for the handshake, so the server loop runs on a thread of its own
+  /// meanwhile.
+  std::unique_ptr<socketcand::client_channel> connect_client(std::string& why, std::error_code& ec,
+                                                             const std::string& bus = "can0") {
+    std::atomic<bool> connected{false};
+    std::thread server_loop([&] { serve_until(connected); });
+    auto ch = socketcand::client_channel::connect("127.0.0.1", srv->port(), bus, ec, why, 3000);
+    connected = true;
+    server_loop.join();
+    return ch;
+  }
   /// A peer that has joined in raw mode.
   std::unique_ptr<tcp_peer> join(int receive_buffer = 0) {
     auto p = std::make_unique<tcp_peer>(srv->port(), receive_buffer);
@@ -386,16 +398,9 @@ TEST_F(socketcand_server_test, a_held_up_host_steps_its_drives_before_it_answers
 
 TEST_F(socketcand_server_test, our_client_channel_joins_and_exchanges_frames) {
   auto peer = join();
-  std::error_code ec;
   std::string why;
-  std::unique_ptr<socketcand::client_channel> ch;
-  // connect() blocks for the handshake, so the server runs on the handshake's own schedule: let
-  // the kernel queue the greeting by accepting first.
-  std::atomic<bool> connected{false};
-  std::thread server_loop([&] { serve_until(connected); });
-  ch = socketcand::client_channel::connect("127.0.0.1", srv->port(), "can0", ec, why, 3000);
-  connected = true;
-  server_loop.join();
+  std::error_code ec;
+  const std::unique_ptr<socketcand::client_channel> ch = connect_client(why, ec);
   ASSERT_TRUE(ch) << why;
   ASSERT_FALSE(ch->send(make_frame(0x222, {9})));
   spin(2);
@@ -413,13 +418,9 @@ TEST_F(socketcand_server_test, our_client_channel_joins_and_exchanges_frames) {
 class master_over_socketcand : public socketcand_server_test {
  protected:
   void connect() {
-    std::error_code ec;
     std::string why;
-    std::atomic<bool> connected{false};
-    std::thread server_loop([&] { serve_until(connected); });
-    channel_ = socketcand::client_channel::connect("127.0.0.1", srv->port(), "can0", ec, why, 3000);
-    connected = true;
-    server_loop.join();
+    std::error_code ec;
+    channel_ = connect_client(why, ec);
     ASSERT_TRUE(channel_) << why;
   }
   std::unique_ptr<drive_master> connect_master(drive_master_config mc = {}) {
@@ -502,11 +503,7 @@ namespace {
 TEST_F(socketcand_server_test, a_client_asking_for_a_bus_the_server_lacks_is_told_so_in_words) {
   std::error_code ec;
   std::string why;
-  std::atomic<bool> done{false};
-  std::thread server_loop([&] { serve_until(done); });
-  auto ch = socketcand::client_channel::connect("127.0.0.1", srv->port(), "can9", ec, why, 3000);
-  done = true;
-  server_loop.join();
+  const auto ch = connect_client(why, ec, "can9");
   EXPECT_EQ(ch, nullptr);
   EXPECT_TRUE(ec);
   EXPECT_EQ(why, "the socketcand server at 127.0.0.1:" + std::to_string(srv->port()) +
