@@ -92,30 +92,41 @@ TEST(eds, object_lists_count_and_name_every_object_section) {
 
 TEST(eds, entries_carry_type_access_default_and_mapping_of_the_dictionary) {
   const ini eds = parse_ini(eds_of(standard_profile()));
-  EXPECT_EQ(eds.at("1000").at("DefaultValue"), "0x00020192");
-  EXPECT_EQ(eds.at("1000").at("DataType"), "0x0007");
-  EXPECT_EQ(eds.at("6040").at("AccessType"), "rw");
-  EXPECT_EQ(eds.at("6040").at("DataType"), "0x0006");
-  EXPECT_EQ(eds.at("6040").at("PDOMapping"), "1");
-  EXPECT_EQ(eds.at("6041").at("AccessType"), "ro");
-  EXPECT_EQ(eds.at("605A").at("DefaultValue"), "2");  // the profile's default (S5)
-  EXPECT_EQ(eds.at("605A").at("DataType"), "0x0003");
-  EXPECT_EQ(eds.at("6083").at("LowLimit"), "0x1");
-  EXPECT_EQ(eds.at("1008").at("DefaultValue"), "cia402 virtual drive");
-  EXPECT_EQ(eds.at("1008").at("AccessType"), "const");
-  EXPECT_EQ(eds.at("2001").at("AccessType"), "wo");
-  EXPECT_EQ(eds.at("1018").at("SubNumber"), "0x5");
-  EXPECT_EQ(eds.at("1018sub4").at("DefaultValue"), "$NODEID+0x0");
-  EXPECT_EQ(eds.at("1A01sub2").at("DefaultValue"), "0x60610008");
-  EXPECT_EQ(eds.at("1802sub1").at("DefaultValue"), "$NODEID+0x380") << "TPDO3 carries the position";
-  EXPECT_EQ(eds.at("1802sub2").at("DefaultValue"), "0x01") << "on every SYNC";
-  EXPECT_EQ(eds.at("1A02sub2").at("DefaultValue"), "0x60640020");
-  EXPECT_EQ(eds.at("1800").at("SubNumber"), "0x5") << "sub 4 is reserved";
-  // Spelled as CiA 306 spells them: parsers read the keys case-sensitively.
-  EXPECT_EQ(eds.at("DeviceInfo").at("NrOfRXPDO"), "4");
-  EXPECT_EQ(eds.at("DeviceInfo").at("NrOfTXPDO"), "4");
-  EXPECT_EQ(eds.at("DeviceInfo").count("NrOfRxPDO"), 0u);
-  EXPECT_EQ(eds.at("FileInfo").at("EDSVersion"), "4.0");
+  // Section, key, value, and why where it is not plain.
+  const struct {
+    const char* section;
+    const char* key;
+    const char* value;
+    const char* why;
+  } entries[] = {
+      {"1000", "DefaultValue", "0x00020192", ""},
+      {"1000", "DataType", "0x0007", ""},
+      {"6040", "AccessType", "rw", ""},
+      {"6040", "DataType", "0x0006", ""},
+      {"6040", "PDOMapping", "1", ""},
+      {"6041", "AccessType", "ro", ""},
+      {"605A", "DefaultValue", "2", "the profile's default (S5)"},
+      {"605A", "DataType", "0x0003", ""},
+      {"6083", "LowLimit", "0x1", ""},
+      {"1008", "DefaultValue", "cia402 virtual drive", ""},
+      {"1008", "AccessType", "const", ""},
+      {"2001", "AccessType", "wo", ""},
+      {"1018", "SubNumber", "0x5", ""},
+      {"1018sub4", "DefaultValue", "$NODEID+0x0", ""},
+      {"1A01sub2", "DefaultValue", "0x60610008", ""},
+      {"1802sub1", "DefaultValue", "$NODEID+0x380", "TPDO3 carries the position"},
+      {"1802sub2", "DefaultValue", "0x01", "on every SYNC"},
+      {"1A02sub2", "DefaultValue", "0x60640020", ""},
+      {"1800", "SubNumber", "0x5", "sub 4 is reserved"},
+      {"FileInfo", "EDSVersion", "4.0", ""},
+      // Spelled as CiA 306 spells them: parsers read the keys case-sensitively.
+      {"DeviceInfo", "NrOfRXPDO", "4", ""},
+      {"DeviceInfo", "NrOfTXPDO", "4", ""},
+  };
+  for (const auto& e : entries) {
+    EXPECT_EQ(eds.at(e.section).at(e.key), e.value) << "[" << e.section << "] " << e.key << " " << e.why;
+  }
+  EXPECT_EQ(eds.at("DeviceInfo").count("NrOfRxPDO"), 0u) << "NrOfRXPDO, as CiA 306 spells it";
 }
 
 // CiA 306 keeps [MandatoryObjects] for CiA 301's 0x1000, 0x1001 and 0x1018; the drive's 0x6040 and
