@@ -28,20 +28,22 @@ const cia402::profile& by_name(const char* name) {
   return p != nullptr ? *p : cia402::standard_profile();
 }
 
+// A drive of the standard profile behind the page, powered up (T0, T1: SWITCH ON DISABLED). A test
+// that needs a page not yet stepped, or another profile, makes its own (`fresh`, `profibus`).
+class instrument : public ::testing::Test {
+ protected:
+  void SetUp() override { run(inst, 10); }
+  virtual_axis_page inst{cia402::standard_profile()};
+};
 
-
-TEST(instrument, power_up_reaches_switch_on_disabled_by_t0_t1) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, power_up_reaches_switch_on_disabled_by_t0_t1) {
   const json s = snapshot(inst);
   EXPECT_EQ(s["state"], "SWITCH_ON_DISABLED");
   EXPECT_EQ(s["last_transition"]["number"], 1);
   EXPECT_EQ(s["last_transition"]["from"], "NOT_READY_TO_SWITCH_ON");
 }
 
-TEST(instrument, shutdown_switch_on_enable_operation_reach_operation_enabled_with_t4_last) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, shutdown_switch_on_enable_operation_reach_operation_enabled_with_t4_last) {
   inst.command(page_command::shutdown);
   EXPECT_EQ(settled_result(inst)["transitions"], json::array({2}));
   inst.command(page_command::switch_on);
@@ -60,9 +62,7 @@ TEST(instrument, shutdown_switch_on_enable_operation_reach_operation_enabled_wit
   EXPECT_EQ(hex_value(s["status_word"]) & 0x03FF, 0x0237);
 }
 
-TEST(instrument, enable_operation_from_switch_on_disabled_is_reported_refused) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, enable_operation_from_switch_on_disabled_is_reported_refused) {
   inst.command(page_command::enable_operation);
   const json r = settled_result(inst);
   EXPECT_EQ(r["outcome"], "refused");
@@ -70,19 +70,15 @@ TEST(instrument, enable_operation_from_switch_on_disabled_is_reported_refused) {
   EXPECT_EQ(snapshot(inst)["state"], "SWITCH_ON_DISABLED");
 }
 
-TEST(instrument, enable_operation_from_ready_to_switch_on_reports_t3_then_t4) {
+TEST_F(instrument, enable_operation_from_ready_to_switch_on_reports_t3_then_t4) {
   // S3: T3 then T4 in consecutive steps, one action.
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
   inst.command(page_command::shutdown);
   run(inst, 100);
   inst.command(page_command::enable_operation);
   EXPECT_EQ(settled_result(inst)["transitions"], json::array({3, 4}));
 }
 
-TEST(instrument, commands_keep_the_bits_the_state_machine_does_not_own) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, commands_keep_the_bits_the_state_machine_does_not_own) {
   inst.toggle_control_bit(4);   // operation-mode specific
   inst.toggle_control_bit(13);  // manufacturer specific
   inst.command(page_command::shutdown);
@@ -90,9 +86,7 @@ TEST(instrument, commands_keep_the_bits_the_state_machine_does_not_own) {
   EXPECT_EQ(snapshot(inst)["control_word"], "0x2016");
 }
 
-TEST(instrument, halt_toggles_bit_8_and_keeps_the_command) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, halt_toggles_bit_8_and_keeps_the_command) {
   inst.command(page_command::shutdown);
   run(inst, 5);
   inst.command(page_command::halt);
@@ -103,11 +97,11 @@ TEST(instrument, halt_toggles_bit_8_and_keeps_the_command) {
   EXPECT_EQ(snapshot(inst)["control_word"], "0x0006");
 }
 
-TEST(instrument, halt_is_not_offered_where_bit_8_is_not_a_halt) {
+TEST_F(instrument, halt_is_not_offered_where_bit_8_is_not_a_halt) {
   for (const char* name : {"s300-profibus", "ax2000-profibus"}) {
-    virtual_axis_page inst(by_name(name));
-    run(inst, 10);
-    const json info = json::parse(inst.info_json(true, false));
+    virtual_axis_page profibus(by_name(name));
+    run(profibus, 10);
+    const json info = json::parse(profibus.info_json(true, false));
     bool listed = false;
     for (const json& c : info["commands"]) {
       if (c["key"] == "halt") {
@@ -116,19 +110,17 @@ TEST(instrument, halt_is_not_offered_where_bit_8_is_not_a_halt) {
       }
     }
     EXPECT_TRUE(listed) << name;
-    const auto r = inst.command(page_command::halt);
+    const auto r = profibus.command(page_command::halt);
     const auto* no = std::get_if<refused>(&r);
     ASSERT_NE(no, nullptr) << name << ": Halt would set bit 8, which this profile calls Jog";
     EXPECT_EQ(no->http_status, 409);
     EXPECT_NE(no->reason.find("Jog"), std::string::npos) << no->reason;
-    run(inst, 5);
-    EXPECT_EQ(json::parse(inst.snapshot_json())["control_word"], "0x0000") << "nothing was sent";
+    run(profibus, 5);
+    EXPECT_EQ(json::parse(profibus.snapshot_json())["control_word"], "0x0000") << "nothing was sent";
   }
 }
 
-TEST(instrument, fault_reset_is_one_edge_of_bit_7_and_leads_fault_to_switch_on_disabled_by_t15) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, fault_reset_is_one_edge_of_bit_7_and_leads_fault_to_switch_on_disabled_by_t15) {
   inst.change_plant(fault_of(0x2310));
   const json fr = settled_result(inst);
   EXPECT_EQ(fr["transitions"], json::array({13, 14}));
@@ -149,9 +141,7 @@ TEST(instrument, fault_reset_is_one_edge_of_bit_7_and_leads_fault_to_switch_on_d
   EXPECT_EQ(hex_value(s["control_word"]) & 0x80, 0);  // cleared after it was seen
 }
 
-TEST(instrument, fault_reset_after_bit_7_was_left_set_still_makes_an_edge) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, fault_reset_after_bit_7_was_left_set_still_makes_an_edge) {
   inst.toggle_control_bit(7);
   inst.change_plant(fault_of());
   run(inst, 300);
@@ -162,9 +152,7 @@ TEST(instrument, fault_reset_after_bit_7_was_left_set_still_makes_an_edge) {
   EXPECT_EQ(settled_result(inst)["transitions"], json::array({15}));
 }
 
-TEST(instrument, fault_reset_while_the_cause_persists_is_refused_and_names_the_cause) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, fault_reset_while_the_cause_persists_is_refused_and_names_the_cause) {
   inst.change_plant(fault_of(0x4310));
   run(inst, 300);
   inst.command(page_command::fault_reset);
@@ -175,9 +163,7 @@ TEST(instrument, fault_reset_while_the_cause_persists_is_refused_and_names_the_c
   EXPECT_EQ(snapshot(inst)["state"], "FAULT");
 }
 
-TEST(instrument, switch_on_without_dc_link_waits_for_it_and_acts_when_it_returns) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, switch_on_without_dc_link_waits_for_it_and_acts_when_it_returns) {
   inst.command(page_command::shutdown);
   run(inst, 100);
   plant_change drop;
@@ -195,9 +181,7 @@ TEST(instrument, switch_on_without_dc_link_waits_for_it_and_acts_when_it_returns
   EXPECT_EQ(snapshot(inst)["state"], "SWITCHED_ON") << "T3 on the word still in the control word";
 }
 
-TEST(instrument, a_command_that_leads_where_the_drive_is_has_nothing_to_do) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, a_command_that_leads_where_the_drive_is_has_nothing_to_do) {
   inst.command(page_command::shutdown);
   run(inst, 100);
   inst.command(page_command::shutdown);  // again, in READY TO SWITCH ON
@@ -210,9 +194,7 @@ TEST(instrument, a_command_that_leads_where_the_drive_is_has_nothing_to_do) {
   EXPECT_EQ(settled_result(inst)["text"], "nothing to do: already OPERATION_ENABLED");
 }
 
-TEST(instrument, shutdown_under_sto_waits_for_sto_to_be_released) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, shutdown_under_sto_waits_for_sto_to_be_released) {
   plant_change sto;
   sto.sto = true;
   inst.change_plant(sto);
@@ -223,18 +205,14 @@ TEST(instrument, shutdown_under_sto_waits_for_sto_to_be_released) {
   EXPECT_EQ(r["text"], "waiting: STO asserted; SHUTDOWN acts once it is gone");
 }
 
-TEST(instrument, a_command_with_no_row_from_the_state_is_still_refused) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, a_command_with_no_row_from_the_state_is_still_refused) {
   inst.command(page_command::enable_operation);  // SWITCH ON DISABLED has no row for it
   const json r = settled_result(inst);
   EXPECT_EQ(r["outcome"], "refused");
   EXPECT_EQ(r["text"], "refused: no transition from SWITCH_ON_DISABLED for ENABLE_OPERATION");
 }
 
-TEST(instrument, option_write_the_profile_refuses_is_an_sdo_abort_and_changes_nothing) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, option_write_the_profile_refuses_is_an_sdo_abort_and_changes_nothing) {
   const auto r = inst.write_object(0x605A, 9);  // 9..32767 reserved (§3)
   const auto* no = std::get_if<refused>(&r);
   ASSERT_NE(no, nullptr);
@@ -245,9 +223,7 @@ TEST(instrument, option_write_the_profile_refuses_is_an_sdo_abort_and_changes_no
   EXPECT_EQ(s["results"][0]["outcome"], "refused");
 }
 
-TEST(instrument, target_velocity_outside_int32_is_refused_and_nothing_else_changes) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, target_velocity_outside_int32_is_refused_and_nothing_else_changes) {
   plant_change c;
   c.target_velocity = std::int64_t{1} << 40;
   c.sto = true;
@@ -260,25 +236,25 @@ TEST(instrument, target_velocity_outside_int32_is_refused_and_nothing_else_chang
   EXPECT_EQ(s["target_velocity"], 0);
 }
 
-TEST(instrument, toggle_of_a_bit_outside_0_to_15_is_refused) {
-  virtual_axis_page inst(cia402::standard_profile());
-  EXPECT_TRUE(std::holds_alternative<refused>(inst.toggle_control_bit(16)));
-  EXPECT_TRUE(std::holds_alternative<refused>(inst.toggle_control_bit(-1)));
+TEST_F(instrument, toggle_of_a_bit_outside_0_to_15_is_refused) {
+  virtual_axis_page fresh(cia402::standard_profile());
+  EXPECT_TRUE(std::holds_alternative<refused>(fresh.toggle_control_bit(16)));
+  EXPECT_TRUE(std::holds_alternative<refused>(fresh.toggle_control_bit(-1)));
 }
 
-TEST(instrument, ax2000_enable_operation_word_sets_fast_stop_bit_4) {
+TEST_F(instrument, ax2000_enable_operation_word_sets_fast_stop_bit_4) {
   // 004_e07fd68605b3a8c6.txt: fast stop is bit 4 (T11 "Bit 4 is canceled", T16 "Bit 4 is set"),
   // so enabling needs bits 0..4: 0x001F.
-  virtual_axis_page inst(by_name("ax2000-profibus"));
-  run(inst, 10);
-  inst.command(page_command::shutdown);
-  run(inst, 100);
-  inst.command(page_command::enable_operation);
-  EXPECT_EQ(settled_result(inst)["transitions"], json::array({3, 4}));
-  EXPECT_EQ(snapshot(inst)["control_word"], "0x001F");
+  virtual_axis_page profibus(by_name("ax2000-profibus"));
+  run(profibus, 10);
+  profibus.command(page_command::shutdown);
+  run(profibus, 100);
+  profibus.command(page_command::enable_operation);
+  EXPECT_EQ(settled_result(profibus)["transitions"], json::array({3, 4}));
+  EXPECT_EQ(snapshot(profibus)["control_word"], "0x001F");
 }
 
-TEST(instrument, drivecom_profiles_name_bits_as_stw_and_zsw) {
+TEST_F(instrument, drivecom_profiles_name_bits_as_stw_and_zsw) {
   virtual_axis_page s300(by_name("s300-profibus"));
   const json info = json::parse(s300.info_json(true, false));
   // STW bits 1 and 2 act when cleared: their names say so, as the standard's do.
@@ -291,9 +267,9 @@ TEST(instrument, drivecom_profiles_name_bits_as_stw_and_zsw) {
   EXPECT_EQ(std_info["control_bits"][8]["name"], "Halt");
 }
 
-TEST(instrument, info_rows_come_from_the_profile_table_with_t13_from_six_states) {
-  virtual_axis_page inst(cia402::standard_profile());
-  const json info = json::parse(inst.info_json(false, true));
+TEST_F(instrument, info_rows_come_from_the_profile_table_with_t13_from_six_states) {
+  virtual_axis_page fresh(cia402::standard_profile());
+  const json info = json::parse(fresh.info_json(false, true));
   EXPECT_EQ(info["control"], false);
   EXPECT_EQ(info["token_required"], true);
   std::set<int> numbers;
@@ -309,20 +285,18 @@ TEST(instrument, info_rows_come_from_the_profile_table_with_t13_from_six_states)
   EXPECT_FALSE(numbers.count(17));
 }
 
-TEST(instrument, a_snapshot_is_published_only_when_something_changed) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 400);  // power-up settles
-  const std::uint64_t before = inst.latest().version;
-  run(inst, 400);  // nothing happens
-  EXPECT_EQ(inst.latest().version, before);
-  inst.command(page_command::shutdown);
-  run(inst, 40);
-  EXPECT_GT(inst.latest().version, before);
+TEST_F(instrument, a_snapshot_is_published_only_when_something_changed) {
+  virtual_axis_page fresh(cia402::standard_profile());
+  run(fresh, 400);  // power-up settles
+  const std::uint64_t before = fresh.latest().version;
+  run(fresh, 400);  // nothing happens
+  EXPECT_EQ(fresh.latest().version, before);
+  fresh.command(page_command::shutdown);
+  run(fresh, 40);
+  EXPECT_GT(fresh.latest().version, before);
 }
 
-TEST(instrument, snapshots_are_published_at_most_once_per_40_cycles) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, snapshots_are_published_at_most_once_per_40_cycles) {
   inst.command(page_command::shutdown);
   run(inst, 5);
   inst.command(page_command::enable_operation);
@@ -337,11 +311,11 @@ TEST(instrument, snapshots_are_published_at_most_once_per_40_cycles) {
   EXPECT_GE(inst.latest().version - before, 9u);
 }
 
-TEST(instrument, wait_for_update_returns_after_close_without_an_update) {
-  virtual_axis_page inst(cia402::standard_profile());
-  inst.close();
+TEST_F(instrument, wait_for_update_returns_after_close_without_an_update) {
+  virtual_axis_page fresh(cia402::standard_profile());
+  fresh.close();
   const auto t0 = std::chrono::steady_clock::now();
-  EXPECT_FALSE(inst.wait_for_update(0, std::chrono::seconds(5)).has_value());
+  EXPECT_FALSE(fresh.wait_for_update(0, std::chrono::seconds(5)).has_value());
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(1));
 }
 
@@ -351,9 +325,7 @@ namespace {
 
 // The page offers the modes 0x6502 announces and the homing methods the drive runs as choices, and
 // the snapshot carries the mode and its actual values.
-TEST(instrument, modes_are_a_choice_and_the_snapshot_shows_mode_position_and_torque) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, modes_are_a_choice_and_the_snapshot_shows_mode_position_and_torque) {
   const json info = json::parse(inst.info_json(true, false));
   json modes, methods;
   for (const json& o : info["objects"]) {
@@ -390,9 +362,7 @@ namespace {
 // Profile position from the page: 0x6060 = 1, 0x607A, the new set-point handshake (bit 4 up until
 // status bit 12, then down: CiA 402-2's set-point handshake), the move to the target (bit 10), a
 // relative move adding to it (bit 6).
-TEST(instrument, the_new_setpoint_handshake_moves_in_profile_position) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, the_new_setpoint_handshake_moves_in_profile_position) {
   id_of(inst.write_object(0x6060, 1));
   EXPECT_EQ(snapshot(inst)["requested_mode"], 1);
   enable(inst);
@@ -435,9 +405,7 @@ TEST(instrument, the_new_setpoint_handshake_moves_in_profile_position) {
 }
 
 // A set-point the drive does not acknowledge (not enabled): bit 4 falls after a second, reported.
-TEST(instrument, an_unacknowledged_setpoint_lets_bit_4_fall_and_says_so) {
-  virtual_axis_page inst(cia402::standard_profile());
-  run(inst, 10);
+TEST_F(instrument, an_unacknowledged_setpoint_lets_bit_4_fall_and_says_so) {
   id_of(inst.write_object(0x6060, 1));
   run(inst, 5);
   id_of(inst.new_setpoint());
@@ -452,9 +420,9 @@ TEST(instrument, an_unacknowledged_setpoint_lets_bit_4_fall_and_says_so) {
 
 // The names of the mode-specific bits per mode, as CiA 402-2 gives them; a DRIVECOM profile keeps
 // the names it gives its control bits, and has no set-point handshake on bit 4.
-TEST(instrument, info_names_the_mode_specific_bits_per_mode) {
-  virtual_axis_page inst(cia402::standard_profile());
-  const json info = json::parse(inst.info_json(true, false));
+TEST_F(instrument, info_names_the_mode_specific_bits_per_mode) {
+  virtual_axis_page fresh(cia402::standard_profile());
+  const json info = json::parse(fresh.info_json(true, false));
   EXPECT_EQ(info["mode_names"]["1"], "Profile position");
   EXPECT_EQ(info["mode_names"]["8"], "Cyclic synchronous position");
   EXPECT_EQ(info["mode_bits"]["1"]["control"]["4"], "New set-point");
