@@ -22,6 +22,13 @@ using cia402::page::server;
 using cia402::page::server_options;
 using json = nlohmann::json;
 
+// A reply that came, with status 200 (its status and body shown when not).
+inline ::testing::AssertionResult ok_reply(const httplib::Result& r) {
+  if (!r) return ::testing::AssertionFailure() << "no response";
+  if (r->status != 200) return ::testing::AssertionFailure() << "status " << r->status << ": " << r->body;
+  return ::testing::AssertionSuccess();
+}
+
 inline constexpr const char* token = "0123456789abcdef0123456789abcdef";
 
 class page_server : public ::testing::Test {

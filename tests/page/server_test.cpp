@@ -26,6 +26,7 @@ using cia402::page::server_options;
 using json = nlohmann::json;
 
 using cia402::page::testing::token;
+using cia402::page::testing::ok_reply;
 using cia402::page::testing::page_server;
 
 // Two servers on one port would answer in turn, so the page could show one drive while its
@@ -59,9 +60,7 @@ TEST_F(page_server, page_and_its_files_are_served_from_the_binary) {
 
 TEST_F(page_server, a_valid_command_is_obeyed) {
   start(false);
-  const auto r = post("/api/command", R"({"command":"shutdown"})");
-  ASSERT_TRUE(r);
-  EXPECT_EQ(r->status, 200) << r->body;
+  ASSERT_TRUE(ok_reply(post("/api/command", R"({"command":"shutdown"})")));
   step(5);
   EXPECT_EQ(json::parse(inst.snapshot_json())["state"], "READY_TO_SWITCH_ON");
 }
@@ -74,12 +73,10 @@ TEST_F(page_server, new_setpoint_is_a_command_of_profile_position) {
   start(false);
   expect_refused(post("/api/command", R"({"command":"new_setpoint"})"), 409, "profile position");
   auto r = post("/api/object", R"({"index":"0x6060","value":1})");
-  ASSERT_TRUE(r);
-  EXPECT_EQ(r->status, 200) << r->body;
+  ASSERT_TRUE(ok_reply(r));
   step(5);
   r = post("/api/command", R"({"command":"new_setpoint"})");
-  ASSERT_TRUE(r);
-  EXPECT_EQ(r->status, 200) << r->body;
+  ASSERT_TRUE(ok_reply(r));
   const json s = json::parse(inst.snapshot_json());
   EXPECT_EQ(s["results"][0]["action"], "NEW_SET-POINT");
 }
@@ -214,8 +211,7 @@ TEST_F(page_server, wrong_content_type_is_415_and_changes_nothing) {
   // Parameters are allowed, and the type is case-insensitive.
   const auto ok = post("/api/command", R"({"command":"shutdown"})", {},
                        "Application/JSON; charset=utf-8");
-  ASSERT_TRUE(ok);
-  EXPECT_EQ(ok->status, 200) << ok->body;
+  ASSERT_TRUE(ok_reply(ok));
 }
 
 TEST_F(page_server, a_key_given_twice_is_400_and_changes_nothing) {
@@ -296,9 +292,7 @@ TEST_F(page_server, token_required_refuses_control_without_the_token_and_changes
   step(5);
   EXPECT_EQ(observable(), before);
 
-  const auto ok = post("/api/command", R"({"command":"shutdown"})", {{"X-Cia402-Token", token}});
-  ASSERT_TRUE(ok);
-  EXPECT_EQ(ok->status, 200) << ok->body;
+  ASSERT_TRUE(ok_reply(post("/api/command", R"({"command":"shutdown"})", {{"X-Cia402-Token", token}})));
   step(5);
   EXPECT_EQ(json::parse(inst.snapshot_json())["state"], "READY_TO_SWITCH_ON");
 }
@@ -449,9 +443,7 @@ TEST(page_server_axes, each_axis_is_its_own_drive_and_may_switch_profile) {
     one.step();
     two.step();
   }
-  const auto r = client.Post("/api/command?axis=2", R"({"command":"shutdown"})", "application/json");
-  ASSERT_TRUE(r);
-  EXPECT_EQ(r->status, 200) << r->body;
+  ASSERT_TRUE(ok_reply(client.Post("/api/command?axis=2", R"({"command":"shutdown"})", "application/json")));
   for (int i = 0; i < 10; ++i) {
     one.step();
     two.step();
@@ -471,9 +463,7 @@ TEST(page_server_axes, each_axis_is_its_own_drive_and_may_switch_profile) {
             404);
 
   // Axis 1 under the PROFIBUS profile of seed 003: from power-up, with its own words.
-  const auto p = client.Post("/api/profile?axis=1", R"({"profile":"s300-profibus"})", "application/json");
-  ASSERT_TRUE(p);
-  EXPECT_EQ(p->status, 200) << p->body;
+  ASSERT_TRUE(ok_reply(client.Post("/api/profile?axis=1", R"({"profile":"s300-profibus"})", "application/json")));
   for (int i = 0; i < 10; ++i) one.step();
   const json info1 = json::parse(client.Get("/api/info")->body);
   EXPECT_EQ(info1["profile"]["name"], "s300-profibus");
