@@ -24,8 +24,7 @@ class homing_page : public page_server {
 
 TEST_F(homing_page, parameters_are_written_through_the_session_and_shown_in_the_snapshot) {
   const auto r = post("/api/homing", R"({"method":3,"fast":400,"slow":40,"acceleration":20000,"offset":-5})");
-  ASSERT_TRUE(r);
-  ASSERT_EQ(r->status, 200) << r->body;
+  ASSERT_TRUE(ok_reply(r));
   EXPECT_EQ(body_of(r)["text"], "0x6098 = 3, 0x6099:1 = 400, 0x6099:2 = 40, 0x609A = 20000, 0x607C = -5");
   const json h = state()["homing"];
   EXPECT_EQ(h["method"], 3);
@@ -67,8 +66,7 @@ TEST_F(homing_page, the_set_point_shown_is_the_one_of_the_mode_the_drive_shows) 
 
 TEST_F(homing_page, method_3_at_the_default_speeds_is_attained_within_3_s_with_its_phases) {
   const auto r = post("/api/homing", R"({"method":3,"start":true})");
-  ASSERT_TRUE(r);
-  ASSERT_EQ(r->status, 200) << r->body;
+  ASSERT_TRUE(ok_reply(r));
   std::set<std::string> phases;
   bool home_switch_seen = false;
   int cycles = 0;
@@ -118,7 +116,7 @@ TEST_F(homing_page, bit_4_toggled_in_homing_mode_says_homing_operation_start) {
   ASSERT_EQ(post("/api/object", R"({"index":"0x6060","value":6})")->status, 200);
   step(5);
   const auto r = post("/api/command", R"({"command":"toggle_bit","bit":4})");
-  ASSERT_EQ(r->status, 200) << r->body;
+  ASSERT_TRUE(ok_reply(r));
   const std::string text = state()["results"][0]["text"];
   EXPECT_EQ(text, "done: Homing operation start (bit 4 in mode 6)");
 }
@@ -135,7 +133,7 @@ TEST_F(homing_page, a_fault_enters_the_drive_error_field_and_clear_empties_it) {
   ASSERT_TRUE(listed);
   EXPECT_EQ(json::parse(listed->body)["entries"][0]["code"], "0x2310") << listed->body;
   const auto read = post("/api/errors/read", "{}");
-  ASSERT_EQ(read->status, 200) << read->body;
+  ASSERT_TRUE(ok_reply(read));
   EXPECT_EQ(body_of(read)["text"], "0x1003 holds 1 error(s)");
   ASSERT_EQ(post("/api/errors/clear", "{}")->status, 200);
   step(3);
