@@ -42,6 +42,36 @@ int list_profiles(std::ostream& out) {
   return 0;
 }
 
+// `cia402 profiles [--dump NAME]`.
+int run_profiles(const std::string& dump_name, std::ostream& out, std::ostream& err) {
+  if (dump_name.empty()) return list_profiles(out);
+  const profile* p = find_builtin_profile(dump_name);
+  if (p == nullptr) {
+    err << "cia402 profiles: unknown profile '" << dump_name
+        << "' (built-in: " << builtin_profile_names() << ")\n";
+    return usage_error;
+  }
+  out << dump_profile_toml(*p);
+  return 0;
+}
+
+// `cia402 decode WORD [--controlword] [--json]`.
+int run_decode(const profile& p, const std::string& word_text, bool as_control_word, bool as_json,
+               std::ostream& out, std::ostream& err) {
+  const auto word = parse_number(word_text);
+  if (!word || *word < 0 || *word > 0xFFFF) {
+    err << "cia402 decode: '" << word_text << "' is not a 16-bit word (decimal or 0x hex)\n";
+    return usage_error;
+  }
+  const auto w = static_cast<std::uint16_t>(*word);
+  if (as_json) {
+    out << (as_control_word ? control_word_json(p, w) : status_word_json(p, w)) << "\n";
+  } else {
+    out << (as_control_word ? describe_control_word(p, w) : describe_status_word(p, w));
+  }
+  return 0;
+}
+
 }  // namespace
 
 int run(const std::vector<std::string>& args, std::istream& in, std::ostream& out,
@@ -148,17 +178,7 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   for (const auto& [command, run] : own_file_commands) {
     if (command->parsed()) return run();
   }
-  if (profiles->parsed()) {
-    if (dump_name.empty()) return list_profiles(out);
-    const profile* p = find_builtin_profile(dump_name);
-    if (p == nullptr) {
-      err << "cia402 profiles: unknown profile '" << dump_name
-          << "' (built-in: " << builtin_profile_names() << ")\n";
-      return usage_error;
-    }
-    out << dump_profile_toml(*p);
-    return 0;
-  }
+  if (profiles->parsed()) return run_profiles(dump_name, out, err);
 
   profile_choice choice;
   if (!choice.resolve(profile_name, profile_file, err)) return usage_error;
@@ -177,23 +197,7 @@ int run(const std::vector<std::string>& args, std::istream& in, std::ostream& ou
   if (replay->parsed()) return run_replay(choice.get(), writes, in, out, err);
   if (path->parsed()) return run_path(choice.get(), writes, path_from, path_to, out, err);
   if (diagram->parsed()) return run_diagram(choice.get(), diagram_format, out, err);
-  if (decode->parsed()) {
-    const auto word = parse_number(word_text);
-    if (!word || *word < 0 || *word > 0xFFFF) {
-      err << "cia402 decode: '" << word_text << "' is not a 16-bit word (decimal or 0x hex)\n";
-      return usage_error;
-    }
-    const auto w = static_cast<std::uint16_t>(*word);
-    if (decode_json) {
-      out << (as_control_word ? control_word_json(choice.get(), w)
-                              : status_word_json(choice.get(), w))
-          << "\n";
-    } else {
-      out << (as_control_word ? describe_control_word(choice.get(), w)
-                              : describe_status_word(choice.get(), w));
-    }
-    return 0;
-  }
+  if (decode->parsed()) return run_decode(choice.get(), word_text, as_control_word, decode_json, out, err);
   if (demo->parsed()) {
     run_demo(choice.get(), out);
     return 0;
