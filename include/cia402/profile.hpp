@@ -384,9 +384,12 @@ struct profile {
           (torque_before && (code & ordinary::stops) != 0)) {
         continue;
       }
-      const unsigned fired = code & ordinary::row;
-      const stored_row* r = fired != 0 ? &rows[fired - 1] : nullptr;
-      const unsigned to = r != nullptr ? static_cast<unsigned>(r->to) : s;
+      // The row that fires, if any, by value: g++ with -fsanitize=undefined holds a pointer's
+      // comparison with nullptr to be no constant expression, and the built-ins compile this then.
+      const unsigned fired_index = code & ordinary::row;
+      const bool fires = fired_index != 0;
+      const stored_row r = fires ? rows[fired_index - 1] : stored_row{};
+      const unsigned to = fires ? static_cast<unsigned>(r.to) : s;
       const state_activity act = states[to].activity;
       const bool torque = act != state_activity::idle;
       const unsigned actions =
@@ -396,16 +399,16 @@ struct profile {
       // Bit 7's flag and torque's are set anew each cycle; a row that fires clears entered_by_fault.
       const unsigned flags_kept =
           0xFFu & ~static_cast<unsigned>(axis_flag::torque_on | axis_flag::fault_reset_bit) &
-          (r != nullptr ? ~static_cast<unsigned>(axis_flag::entered_by_fault) : 0xFFu);
+          (fires ? ~static_cast<unsigned>(axis_flag::entered_by_fault) : 0xFFu);
       const unsigned flags_set = (torque ? unsigned{axis_flag::torque_on} : 0u) |
                                  (bit7 ? unsigned{axis_flag::fault_reset_bit} : 0u);
       t.axis_words[at / 4] = (flags_kept << byte_shift<4>(0)) | (actions << byte_shift<4>(2)) |
-                             ((r != nullptr ? 0u : 0xFFu) << byte_shift<4>(3));
+                             ((fires ? 0u : 0xFFu) << byte_shift<4>(3));
       t.axis_words[at / 4 + 1] = (flags_set << byte_shift<4>(0)) | (to << byte_shift<4>(1)) |
                                  (0xFFu << byte_shift<4>(2)) |
-                                 ((r != nullptr ? unsigned{r->number} : 0u) << byte_shift<4>(3));
-      const bool clear = r != nullptr && (r->flags & row_flag::clears_setpoints) != 0;
-      const unsigned transition = r != nullptr ? r->number : no_transition;
+                                 ((fires ? unsigned{r.number} : 0u) << byte_shift<4>(3));
+      const bool clear = fires && (r.flags & row_flag::clears_setpoints) != 0;
+      const unsigned transition = fires ? r.number : no_transition;
       t.images[at / 8] = (std::uint64_t{to} << byte_shift<8>(0)) | (std::uint64_t{clear} << byte_shift<8>(1)) |
                          (std::uint64_t{states[to].status_pattern | 0x0210u} << detail::status_shift) |
                          (std::uint64_t{transition} << byte_shift<8>(4)) |
