@@ -246,7 +246,6 @@ inline constexpr std::uint8_t fault_reset_bit = 1u << 3;   ///< bit 7 of the pre
 inline constexpr std::uint8_t torque_on = 1u << 4;         ///< torque was on in the previous cycle
 }  // namespace axis_flag
 
-
 /// What profile::ordinary_entry() says of a state under a command: bits 0..5 the row that fires
 /// plus 1 (0: none, quiet).
 namespace ordinary {

@@ -12,9 +12,9 @@ constexpr std::uint8_t no_row = 0xFF;
 // and then an ordinary cycle's constant inputs (ordinary_full_step) did not reach them. A build
 // for size leaves the choice to the compiler, which keeps the firmware smaller (bench/cortex_m4).
 #if defined(__OPTIMIZE_SIZE__) || !defined(__GNUC__)
-#define step_piece
+#define CIA402_STEP_PIECE
 #else
-#define step_piece [[gnu::always_inline]] inline
+#define CIA402_STEP_PIECE [[gnu::always_inline]] inline
 #endif
 
 constexpr std::uint32_t bits(fact f) noexcept { return static_cast<std::uint32_t>(f); }
@@ -199,7 +199,7 @@ std::uint8_t first_row(const profile& p, int from, std::uint32_t f) noexcept {
 
 // The state change of a row whose stop (if any) is done: the new state, its stop code (S16), the
 // axis flags and the error code its reasons call for.
-step_piece void commit_row(const profile& p, axis& a, const stored_row& r, std::uint32_t f, const cycle_fault& fault,
+CIA402_STEP_PIECE void commit_row(const profile& p, axis& a, const stored_row& r, std::uint32_t f, const cycle_fault& fault,
                 bool torque_was_on, bool sto, drive_outputs& out) noexcept {
   const std::uint32_t why = p.fact_sets[r.any] & f;
   a.current = r.to;
@@ -230,7 +230,7 @@ step_piece void commit_row(const profile& p, axis& a, const stored_row& r, std::
 
 // The outputs of the state the drive is in now (or of the stop it runs), and torque_on for the next
 // cycle.
-step_piece void state_outputs(const profile& p, axis& a, const drive_inputs& in, bool halt, drive_outputs& out) noexcept {
+CIA402_STEP_PIECE void state_outputs(const profile& p, axis& a, const drive_inputs& in, bool halt, drive_outputs& out) noexcept {
   const unsigned now = activity_of(p, a, halt);
   const state s = a.current;
   out.current = s;
@@ -272,11 +272,10 @@ axis make_axis(const profile& p) noexcept {
   return a;
 }
 
-// Everything but the ordinary cycle (detail/quiet_step.hpp): facts, the first matching row, pending
-// stops (S7), outputs.
 namespace {
 
-// The full step; with Ordinary the inputs an ordinary cycle has (no fault code, DC link, no STO,
+// Everything but the ordinary cycle (detail/quiet_step.hpp): facts, the first matching row, pending
+// stops (S7), outputs. With Ordinary the inputs an ordinary cycle has (no fault code, DC link, no STO,
 // remote, link up, no local request) are constants the compiler folds away.
 template <bool Ordinary>
 drive_outputs full_step_of(const profile& p, axis& a, const drive_inputs& given) noexcept {
