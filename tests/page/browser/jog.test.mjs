@@ -222,6 +222,13 @@ async function jogChecks(context, server, where, remote) {
 
   const relay = await startRelay(url);
   page = await openPage(context, server, remote, relay.url);
+  // The closed tab held the axis, and its hold lapses only once nothing renewed it for a second
+  // (docs/instrument-page.md, "Control model"): until then this new tab's commands are refused.
+  // How soon that is after the close depends on the machine's speed, so wait for the page to say so.
+  await page.waitForFunction(() => {
+    const c = document.getElementById('control-banner').dataset.control;
+    return c !== undefined && c !== 'elsewhere';
+  }, null, { timeout: patience });
   await enable(page, url);
   await check(`${where}: the page's network cut while the jog is held: its event stream drops, the page goes stale, the server's dead-man stops the jog in the bound`, async () => {
     const { fromMs } = await holdJog(page, url);
