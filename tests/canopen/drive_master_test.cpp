@@ -175,15 +175,30 @@ TEST(drive_master, a_fault_is_reported_with_its_emcy_and_a_reset_edge_it_carries
   EXPECT_EQ(b.emcy.back(), 0x0000) << "EMCY error reset after T15";
 }
 
+// A master that sends its heartbeat every 20 ms and has the drive watch it (0x1016): the guard
+// whose loss the cases below provoke.
+drive_master_config heartbeat_guarded() {
+  drive_master_config mc;
+  mc.master_heartbeat_ms = 20;
+  return mc;
+}
+
+// 0x6007, what a lost connection makes the drive do, set to `reaction` (1 = fault), then the drive
+// enabled by the master's words.
+::testing::AssertionResult enable_with_loss_reaction(bench& b, std::int64_t reaction) {
+  if (b.node().write(0x6007, 0, reaction) != sdo_abort::none) {
+    return ::testing::AssertionFailure() << "0x6007 = " << reaction << " refused";
+  }
+  if (!b.enable_by_words()) return ::testing::AssertionFailure() << "not enabled: " << b.master().failure_text();
+  return ::testing::AssertionSuccess();
+}
+
 class master_heartbeat_loss : public ::testing::TestWithParam<int> {};
 
 TEST_P(master_heartbeat_loss, silent_master_makes_the_drive_apply_0x6007) {
   const int code = GetParam();
-  drive_master_config mc;
-  mc.master_heartbeat_ms = 20;
-  bench b(mc);
-  ASSERT_EQ(b.node().write(0x6007, 0, code), sdo_abort::none);
-  ASSERT_TRUE(b.enable_by_words()) << b.master().failure_text();
+  bench b(heartbeat_guarded());
+  ASSERT_TRUE(enable_with_loss_reaction(b, code));
   std::int64_t watch = 0;
   b.node().read(0x1016, 1, watch);
   EXPECT_EQ(watch, (127 << 16) | 60);
@@ -206,11 +221,8 @@ INSTANTIATE_TEST_SUITE_P(codes_0_to_3, master_heartbeat_loss, ::testing::Range(0
 TEST(drive_master, a_master_that_disabled_the_drive_then_went_silent_leaves_no_fault) {
   // An orderly end whose guard outlived the master: the drive was taken to READY TO SWITCH ON
   // first, so the lost heartbeat has nothing to protect (0x6007 acts on an enabled drive only).
-  drive_master_config guarded;
-  guarded.master_heartbeat_ms = 20;
-  bench b(guarded);
-  ASSERT_EQ(b.node().write(0x6007, 0, 1), sdo_abort::none);  // 1 = fault
-  ASSERT_TRUE(b.enable_by_words());
+  bench b(heartbeat_guarded());
+  ASSERT_TRUE(enable_with_loss_reaction(b, 1));
   ASSERT_TRUE(b.carry_until(shutdown_word, state::ready_to_switch_on));  // T8
   b.run_ms(500, /*master_alive=*/false);
   EXPECT_TRUE(b.node().connection_lost());
@@ -221,9 +233,7 @@ TEST(drive_master, a_master_that_disabled_the_drive_then_went_silent_leaves_no_f
 TEST(drive_master, a_drive_enabled_while_the_heartbeat_is_lost_applies_0x6007_then) {
   // The loss came while the drive was disabled; a control word that enables it while the master
   // is still gone (a second master, a local tool) brings 0x6007 into play at once.
-  drive_master_config guarded;
-  guarded.master_heartbeat_ms = 20;
-  bench b(guarded);
+  bench b(heartbeat_guarded());
   ASSERT_TRUE(b.enable_by_words());
   ASSERT_TRUE(b.carry_until(disable_voltage_word, state::switch_on_disabled));  // T9
   b.run_ms(500, /*master_alive=*/false);
@@ -265,11 +275,8 @@ TEST_P(nmt_stop_of_a_drive, acts_as_0x6007_says_when_enabled_and_changes_nothing
 INSTANTIATE_TEST_SUITE_P(enabled_or_not, nmt_stop_of_a_drive, ::testing::Bool());
 
 TEST(drive_master, a_master_without_guard_clears_the_guard_a_gone_master_left_and_carries_the_reset) {
-  drive_master_config guarded;
-  guarded.master_heartbeat_ms = 20;
-  bench b(guarded);
-  ASSERT_EQ(b.node().write(0x6007, 0, 1), sdo_abort::none);  // 1 = fault
-  ASSERT_TRUE(b.enable_by_words());
+  bench b(heartbeat_guarded());
+  ASSERT_TRUE(enable_with_loss_reaction(b, 1));
   b.run_ms(500, /*master_alive=*/false);
   ASSERT_EQ(b.drive().view().current(), state::fault);
   b.replace_master({});
