@@ -9,6 +9,7 @@
 #include "cia402/apps/local_link.hpp"
 #include "cia402/axis/session.hpp"
 #include "cia402/objects.hpp"
+#include "forwarding_link.hpp"
 #include "sim_link.hpp"
 
 namespace cia402::axes::test {
@@ -16,13 +17,9 @@ namespace {
 
 // A bus-like link around sim_link that counts its polls and says work_now() as a test sets it:
 // false as a bus's link does, true as a broken link that always claims more.
-class counting_link final : public drive_link {
+class counting_link final : public cia402::test::forwarding_link<sim_link> {
  public:
-  explicit counting_link(bool busy) : busy_(busy) {
-    inner.on_event = [this](link_event e, const std::string& t) { if (on_event) on_event(e, t); };
-    inner.before_cycle = [this] { if (before_cycle) before_cycle(); };
-  }
-  sim_link inner;
+  explicit counting_link(bool busy) : busy_(busy) {}
   int polls = 0;
 
   std::uint32_t poll(std::uint32_t elapsed_us) override {
@@ -30,29 +27,6 @@ class counting_link final : public drive_link {
     return inner.poll(elapsed_us);
   }
   bool work_now() const override { return busy_; }
-  link_phase phase() const override { return inner.phase(); }
-  std::string phase_text() const override { return inner.phase_text(); }
-  std::string what() const override { return inner.what(); }
-  std::string short_name() const override { return inner.short_name(); }
-  bool cyclic() const override { return inner.cyclic(); }
-  void start_cyclic() override { inner.start_cyclic(); }
-  std::uint32_t cycle_us() const override { return inner.cycle_us(); }
-  bool status_known() const override { return inner.status_known(); }
-  std::uint16_t status_word() const override { return inner.status_word(); }
-  std::uint64_t status_count() const override { return inner.status_count(); }
-  std::optional<std::uint16_t> error_code() const override { return inner.error_code(); }
-  void set_control_word(std::uint16_t w) override { inner.set_control_word(w); }
-  const std::vector<cyclic_object>& cyclic_inputs() const override { return inner.cyclic_inputs(); }
-  const std::vector<cyclic_object>& cyclic_outputs() const override { return inner.cyclic_outputs(); }
-  std::optional<std::int64_t> cyclic_input(std::uint16_t i, std::uint8_t s) const override { return inner.cyclic_input(i, s); }
-  bool set_cyclic_output(std::uint16_t i, std::uint8_t s, std::int64_t v) override { return inner.set_cyclic_output(i, s, v); }
-  bool upload(std::uint16_t i, std::uint8_t s, transfer_done d) override { return inner.upload(i, s, std::move(d)); }
-  bool download(std::uint16_t i, std::uint8_t s, std::vector<std::uint8_t> b, transfer_done d) override {
-    return inner.download(i, s, std::move(b), std::move(d));
-  }
-  std::optional<value_format> describe(std::uint16_t i, std::uint8_t s) const override { return inner.describe(i, s); }
-  void close() override { inner.close(); }
-  const close_report& closing() const override { return inner.closing(); }
 
  private:
   bool busy_;

@@ -15,6 +15,7 @@
 #include "blocking_request.hpp"
 #include "cia402/apps/local_link.hpp"
 #include "cia402/page/server.hpp"
+#include "forwarding_link.hpp"
 #include "json_text.hpp"
 #include "page_server_fixture.hpp"
 
@@ -80,60 +81,22 @@ TEST_F(page_server, an_axis_that_is_not_utf8_is_refused_with_404_not_500) {
 
 // A virtual drive whose 0x1008 answers Latin-1 bytes, as a drive on a bus may: every other object
 // as the virtual drive has it. The page takes it for a drive on a bus (no plant in this process).
-class latin1_name_link final : public axes::drive_link {
+class latin1_name_link final : public cia402::test::forwarding_link<cia402::apps::local_link> {
  public:
-  explicit latin1_name_link(const cia402::profile& p) : inner_(p) {
-    inner_.on_event = [this](axes::link_event e, const std::string& text) {
-      if (on_event) on_event(e, text);
-    };
-    inner_.on_emergency = [this](std::uint16_t code, std::uint8_t reg, std::span<const std::uint8_t> bytes) {
-      if (on_emergency) on_emergency(code, reg, bytes);
-    };
-    inner_.before_cycle = [this] {
-      if (before_cycle) before_cycle();
-    };
-  }
-  std::uint32_t poll(std::uint32_t us) override { return inner_.poll(us); }
-  axes::link_phase phase() const override { return inner_.phase(); }
-  std::string phase_text() const override { return inner_.phase_text(); }
+  explicit latin1_name_link(const cia402::profile& p) : forwarding_link(p) {}
+  // As a bus's link: nothing is answered before time passes.
+  bool work_now() const override { return false; }
   std::string what() const override { return "a drive named in Latin-1"; }
   std::string short_name() const override { return "node 7"; }
-  bool cyclic() const override { return inner_.cyclic(); }
-  void start_cyclic() override { inner_.start_cyclic(); }
-  std::uint32_t cycle_us() const override { return inner_.cycle_us(); }
-  bool status_known() const override { return inner_.status_known(); }
-  std::uint16_t status_word() const override { return inner_.status_word(); }
-  std::uint64_t status_count() const override { return inner_.status_count(); }
-  std::optional<std::uint16_t> error_code() const override { return inner_.error_code(); }
-  void set_control_word(std::uint16_t w) override { inner_.set_control_word(w); }
-  const std::vector<axes::cyclic_object>& cyclic_inputs() const override { return inner_.cyclic_inputs(); }
-  const std::vector<axes::cyclic_object>& cyclic_outputs() const override { return inner_.cyclic_outputs(); }
-  std::optional<std::int64_t> cyclic_input(std::uint16_t i, std::uint8_t s) const override {
-    return inner_.cyclic_input(i, s);
-  }
-  bool set_cyclic_output(std::uint16_t i, std::uint8_t s, std::int64_t v) override {
-    return inner_.set_cyclic_output(i, s, v);
-  }
   bool upload(std::uint16_t index, std::uint8_t sub, axes::transfer_done done) override {
-    if (index != axes::device_name_index) return inner_.upload(index, sub, std::move(done));
-    return inner_.upload(index, sub, [done = std::move(done)](const axes::transfer_result& r) {
+    if (index != axes::device_name_index) return inner.upload(index, sub, std::move(done));
+    return inner.upload(index, sub, [done = std::move(done)](const axes::transfer_result& r) {
       axes::transfer_result latin1 = r;
       const std::string name = latin1_name;
       if (r.ok) latin1.data.assign(name.begin(), name.end());
       done(latin1);
     });
   }
-  bool download(std::uint16_t i, std::uint8_t s, std::vector<std::uint8_t> b, axes::transfer_done d) override {
-    return inner_.download(i, s, std::move(b), std::move(d));
-  }
-  std::optional<axes::value_format> describe(std::uint16_t i, std::uint8_t s) const override {
-    return inner_.describe(i, s);
-  }
-  void close() override { inner_.close(); }
-  const axes::close_report& closing() const override { return inner_.closing(); }
-
- private:
-  cia402::apps::local_link inner_;
 };
 
 TEST(hostile_text, a_drive_named_in_latin1_is_shown_and_the_server_answers_on) {
