@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -68,6 +69,15 @@ class page_server : public ::testing::Test {
     json s = json::parse(inst.snapshot_json());
     return {s["state"], s["control_word"], s["dc_link"], s["sto"], s["fault_cause"],
             s["target_velocity"], s["objects"], s["results"]};
+  }
+
+  // Sends `requests`, each refused, then runs 5 cycles: what a request could change must be as it
+  // was before them (a refused request has no effect that shows up later either).
+  void expect_unchanged_by(const std::function<void()>& requests) {
+    const json before = observable();
+    requests();
+    step(5);
+    EXPECT_EQ(observable(), before);
   }
 
   void expect_refused(const httplib::Result& r, int status, const std::string& reason_part) {

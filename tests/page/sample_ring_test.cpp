@@ -27,13 +27,19 @@ cycle_sample sample_at(std::uint64_t k) {
   return s;
 }
 
+// Pushes sample_at(0) .. sample_at(count - 1): every case fills its ring with the same numbered
+// samples and checks what it keeps of them.
+void push_samples(sample_ring& ring, std::uint64_t count) {
+  for (std::uint64_t k = 0; k < count; ++k) ring.push(sample_at(k));
+}
+
 std::vector<decoded_sample> read(const sample_ring& ring, std::uint64_t from, std::size_t max, std::uint64_t& next) {
   return decode_batch(json::parse(ring.batch_json(from, max, next, {"torque"})));
 }
 
 TEST(sample_ring, numbers_every_sample_without_a_gap_and_decodes_each_value) {
   sample_ring ring(64);
-  for (std::uint64_t k = 0; k < 40; ++k) ring.push(sample_at(k));
+  push_samples(ring, 40);
   EXPECT_EQ(ring.begin(), 0u);
   EXPECT_EQ(ring.end(), 40u);
   std::uint64_t next = 0;
@@ -52,7 +58,7 @@ TEST(sample_ring, numbers_every_sample_without_a_gap_and_decodes_each_value) {
 
 TEST(sample_ring, a_batch_is_run_length_coded_and_names_the_polled_signals) {
   sample_ring ring(64);
-  for (std::uint64_t k = 0; k < 30; ++k) ring.push(sample_at(k));
+  push_samples(ring, 30);
   std::uint64_t next = 0;
   const json b = json::parse(ring.batch_json(0, 100, next, {"torque"}));
   EXPECT_EQ(b["dt"], json({1000, 29}));                        // a steady cycle: one pair
@@ -64,7 +70,7 @@ TEST(sample_ring, a_batch_is_run_length_coded_and_names_the_polled_signals) {
 
 TEST(sample_ring, a_batch_holds_at_most_max_and_the_next_one_goes_on_from_there) {
   sample_ring ring(64);
-  for (std::uint64_t k = 0; k < 50; ++k) ring.push(sample_at(k));
+  push_samples(ring, 50);
   std::uint64_t next = 0;
   auto first = read(ring, 0, 20, next);
   ASSERT_EQ(first.size(), 20u);
@@ -79,7 +85,7 @@ TEST(sample_ring, a_batch_holds_at_most_max_and_the_next_one_goes_on_from_there)
 
 TEST(sample_ring, the_oldest_go_when_full_and_a_reader_behind_skips_ahead_to_the_oldest_kept) {
   sample_ring ring(16);
-  for (std::uint64_t k = 0; k < 100; ++k) ring.push(sample_at(k));
+  push_samples(ring, 100);
   EXPECT_EQ(ring.begin(), 84u);
   EXPECT_EQ(ring.end(), 100u);
   std::uint64_t next = 0;
@@ -96,7 +102,7 @@ TEST(sample_ring, the_oldest_go_when_full_and_a_reader_behind_skips_ahead_to_the
 
 TEST(sample_ring, clear_forgets_the_samples_but_the_numbers_go_on) {
   sample_ring ring(64);
-  for (std::uint64_t k = 0; k < 10; ++k) ring.push(sample_at(k));
+  push_samples(ring, 10);
   ring.clear();
   std::uint64_t next = 0;
   EXPECT_TRUE(read(ring, 0, 100, next).empty());
