@@ -177,19 +177,6 @@ bool local_link::set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::i
   return false;
 }
 
-bool local_link::upload(std::uint16_t index, std::uint8_t sub, axes::transfer_done done) {
-  if (closed_) return false;
-  transfers_.push_back({index, sub, false, {}, std::move(done)});
-  return true;
-}
-
-bool local_link::download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes,
-                          axes::transfer_done done) {
-  if (closed_) return false;
-  transfers_.push_back({index, sub, true, std::move(bytes), std::move(done)});
-  return true;
-}
-
 std::optional<axes::value_format> local_link::describe(std::uint16_t index, std::uint8_t sub) const {
   const object_dictionary::slot* s = objects_->table().find(index, sub);
   if (s == nullptr) return std::nullopt;

@@ -21,6 +21,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cia402/axis/drive_link.hpp"
@@ -60,8 +61,6 @@ class local_link final : public axes::link_base {
   std::optional<std::int64_t> cyclic_input(std::uint16_t index, std::uint8_t sub) const override;
   bool set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) override;
 
-  bool upload(std::uint16_t index, std::uint8_t sub, axes::transfer_done done) override;
-  bool download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes, axes::transfer_done done) override;
   std::optional<axes::value_format> describe(std::uint16_t index, std::uint8_t sub) const override;
 
   void close() override;
@@ -76,6 +75,10 @@ class local_link final : public axes::link_base {
   class objects;
   using transfer = axes::pending_transfer;
 
+  bool queue_transfer(transfer t) override {
+    transfers_.push_back(std::move(t));  // answered at the next poll
+    return true;
+  }
   void one_cycle();
   void note_error(std::uint16_t code, std::uint8_t reg);
 

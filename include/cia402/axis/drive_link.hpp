@@ -157,8 +157,15 @@ class link_base : public drive_link {
   const std::vector<cyclic_object>& cyclic_inputs() const override { return inputs_; }
   const std::vector<cyclic_object>& cyclic_outputs() const override { return outputs_; }
   const close_report& closing() const override { return report_; }
+  /// Refused while the link is not running (drive_link's rule); else handed to queue_transfer().
+  bool upload(std::uint16_t index, std::uint8_t sub, transfer_done done) final;
+  bool download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes, transfer_done done) final;
 
  protected:
+  /// Takes a transfer upload() or download() accepted into the link's own queue for its bus; false
+  /// (nothing queued) when the link refuses it after all.
+  virtual bool queue_transfer(pending_transfer t) = 0;
+
   std::uint64_t status_count_ = 0;
   std::vector<cyclic_object> inputs_, outputs_;
   close_report report_;

@@ -284,17 +284,8 @@ void can_link::note_name(std::uint16_t index, std::uint8_t sub, const std::vecto
 
 // --- transfers ----------------------------------------------------------------------------------
 
-bool can_link::upload(std::uint16_t index, std::uint8_t sub, axes::transfer_done done) {
-  if (phase() != axes::link_phase::running) return false;
-  return queue({index, sub, false, {}, std::move(done)});
-}
-
-bool can_link::download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes, axes::transfer_done done) {
-  if (phase() != axes::link_phase::running || bytes.empty()) return false;
-  return queue({index, sub, true, std::move(bytes), std::move(done)});
-}
-
-bool can_link::queue(transfer t) {
+bool can_link::queue_transfer(transfer t) {
+  if (t.download && t.bytes.empty()) return false;  // an SDO download carries at least one byte
   if (stage_ != stage::acyclic && !sdo_held_) return forward(std::move(t));
   if ((sdo_held_ || booting_) && own_.empty()) held_since_us_ = now_us_;
   own_.push_back(std::move(t));

@@ -252,15 +252,9 @@ bool ecat_link::set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::in
 
 // --- transfers ----------------------------------------------------------------------------------
 
-bool ecat_link::upload(std::uint16_t index, std::uint8_t sub, axes::transfer_done done) {
-  if (phase() != axes::link_phase::running) return false;
-  transfers_.push_back({index, sub, false, {}, std::move(done)});
-  return true;
-}
-
-bool ecat_link::download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes, axes::transfer_done done) {
-  if (phase() != axes::link_phase::running || bytes.empty()) return false;
-  transfers_.push_back({index, sub, true, std::move(bytes), std::move(done)});
+bool ecat_link::queue_transfer(transfer t) {
+  if (t.download && t.bytes.empty()) return false;  // a CoE SDO download carries at least one byte
+  transfers_.push_back(std::move(t));
   return true;
 }
 

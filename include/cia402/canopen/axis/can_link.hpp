@@ -92,8 +92,6 @@ class can_link final : public axes::link_base {
   std::optional<std::int64_t> cyclic_input(std::uint16_t index, std::uint8_t sub) const override;
   bool set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) override;
 
-  bool upload(std::uint16_t index, std::uint8_t sub, axes::transfer_done done) override;
-  bool download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes, axes::transfer_done done) override;
   std::optional<axes::value_format> describe(std::uint16_t index, std::uint8_t sub) const override;
 
   void close() override;
@@ -118,7 +116,7 @@ class can_link final : public axes::link_base {
   void record_next();
   void note_name(std::uint16_t index, std::uint8_t sub, const std::vector<std::uint8_t>& data);
   void fail_own(std::string text);
-  bool queue(transfer t);
+  bool queue_transfer(transfer t) override;
   bool forward(transfer t);
   void hold_own_transfer();
   void run_held();

@@ -105,8 +105,6 @@ class ecat_link final : public axes::link_base {
   std::optional<std::int64_t> cyclic_input(std::uint16_t index, std::uint8_t sub) const override;
   bool set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) override;
 
-  bool upload(std::uint16_t index, std::uint8_t sub, axes::transfer_done done) override;
-  bool download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes, axes::transfer_done done) override;
   std::optional<axes::value_format> describe(std::uint16_t index, std::uint8_t sub) const override;
 
   void close() override;
@@ -120,6 +118,7 @@ class ecat_link final : public axes::link_base {
   void after_cycle(bool ok);
   void fail(std::string why);
   void restart();  // the line is back in OP: the link runs afresh
+  bool queue_transfer(transfer t) override;
   void run_one_transfer();
   void step_stop();     // close(): an enabled drive on its way to SWITCH ON DISABLED, each cycle
   void finish_close();
