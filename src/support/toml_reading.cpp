@@ -6,6 +6,8 @@
 #include <system_error>
 #include <utility>
 
+#include "cia402/support/text.hpp"
+
 namespace cia402::toml_reading {
 
 void refuse(const toml::source_region& at, std::string reason) {
@@ -92,40 +94,6 @@ const toml::table& get_table(const toml::node& n, std::string_view what) {
   return *v;
 }
 
-namespace {
-
-// Length of the UTF-8 sequence starting at text[i] (1..4), or 0 when it is not one (overlong
-// forms, surrogates, above U+10FFFF, truncated).
-std::size_t utf8_length(std::string_view text, std::size_t i) {
-  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
-  const unsigned char c = b(i);
-  if (c < 0x80) return 1;
-  std::size_t n = 0;
-  unsigned char lo = 0x80;
-  unsigned char hi = 0xBF;
-  if (c >= 0xC2 && c <= 0xDF) {
-    n = 2;
-  } else if (c >= 0xE0 && c <= 0xEF) {
-    n = 3;
-    if (c == 0xE0) lo = 0xA0;
-    if (c == 0xED) hi = 0x9F;
-  } else if (c >= 0xF0 && c <= 0xF4) {
-    n = 4;
-    if (c == 0xF0) lo = 0x90;
-    if (c == 0xF4) hi = 0x8F;
-  } else {
-    return 0;
-  }
-  if (i + n > text.size()) return 0;
-  if (b(i + 1) < lo || b(i + 1) > hi) return 0;
-  for (std::size_t k = 2; k < n; ++k) {
-    if (b(i + k) < 0x80 || b(i + k) > 0xBF) return 0;
-  }
-  return n;
-}
-
-}  // namespace
-
 std::optional<refusal> check_toml_text(std::string_view text) {
   if (text.size() > max_file_bytes) {
     return refusal{0, 0, "larger than " + std::to_string(max_file_bytes) + " bytes"};
@@ -138,7 +106,7 @@ std::optional<refusal> check_toml_text(std::string_view text) {
   for (std::size_t i = 0; i < text.size();) {
     const char c = text[i];
     if (c == '\0') return refusal{line, column, "a NUL byte"};
-    const std::size_t n = utf8_length(text, i);
+    const std::size_t n = support::utf8_length(text, i);
     if (n == 0) return refusal{line, column, "not UTF-8 text"};
     if (n > 1 && where == in::code) {
       return refusal{line, column, "a non-ASCII character outside a string or comment"};
@@ -191,7 +159,7 @@ std::optional<refusal> check_toml_text(std::string_view text) {
     }
     if (escaped) {
       // The escaped character may be a multi-byte one: take it whole.
-      const std::size_t m = utf8_length(text, i + 1);
+      const std::size_t m = support::utf8_length(text, i + 1);
       if (m == 0) return refusal{line, column + 1, "not UTF-8 text"};
       step = 1 + m;
     }

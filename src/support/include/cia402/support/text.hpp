@@ -1,8 +1,10 @@
 // Text helpers the layers above the core share: one way to write a number in hexadecimal and one
-// way to read an integer a person typed (decimal or 0x-hexadecimal), and one way to put text into XML
-// (the ESI file, the SVG plot), so every file format, message and command line agrees.
+// way to read an integer a person typed (decimal or 0x-hexadecimal), one way to put text into XML
+// (the ESI file, the SVG plot), and one reading of UTF-8 (a TOML file, a drive's text on the page),
+// so every file format, message and command line agrees.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -27,6 +29,12 @@ std::optional<std::int64_t> parse_integer(std::string_view text, std::int64_t mi
 /// `text` with XML's five special characters written as entities, for element content and quoted
 /// attribute values alike.
 std::string xml_escaped(std::string_view text);
+
+/// Length of the UTF-8 sequence that starts at text[i] (1..4), or 0 where none does: an overlong
+/// form, a surrogate, a code point above U+10FFFF, a sequence cut short. `i` < text.size().
+std::size_t utf8_length(std::string_view text, std::size_t i);
+/// Whether all of `text` is well-formed UTF-8 (by utf8_length).
+bool is_utf8(std::string_view text);
 
 /// The words of `line`: runs of anything but spaces and tabs, in order, viewing `line`.
 std::vector<std::string_view> split_words(std::string_view line);
