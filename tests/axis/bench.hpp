@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <initializer_list>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "cia402/axis/session.hpp"
@@ -65,5 +68,17 @@ struct bench {
     return false;
   }
 };
+
+/// The request failed and its error names every one of `parts`: what most failure cases check of a
+/// result. When not, the message says which part is missing and shows the whole error.
+inline ::testing::AssertionResult failed_naming(const result& r, std::initializer_list<std::string_view> parts) {
+  if (r.ok()) return ::testing::AssertionFailure() << "the request succeeded";
+  for (const std::string_view part : parts) {
+    if (r.error.find(part) == std::string::npos) {
+      return ::testing::AssertionFailure() << "the error does not name \"" << part << "\": " << r.error;
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
 
 }  // namespace cia402::axes::test
