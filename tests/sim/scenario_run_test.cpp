@@ -40,6 +40,20 @@ std::size_t count_failed(const run_result& r) {
                                                 [](const log_entry& e) { return e.failed; }));
 }
 
+// The run counted `checks` expectations, `failures` of them failed, and it passed only without one.
+void expect_tally(const run_result& r, int checks, int failures) {
+  EXPECT_EQ(r.checks, checks);
+  EXPECT_EQ(r.failures, failures);
+  EXPECT_EQ(r.passed(), failures == 0);
+}
+
+// The run's log as `cia402 scenario` prints it, a line per entry.
+std::string log_text(const run_result& r) {
+  std::string log;
+  for (const log_entry& e : r.log) log += format_log_entry(e) + "\n";
+  return log;
+}
+
 TEST(scenario_run, true_expectations_pass_and_are_logged_as_pass) {
   const scenario s = load(enable +
                           "expect = [\n"
@@ -49,9 +63,7 @@ TEST(scenario_run, true_expectations_pass_and_are_logged_as_pass) {
                           "  { between = [\"70ms\", \"200ms\"], velocity = 500, state = \"OPERATION_ENABLED\" },\n"
                           "]\n");
   const run_result r = run_scenario(s);
-  EXPECT_EQ(r.checks, 6);
-  EXPECT_EQ(r.failures, 0);
-  EXPECT_TRUE(r.passed());
+  expect_tally(r, 6, 0);
   EXPECT_EQ(r.trace.size(), 201u);
   EXPECT_EQ(count_failed(r), 0u);
 }
@@ -66,11 +78,8 @@ TEST(scenario_run, false_expectations_fail_with_what_was_seen) {
                           "  { at = \"100ms\", statusword = 0x0000 },\n"
                           "]\n");
   const run_result r = run_scenario(s);
-  EXPECT_EQ(r.checks, 5);
-  EXPECT_EQ(r.failures, 5);
-  EXPECT_FALSE(r.passed());
-  std::string log;
-  for (const log_entry& e : r.log) log += format_log_entry(e) + "\n";
+  expect_tally(r, 5, 5);
+  const std::string log = log_text(r);
   EXPECT_NE(log.find("FAIL  state QUICK_STOP_ACTIVE at 0.100 s (line 11): state is OPERATION_ENABLED"),
             std::string::npos) << log;
   EXPECT_NE(log.find("velocity is 500 rpm"), std::string::npos) << log;
@@ -85,10 +94,8 @@ TEST(scenario_run, writes_refused_unexpectedly_or_accepted_against_an_expected_a
                           "  { at = \"7ms\", write = { 0x605A = 10 }, abort = 0x06090030 },\n"
                           "]\n");
   const run_result r = run_scenario(s);
-  EXPECT_EQ(r.checks, 3);
-  EXPECT_EQ(r.failures, 2);
-  std::string log;
-  for (const log_entry& e : r.log) log += format_log_entry(e) + "\n";
+  expect_tally(r, 3, 2);
+  const std::string log = log_text(r);
   EXPECT_NE(log.find("FAIL  write 0x605A = 9: refused, SDO abort 0x06090030"), std::string::npos) << log;
   EXPECT_NE(log.find("accepted, but the scenario expects SDO abort 0x06090030"), std::string::npos) << log;
   EXPECT_NE(log.find("refused as expected"), std::string::npos) << log;
