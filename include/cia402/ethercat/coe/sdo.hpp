@@ -17,6 +17,8 @@
 #include <span>
 #include <vector>
 
+#include "cia402/ethercat/coe/mailbox.hpp"
+
 namespace cia402::ethercat {
 
 /// CoE services (the high nibble of the CoE header's second byte).
@@ -32,16 +34,22 @@ enum class coe_service : std::uint8_t {
 };
 
 inline constexpr std::size_t coe_header_size = 2;
+/// Bytes a CoE service's data may take in a mailbox of `mailbox_size` bytes, after the mailbox
+/// header, the CoE header and the service's own `service_header_size` bytes (0 when it is too small
+/// for any): the one sum behind every "room" of an SDO and SDO information frame.
+constexpr std::size_t coe_room(std::size_t mailbox_size, std::size_t service_header_size) noexcept {
+  const std::size_t headers = mailbox_header_size + coe_header_size + service_header_size;
+  return mailbox_size > headers ? mailbox_size - headers : 0;
+}
 /// An SDO's fixed part: command, index, sub-index, then 4 bytes of data or of size.
 inline constexpr std::size_t sdo_header_size = 8;
 /// Bytes of value the first mailbox of a normal transfer carries, and a segment carries, in a
 /// mailbox of `mailbox_size` bytes (0 when it is too small for any).
+/// (A segment's own header is its one command byte.)
 constexpr std::size_t sdo_initiate_room(std::size_t mailbox_size) noexcept {
-  return mailbox_size > 6 + coe_header_size + sdo_header_size ? mailbox_size - 6 - coe_header_size - sdo_header_size : 0;
+  return coe_room(mailbox_size, sdo_header_size);
 }
-constexpr std::size_t sdo_segment_room(std::size_t mailbox_size) noexcept {
-  return mailbox_size > 6 + coe_header_size + 1 ? mailbox_size - 6 - coe_header_size - 1 : 0;
-}
+constexpr std::size_t sdo_segment_room(std::size_t mailbox_size) noexcept { return coe_room(mailbox_size, 1); }
 
 /// A mailbox's CoE data: the service and what follows the CoE header.
 struct coe_view {

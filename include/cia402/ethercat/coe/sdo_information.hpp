@@ -10,6 +10,8 @@
 #include <string_view>
 #include <vector>
 
+#include "cia402/ethercat/coe/sdo.hpp"
+
 namespace cia402::ethercat {
 
 enum class sdo_info_opcode : std::uint8_t {
@@ -25,7 +27,7 @@ enum class sdo_info_opcode : std::uint8_t {
 inline constexpr std::size_t sdo_info_header_size = 4;
 /// Bytes of data one fragment carries in a mailbox of `mailbox_size` bytes.
 constexpr std::size_t sdo_info_room(std::size_t mailbox_size) noexcept {
-  return mailbox_size > 6 + 2 + sdo_info_header_size ? mailbox_size - 6 - 2 - sdo_info_header_size : 0;
+  return coe_room(mailbox_size, sdo_info_header_size);
 }
 
 /// An SDO information frame: opcode, whether fragments follow, how many, and its data.
