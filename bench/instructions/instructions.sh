@@ -3,10 +3,9 @@
 # lookup table, counted by valgrind's callgrind: the counts do not move with the machine's load.
 #   bash bench/instructions/instructions.sh [build/release/bench/cia402_instructions] [PROFILE]
 # The step every layer runs, step(profile, ...), is held to the bounds of the open issue: 30
-# instructions a quiet step, 45 a transition-heavy one. Each is judged in the output. A quiet step
-# over its bound fails the script (the bound is met: a change that loses it fails CI); with
-# INSTRUCTIONS_STRICT=1 so does a transition-heavy one, which is not met yet (see
-# docs/compiled-step.md, "The step through a profile").
+# instructions a quiet step, 45 a transition-heavy one. Each is judged in the output, and a step
+# over its bound fails the script: CI runs it for cia402, which meets both (lexium32's
+# transition-heavy figure does not yet: docs/compiled-step.md, "The step through a profile").
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 program=${1:-"$here/../../build/release/bench/cia402_instructions"}
@@ -22,27 +21,21 @@ per_step() {  # SCENARIO: instructions per step inside the scenario's own functi
   awk -v t="$total" -v n="$steps" 'BEGIN { printf "%.1f", t / n }'
 }
 echo "instructions per step, profile $profile (callgrind; the lookup table is a bare 256-entry table):"
-over=0
 failed=0
-for pair in "quiet:table_quiet:compiled_quiet:core_quiet:30:enforced" \
-             "transitions:table_transitions:compiled_transitions:core_transitions:45:strict"; do
-  IFS=: read -r what table compiled core bound rule <<<"$pair"
+for pair in "quiet:table_quiet:compiled_quiet:core_quiet:30" \
+             "transitions:table_transitions:compiled_transitions:core_transitions:45"; do
+  IFS=: read -r what table compiled core bound <<<"$pair"
   t=$(per_step "$table"); c=$(per_step "$compiled"); p=$(per_step "$core")
   if awk -v p="$p" -v b="$bound" 'BEGIN { exit !(p <= b) }'; then
     verdict="within its bound of $bound"
   else
     verdict="OVER its bound of $bound"
-    over=1
-    if [ "$rule" = enforced ]; then failed=1; fi
+    failed=1
   fi
   echo "  $what: lookup table $t, compiled step $c, profile step $p ($verdict)"
 done
 echo "  master: repeated status word $(per_step master_repeated), a new word in the same state $(per_step master_changing)"
 if [ "$failed" = 1 ]; then
-  echo "instructions: the quiet step through a profile is over its bound" >&2
-  exit 1
-fi
-if [ "$over" = 1 ] && [ "${INSTRUCTIONS_STRICT:-0}" = 1 ]; then
-  echo "instructions: the step through a profile is over its bound" >&2
+  echo "instructions: the step through profile $profile is over its bound" >&2
   exit 1
 fi

@@ -98,6 +98,33 @@ enum class row_stop : std::uint8_t {
 
 inline constexpr int row_stop_count = 7;
 
+namespace detail {
+// What a row's stop does, as a few bits, so the drive reads a table rather than a switch: the ramp
+// (none, slow-down or quick-stop as stop_ramp numbers them, or `halt_ramp_live`: the one 0x605D
+// picks, read live because 0x605D acts at once, S16), whether it only runs when the option code
+// read as the stop starts is 1 (else the change is immediate), and which code that is. The full
+// step (src/core/drive.cpp) and the ordinary cycles (compile_ordinary) both read it.
+namespace stop_bits {
+inline constexpr unsigned halt_ramp_live = 3;  ///< bits 0..1: the ramp; 3 = as 0x605D says
+inline constexpr unsigned ramp = 3;
+inline constexpr unsigned if_code_is_1 = 1u << 2;  ///< ramp only if the code read at the start is 1
+inline constexpr unsigned code_605c = 1u << 3;     ///< that code is 0x605C, else 0x605B
+}  // namespace stop_bits
+
+constexpr unsigned stop_nibble(row_stop s) noexcept {
+  switch (s) {
+    case row_stop::immediate: break;
+    case row_stop::shutdown_option: return stop_bits::if_code_is_1 | 1u;
+    case row_stop::disable_operation_option: return stop_bits::if_code_is_1 | stop_bits::code_605c | 1u;
+    case row_stop::slow_down_ramp: return 1u;   // stop_ramp::slow_down
+    case row_stop::quick_stop_ramp: return 2u;  // stop_ramp::quick_stop
+    case row_stop::halt_ramp: return stop_bits::halt_ramp_live;
+    case row_stop::shutdown_option_halt: return stop_bits::if_code_is_1 | stop_bits::halt_ramp_live;
+  }
+  return 0;
+}
+}  // namespace detail
+
 namespace row_flag {
 /// The row may fire while another row's stop is still running (S7: T9, T11, T13 take over).
 inline constexpr std::uint8_t interrupts_stop = 1u << 0;
@@ -377,10 +404,13 @@ struct profile {
       const bool bit7 = ((key >> 7) & 1u) != 0, reset_before = ((key >> 8) & 1u) != 0,
                  torque_before = ((key >> 9) & 1u) != 0;
       const std::uint8_t code = ordinary_entry(static_cast<int>(s), c);
-      // A fault-reset edge where a row reads it, or torque on where the row stops first (S7): the
-      // full step decides.
-      if (code == ordinary::full || (bit7 && !reset_before && (code & ordinary::reset_reads) != 0) ||
-          (torque_before && (code & ordinary::stops) != 0)) {
+      // A fault-reset edge where a row reads it: the full step decides.
+      if (code == ordinary::full || (bit7 && !reset_before && (code & ordinary::reset_reads) != 0)) continue;
+      // Torque on where the row stops first (S7): its stop starts, unless the option code it reads
+      // makes the change immediate (the full step then). A ramp 0x605D picks is read live: the full
+      // step's.
+      if (torque_before && (code & ordinary::stops) != 0) {
+        compile_stop_start(t, at, static_cast<unsigned>(s), (code & ordinary::row) - 1u, bit7);
         continue;
       }
       // The row that fires, if any, by value: g++ with -fsanitize=undefined holds a pointer's
@@ -417,6 +447,36 @@ struct profile {
       t.row_offset[bits] = static_cast<std::uint16_t>(
           ordinary_tables::offset_of((unsigned{command_of_bits[bits & 0x1Fu]} << 4) | (bits & 0x80u)));
     }
+  }
+
+  /// The entry at byte offset `at` of a key whose row (index `take`, leaving state s) starts its stop
+  /// with torque on: the row becomes the pending one, the state and the last transition stay, and
+  /// the outputs are the stop's (its ramp, torque on, the brake open but at standstill where the
+  /// stop ends torque). The full step's way, byte for byte (the model check).
+  constexpr void compile_stop_start(ordinary_tables& t, std::size_t at, unsigned s, unsigned take,
+                                    bool bit7) const noexcept {
+    using detail::byte_shift;
+    const stored_row& r = rows[take];
+    const unsigned stop = detail::stop_nibble(r.stop);
+    const unsigned ramp = stop & detail::stop_bits::ramp;
+    if (ramp == detail::stop_bits::halt_ramp_live) return;  // stays `full`
+    const unsigned actions =
+        ordinary_action::full | ordinary_action::stop_starts |
+        ((stop & detail::stop_bits::if_code_is_1) ? ordinary_action::stop_reads_code : 0u) |
+        ((stop & detail::stop_bits::code_605c) ? ordinary_action::stop_code_605c : 0u) |
+        (states[static_cast<int>(r.to)].activity == state_activity::idle ? ordinary_action::stop_ends_torque : 0u) |
+        (speed_limit_rpm > 0 ? ordinary_action::speed_limit : 0u);
+    const unsigned flags_kept =
+        0xFFu & ~static_cast<unsigned>(axis_flag::torque_on | axis_flag::fault_reset_bit);
+    const unsigned flags_set = unsigned{axis_flag::torque_on} | (bit7 ? unsigned{axis_flag::fault_reset_bit} : 0u);
+    t.axis_words[at / 4] = (flags_kept << byte_shift<4>(0)) | (0xFFu << byte_shift<4>(1)) |
+                           (actions << byte_shift<4>(2)) | (0xFFu << byte_shift<4>(3));
+    t.axis_words[at / 4 + 1] = (flags_set << byte_shift<4>(0)) | (take << byte_shift<4>(2));
+    t.images[at / 8] = (std::uint64_t{s} << byte_shift<8>(0)) |
+                       (std::uint64_t{states[s].status_pattern | 0x0210u} << detail::status_shift) |
+                       (std::uint64_t{no_transition} << byte_shift<8>(4)) |
+                       (std::uint64_t{ramp} << byte_shift<8>(5)) | (std::uint64_t{1} << byte_shift<8>(6)) |
+                       (std::uint64_t{1} << byte_shift<8>(7));
   }
 
   /// Where the ordinary cycle of state s under command c is.

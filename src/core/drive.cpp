@@ -35,30 +35,8 @@ stop_ramp ramp_of_code(int code) noexcept {
   return static_cast<stop_ramp>(((code - 1) & 3) + 1);
 }
 
-// What a row's stop does, as a few bits, so the drive reads a table rather than a switch: the ramp
-// (none, slow-down or quick-stop as stop_ramp numbers them, or `halt_ramp_live`: the one 0x605D
-// picks, read live because 0x605D acts at once, S16), whether it only runs when the option code
-// read as the stop starts is 1 (else the change is immediate), and which code that is.
-namespace stop_bits {
-constexpr unsigned halt_ramp_live = 3;  ///< bits 0..1: the ramp; 3 = as 0x605D says
-constexpr unsigned ramp = 3;
-constexpr unsigned if_code_is_1 = 1u << 2;  ///< ramp only if the code read at the start is 1
-constexpr unsigned code_605c = 1u << 3;     ///< that code is 0x605C, else 0x605B
-}  // namespace stop_bits
-
-constexpr unsigned stop_nibble(row_stop s) noexcept {
-  switch (s) {
-    case row_stop::immediate: break;
-    case row_stop::shutdown_option: return stop_bits::if_code_is_1 | 1u;
-    case row_stop::disable_operation_option:
-      return stop_bits::if_code_is_1 | stop_bits::code_605c | 1u;
-    case row_stop::slow_down_ramp: return static_cast<unsigned>(stop_ramp::slow_down);
-    case row_stop::quick_stop_ramp: return static_cast<unsigned>(stop_ramp::quick_stop);
-    case row_stop::halt_ramp: return stop_bits::halt_ramp_live;
-    case row_stop::shutdown_option_halt: return stop_bits::if_code_is_1 | stop_bits::halt_ramp_live;
-  }
-  return 0;
-}
+namespace stop_bits = detail::stop_bits;
+using detail::stop_nibble;
 
 constexpr std::uint32_t stop_table = [] {
   std::uint32_t t = 0;

@@ -122,10 +122,16 @@ TEST(ordinary_tables, every_built_in_profile_has_them_compiled_with_it) {
   }
 }
 
-TEST(ordinary_tables, a_stop_with_torque_on_and_a_reset_edge_where_a_row_reads_it_go_to_the_full_step) {
+TEST(ordinary_tables, a_stop_with_torque_on_starts_in_the_table_and_a_reset_edge_where_a_row_reads_it_goes_to_the_full_step) {
   const profile& p = standard_profile();
   // T5 (Switch on in OPERATION ENABLED) ramps first where torque was on (S7), else fires at once.
-  EXPECT_TRUE(to_full_step(compiled(p, state::operation_enabled, 0x07, false, true)));
+  const compiled_entry starts = compiled(p, state::operation_enabled, 0x07, false, true);
+  const unsigned actions = (starts.keep >> detail::byte_shift<4>(2)) & 0xFFu;
+  EXPECT_NE(actions & ordinary_action::stop_starts, 0u);
+  EXPECT_NE(actions & ordinary_action::stop_code_605c, 0u) << "T5's stop reads 0x605C";
+  const unsigned pending = (starts.set >> detail::byte_shift<4>(2)) & 0xFFu;
+  ASSERT_LT(pending, p.row_count);
+  EXPECT_EQ(p.rows[pending].number, 5);
   const compiled_entry t5 = compiled(p, state::operation_enabled, 0x07, false, false);
   ASSERT_FALSE(to_full_step(t5));
   EXPECT_EQ((t5.set >> detail::byte_shift<4>(1)) & 0xFFu, static_cast<unsigned>(state::switched_on));
@@ -138,6 +144,35 @@ TEST(ordinary_tables, a_stop_with_torque_on_and_a_reset_edge_where_a_row_reads_i
       << "bit 7 kept for the next cycle's edge";
   // QUICK STOP ACTIVE stops by 0x605A in every cycle.
   EXPECT_TRUE(to_full_step(compiled(p, state::quick_stop_active, 0x0F, false, true)));
+}
+
+// T5 under torque by the table: with 0x605C = 1 the stop starts (the pending row is T5's, the state
+// stays until standstill), with 0 the state changes at once; each as the full step does.
+TEST(ordinary_tables, the_stop_of_t5_starts_by_0x605c_as_the_full_step_starts_it) {
+  const profile& p = standard_profile();
+  for (const std::int8_t code : {std::int8_t{1}, std::int8_t{0}}) {
+    axis a = make_axis(p);
+    drive_inputs in;
+    for (const std::uint16_t cw : {0x00, 0x00, 0x06, 0x07, 0x0F}) {
+      in.control_word = cw;
+      step(p, a, in);
+    }
+    ASSERT_EQ(a.current, state::operation_enabled);
+    ASSERT_EQ(write_option(p, a, 0x605C, code), sdo_abort::none);
+    in.control_word = 0x07;
+    in.standstill = false;
+    axis by_full = a;
+    drive_outputs quiet{};
+    axis by_quiet = a;
+    EXPECT_EQ(detail::quiet_step(p, by_quiet, in, quiet), code == 1) << "0x605C = " << int{code};
+    const drive_outputs x = step(p, a, in);
+    const drive_outputs y = detail::full_step(p, by_full, in);
+    EXPECT_TRUE(test::same_outputs(x, y));
+    EXPECT_EQ(std::memcmp(&a, &by_full, sizeof(axis)), 0);
+    EXPECT_EQ(a.current, code == 1 ? state::operation_enabled : state::switched_on);
+    EXPECT_EQ(stop_running(a), code == 1);
+    EXPECT_EQ(x.torque, code == 1) << "the ramp runs with torque on";
+  }
 }
 
 TEST(ordinary_tables, a_profile_finalized_without_tables_steps_by_the_full_step_alone) {

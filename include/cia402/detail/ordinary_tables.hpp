@@ -42,6 +42,11 @@ namespace ordinary_action {
 inline constexpr std::uint8_t has_halt = 1u << 0;     ///< the profile has 0x605D (S8)
 inline constexpr std::uint8_t full = 1u << 1;         ///< detail::full_step decides every such cycle
 inline constexpr std::uint8_t runs = 1u << 2;         ///< the state after runs: bit 10 shows, halt acts
+/// With `full`: torque is on and the row that fires stops first (S7); set's byte 2 is its index.
+inline constexpr std::uint8_t stop_starts = 1u << 3;
+inline constexpr std::uint8_t stop_reads_code = 1u << 4;   ///< it ramps only if 0x605B (0x605C) is 1
+inline constexpr std::uint8_t stop_code_605c = 1u << 6;    ///< that code is 0x605C
+inline constexpr std::uint8_t stop_ends_torque = 1u << 7;  ///< the brake closes at standstill (S12)
 inline constexpr std::uint8_t speed_limit = 1u << 5;  ///< the profile watches |speed| (seed 001)
 }  // namespace ordinary_action
 

@@ -112,7 +112,25 @@ inline bool quiet_cycle(const profile& p, axis& a, const drive_inputs& in, std::
   // One test of the keep word for the rare entries: the full step decides, or the control word
   // halts (bit 8) where the profile has 0x605D.
   if (seldom(keep & ((((cw >> 8) & 1u) | ordinary_action::full) << actions_shift))) {
-    if (actions & ordinary_action::full) return false;
+    if (actions & ordinary_action::full) {
+      if (!(actions & ordinary_action::stop_starts)) return false;
+      // S7: the row's stop starts, by the option code it reads as it starts (S16), if any: a code
+      // other than 1 makes the change immediate, which the full step commits.
+      std::int8_t code = 0;
+      if (actions & ordinary_action::stop_reads_code) {
+        code = a.options[static_cast<int>((actions & ordinary_action::stop_code_605c) ? option::disable_operation
+                                                                                      : option::shutdown)];
+        if (code != 1) return false;
+      }
+      // A stop that ends with torque off closes the brake at standstill (S12).
+      if ((actions & ordinary_action::stop_ends_torque) && in.standstill) {
+        head &= ~(std::uint64_t{0xFF} << byte_shift<8>(7));
+      }
+      const std::uint32_t pending = (word & keep & ~(0xFFu << actions_shift)) | set;
+      std::memcpy(static_cast<void*>(&a), &pending, 4);
+      a.stop_code = code;
+      return true;
+    }
     if ((actions & ordinary_action::has_halt) && (cw & control_bit::halt)) {
       // Halt (S8) ramps by 0x605D: 1 slow-down, 2 quick-stop, 3 current limit, 4 voltage limit
       // (stop_ramp's values); bit 10 then says standstill. A value outside 1..4 is the full step's.
