@@ -12,13 +12,10 @@ TEST(path_cli, switch_on_disabled_to_operation_enabled_takes_shutdown_then_enabl
   const auto r = run_tool({"path", "SWITCH_ON_DISABLED", "OPERATION_ENABLED"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_EQ(r.lines.size(), 4u) << r.out;
-  EXPECT_NE(r.lines[0].find("in 3 cycles"), std::string::npos);
-  EXPECT_NE(r.lines[1].find("cw 0x0006"), std::string::npos);
-  EXPECT_NE(r.lines[1].find("T2 "), std::string::npos);
-  EXPECT_NE(r.lines[2].find("cw 0x000F"), std::string::npos);
-  EXPECT_NE(r.lines[2].find("T3 "), std::string::npos);
-  EXPECT_NE(r.lines[3].find("T4 "), std::string::npos);
-  EXPECT_NE(r.lines[3].find("-> OPERATION_ENABLED"), std::string::npos);
+  EXPECT_TRUE(line_names(r, 0, {"in 3 cycles"}));
+  EXPECT_TRUE(line_names(r, 1, {"cw 0x0006", "T2 "}));
+  EXPECT_TRUE(line_names(r, 2, {"cw 0x000F", "T3 "}));
+  EXPECT_TRUE(line_names(r, 3, {"T4 ", "-> OPERATION_ENABLED"}));
 }
 
 TEST(path_cli, abbreviations_name_the_same_states_as_the_full_names) {
@@ -45,20 +42,18 @@ TEST(path_cli, from_fault_starts_with_the_reset_edge) {
   const auto r = run_tool({"path", "fault", "switch_on_disabled"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_EQ(r.lines.size(), 2u) << r.out;
-  EXPECT_NE(r.lines[1].find("cw 0x0080"), std::string::npos);
-  EXPECT_NE(r.lines[1].find("FAULT_RESET"), std::string::npos);
-  EXPECT_NE(r.lines[1].find("T15"), std::string::npos);
+  EXPECT_TRUE(line_names(r, 1, {"cw 0x0080", "FAULT_RESET", "T15"}));
 }
 
 TEST(path_cli, quick_stop_code_decides_the_way_back_to_operation_enabled) {
   const auto ends = run_tool({"path", "QUICK_STOP_ACTIVE", "OPERATION_ENABLED", "--set", "0x605A=2"});
   ASSERT_EQ(ends.exit_code, 0) << ends.err;
-  EXPECT_NE(ends.lines[0].find("in 4 cycles"), std::string::npos) << ends.out;
-  EXPECT_NE(ends.lines[1].find("T12"), std::string::npos) << ends.out;
+  EXPECT_TRUE(line_names(ends, 0, {"in 4 cycles"}));
+  EXPECT_TRUE(line_names(ends, 1, {"T12"}));
   const auto stays = run_tool({"path", "QUICK_STOP_ACTIVE", "OPERATION_ENABLED", "--set", "0x605A=6"});
   ASSERT_EQ(stays.exit_code, 0) << stays.err;
-  EXPECT_NE(stays.lines[0].find("in 1 cycle"), std::string::npos) << stays.out;
-  EXPECT_NE(stays.lines[1].find("T16"), std::string::npos) << stays.out;
+  EXPECT_TRUE(line_names(stays, 0, {"in 1 cycle"}));
+  EXPECT_TRUE(line_names(stays, 1, {"T16"}));
 }
 
 TEST(path_cli, unreachable_target_exits_1_and_says_so) {

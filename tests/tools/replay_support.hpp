@@ -1,6 +1,10 @@
 // Runs `cia402 replay` through the tool's own entry point, with string streams.
 #pragma once
 
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <initializer_list>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -27,6 +31,19 @@ inline tool_run run_tool(const std::vector<std::string>& args, const std::string
   std::istringstream split(r.out);
   for (std::string line; std::getline(split, line);) r.lines.push_back(line);
   return r;
+}
+
+/// Line `n` of the run's standard output holds every one of `parts` (a step of `cia402 path`: its
+/// control word, its transition; a replay line: its state, its transitions). When not, the message
+/// names the missing part and shows the line, or the whole output when there is no line `n`.
+inline ::testing::AssertionResult line_names(const tool_run& r, std::size_t n, std::initializer_list<const char*> parts) {
+  if (n >= r.lines.size()) return ::testing::AssertionFailure() << "no line " << n << " in:\n" << r.out;
+  for (const char* part : parts) {
+    if (r.lines[n].find(part) == std::string::npos) {
+      return ::testing::AssertionFailure() << "line " << n << " does not name \"" << part << "\": " << r.lines[n];
+    }
+  }
+  return ::testing::AssertionSuccess();
 }
 
 /// A replay line with only the fields the first replay interface printed (state, statusword,
