@@ -1,6 +1,5 @@
 #include "cia402/page/server.hpp"
 
-#include <arpa/inet.h>
 #include <httplib.h>
 #include <netinet/tcp.h>
 #include <poll.h>
@@ -11,7 +10,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cctype>
 #include <charconv>
 #include <cstdio>
 #include <functional>
@@ -46,8 +44,6 @@ using detail::send_error;
 using detail::send_json;
 using detail::unknown_key;
 
-
-
 // cpp-httplib 0.11.4 (Debian 12's, a compiled library) reads a request's whole head, every header
 // line of it, before any hook of ours runs, and its per-connection entry point is private. So the
 // page's server is two: `guard_server` only accepts, and checks each connection before anything is
@@ -75,7 +71,6 @@ struct guard_server : httplib::Server {
   std::function<bool(socket_t)> admit;  // checks, then processes or refuses; closes the socket
   bool process_and_close_socket(socket_t sock) override { return admit(sock); }
 };
-
 
 }  // namespace
 
@@ -113,18 +108,7 @@ struct server::impl {
     ::setsockopt(sock, IPPROTO_TCP, TCP_NODELAY, &yes, sizeof yes);
     // Connections per client address, beyond loopback (on loopback every client is one address,
     // the page's own among them).
-    std::string address;
-    sockaddr_storage peer{};
-    socklen_t len = sizeof peer;
-    if (::getpeername(sock, reinterpret_cast<sockaddr*>(&peer), &len) == 0) {
-      char text[INET6_ADDRSTRLEN] = {};
-      if (peer.ss_family == AF_INET) {
-        inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(&peer)->sin_addr, text, sizeof text);
-      } else if (peer.ss_family == AF_INET6) {
-        inet_ntop(AF_INET6, &reinterpret_cast<sockaddr_in6*>(&peer)->sin6_addr, text, sizeof text);
-      }
-      address = text;
-    }
+    const std::string address = detail::peer_address(sock);
     const bool counted = !address.empty() && !is_loopback_address(address);
     if (counted) {
       std::lock_guard lock(clients_mutex);
@@ -224,16 +208,7 @@ struct server::impl {
         req.get_header_value("Origin") != "http://" + req.get_header_value("Host")) {
       return request_error{403, "cross-origin request refused"};
     }
-    // application/json exactly, parameters (charset) allowed: not a type that merely starts so.
-    const std::string type = req.get_header_value("Content-Type");
-    const std::string media = type.substr(0, type.find(';'));
-    const auto space = [](char c) { return c == ' ' || c == '\t'; };
-    const auto first = std::find_if_not(media.begin(), media.end(), space);
-    const auto last = std::find_if_not(media.rbegin(), media.rend(), space).base();
-    std::string bare = first < last ? std::string(first, last) : std::string();
-    std::transform(bare.begin(), bare.end(), bare.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (bare != "application/json") {
+    if (!detail::is_json_content_type(req.get_header_value("Content-Type"))) {
       return request_error{415, "Content-Type must be application/json"};
     }
     if (req.body.size() > max_body) {
@@ -322,7 +297,18 @@ struct server::impl {
     return a != nullptr ? a->drive : nullptr;
   }
 
+  // The routes by concern, registered in this order (cpp-httplib takes the first that matches).
   void routes() {
+    set_up_connections();
+    add_asset_routes();
+    add_view_routes();
+    add_recording_routes();
+    add_action_routes();
+  }
+
+  // How the two servers take connections and requests: the socket options, the limits on what a
+  // request may bring, the headers of every answer, and the answers to errors.
+  void set_up_connections() {
     // cpp-httplib's default sets SO_REUSEPORT, so a second `cia402 serve` on the same port would
     // listen too and the two would answer in turn. SO_REUSEADDR alone still allows a restart while
     // old connections linger, and makes the second bind fail.
@@ -384,7 +370,10 @@ struct server::impl {
         [](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
           send_error(res, 500, "internal error");
         });
+  }
 
+  // The page itself: its embedded files, "/" for index.html.
+  void add_asset_routes() {
     for (const web::asset& a : web::assets()) {
       const std::string content_type = a.content_type;
       const std::string_view data(reinterpret_cast<const char*>(a.data), a.size);
@@ -395,7 +384,11 @@ struct server::impl {
       if (std::string_view(a.path) == "/index.html") http.Get("/", serve);
     }
     http.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
+  }
 
+  // What the page reads of an axis (GET): its info, who controls it (and POST to take or leave
+  // control), the overview of every axis, its state, its drive's errors, the event stream.
+  void add_view_routes() {
     http.Get("/api/info", [this](const httplib::Request& req, httplib::Response& res) {
       const axis* a = axis_named(req, res);
       if (a == nullptr) return;
@@ -441,6 +434,10 @@ struct server::impl {
       if (may_control(req)) renew = [this, k = index_of(a), client = client_of(req)] { renew_for(k, client); };
       detail::serve_events(*a->drive, res, options, streams, stopping, std::move(renew));
     });
+  }
+
+  // The recorder's rows and transitions: as JSON since what the page has seen, and as files.
+  void add_recording_routes() {
     http.Get("/api/recording", [this](const httplib::Request& req, httplib::Response& res) {
       std::uint64_t seen[2] = {0, 0};
       const char* keys[2] = {"rows_seen", "transitions_seen"};
@@ -474,6 +471,12 @@ struct server::impl {
                                                             : recording_format::vcd),
                       "text/plain");
     });
+  }
+
+  // What commands an axis (POST with a JSON body, checked by post()): commands, the plant, object
+  // writes, the profile, enable and stop, jog, homing, the drive's error field, the parameter list;
+  // a GET to one of them is told to POST.
+  void add_action_routes() {
     http.Post("/api/command", [this](const httplib::Request& req, httplib::Response& res) {
       post(req, res, &detail::command_request);
     });

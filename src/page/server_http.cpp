@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <memory>
 #include <random>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <thread>
@@ -35,6 +36,17 @@ bool length_within(const std::string& text, std::size_t max) {
   std::size_t n = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
   return ec == std::errc() && end == text.data() + text.size() && !text.empty() && n <= max;
+}
+
+bool is_json_content_type(std::string_view content_type) {
+  std::string_view media = content_type.substr(0, content_type.find(';'));
+  const auto space = [](char c) { return c == ' ' || c == '\t'; };
+  while (!media.empty() && space(media.front())) media.remove_prefix(1);
+  while (!media.empty() && space(media.back())) media.remove_suffix(1);
+  std::string bare(media);
+  std::transform(bare.begin(), bare.end(), bare.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return bare == "application/json";
 }
 
 // Equal-time comparison, so the time a refusal takes tells nothing about the token.
@@ -213,6 +225,19 @@ std::variant<reply, request_error> homing_request_of(backend& drive, const json&
     return request_error{400, "nothing to do: give a parameter or 'start'"};
   }
   return drive.home(r);
+}
+
+std::string peer_address(socket_t sock) {
+  sockaddr_storage peer{};
+  socklen_t len = sizeof peer;
+  if (::getpeername(sock, reinterpret_cast<sockaddr*>(&peer), &len) != 0) return {};
+  char text[INET6_ADDRSTRLEN] = {};
+  if (peer.ss_family == AF_INET) {
+    inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(&peer)->sin_addr, text, sizeof text);
+  } else if (peer.ss_family == AF_INET6) {
+    inet_ntop(AF_INET6, &reinterpret_cast<sockaddr_in6*>(&peer)->sin6_addr, text, sizeof text);
+  }
+  return text;
 }
 
 // A refusal written straight to the socket (the request was never parsed).

@@ -30,6 +30,10 @@ void send_error(httplib::Response& res, int status, const std::string& reason);
 /// A Content-Length of digits only, at most `max`.
 bool length_within(const std::string& text, std::size_t max);
 
+/// A Content-Type that is application/json exactly, parameters (charset) allowed, in any case: not
+/// a type that merely starts so.
+bool is_json_content_type(std::string_view content_type);
+
 /// Equal-time comparison, so the time a refusal takes tells nothing about the token.
 bool same_secret(std::string_view a, std::string_view b);
 
@@ -86,6 +90,9 @@ struct parameter_route_hooks {
       post_body;
 };
 void add_parameter_routes(httplib::Server& http, parameter_route_hooks hooks);
+
+/// The address of the connection's peer as text ("192.0.2.7", "::1"); empty when it has none.
+std::string peer_address(socket_t sock);
 
 /// A refusal written straight to the socket (the request was never parsed); closes it.
 void answer_and_close(socket_t sock, int status, const std::string& reason);
