@@ -15,6 +15,21 @@ function(cia402_cxx20_library target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wconversion -Wshadow)
 endfunction()
 
+# A library above the core: `target` built from the sources that follow (STATIC first where it must
+# be), with the settings every C++20 library shares, `include/cia402/<headers>` (a folder or a
+# header) as its own headers and, for a whole layer, the name `cia402::<ALIAS>` others link it by.
+# Each layer's folder, and each part of canopen/ and ethercat/, is one:
+#   cia402_layer_library(cia402_axis axis ALIAS axis session.cpp ...)
+function(cia402_layer_library target headers)
+  cmake_parse_arguments(PARSE_ARGV 2 arg "" "ALIAS" "")
+  add_library(${target} ${arg_UNPARSED_ARGUMENTS})
+  if(arg_ALIAS)
+    add_library(cia402::${arg_ALIAS} ALIAS ${target})
+  endif()
+  cia402_cxx20_library(${target})
+  cia402_export_headers(${target} ${headers})
+endfunction()
+
 # Links `include/cia402/<item>` (a folder or a header) for `target` and makes the folder of links the
 # target's public include directory (the installed tree stays CMAKE_INSTALL_INCLUDEDIR).
 function(cia402_export_headers target)
