@@ -10,60 +10,51 @@
 #include <mutex>
 #include <thread>
 
+#include "event_stream_reader.hpp"
 #include "page_server_fixture.hpp"
 #include "sample_batch.hpp"
 
 namespace {
 
 using cia402::page::testing::decode_batch;
+using cia402::page::testing::event_stream_reader;
 using cia402::page::testing::page_server;
 using json = nlohmann::json;
 
-// The `samples` events of /api/events, read on a thread of its own until told to stop.
+// The `samples` events of /api/events, each batch parsed as it comes, read until told to stop.
 class sample_reader {
  public:
-  explicit sample_reader(int port) {
-    thread_ = std::thread([this, port] {
-      httplib::Client c("127.0.0.1", port);
-      c.set_read_timeout(5, 0);
-      c.Get("/api/events", [this](const char* data, std::size_t n) {
-        std::lock_guard lock(mutex_);
-        bytes_ += n;
-        pending_.append(data, n);
-        for (std::size_t end; (end = pending_.find("\n\n")) != std::string::npos;) {
-          const std::string event = pending_.substr(0, end);
-          pending_.erase(0, end + 2);
-          const std::string head = "event: samples\ndata: ";
-          if (event.rfind(head, 0) == 0) batches_.push_back(json::parse(event.substr(head.size())));
-        }
-        return !stop_;
-      });
-    });
-  }
+  explicit sample_reader(int port)
+      : stream_(port, [this](std::string_view piece) {
+          bytes_ += piece.size();
+          pending_.append(piece);
+          for (std::size_t end; (end = pending_.find("\n\n")) != std::string::npos;) {
+            const std::string event = pending_.substr(0, end);
+            pending_.erase(0, end + 2);
+            const std::string head = "event: samples\ndata: ";
+            if (event.rfind(head, 0) == 0) batches_.push_back(json::parse(event.substr(head.size())));
+          }
+          return !stop_;
+        }) {}
   ~sample_reader() { stop(); }
+  // Ends the reading at the next piece of the stream.
   void stop() {
-    {
-      std::lock_guard lock(mutex_);
-      stop_ = true;
-    }
-    if (thread_.joinable()) thread_.join();
+    stream_.locked([this] { stop_ = true; });
+    stream_.join();
   }
   std::vector<json> batches() {
-    std::lock_guard lock(mutex_);
-    return batches_;
+    return stream_.locked([this] { return batches_; });
   }
   std::size_t bytes() {
-    std::lock_guard lock(mutex_);
-    return bytes_;
+    return stream_.locked([this] { return bytes_; });
   }
 
  private:
-  std::mutex mutex_;
   std::string pending_;
   std::vector<json> batches_;
   std::size_t bytes_ = 0;
   bool stop_ = false;
-  std::thread thread_;
+  event_stream_reader stream_;  // last: its thread uses the members above
 };
 
 TEST_F(page_server, the_event_stream_brings_every_cycle_of_a_moving_drive_at_1_khz_without_a_gap) {

@@ -16,6 +16,7 @@
 #include <mutex>
 #include <thread>
 
+#include "event_stream_reader.hpp"
 #include "page_server_fixture.hpp"
 
 namespace {
@@ -313,43 +314,28 @@ TEST_F(page_server, loopback_without_token_required_gives_control) {
   EXPECT_EQ(http->url().find("token"), std::string::npos);
 }
 
-// Reads /api/events on a thread of its own until `done` says the text is enough.
+// Reads /api/events until `done` says the text is enough.
 class event_reader {
  public:
-  event_reader(int port, std::function<bool(const std::string&)> done) : done_(std::move(done)) {
-    thread_ = std::thread([this, port] {
-      httplib::Client c("127.0.0.1", port);
-      c.set_read_timeout(5, 0);
-      c.Get("/api/events", [this](const char* data, std::size_t n) {
-        std::lock_guard lock(mutex_);
-        text_.append(data, n);
-        finished_ = done_(text_);
-        return !finished_;
-      });
-      std::lock_guard lock(mutex_);
-      ended_ = true;
-    });
-  }
-  ~event_reader() { join(); }
-  void join() {
-    if (thread_.joinable()) thread_.join();
-  }
+  event_reader(int port, std::function<bool(const std::string&)> done)
+      : done_(std::move(done)), stream_(port, [this](std::string_view piece) {
+          text_.append(piece);
+          finished_ = done_(text_);
+          return !finished_;
+        }) {}
+  void join() { stream_.join(); }
   std::string text() {
-    std::lock_guard lock(mutex_);
-    return text_;
+    return stream_.locked([this] { return text_; });
   }
   bool finished() {
-    std::lock_guard lock(mutex_);
-    return finished_;
+    return stream_.locked([this] { return finished_; });
   }
 
  private:
   std::function<bool(const std::string&)> done_;
-  std::mutex mutex_;
   std::string text_;
   bool finished_ = false;
-  bool ended_ = false;
-  std::thread thread_;
+  cia402::page::testing::event_stream_reader stream_;  // last: its thread uses the members above
 };
 
 TEST_F(page_server, event_stream_sends_a_snapshot_at_once_then_the_states_the_drive_takes) {
