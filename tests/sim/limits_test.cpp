@@ -121,9 +121,7 @@ TEST(speed_limit, csp_travels_no_faster_than_0x6080_and_says_so) {
 TEST(speed_limit, homing_searches_no_faster_than_0x607F) {
   virtual_drive d(standard_profile());
   write(d, 0x607F, 400);
-  write(d, 0x6098, 3);
-  enable_in_mode(d, cia402::mode::homing);
-  write(d, 0x6040, 0x1F);
+  start_homing(d, 3);
   std::int64_t fastest = 0;
   bool limited = false;
   const int done = cycles_until(d, [&] {
@@ -160,8 +158,7 @@ TEST(software_limit, pv_brakes_so_as_to_stand_at_the_limit_not_beyond_it) {
   for (const std::int32_t rpm : {3000, -3000, 100, 5999}) {
     SCOPED_TRACE(rpm);
     virtual_drive d(standard_profile());
-    write(d, 0x607D, -300000, 1);
-    write(d, 0x607D, 300000, 2);
+    write_position_limits(d, -300000, 300000);
     write(d, 0x6083, 10000);
     enable_in_mode(d, cia402::mode::profile_velocity);
     write(d, 0x60FF, rpm);
@@ -192,8 +189,7 @@ TEST(software_limit, csv_brakes_so_as_to_stand_at_the_limit_not_beyond_it) {
   for (const std::int32_t rpm : {3000, -3000, 100, 5999}) {
     SCOPED_TRACE(rpm);
     virtual_drive d(standard_profile());
-    write(d, 0x607D, -300000, 1);
-    write(d, 0x607D, 300000, 2);
+    write_position_limits(d, -300000, 300000);
     enable_in_mode(d, cia402::mode::cyclic_synchronous_velocity);
     write(d, 0x60FF, rpm);
     const std::int64_t limit = rpm > 0 ? 300000 : -300000;
@@ -226,8 +222,7 @@ TEST(software_limit, the_torque_modes_brake_so_as_to_stand_at_the_limit_not_beyo
     for (const std::int32_t torque : {1000, -1000, 150}) {
       SCOPED_TRACE(testing::Message() << "mode " << static_cast<int>(mode) << " torque " << torque);
       virtual_drive d(standard_profile());
-      write(d, 0x607D, -300000, 1);
-      write(d, 0x607D, 300000, 2);
+      write_position_limits(d, -300000, 300000);
       write(d, 0x6087, 1000000);
       enable_in_mode(d, mode);
       write(d, 0x6071, torque);
@@ -263,8 +258,7 @@ TEST(software_limit, turning_back_towards_a_near_limit_moves_the_shaft_no_faster
   for (const std::int8_t mode : {cia402::mode::profile_velocity, cia402::mode::cyclic_synchronous_velocity}) {
     SCOPED_TRACE(static_cast<int>(mode));
     virtual_drive d(standard_profile());
-    write(d, 0x607D, -300000, 1);
-    write(d, 0x607D, 5000, 2);
+    write_position_limits(d, -300000, 5000);
     write(d, 0x6083, 10000);
     enable_in_mode(d, mode);
     write(d, 0x60FF, -600);

@@ -30,6 +30,12 @@ inline void write(virtual_drive& d, std::uint16_t index, std::int64_t value, std
   ASSERT_EQ(d.write(index, sub, value), sdo_abort::none) << std::hex << index << " = " << value;
 }
 
+// 0x607D, the software position limit, in increments: sub 1 the minimum, sub 2 the maximum.
+inline void write_position_limits(virtual_drive& d, std::int64_t min, std::int64_t max) {
+  write(d, 0x607D, min, 1);
+  write(d, 0x607D, max, 2);
+}
+
 inline std::uint16_t status(virtual_drive& d) { return d.view().outputs().status_word; }
 
 // Shutdown, switch on, enable operation: the brake (30 ms) opens within the 60 cycles each gets.
@@ -41,6 +47,15 @@ inline void enable_in_mode(virtual_drive& d, std::int8_t mode) {
   }
   ASSERT_EQ(d.view().current(), state::operation_enabled);
   ASSERT_EQ(read(d, 0x6061), mode);
+}
+
+// Homing with `method` (0x6098) started as a master starts it: the drive enabled in homing mode,
+// then bit 4 (homing operation start) with Enable operation, 0x1F. A case writes the other homing
+// objects (0x607C, 0x6099, ...) before.
+inline void start_homing(virtual_drive& d, std::int8_t method) {
+  write(d, 0x6098, method);
+  enable_in_mode(d, cia402::mode::homing);
+  write(d, 0x6040, 0x1F);
 }
 
 // Steps until `done` holds (at most `limit` cycles); the cycles it took, or -1.

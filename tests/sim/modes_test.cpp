@@ -113,8 +113,7 @@ TEST(profile_position, halt_ramps_by_0x605D_and_the_move_resumes) {
 
 TEST(profile_position, a_target_beyond_the_software_limit_stops_at_it_with_bit_11) {
   virtual_drive d(standard_profile());
-  write(d, 0x607D, -1000, 1);
-  write(d, 0x607D, 30000, 2);
+  write_position_limits(d, -1000, 30000);
   enable_in_mode(d, cia402::mode::profile_position);
   offer_setpoint(d, 50000);
   cycles_until(d, [&] { return (status(d) & bit10) != 0; });
@@ -124,8 +123,7 @@ TEST(profile_position, a_target_beyond_the_software_limit_stops_at_it_with_bit_1
 
 TEST(profile_velocity, runs_into_a_software_limit_and_stops_with_bit_11) {
   virtual_drive d(standard_profile());
-  write(d, 0x607D, -100000, 1);
-  write(d, 0x607D, 5000, 2);
+  write_position_limits(d, -100000, 5000);
   enable_in_mode(d, cia402::mode::profile_velocity);
   write(d, 0x60FF, 100);
   const int stopped = cycles_until(d, [&] { return d.view().position() >= 5000 && d.view().velocity_micro_rpm() == 0; });
@@ -154,10 +152,8 @@ TEST(homing, method_3_homes_on_the_index_pulse_left_of_the_home_switch_edge) {
   // The plant's switch is active from 50,000 increments up; index pulses every 10,000 from 0: the
   // pulse left of the edge is at 40,000, which then reads as the home offset.
   virtual_drive d(standard_profile());
-  write(d, 0x6098, 3);
   write(d, 0x607C, 1234);
-  enable_in_mode(d, cia402::mode::homing);
-  write(d, 0x6040, 0x1F);
+  start_homing(d, 3);
   std::int64_t last = d.view().position();
   std::int64_t jump = 0;
   std::int64_t highest = last;
@@ -487,8 +483,7 @@ TEST(cyclic_synchronous_position, halt_stops_following_on_the_0x605D_ramp) {
 
 TEST(cyclic_synchronous_position, a_set_point_beyond_the_software_limit_is_cut_with_bit_11) {
   virtual_drive d(standard_profile());
-  write(d, 0x607D, -500, 1);
-  write(d, 0x607D, 500, 2);
+  write_position_limits(d, -500, 500);
   enable_in_mode(d, cia402::mode::cyclic_synchronous_position);
   write(d, 0x607A, 400);
   d.step();
@@ -505,10 +500,8 @@ TEST(cyclic_synchronous_position, a_set_point_beyond_the_software_limit_is_cut_w
 
 TEST(homing, halt_interrupts_the_search_on_the_0x605D_ramp) {
   virtual_drive d(standard_profile());
-  write(d, 0x6098, 3);
   write(d, 0x6099, 600, 1);
-  enable_in_mode(d, cia402::mode::homing);
-  write(d, 0x6040, 0x1F);
+  start_homing(d, 3);
   cycles_until(d, [&] { return d.view().velocity_rpm() == 600; });
   expect_halt_ramps(d, 1, 1000);
   // Interrupted (CiA 402-2: bit 13 = 0, bit 12 = 0, bit 10 = 1), then bit 8 falls: still interrupted
@@ -532,10 +525,8 @@ TEST(homing, methods_33_and_34_home_on_the_next_index_pulse_below_or_above) {
     cia402::sim::plant_config c;
     c.index_position = 3000;
     virtual_drive d(standard_profile(), c);
-    write(d, 0x6098, method);
     write(d, 0x607C, 100);
-    enable_in_mode(d, cia402::mode::homing);
-    write(d, 0x6040, 0x1F);
+    start_homing(d, method);
     std::int64_t last = d.view().position(), jump = 0;
     const int done = cycles_until(d, [&] {
       const std::int64_t p = d.view().position();
