@@ -9,7 +9,7 @@
 //   node homing.test.mjs CIA402_BINARY OUTPUT_DIR
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
 import {
-  patience, run, startRun, expect, check, launchBrowser, closeBrowser, runChecks, startServer, startBus,
+  patience, startRun, expect, check, runInBrowser, startServer, startCanServer,
   stopServer, waitPresent, click, stopCleanly, newTab,
 } from './page_harness.mjs';
 
@@ -78,8 +78,7 @@ async function errorChecks(page, where) {
   });
 }
 
-runChecks(async () => {
-  const context = await launchBrowser();
+runInBrowser(async (context) => {
   const local = await startServer([]);
   const lp = await newTab(context);
   await lp.goto(local.url);
@@ -89,8 +88,7 @@ runChecks(async () => {
   await lp.close();
   await stopCleanly(local, 'local server');
 
-  const bus = await startBus(['--nodes', '1']);
-  const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
+  const { bus, server: remote } = await startCanServer();
   const rp = await newTab(context);
   await rp.goto(remote.url);
   await rp.waitForSelector('#remote[data-status="running"]', { timeout: patience });
@@ -101,6 +99,4 @@ runChecks(async () => {
   await rp.close();
   await stopServer(remote);
   await stopServer(bus);
-  await closeBrowser();
-  console.log(`1..${run.passed}`);
 });

@@ -10,15 +10,12 @@ import path from 'node:path';
 
 import {
   patience,
-  run,
   startRun,
   expect,
   check,
-  launchBrowser,
-  closeBrowser,
-  runChecks,
+  runInBrowser,
   startServer,
-  startBus,
+  startCanServer,
   waitPresent,
   expectPresentState,
   expectAccented,
@@ -26,13 +23,13 @@ import {
   stopCleanly,
   pageProblems,
   enableByClicks,
+  injectFault,
   newTab,
 } from './page_harness.mjs';
 
 const [, outDir] = startRun('instrument_page_servers.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR']);
 
-async function main() {
-  const context = await launchBrowser();
+async function main(context) {
 
   // --- a server that requires its token -------------------------------------------------------
   const guarded = await startServer(['--token-required']);
@@ -145,8 +142,7 @@ async function main() {
   await mp.close();
 
   // --- a drive on a CAN bus: cia402 serve --can against a cia402 bus node ----------------------
-  const bus = await startBus(['--nodes', '1']);
-  const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
+  const { bus, server: remote } = await startCanServer();
   const rp = await newTab(context);
   // Its own list: the earlier pages keep retrying their stopped servers.
   const remoteProblems = pageProblems(rp);
@@ -183,12 +179,7 @@ async function main() {
   });
   await rp.screenshot({ path: path.join(outDir, 'remote-operation-enabled-1280x800.png') });
   await check('--can: fault through 0x2001 gives FAULT (T14), reset after clearing gives T15', async () => {
-    await rp.fill('#fault-code', '0x2310');
-    await rp.click('label:has(#fault-switch)');
-    await expectPresentState(rp, 'FAULT');
-    await expectAccented(rp, 14);
-    await rp.waitForFunction(() => document.getElementById('error-code').textContent === '0x2310',
-      null, { timeout: patience });
+    await injectFault(rp, '0x2310');
     await rp.click('label:has(#fault-switch)');
     await rp.waitForFunction(() => document.getElementById('lamp-fault').textContent.includes('OFF'),
       null, { timeout: patience });
@@ -210,9 +201,6 @@ async function main() {
     await stopCleanly(remote, 'cia402 serve');
   });
 
-
-  await closeBrowser();
-  console.log(`# ${run.passed} checks passed`);
 }
 
-runChecks(main);
+runInBrowser(main);

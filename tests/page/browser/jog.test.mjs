@@ -12,7 +12,7 @@
 //   node jog.test.mjs CIA402_BINARY OUTPUT_DIR
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
 import {
-  patience, run, startRun, fail, expect, check, launchBrowser, closeBrowser, runChecks, startServer, startBus,
+  patience, run, startRun, fail, expect, check, runInBrowser, startServer, startCanServer,
   stopServer, waitPresent, driveState, untilDrive, stopCleanly, newTab,
 } from './page_harness.mjs';
 import net from 'node:net';
@@ -248,17 +248,13 @@ async function jogChecks(context, server, where, remote) {
   run.currentPage = null;
 }
 
-runChecks(async () => {
-  const context = await launchBrowser();
+runInBrowser(async (context) => {
   const local = await startServer([]);
   await jogChecks(context, local, 'local drive', false);
   await stopCleanly(local, 'local server');
 
-  const bus = await startBus(['--nodes', '1']);
-  const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
+  const { bus, server: remote } = await startCanServer();
   await jogChecks(context, remote, '--can', true);
   await stopServer(remote);
   await stopServer(bus);
-  await closeBrowser();
-  console.log(`1..${run.passed}`);
 });

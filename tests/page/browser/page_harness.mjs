@@ -98,6 +98,18 @@ export function runChecks(main) {
   });
 }
 
+// A script's checks in one fresh browser, as every script but scope.test.mjs and control.test.mjs
+// (browsers of their own) runs them: `checks(context)` between launchBrowser() and closeBrowser(),
+// then TAP's plan line with the count of passed checks; a failure is reported as runChecks() does.
+export function runInBrowser(checks) {
+  runChecks(async () => {
+    const context = await launchBrowser();
+    await checks(context);
+    await closeBrowser();
+    console.log(`1..${run.passed}`);
+  });
+}
+
 // --- cia402 serve ----------------------------------------------------------------------------
 
 // `cia402 COMMAND ...args`, kept in run.servers: resolves with it once its output matches `pattern`
@@ -139,6 +151,15 @@ export function startServer(extraArgs) {
 // `cia402 bus --listen 127.0.0.1:0`: resolves with the socketcand port it printed.
 export function startBus(extraArgs) {
   return startProcess('bus', ['--listen', '127.0.0.1:0', ...extraArgs], /socketcand on (127\.0\.0\.1:\d+)/, 'port');
+}
+
+// `cia402 bus` with node 1 and `cia402 serve --can` on that node over socketcand: the drive behind
+// a bus the scripts check besides (or instead of) the drive in this process. The caller stops both,
+// the server first.
+export async function startCanServer() {
+  const bus = await startBus(['--nodes', '1']);
+  const server = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
+  return { bus, server };
 }
 
 // Ctrl-C: the server must stop cleanly, exit status 0.
@@ -267,6 +288,17 @@ export async function expectAccented(page, number) {
     `transition ${number} is accented by shape: weight ${a.weight}, underline ${a.underline}, box ${a.boxed}`);
   expect(others.every((n) => n.size < a.size && n.weight < 700 && !n.boxed && !n.underline),
     'the other transition numbers are plain');
+}
+
+// A fault through the page's plant switch: `code` typed into the fault-code field, the switch
+// turned on, FAULT reached through T14 (accented) and the error code shown.
+export async function injectFault(page, code) {
+  await page.fill('#fault-code', code);
+  await page.click('label:has(#fault-switch)');
+  await expectPresentState(page, 'FAULT');
+  await expectAccented(page, 14);
+  await page.waitForFunction((c) => document.getElementById('error-code').textContent === c, code,
+    { timeout: patience });
 }
 
 export async function statusWord(page) {

@@ -11,15 +11,12 @@ import path from 'node:path';
 
 import {
   patience,
-  run,
   startRun,
   expect,
   check,
-  launchBrowser,
-  closeBrowser,
-  runChecks,
+  runInBrowser,
   startServer,
-  startBus,
+  startCanServer,
   stopCleanly,
   newTab,
 } from './page_harness.mjs';
@@ -124,20 +121,15 @@ async function checks(context, name, server) {
   await page.close();
 }
 
-async function main() {
-  const context = await launchBrowser();
+async function main(context) {
   const local = await startServer([]);
   await checks(context, 'local', local);
   await stopCleanly(local, 'local server');
 
-  const bus = await startBus(['--nodes', '1']);
-  const remote = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
+  const { bus, server: remote } = await startCanServer();
   await checks(context, 'can', remote);
   await stopCleanly(remote, '--can server');
   await stopCleanly(bus, 'cia402 bus');
-
-  await closeBrowser();
-  console.log(`# ${run.passed} checks passed`);
 }
 
-runChecks(main);
+runInBrowser(main);

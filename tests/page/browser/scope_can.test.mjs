@@ -11,7 +11,7 @@
 //   node scope_can.test.mjs CIA402_BINARY OUTPUT_DIR
 // Environment: CIA402_NODE_MODULES (where npm ci put playwright-core), CIA402_CHROMIUM.
 import {
-  patience, run, startRun, expect, check, launchBrowser, closeBrowser, runChecks, startServer, startBus,
+  patience, startRun, expect, check, runInBrowser, startCanServer,
   stopServer, waitPresent, stopCleanly, pageProblems, enableByClicks, newTab,
 } from './page_harness.mjs';
 import { arm, cursorMs, cursorsFromTrigger, cycleMs, cyclesFilling, dataset, recording } from './scope_harness.mjs';
@@ -26,10 +26,8 @@ const before = (span * capture.pre) / 100;
 // The times (ms) of the drive's cycles the page holds, newest last.
 const cycleTimes = (page) => page.evaluate(async () => (await import('/scope_data.js')).store.cyc.map((r) => r.t));
 
-runChecks(async () => {
-  const context = await launchBrowser();
-  const bus = await startBus(['--nodes', '1']);
-  const server = await startServer(['--can', `socketcand://${bus.url}/can0`, '--node', '1']);
+runInBrowser(async (context) => {
+  const { bus, server } = await startCanServer();
   const page = await newTab(context);
   const problems = pageProblems(page);
   await page.goto(server.url);
@@ -98,6 +96,4 @@ runChecks(async () => {
   await page.close();
   await stopCleanly(server, 'serve');
   await stopServer(bus);
-  await closeBrowser();
-  console.log(`1..${run.passed}`);
 });
