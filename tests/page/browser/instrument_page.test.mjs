@@ -29,6 +29,7 @@ import {
   pageProblems,
   enableByClicks,
   injectFault,
+  clearAndResetFault,
 } from './page_harness.mjs';
 
 const [, outDir, screenshotPath] = startRun('instrument_page.test.mjs', ['CIA402_BINARY', 'OUTPUT_DIR', 'SCREENSHOT_PNG']);
@@ -191,12 +192,7 @@ async function main(context) {
   });
 
   await check('cause gone, Fault reset: SWITCH ON DISABLED by T15, transition 15 accented', async () => {
-    await page.click('label:has(#fault-switch)');
-    await page.waitForFunction(() => document.getElementById('lamp-fault').textContent.includes('OFF'),
-      null, { timeout: patience });
-    await click(page, 'fault_reset');
-    await expectPresentState(page, 'SWITCH_ON_DISABLED');
-    await expectAccented(page, 15);
+    await clearAndResetFault(page);
     await waitResult(page, 'done: T15');
     const cw = parseInt(await page.textContent('#cw-hex'), 16);
     expect((cw & 0x80) === 0, `bit 7 cleared after the edge (control word ${cw.toString(16)})`);

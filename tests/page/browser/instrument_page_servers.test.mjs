@@ -24,6 +24,7 @@ import {
   pageProblems,
   enableByClicks,
   injectFault,
+  clearAndResetFault,
   newTab,
 } from './page_harness.mjs';
 
@@ -180,12 +181,7 @@ async function main(context) {
   await rp.screenshot({ path: path.join(outDir, 'remote-operation-enabled-1280x800.png') });
   await check('--can: fault through 0x2001 gives FAULT (T14), reset after clearing gives T15', async () => {
     await injectFault(rp, '0x2310');
-    await rp.click('label:has(#fault-switch)');
-    await rp.waitForFunction(() => document.getElementById('lamp-fault').textContent.includes('OFF'),
-      null, { timeout: patience });
-    await click(rp, 'fault_reset');
-    await expectPresentState(rp, 'SWITCH_ON_DISABLED');
-    await expectAccented(rp, 15);
+    await clearAndResetFault(rp);
   });
   await check('--can: when the bus goes away the page says so and shows no present state', async () => {
     await stopCleanly(bus, 'cia402 bus');

@@ -301,6 +301,17 @@ export async function injectFault(page, code) {
     { timeout: patience });
 }
 
+// The fault injectFault() set taken back: the plant switch turned off, the fault lamp OFF, then
+// Fault reset, SWITCH ON DISABLED by T15 (accented).
+export async function clearAndResetFault(page) {
+  await page.click('label:has(#fault-switch)');
+  await page.waitForFunction(() => document.getElementById('lamp-fault').textContent.includes('OFF'),
+    null, { timeout: patience });
+  await click(page, 'fault_reset');
+  await expectPresentState(page, 'SWITCH_ON_DISABLED');
+  await expectAccented(page, 15);
+}
+
 export async function statusWord(page) {
   return parseInt(await page.textContent('#sw-hex'), 16);
 }
