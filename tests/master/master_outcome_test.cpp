@@ -11,16 +11,24 @@ using cia402::state;
 
 const cia402::profile& standard = cia402::standard_profile();
 
-cia402::master_policy policy_to(state target, const cia402::profile& p = standard) {
-  return cia402::master_policy::make(p, cia402::make_axis(p), target);
-}
+// A master set toward `target` by its policy at `now`, with `timeout` as set_target() takes it: how
+// every case starts. The policy lives beside the master, which steers by it.
+class master_toward : public cia402::master {
+ public:
+  master_toward(state target, std::uint64_t now, std::uint64_t timeout, const cia402::profile& p = standard)
+      : policy_(cia402::master_policy::make(p, cia402::make_axis(p), target)) {
+    set_target(policy_, now, timeout);
+  }
+  const cia402::master_policy& policy() const { return policy_; }
+
+ private:
+  cia402::master_policy policy_;
+};
 
 TEST(master_outcome, fault_during_enable_is_reported_with_its_code_and_never_reset_by_the_master) {
-  const cia402::master_policy policy = policy_to(state::operation_enabled);
   cia402::axis a = cia402::axis_at_rest(standard, cia402::make_axis(standard),
                                         state::switch_on_disabled, false);
-  cia402::master m;
-  m.set_target(policy, 0, 100);
+  master_toward m(state::operation_enabled, 0, 100);
   std::uint16_t sw = 0x0250;
   for (int cycle = 0; cycle < 30; ++cycle) {
     const std::uint16_t cw = m.step(sw, static_cast<std::uint64_t>(cycle), 0x2310);
@@ -38,7 +46,7 @@ TEST(master_outcome, fault_during_enable_is_reported_with_its_code_and_never_res
   EXPECT_EQ(m.last_control_word() & 0x8F, 0x00);  // Disable voltage, bit 7 clear
 
   // A new target is the user's decision to reset: it then goes through T15.
-  m.set_target(policy, 100, 100);
+  m.set_target(m.policy(), 100, 100);
   int cycles = 0;
   for (; cycles < 10 && m.outcome() != master_outcome::reached; ++cycles) {
     cia402::drive_inputs in;
@@ -51,9 +59,7 @@ TEST(master_outcome, fault_during_enable_is_reported_with_its_code_and_never_res
 }
 
 TEST(master_outcome, remote_bit_cleared_is_reported_and_the_control_word_is_not_changed) {
-  const cia402::master_policy policy = policy_to(state::operation_enabled);
-  cia402::master m;
-  m.set_target(policy, 0, 0);
+  master_toward m(state::operation_enabled, 0, 0);
   const std::uint16_t first = m.step(0x0250, 0);  // SOD, remote
   EXPECT_EQ(m.outcome(), master_outcome::in_progress);
   const std::uint16_t second = m.step(0x0031, 1);  // RTSO, remote cleared
@@ -64,9 +70,7 @@ TEST(master_outcome, remote_bit_cleared_is_reported_and_the_control_word_is_not_
 }
 
 TEST(master_outcome, a_drive_that_does_not_move_times_out_naming_the_expected_transition) {
-  const cia402::master_policy policy = policy_to(state::operation_enabled);
-  cia402::master m;
-  m.set_target(policy, 1000, 50);
+  master_toward m(state::operation_enabled, 1000, 50);
   for (std::uint64_t t = 1000; t < 1049; t += 7) {
     m.step(0x0250, t);  // stays in SWITCH ON DISABLED
     ASSERT_EQ(m.outcome(), master_outcome::in_progress) << t;
@@ -77,10 +81,8 @@ TEST(master_outcome, a_drive_that_does_not_move_times_out_naming_the_expected_tr
 }
 
 TEST(master_outcome, a_persisting_fault_cause_times_out_in_t15_and_the_edge_is_repeated) {
-  const cia402::master_policy policy = policy_to(state::switch_on_disabled);
   cia402::axis a = cia402::axis_at_rest(standard, cia402::make_axis(standard), state::fault, false);
-  cia402::master m;
-  m.set_target(policy, 0, 20);
+  master_toward m(state::switch_on_disabled, 0, 20);
   std::uint16_t sw = 0x0218;
   int edges = 0;
   std::uint16_t previous = 0;
@@ -101,17 +103,13 @@ TEST(master_outcome, a_persisting_fault_cause_times_out_in_t15_and_the_edge_is_r
 
 TEST(master_outcome, quick_stop_active_is_unreachable_without_quick_stop) {
   const cia402::profile& p = *cia402::find_builtin_profile("no-quick-stop");
-  const cia402::master_policy policy = policy_to(state::quick_stop_active, p);
-  cia402::master m;
-  m.set_target(policy, 0, 0);
+  master_toward m(state::quick_stop_active, 0, 0, p);
   m.step(0x0250, 0);
   EXPECT_EQ(m.outcome(), master_outcome::unreachable);
 }
 
 TEST(master_outcome, a_word_showing_no_state_is_reported_and_the_next_good_one_resumes) {
-  const cia402::master_policy policy = policy_to(state::operation_enabled);
-  cia402::master m;
-  m.set_target(policy, 0, 0);
+  master_toward m(state::operation_enabled, 0, 0);
   m.step(0x0250, 0);
   const std::uint16_t before = m.last_control_word();
   EXPECT_EQ(m.step(0x0201, 1), before);  // 0x01 with bit 5 clear: no state
@@ -122,12 +120,10 @@ TEST(master_outcome, a_word_showing_no_state_is_reported_and_the_next_good_one_r
 }
 
 TEST(master_outcome, halt_and_mode_bits_of_the_application_are_kept_in_every_word) {
-  const cia402::master_policy policy = policy_to(state::operation_enabled);
   cia402::axis a = cia402::axis_at_rest(standard, cia402::make_axis(standard),
                                         state::switch_on_disabled, false);
-  cia402::master m;
+  master_toward m(state::operation_enabled, 0, 0);
   m.application_bits = 0x0170;  // halt + mode bits 4..6
-  m.set_target(policy, 0, 0);
   std::uint16_t sw = 0x0250;
   for (int cycle = 0; cycle < 6; ++cycle) {
     const std::uint16_t cw = m.step(sw, static_cast<std::uint64_t>(cycle));
