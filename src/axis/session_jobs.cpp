@@ -48,23 +48,35 @@ void session::run_jobs() {
     }
     return;
   }
-  if (transfer_busy_ || link_->phase() != link_phase::running) return;
-  if (jobs_.empty()) {
-    (void)poll_due();
-    return;
-  }
-  std::unique_ptr<job> j = std::move(jobs_.front());
-  jobs_.pop_front();
-  transfer_busy_ = true;
-  auto done = [this, done = std::move(j->done)](const transfer_result& r) {
-    transfer_busy_ = false;
-    if (done) done(r);
-  };
-  const bool queued = j->download ? link_->download(j->index, j->sub, std::move(j->bytes), done)
-                                  : link_->upload(j->index, j->sub, done);
-  if (!queued) {
-    transfer_busy_ = false;
-    jobs_.push_front(std::move(j));  // the link is not running after all: it runs when it is
+  // The jobs queued now, at most: one the link refuses is answered at once and the next one tried;
+  // what their completions queue runs from the next poll.
+  for (std::size_t tries = jobs_.size() + 1; tries > 0; --tries) {
+    if (transfer_busy_ || link_->phase() != link_phase::running) return;
+    if (jobs_.empty()) {
+      (void)poll_due();
+      return;
+    }
+    std::unique_ptr<job> j = std::move(jobs_.front());
+    jobs_.pop_front();
+    transfer_busy_ = true;
+    auto done = [this, done = std::move(j->done)](const transfer_result& r) {
+      transfer_busy_ = false;
+      if (done) done(r);
+    };
+    const bool no_bytes = j->download && j->bytes.empty();
+    const bool queued = j->download ? link_->download(j->index, j->sub, std::move(j->bytes), done)
+                                    : link_->upload(j->index, j->sub, done);
+    if (queued) return;
+    if (link_->phase() != link_phase::running) {
+      transfer_busy_ = false;
+      jobs_.push_front(std::move(j));  // the link is not running after all: it runs when it is
+      return;
+    }
+    // A running link that refuses the transfer itself (a bus's SDO carries at least one byte) will
+    // refuse it each time: it fails now, or it would stand before every later transfer for ever.
+    transfer_result r;
+    r.error = link_->short_name() + " refused the transfer" + (no_bytes ? ": a download of no bytes" : "");
+    done(r);
   }
 }
 

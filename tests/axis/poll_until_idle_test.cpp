@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include "cia402/apps/local_link.hpp"
 #include "cia402/axis/session.hpp"
@@ -31,6 +32,33 @@ class counting_link final : public cia402::test::forwarding_link<sim_link> {
  private:
   bool busy_;
 };
+
+// A link that refuses a download of no bytes while running, as the CANopen and EtherCAT links do
+// (an SDO carries at least one byte).
+class no_empty_download_link final : public cia402::test::forwarding_link<apps::local_link> {
+ public:
+  no_empty_download_link() : forwarding_link(standard_profile()) {}
+  bool download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> bytes,
+                transfer_done done) override {
+    if (bytes.empty()) return false;
+    return inner.download(index, sub, std::move(bytes), std::move(done));
+  }
+};
+
+TEST(poll_until_idle, a_transfer_a_running_link_refuses_fails_and_the_next_one_runs) {
+  no_empty_download_link link;
+  session s(link);
+  ASSERT_TRUE(s.poll_until_idle());
+  std::optional<result> written, read;
+  s.write_object(0x2100, 0, object_value::of_bytes({}), [&](const result& r) { written = r; });
+  s.read_object(0x6041, 0, [&](const result& r) { read = r; });
+  EXPECT_TRUE(s.poll_until_idle());
+  ASSERT_TRUE(written.has_value()) << "the refused download was never answered";
+  EXPECT_FALSE(written->ok());
+  EXPECT_NE(written->error.find("a download of no bytes"), std::string::npos) << written->error;
+  ASSERT_TRUE(read.has_value()) << "the read behind the refused download never ran";
+  EXPECT_TRUE(read->ok()) << read->error;
+}
 
 TEST(poll_until_idle, a_drive_in_this_process_is_prepared_at_start_without_time_passing) {
   apps::local_link link(standard_profile());
