@@ -46,9 +46,9 @@ constexpr transition_row rows[] = {
     // T11: "Bit 4 is canceled" (seed line 45).
     row(11, from(S::operation_enabled), S::quick_stop_active, facts(F::quick_stop), {}, {},
         row_stop::immediate, interrupts | clears),
-    row(12, from(S::quick_stop_active), S::switch_on_disabled, facts(F::disable_voltage)),
-    row(14, from(S::fault_reaction_active), S::fault, facts(F::automatic), facts(F::stop_complete)),
-    row(15, from(S::fault), S::switch_on_disabled, facts(F::fault_reset), {}, facts(F::fault_present)),
+    t12_disable_voltage,
+    t14_reaction_done,
+    t15_fault_reset,
     // T16: "Bit 4 is set" with bits 0..3 still set (seed line 62).
     row(16, from(S::quick_stop_active), S::operation_enabled, facts(F::enable_operation)),
     // T17: "Bit 2 is canceled: switch-on inhibited, output stage disabled" (seed lines 64..66), from

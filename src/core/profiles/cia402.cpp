@@ -15,8 +15,7 @@ constexpr transition_row rows[] = {
     // S14: SWITCH ON DISABLED is not left while STO is active.
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown), {}, facts(F::sto)),
     // S3: Enable operation here runs T3, then T4 in the next step. S13/S14: voltage, no STO.
-    row(3, from(S::ready_to_switch_on), S::switched_on, facts(F::switch_on, F::enable_operation),
-        facts(F::dc_link), facts(F::sto)),
+    t3_switch_on,
     row(4, from(S::switched_on), S::operation_enabled, facts(F::enable_operation),
         facts(F::dc_link), facts(F::sto), row_stop::immediate, clears),
     row(5, from(S::operation_enabled), S::switched_on, facts(F::switch_on), {}, {},
@@ -34,11 +33,11 @@ constexpr transition_row rows[] = {
         facts(F::disable_voltage, F::quick_stop, F::sto)),
     row(11, from(S::operation_enabled), S::quick_stop_active, facts(F::quick_stop), {}, {},
         row_stop::immediate, interrupts),
-    row(12, from(S::quick_stop_active), S::switch_on_disabled, facts(F::disable_voltage)),
+    t12_disable_voltage,
     row(12, from(S::quick_stop_active), S::switch_on_disabled, facts(F::automatic),
         facts(F::quick_stop_ends, F::stop_complete)),
-    row(14, from(S::fault_reaction_active), S::fault, facts(F::automatic), facts(F::stop_complete)),
-    row(15, from(S::fault), S::switch_on_disabled, facts(F::fault_reset), {}, facts(F::fault_present)),
+    t14_reaction_done,
+    t15_fault_reset,
     row(16, from(S::quick_stop_active), S::operation_enabled, facts(F::enable_operation),
         facts(F::quick_stop_stays)),
 };

@@ -51,7 +51,7 @@ constexpr transition_row rows[] = {
     row(12, from(S::quick_stop_active), S::switch_on_disabled,
         facts(F::disable_voltage, F::local_disable)),
     // T14: error response terminated (class 2), at once for classes 3 and 4 (seed lines 46..47).
-    row(14, from(S::fault_reaction_active), S::fault, facts(F::automatic), facts(F::stop_complete)),
+    t14_reaction_done,
     // T15: Fault Reset once the cause is corrected; class 4 needs a power cycle (eSM table).
     row(15, from(S::fault), S::switch_on_disabled, facts(F::fault_reset), {},
         facts(F::fault_present, F::fault_latched)),

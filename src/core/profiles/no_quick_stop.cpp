@@ -20,8 +20,7 @@ constexpr transition_row rows[] = {
     // S14: SWITCH ON DISABLED is not left while STO is active.
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown), {}, facts(F::sto)),
     // "System checks if power supply is switched on" (seed line 49).
-    row(3, from(S::ready_to_switch_on), S::switched_on, facts(F::switch_on, F::enable_operation),
-        facts(F::dc_link), facts(F::sto)),
+    t3_switch_on,
     row(4, from(S::switched_on), S::operation_enabled, facts(F::enable_operation),
         facts(F::dc_link), facts(F::sto), row_stop::immediate, clears),
     // T5, T8: ramp on 0x221E, close the brake at standstill, then power off (seed lines 69, 99).
@@ -39,8 +38,8 @@ constexpr transition_row rows[] = {
         facts(F::disable_voltage, F::quick_stop), {}, {}, row_stop::immediate, interrupts),
     row(10, from(S::switched_on), S::switch_on_disabled,
         facts(F::disable_voltage, F::quick_stop, F::sto)),
-    row(14, from(S::fault_reaction_active), S::fault, facts(F::automatic), facts(F::stop_complete)),
-    row(15, from(S::fault), S::switch_on_disabled, facts(F::fault_reset), {}, facts(F::fault_present)),
+    t14_reaction_done,
+    t15_fault_reset,
 };
 
 constexpr std::array<option_spec, option_count> options = {{

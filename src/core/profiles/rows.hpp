@@ -78,6 +78,21 @@ inline constexpr transition_row t0_power_on =
     row(0, from(S::start), S::not_ready_to_switch_on, facts(F::automatic));
 inline constexpr transition_row t1_initialised =
     row(1, from(S::not_ready_to_switch_on), S::switch_on_disabled, facts(F::automatic));
+/// T14: the fault reaction has stopped the motor (S4); every seed's.
+inline constexpr transition_row t14_reaction_done =
+    row(14, from(S::fault_reaction_active), S::fault, facts(F::automatic), facts(F::stop_complete));
+/// T15: a fault reset edge (S2) once no fault cause is present, in every seed without error classes.
+inline constexpr transition_row t15_fault_reset =
+    row(15, from(S::fault), S::switch_on_disabled, facts(F::fault_reset), {}, facts(F::fault_present));
+
+/// The rows the standard's way where a seed follows it. T3: Switch on, or Enable operation (which
+/// runs T3 then T4, S3), with DC-link voltage (S13) and no STO (S14).
+inline constexpr transition_row t3_switch_on =
+    row(3, from(S::ready_to_switch_on), S::switched_on, facts(F::switch_on, F::enable_operation),
+        facts(F::dc_link), facts(F::sto));
+/// T12 on Disable voltage, whatever 0x605A says.
+inline constexpr transition_row t12_disable_voltage =
+    row(12, from(S::quick_stop_active), S::switch_on_disabled, facts(F::disable_voltage));
 
 /// Puts the pieces together and derives the lookup tables.
 template <std::size_t NDecoder, std::size_t NRows, std::size_t NSets>

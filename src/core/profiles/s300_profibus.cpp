@@ -16,8 +16,7 @@ constexpr transition_row rows[] = {
     // T2: bits 1 and 2 set (shutdown), DC-link voltage present (seed lines 73..74).
     row(2, from(S::switch_on_disabled), S::ready_to_switch_on, facts(F::shutdown),
         facts(F::dc_link), facts(F::sto)),
-    row(3, from(S::ready_to_switch_on), S::switched_on, facts(F::switch_on, F::enable_operation),
-        facts(F::dc_link), facts(F::sto)),
+    t3_switch_on,
     row(4, from(S::switched_on), S::operation_enabled, facts(F::enable_operation),
         facts(F::dc_link), facts(F::sto)),
     // T5: "braked, using the relevant ramp" (seed line 109).
@@ -38,9 +37,9 @@ constexpr transition_row rows[] = {
     // T11: emergency ramp, output stage stays on, set-points cancelled (seed line 169).
     row(11, from(S::operation_enabled), S::quick_stop_active, facts(F::quick_stop), {}, {},
         row_stop::immediate, interrupts | clears),
-    row(12, from(S::quick_stop_active), S::switch_on_disabled, facts(F::disable_voltage)),
-    row(14, from(S::fault_reaction_active), S::fault, facts(F::automatic), facts(F::stop_complete)),
-    row(15, from(S::fault), S::switch_on_disabled, facts(F::fault_reset), {}, facts(F::fault_present)),
+    t12_disable_voltage,
+    t14_reaction_done,
+    t15_fault_reset,
     // T16: "Bit 2 is set" with bits 0, 1, 3 still set: Enable operation (seed line 215).
     row(16, from(S::quick_stop_active), S::operation_enabled, facts(F::enable_operation)),
 };
