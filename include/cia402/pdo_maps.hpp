@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <initializer_list>
 
+#include "cia402/data_type.hpp"
 #include "cia402/sdo_abort.hpp"
 
 namespace cia402 {
@@ -28,7 +29,80 @@ struct pdo_mapping_entry {
   constexpr std::uint32_t word() const noexcept {
     return (static_cast<std::uint32_t>(index) << 16) | (static_cast<std::uint32_t>(sub) << 8) | bits;
   }
+  /// The entry a mapping object's sub-index holding `w` names.
+  static constexpr pdo_mapping_entry of_word(std::uint32_t w) noexcept {
+    return {static_cast<std::uint16_t>(w >> 16), static_cast<std::uint8_t>(w >> 8), static_cast<std::uint8_t>(w)};
+  }
 };
+
+/// Padding: mapping entries that name no object and carry no value. A dummy entry (CiA 301
+/// §7.4.8.2), index 0x0001..0x0007, one of the static data types BOOLEAN..UNSIGNED32, is padding on
+/// either bus; a gap (ETG.1000.6 §5.6.7.4, the ETG's convention that KickCAT and SOES follow), index
+/// 0, on EtherCAT only. A received PDO skips their bits, a transmitted one sends them as zeros; they
+/// count in the PDO's length as any entry does. Both buses' mapping rules and packing take them from
+/// here.
+enum class pdo_padding : std::uint8_t {
+  dummies,           ///< CANopen: dummy entries
+  dummies_and_gaps,  ///< EtherCAT: dummy entries and index-0 gaps
+};
+
+/// Whether an entry of this index is padding (then it names no object, whatever its sub-index and
+/// length say): 0x0001..0x0007, and 0 under dummies_and_gaps.
+constexpr bool is_pdo_padding(std::uint16_t index, pdo_padding p) noexcept {
+  return (index >= 0x0001 && index <= 0x0007) || (index == 0 && p == pdo_padding::dummies_and_gaps);
+}
+
+/// The bits a sound padding entry takes: a dummy with sub-index 0 and its type's length (1 bit for
+/// BOOLEAN, else the type's size in bits); a gap with sub-index 0 and 1..64 bits. 0 for any other
+/// entry: not padding, or padding with another sub-index or length, which a mapping refuses
+/// (0x06040041).
+constexpr unsigned pdo_padding_bits(pdo_mapping_entry e, pdo_padding p) noexcept {
+  if (!is_pdo_padding(e.index, p) || e.sub != 0) return 0;
+  if (e.index == 0) return e.bits >= 1 && e.bits <= 64 ? e.bits : 0;
+  const auto type = static_cast<data_type>(e.index);
+  const unsigned want = type == data_type::boolean ? 1 : type_size(type) * 8;
+  return e.bits == want ? want : 0;
+}
+
+/// A mapped entry's value, `bits` (1..64) long from `bit_offset` of a little-endian PDO of `size`
+/// bytes (CANopen's and EtherCAT's byte order), zero-extended; bits beyond `size` read as 0. At most
+/// nine steps: a byte, or the part of one, each.
+constexpr std::uint64_t pdo_get_bits(const std::uint8_t* data, std::size_t size, unsigned bit_offset,
+                                     unsigned bits) noexcept {
+  std::uint64_t v = 0;
+  for (unsigned done = 0; done < bits && done < 64;) {
+    const unsigned at = bit_offset + done;
+    if (at / 8 >= size) break;
+    const unsigned shift = at % 8;
+    const unsigned take = (8 - shift) < (bits - done) ? 8 - shift : bits - done;
+    v |= static_cast<std::uint64_t>((data[at / 8] >> shift) & ((1u << take) - 1u)) << done;
+    done += take;
+  }
+  return v;
+}
+
+/// Puts the low `bits` (1..64) of `v` at `bit_offset` of a little-endian PDO of `size` bytes, the
+/// bits around them kept; bits beyond `size` are dropped.
+constexpr void pdo_put_bits(std::uint8_t* data, std::size_t size, unsigned bit_offset, unsigned bits,
+                            std::uint64_t v) noexcept {
+  for (unsigned done = 0; done < bits && done < 64;) {
+    const unsigned at = bit_offset + done;
+    if (at / 8 >= size) break;
+    const unsigned shift = at % 8;
+    const unsigned take = (8 - shift) < (bits - done) ? 8 - shift : bits - done;
+    const auto mask = static_cast<std::uint8_t>(((1u << take) - 1u) << shift);
+    const auto part = static_cast<std::uint8_t>(static_cast<unsigned>(v >> done) << shift);
+    data[at / 8] = static_cast<std::uint8_t>((data[at / 8] & ~mask) | (part & mask));
+    done += take;
+  }
+}
+
+/// A signed entry's value from its `bits` (1..64) as pdo_get_bits read them: sign-extended.
+constexpr std::int64_t pdo_sign_extended(std::uint64_t raw, unsigned bits) noexcept {
+  if (bits == 0 || bits >= 64) return static_cast<std::int64_t>(raw);
+  const std::uint64_t sign = std::uint64_t{1} << (bits - 1);
+  return static_cast<std::int64_t>((raw ^ sign) - sign);
+}
 
 /// Entries a default map holds at most (CANopen's 8 bytes of a frame take 8 entries at most).
 inline constexpr std::size_t max_default_pdo_entries = 8;
@@ -119,10 +193,11 @@ inline constexpr pdo_map ecat_txpdo = detail::make_pdo_map({{0x6041, 0, 16},
 
 }  // namespace pdo_maps
 
-/// Whether a map keeps the object table's rules (objects.hpp): every entry an object of the table,
-/// PDO-mappable, writable when `receive` (the PDO writes it) or readable otherwise, and mapped with
-/// its type's full length. sdo_abort::none, or the code a dictionary gives for such an entry
-/// (object_does_not_exist, sub_index_does_not_exist, cannot_map_to_pdo).
-sdo_abort check_pdo_map(const pdo_map& m, bool receive) noexcept;
+/// Whether a map keeps the object table's rules (objects.hpp): every entry padding of sound form
+/// (pdo_padding_bits, under `padding`) or an object of the table, PDO-mappable, writable when
+/// `receive` (the PDO writes it) or readable otherwise, and mapped with its type's full length.
+/// sdo_abort::none, or the code a dictionary gives for such an entry (object_does_not_exist,
+/// sub_index_does_not_exist, cannot_map_to_pdo).
+sdo_abort check_pdo_map(const pdo_map& m, bool receive, pdo_padding padding = pdo_padding::dummies) noexcept;
 
 }  // namespace cia402
