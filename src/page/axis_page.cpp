@@ -40,12 +40,13 @@ axis_page::impl::impl(const profile& p, connection_factory f, axis_page_config c
       connect(std::move(f)),
       config(std::move(c)),
       drive(connect ? connect(p) : drive_connection{}),
+      plant(detail::local_plant::of(drive)),
       log({config.results_kept, config.settle_quiet_us, config.settle_limit_us,
-           "still busy when the page stopped waiting", drive.plant == nullptr ? " (numbers inferred)" : ""},
+           "still busy when the page stopped waiting", plant ? "" : " (numbers inferred)"},
           [this] { return how_it_stands(); }) {
   if (config.cycle_us == 0) config.cycle_us = 1000;
   start_session(p);
-  if (drive.plant != nullptr) {
+  if (plant) {
     if (config.selectable.empty()) {
       for (std::size_t i = 0; i < builtin_profile_count(); ++i) config.selectable.push_back(&builtin_profile(i));
     }
@@ -97,7 +98,7 @@ void axis_page::impl::start_session(const profile& p) {
       log.report_now(action, "nothing to do", "nothing to do: " + what);
     }
   };
-  if (drive.plant == nullptr) {
+  if (!plant) {
     for (const std::uint16_t index : shown_actuals) session->keep_polled(index, true);
   }
   drive.link->start_cyclic();
@@ -109,14 +110,13 @@ void axis_page::impl::start_session(const profile& p) {
 void axis_page::impl::advance(std::uint32_t elapsed_us) {
   now_us += elapsed_us;
   session->poll(elapsed_us);
-  if (drive.plant != nullptr) {
+  if (elapsed_us > 0) ++cycles;
+  if (plant) {
     close_row();
+    if (observed) note_error_code(plant->error_code());
   } else if (observed) {
     record_bus_row();
-  }
-  if (elapsed_us > 0) ++cycles;
-  if (observed) {
-    note_error_code(drive.plant != nullptr ? drive.plant->view().outputs().error_code : session->error_code());
+    note_error_code(session->error_code());
   }
   keep_views_read();
   check_enable_walk();
@@ -135,7 +135,7 @@ void axis_page::impl::on_state(state from, state to, std::uint16_t status_word) 
   observed = to;
   // A drive in this process: its step ran, the row that closes says which transition it took
   // (before the session's requests learn the new state).
-  if (drive.plant != nullptr) return close_row();
+  if (plant) return close_row();
   if (first || from == to) return;
   const std::vector<inferred_transition> chain = infer_transitions(
       *table, from, to, observer_facts(*table, word_shown(), reset_sent_since_change));
@@ -169,29 +169,21 @@ void axis_page::impl::note_error_code(std::uint16_t code) {
 
 // Once per cycle of a drive in this process, before its step: the cycle before is complete.
 void axis_page::impl::on_cycle() {
-  if (drive.plant == nullptr) return push_bus_sample();
+  if (!plant) return push_bus_sample();
   close_row();
-  const sim::drive_view v = drive.plant->view();
-  open_row = sim::begin_row(drive.plant->time_us(), drive.plant->constants(), v.state_of_axis());
-  open_row_cycle = drive.plant->cycle();
-  open_row_state = v.current();
-  open_plant_sample();
+  open_plant_sample(plant->open_cycle());
 }
 
+// A drive in this process only: the cycle its step ended, once.
 void axis_page::impl::close_row() {
-  if (!open_row || drive.plant == nullptr) return;
-  if (drive.plant->cycle() == open_row_cycle) return;  // its step has not run yet
-  const sim::drive_view v = drive.plant->view();
-  const drive_outputs& out = v.outputs();
-  const state before = open_row_state;
-  sim::complete_row(*open_row, out);
-  recording.record(*open_row);
-  push_plant_sample(out);
-  if (out.transition != no_transition) {
+  const auto c = plant->close_cycle();
+  if (!c) return;
+  recording.record(c->row);
+  push_plant_sample(c->out);
+  if (c->out.transition != no_transition) {
     // At the time of the cycle whose step took it, as the recording's row for that cycle says.
-    note_transition(int{out.transition}, before, out.current, false, out.status_word, open_row->time_us);
+    note_transition(int{c->out.transition}, c->before, c->out.current, false, c->out.status_word, c->row.time_us);
   }
-  open_row.reset();
 }
 
 // A drive on a bus shows the words, the state, the velocity and the error code; the plant columns
@@ -246,11 +238,7 @@ void axis_page::impl::check_enable_walk() {
 // that ramps (QUICK STOP ACTIVE, FAULT REACTION ACTIVE until the shaft stands).
 bool axis_page::impl::busy_now() const {
   if (requested_word) return true;
-  if (drive.plant == nullptr) return false;
-  const sim::drive_view v = drive.plant->view();
-  const state_activity act = table->info(v.current()).activity;
-  return cia402::stop_running(v.state_of_axis().core) ||
-         ((act == state_activity::quick_stop || act == state_activity::fault_reaction) && !v.inputs().standstill);
+  return plant && plant->stop_ramping(*table);
 }
 
 std::optional<std::int64_t> axis_page::impl::value_of(std::uint16_t index) const {
@@ -275,11 +263,8 @@ std::string axis_page::impl::link_text() const {
 std::string axis_page::impl::conditions() const {
   std::string s;
   auto add = [&s](const std::string& what) { s += (s.empty() ? " (" : ", ") + what; };
-  if (drive.plant != nullptr) {
-    const sim::drive_view v = drive.plant->view();
-    if (v.fault_cause() != 0) add("fault cause " + hex(v.fault_cause(), 4) + " present");
-    if (v.sto()) add("STO asserted");
-    if (!v.dc_link()) add("no DC-link voltage");
+  if (plant) {
+    for (const std::string& held : plant->conditions()) add(held);
   } else if (session->status_known()) {
     const std::uint16_t sw = session->status_word();
     if (session->error_code() != 0) add("the drive reports error code " + hex(session->error_code(), 4));
@@ -292,22 +277,13 @@ std::string axis_page::impl::conditions() const {
 
 detail::action_log::standing axis_page::impl::how_it_stands() const {
   const state now = observed.value_or(state::start);
-  std::string waiting_for;
-  if (drive.plant != nullptr) {
-    const sim::drive_view v = drive.plant->view();
-    if (v.sto()) {
-      waiting_for = "STO asserted";
-    } else if (!v.dc_link()) {
-      waiting_for = "no DC-link voltage";
-    } else if (cia402::stop_running(v.state_of_axis().core)) {
-      waiting_for = "a stop is ramping";
-    }
-  }
+  // On a bus the page cannot tell what holds a tracked action back: it settles on the quiet alone.
+  const std::string waiting_for = plant ? plant->waiting_for() : std::string();
   return {now, observed ? state_name(now) : "UNKNOWN", conditions(), waiting_for};
 }
 
 json axis_page::impl::capabilities() const {
-  if (drive.plant != nullptr) return {{"fault", true}, {"dc_link", true}, {"sto", true}, {"reasons", json::object()}};
+  if (plant) return {{"fault", true}, {"dc_link", true}, {"sto", true}, {"reasons", json::object()}};
   json reasons = json::object();
   const bool fault_injection = session->device_name() == virtual_drive_device_name;
   if (!fault_injection) {
@@ -351,38 +327,10 @@ json axis_page::impl::snapshot(bool with_time) const {
   } else {
     j["last_transition"] = nullptr;
   }
-  if (drive.plant == nullptr) {
-    j = bus_snapshot(std::move(j));
+  if (plant) {
+    plant->show(j, *table);
   } else {
-    const sim::drive_view v = drive.plant->view();
-    const drive_outputs& out = v.outputs();
-    j["stop_running"] = cia402::stop_running(v.state_of_axis().core);
-    j["ramp"] = stop_ramp_name(out.ramp);
-    j["error_code"] = hex(out.error_code, 4);
-    j["error_text"] = error_code_text(out.error_code);
-    j["error_register"] = hex(out.error_register, 2);
-    j["velocity"] = v.velocity_rpm();
-    j["target_velocity"] = v.target_velocity();
-    j["effective_target"] = v.effective_target();
-    j["torque"] = out.torque;
-    j["brake_engaged"] = v.brake_engaged();
-    j["dc_link"] = v.dc_link();
-    j["sto"] = v.sto();
-    j["fault_cause"] = hex(v.fault_cause(), 4);
-    j["mode"] = v.operation_mode();
-    j["requested_mode"] = v.requested_mode();
-    j["position"] = v.position();
-    j["position_demand"] = v.position_demand();
-    j["following_error"] = v.following_error();
-    j["torque_actual"] = v.torque();
-    std::int64_t inputs = 0;
-    j["digital_inputs"] = v.read(object_index::digital_inputs, 0, inputs) == sdo_abort::none ? json(inputs) : json(nullptr);
-    json objs = json::object();
-    for (const object_name& o : object_names(*table)) {
-      std::int64_t value = 0;
-      if (v.read(o.index, 0, value) == sdo_abort::none) objs[hex(o.index, 4)] = value;
-    }
-    j["objects"] = std::move(objs);
+    j = bus_snapshot(std::move(j));
   }
   j["results"] = log.results_json();
   json history = json::array();
@@ -497,35 +445,38 @@ std::string axis_page::info_json(bool control, bool token_required) const {
   std::lock_guard lock(impl_->mutex);
   const impl& m = *impl_;
   json j = detail::profile_info(*m.table);
-  j["backend"] = m.drive.plant != nullptr ? "virtual" : "remote";
-  if (m.drive.plant != nullptr) {
+  // The period of the drive's cycles, one scope sample each: a step here, the link's cycle on a bus
+  // (the SYNC period over CANopen, the LRW's over EtherCAT), not the page's own step.
+  std::uint32_t cycle_us = m.config.cycle_us;
+  if (m.plant) {
+    j["backend"] = "virtual";
     json profiles = json::array();
     for (const profile* p : m.config.selectable) profiles.push_back({{"name", p->name}, {"title", p->title}});
     j["profiles"] = std::move(profiles);
   } else {
+    j["backend"] = "remote";
     j["remote"] = {{"node", m.config.node}, {"bus", m.config.bus.empty() ? m.session->link().what() : m.config.bus}};
     j["transitions_inferred"] = true;
+    cycle_us = m.session->link().cycle_us();
+    // The modes the drive's own 0x6502 announces, where it was read.
+    if (const auto supported = m.session->supported_modes()) {
+      for (json& o : j["objects"]) {
+        if (o["index"] != hex(object_index::modes_of_operation, 4)) continue;
+        json values = json::array();
+        for (int k = 1; k <= 10; ++k) {
+          if ((mode::supported_bit(k) & *supported) != 0) values.push_back(k);
+        }
+        o["values"] = std::move(values);
+      }
+    }
   }
   j["control"] = control;
   j["token_required"] = token_required;
-  // The period of the drive's cycles, one scope sample each: a step here, the link's cycle on a bus
-  // (the SYNC period over CANopen, the LRW's over EtherCAT), not the page's own step.
-  j["cycle_us"] = m.drive.plant != nullptr ? m.config.cycle_us : m.session->link().cycle_us();
+  j["cycle_us"] = cycle_us;
   j["lease_ms"] = m.config.lease_us / 1000;
   // Snapshots come at most this often (the plot holds a value across a gap between them).
   j["publish_ms"] = m.config.publish_us / 1000.0;
   j["capabilities"] = m.capabilities();
-  // The modes the drive's own 0x6502 announces, where it was read.
-  if (const auto supported = m.session->supported_modes(); supported && m.drive.plant == nullptr) {
-    for (json& o : j["objects"]) {
-      if (o["index"] != hex(object_index::modes_of_operation, 4)) continue;
-      json values = json::array();
-      for (int k = 1; k <= 10; ++k) {
-        if ((mode::supported_bit(k) & *supported) != 0) values.push_back(k);
-      }
-      o["values"] = std::move(values);
-    }
-  }
   return detail::json_text(j);
 }
 
@@ -545,7 +496,7 @@ std::string axis_page::recording_file(recording_format format) const {
   sim::trace_info info;
   info.profile_name = m.table->name;
   info.cycle_us = m.config.cycle_us;
-  if (m.drive.plant != nullptr) {
+  if (m.plant) {
     info.title = "instrument page recording";
   } else {
     info.title = "instrument page recording of " + m.session->link().short_name() +

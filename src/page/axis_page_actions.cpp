@@ -55,11 +55,7 @@ std::uint64_t axis_page::impl::change_word(const detail::word_change& w) {
 }
 
 std::string axis_page::impl::enable_blocker(state s) const {
-  if (drive.plant != nullptr) {
-    const sim::drive_view v = drive.plant->view();
-    return detail::enable_blocker(s, v.outputs().error_code, v.sto(), v.dc_link(),
-                                  (v.outputs().status_word & status_bit::remote) != 0);
-  }
+  if (plant) return plant->enable_blocker(s);
   // On a bus STO and the DC link are not the drive's objects (bit 4 says voltage enabled, which a
   // drive may show only once switched on): only what the status word says for certain.
   const bool remote = !session->status_known() || (session->status_word() & status_bit::remote) != 0;
@@ -292,7 +288,7 @@ reply axis_page::jog(std::int64_t velocity_rpm, std::uint64_t time_to_live_us) {
 reply axis_page::select_profile(std::string_view name) {
   std::lock_guard lock(impl_->mutex);
   impl& m = *impl_;
-  if (m.drive.plant == nullptr) {
+  if (!m.plant) {
     return refused{409, "profile " + std::string(name) +
                             ": a drive on a bus keeps the profile `cia402 serve --profile` gave it"};
   }
@@ -309,7 +305,6 @@ reply axis_page::select_profile(std::string_view name) {
   m.jogging.reset();
   m.offering.reset();
   m.requested_word.reset();
-  m.open_row.reset();
   m.observed.reset();
   m.last_transition.reset();
   m.recording.clear();
@@ -318,6 +313,7 @@ reply axis_page::select_profile(std::string_view name) {
   m.transition_for_row.reset();
   m.session.reset();  // before the link it uses
   m.drive = m.connect(*chosen);
+  m.plant = detail::local_plant::of(m.drive);
   m.start_session(*chosen);
   return accepted{m.log.report_now("PROFILE " + std::string(chosen->name), "done",
                                    std::string("done: ") + chosen->title + ", from power-up")};
@@ -344,7 +340,7 @@ reply axis_page::change_plant(const plant_change& change) {
   }
   std::unique_lock lock(impl_->mutex);
   impl& m = *impl_;
-  if (m.drive.plant == nullptr) return m.change_bus_plant(lock, change);
+  if (!m.plant) return m.change_bus_plant(lock, change);
   std::string action;
   auto add = [&action](const std::string& what) { action += (action.empty() ? "" : ", ") + what; };
   if (change.target_velocity) {
@@ -357,24 +353,7 @@ reply axis_page::change_plant(const plant_change& change) {
     if (!r || !r->ok()) return m.write_reply(r, what);
     add("TARGET_VELOCITY=" + std::to_string(v));
   }
-  sim::drive_view v = m.drive.plant->view();
-  if (change.fault) {
-    if (*change.fault) {
-      v.inject_fault(change.fault_code, change.fault_class);
-      add("FAULT " + hex(change.fault_code, 4) + " ON");
-    } else {
-      v.clear_faults();
-      add("FAULT OFF");
-    }
-  }
-  if (change.dc_link) {
-    v.set_dc_link(*change.dc_link);
-    add(std::string("DC_LINK ") + (*change.dc_link ? "ON" : "OFF"));
-  }
-  if (change.sto) {
-    v.set_sto(*change.sto);
-    add(std::string("STO ") + (*change.sto ? "ON" : "OFF"));
-  }
+  for (const std::string& input : m.plant->change_inputs(change)) add(input);
   if (action.empty()) return refused{400, "nothing to change"};
   // A plant input is never refused; the page learns which transitions it caused.
   return accepted{m.log.track(action, false, m.observed, m.now_us)};

@@ -38,7 +38,7 @@ std::string failure_text(const axes::result& r) {
 
 void axis_page::impl::keep_views_read() {
   if (!running()) return;
-  if (drive.plant == nullptr && !homing_read_asked) {
+  if (!plant && !homing_read_asked) {
     homing_read_asked = true;
     for (const std::uint8_t sub : {std::uint8_t{1}, std::uint8_t{2}}) {
       session->read_object(object_index::homing_speeds, sub, [this, sub](const axes::result& r) {
@@ -96,32 +96,28 @@ void axis_page::impl::end_error_field_read(std::string error) {
   for (auto& w : waiting) w();
 }
 
-std::optional<std::int64_t> axis_page::impl::homing_value(std::uint16_t index, std::uint8_t sub) const {
-  if (drive.plant != nullptr) {
-    std::int64_t v = 0;
-    if (drive.plant->view().read(index, sub, v) == sdo_abort::none) return v;
-    return std::nullopt;
-  }
+std::optional<std::int64_t> axis_page::impl::shown_value(std::uint16_t index, std::uint8_t sub) const {
+  if (plant) return plant->read(index, sub);
   if (index == object_index::homing_speeds) return sub == 1 ? switch_speed_read : zero_speed_read;
   return value_of(index);
 }
 
 detail::mode_reading axis_page::impl::mode_reading_now() const {
   detail::mode_reading r;
-  const bool live = drive.plant != nullptr || session->link().phase() == axes::link_phase::running;
+  const bool live = plant || session->link().phase() == axes::link_phase::running;
   if (!live) return r;
   r.enabled = observed == state::operation_enabled;
   r.status_word = session->status_word();
   r.control_word = word_shown();
-  r.mode = homing_value(object_index::modes_of_operation_display, 0);
-  r.velocity_rpm = homing_value(object_index::velocity_actual_value, 0);
-  r.digital_inputs = homing_value(object_index::digital_inputs, 0);
-  r.target_position = homing_value(object_index::target_position, 0);
-  r.target_velocity = homing_value(object_index::target_velocity, 0);
-  r.target_torque = homing_value(object_index::target_torque, 0);
-  r.homing_method = homing_value(object_index::homing_method, 0);
-  r.switch_speed_rpm = homing_value(object_index::homing_speeds, 1);
-  r.zero_speed_rpm = homing_value(object_index::homing_speeds, 2);
+  r.mode = shown_value(object_index::modes_of_operation_display, 0);
+  r.velocity_rpm = shown_value(object_index::velocity_actual_value, 0);
+  r.digital_inputs = shown_value(object_index::digital_inputs, 0);
+  r.target_position = shown_value(object_index::target_position, 0);
+  r.target_velocity = shown_value(object_index::target_velocity, 0);
+  r.target_torque = shown_value(object_index::target_torque, 0);
+  r.homing_method = shown_value(object_index::homing_method, 0);
+  r.switch_speed_rpm = shown_value(object_index::homing_speeds, 1);
+  r.zero_speed_rpm = shown_value(object_index::homing_speeds, 2);
   return r;
 }
 
@@ -132,8 +128,8 @@ axis_page::impl::json axis_page::impl::homing_json() const {
   j["method"] = number(r.homing_method);
   j["fast"] = number(r.switch_speed_rpm);
   j["slow"] = number(r.zero_speed_rpm);
-  j["acceleration"] = number(homing_value(object_index::homing_acceleration, 0));
-  j["offset"] = number(homing_value(object_index::home_offset, 0));
+  j["acceleration"] = number(shown_value(object_index::homing_acceleration, 0));
+  j["offset"] = number(shown_value(object_index::home_offset, 0));
   // Inferred from the status bits and the speed (mode_view.hpp), so a bus drive reads the same.
   j["phase"] = r.mode == mode::homing ? json(detail::homing_phase_text(r)) : json(nullptr);
   j["running"] = homing_run.has_value();
@@ -243,7 +239,7 @@ reply axis_page::home(const homing_request& request) {
     });
     return accepted{id, written};
   }
-  const auto method = m.homing_value(object_index::homing_method, 0);
+  const auto method = m.shown_value(object_index::homing_method, 0);
   const std::string action = "HOMING" + (method ? " method " + std::to_string(*method) : std::string());
   const std::uint64_t id = m.log.report_now(
       action, "pending",

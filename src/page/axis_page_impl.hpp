@@ -14,7 +14,7 @@
 
 #include "action_log.hpp"
 #include "cia402/axis/session.hpp"
-#include "cia402/sim/trace.hpp"
+#include "local_plant.hpp"
 #include "mode_view.hpp"
 #include "recorder.hpp"
 #include "sample_ring.hpp"
@@ -34,6 +34,8 @@ struct axis_page::impl {
   connection_factory connect;
   axis_page_config config;
   drive_connection drive;
+  /// The drive's simulator beside the session: a drive in this process only (local_plant.hpp).
+  std::optional<detail::local_plant> plant;
   std::unique_ptr<axes::session> session;
 
   mutable std::mutex mutex;          // guards all here but the board, which has a lock of its own
@@ -74,14 +76,11 @@ struct axis_page::impl {
   detail::action_log log;
   detail::snapshot_board board;
   detail::recorder recording;
-  std::optional<sim::trace_row> open_row;  // a drive in this process: the cycle under way
   // The scope's per-cycle samples (axis_page_samples.cpp): each cycle of the link, once.
   detail::sample_ring samples;
   detail::cycle_sample open_sample;                // a drive in this process: the cycle under way
   std::optional<int> transition_for_sample;        // a bus: noted since the last sample
   std::optional<int> transition_for_row;           // a bus: noted in this cycle, for its row
-  std::uint64_t open_row_cycle = 0;        // the simulator's cycle count when it began
-  state open_row_state = state::start;     // the drive's state when it began
 
   // Profile position's handshake (backend::new_setpoint), the session's offer_set_point: its id
   // while it runs; reset when another request supersedes it (its end is then no news).
@@ -137,7 +136,7 @@ struct axis_page::impl {
   void close_row();
   void record_bus_row();
   // --- axis_page_samples.cpp ----------------------------------------------------------------------
-  void open_plant_sample();
+  void open_plant_sample(const sim::trace_row& row);
   void push_plant_sample(const drive_outputs& out);
   void push_bus_sample();
   std::vector<std::string> polled_signals() const;
@@ -181,7 +180,8 @@ struct axis_page::impl {
   void keep_views_read();
   void read_error_field(std::size_t sub, std::vector<std::uint32_t> so_far);
   void end_error_field_read(std::string error);
-  std::optional<std::int64_t> homing_value(std::uint16_t index, std::uint8_t sub) const;
+  /// An object's value as the panels show it: the simulator's own, else what the session last had.
+  std::optional<std::int64_t> shown_value(std::uint16_t index, std::uint8_t sub) const;
   detail::mode_reading mode_reading_now() const;
   json homing_json() const;
   json drive_errors_json() const;

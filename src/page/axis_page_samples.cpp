@@ -52,44 +52,38 @@ bool carried(const std::vector<axes::cyclic_object>& objects, std::uint16_t inde
 
 // The mode panel's set-point: the object of the mode the drive shows and its value now, the local
 // drive's own, else what goes out in this cycle (a csp, csv or cst stream's value) or the last read
-// or written. `cyclic`: it travels in every cycle.
+// or written. `cyclic`: it travels in every cycle (the local link carries every set-point so).
 axis_page::impl::json axis_page::impl::set_point_json() const {
-  std::optional<std::int64_t> mode = value_of(object_index::modes_of_operation_display);
-  if (drive.plant != nullptr) mode = drive.plant->view().operation_mode();
+  // The simulator's mode itself: its 0x6061 may read as the object's fixed value (one mode only).
+  const std::optional<std::int64_t> mode =
+      plant ? plant->view().operation_mode() : value_of(object_index::modes_of_operation_display);
   const std::uint16_t index = mode ? set_point_of(*mode) : 0;
   if (index == 0) return nullptr;
-  std::optional<std::int64_t> value;
-  if (drive.plant != nullptr) {
-    std::int64_t v = 0;
-    if (drive.plant->view().read(index, 0, v) == sdo_abort::none) value = v;
-  } else {
-    value = value_of(index);
-  }
+  const std::optional<std::int64_t> value = shown_value(index, 0);
   const object_description* d = find_drive_object(index);
   return {{"index", hex(index, 4)},
           {"name", d != nullptr ? d->name : ""},
           {"unit", d != nullptr ? d->unit : ""},
           {"value", value ? json(*value) : json(nullptr)},
-          {"cyclic", drive.plant != nullptr || carried(session->link().cyclic_outputs(), index)}};
+          {"cyclic", carried(session->link().cyclic_outputs(), index)}};
 }
 
 // The values the drive reads as its cycle begins, as the recording's row has them.
-void axis_page::impl::open_plant_sample() {
-  const sim::drive_view v = drive.plant->view();
+void axis_page::impl::open_plant_sample(const sim::trace_row& row) {
+  const sim::drive_view v = plant->view();
   detail::cycle_sample& s = open_sample;
   s = {};
-  s.time_us = open_row->time_us;
-  s.set(signal::control_word, open_row->control_word);
+  s.time_us = row.time_us;
+  s.set(signal::control_word, row.control_word);
   s.set(signal::velocity, v.velocity_rpm());
-  s.set(signal::position, open_row->position);
-  s.set(signal::torque, open_row->torque_permille);
+  s.set(signal::position, row.position);
+  s.set(signal::torque, row.torque_permille);
   s.set(signal::following_error, v.following_error());
-  s.set(signal::position_demand, open_row->position_demand);
-  s.set(signal::digital_inputs, open_row->digital_inputs);
-  s.set(signal::mode, open_row->mode);
-  if (const std::uint16_t index = set_point_of(open_row->mode); index != 0) {
-    std::int64_t value = 0;
-    if (v.read(index, 0, value) == sdo_abort::none) s.set(signal::set_point, value);
+  s.set(signal::position_demand, row.position_demand);
+  s.set(signal::digital_inputs, row.digital_inputs);
+  s.set(signal::mode, row.mode);
+  if (const std::uint16_t index = set_point_of(row.mode); index != 0) {
+    if (const auto value = plant->read(index, 0)) s.set(signal::set_point, *value);
   }
 }
 
@@ -138,7 +132,7 @@ void axis_page::impl::push_bus_sample() {
 // process has none).
 std::vector<std::string> axis_page::impl::polled_signals() const {
   std::vector<std::string> polled;
-  if (drive.plant != nullptr) return polled;
+  if (plant) return polled;
   const axes::drive_link& link = session->link();
   const auto name = [](signal s) { return std::string(detail::signal_names()[static_cast<std::size_t>(s)]); };
   for (const object_column& c : object_columns) {
