@@ -418,8 +418,11 @@ struct profile {
     using detail::byte_shift;
     const stored_row& r = rows[take];
     const unsigned stop = detail::stop_nibble(r.stop);
-    const unsigned ramp = stop & detail::stop_bits::ramp;
-    if (ramp == detail::stop_bits::halt_ramp_live) return;  // stays `full`
+    // A ramp 0x605D picks is read as the cycle runs (S16): the image's ramp is 0, which no stop's
+    // ramp is, and the step fills it in.
+    const unsigned ramp = (stop & detail::stop_bits::ramp) == detail::stop_bits::halt_ramp_live
+                              ? 0u
+                              : stop & detail::stop_bits::ramp;
     const unsigned actions =
         ordinary_action::full | ordinary_action::stop_starts |
         ((stop & detail::stop_bits::if_code_is_1) ? ordinary_action::stop_reads_code : 0u) |

@@ -122,6 +122,12 @@ inline bool quiet_cycle(const profile& p, axis& a, const drive_inputs& in, std::
                                                                                       : option::shutdown)];
         if (code != 1) return false;
       }
+      // The ramp 0x605D picks, read live (S8, S16): 1..4; any other value is the full step's.
+      if (((head >> byte_shift<8>(5)) & 0xFFu) == 0) {
+        const auto ramp = static_cast<std::uint8_t>(a.options[static_cast<int>(option::halt)]);
+        if (static_cast<std::uint8_t>(ramp - 1u) >= 4u) return false;
+        head |= std::uint64_t{ramp} << byte_shift<8>(5);
+      }
       // A stop that ends with torque off closes the brake at standstill (S12).
       if ((actions & ordinary_action::stop_ends_torque) && in.standstill) {
         head &= ~(std::uint64_t{0xFF} << byte_shift<8>(7));
