@@ -372,6 +372,72 @@ TEST_F(pdo_test, rpdo_shorter_than_its_mapping_is_dropped_with_emcy_0x8210) {
   EXPECT_EQ(get_le(after[1].data.data(), 2), 0x0000u) << "error reset";
 }
 
+// CiA 301 dummy entries (issue 44): a BOOLEAN dummy (1 bit) and an UNSIGNED8 dummy (8 bits) between
+// two objects. The RPDO's dummy bits are skipped whatever they hold; the TPDO sends them as zeros;
+// the objects after them sit at bit 25, as the mapping puts them.
+constexpr std::uint32_t boolean_dummy = 0x00010001;
+constexpr std::uint32_t unsigned8_dummy = 0x00050008;
+
+frame pdo_frame(std::uint32_t id, std::uint64_t payload) {
+  frame f;
+  f.id = id;
+  f.len = 8;
+  for (std::size_t i = 0; i < 8; ++i) f.data[i] = static_cast<std::uint8_t>(payload >> (8 * i));
+  return f;
+}
+std::uint64_t payload_of(const frame& f) {
+  std::uint64_t v = 0;
+  for (std::size_t i = 0; i < f.len; ++i) v |= std::uint64_t{f.data[i]} << (8 * i);
+  return v;
+}
+
+TEST_F(pdo_test, dummy_entries_are_skipped_in_an_rpdo_and_sent_as_zeros_in_a_tpdo) {
+  ASSERT_NO_FATAL_FAILURE(remap(0x1400, 0x203, {0x60400010, boolean_dummy, unsigned8_dummy, 0x60FF0020}));
+  ASSERT_NO_FATAL_FAILURE(remap(0x1800, 0x183, {0x60410010, boolean_dummy, unsigned8_dummy, 0x606C0020}));
+  EXPECT_EQ(node().rpdo(0).length, 8) << "57 bits";
+  EXPECT_EQ(node().tpdo(0).length, 8);
+  std::int64_t entry = 0;
+  ASSERT_EQ(node().read(0x1600, 2, entry), sdo_abort::none);
+  EXPECT_EQ(entry, boolean_dummy) << "the entry reads as written";
+  ASSERT_EQ(node().read(0x1A00, 3, entry), sdo_abort::none);
+  EXPECT_EQ(entry, unsigned8_dummy);
+  start();
+  net.run(3000, 1000);
+  // The dummies' 9 bits (16..24) all set: nothing takes them.
+  const std::uint64_t dummy_bits = std::uint64_t{0x1FF} << 16;
+  const auto velocity = static_cast<std::uint32_t>(-1000);
+  for (const std::uint64_t cw : {0x06u, 0x0Fu}) {
+    net.send(pdo_frame(0x203, cw | dummy_bits | (std::uint64_t{velocity} << 25) | (std::uint64_t{0x7F} << 57)));
+    net.run(3000, 1000);
+  }
+  ASSERT_EQ(dev().current(), state::operation_enabled);
+  EXPECT_EQ(dev().control_word(), 0x000F);
+  EXPECT_EQ(dev().target_velocity(), -1000) << "0x60FF from bit 25, sign kept";
+  const auto sent = net.with_id(0x183);
+  ASSERT_FALSE(sent.empty());
+  EXPECT_EQ(sent.back().len, 8);
+  const std::uint64_t tx = payload_of(sent.back());
+  EXPECT_EQ(tx & 0x6F, 0x27u) << "OPERATION ENABLED in bits 0..15";
+  EXPECT_EQ((tx >> 16) & 0x1FF, 0u) << "the dummies' bits are zeros";
+  EXPECT_EQ(static_cast<std::uint32_t>(tx >> 25), velocity) << "0x606C from bit 25";
+  EXPECT_EQ(tx >> 57, 0u);
+}
+
+TEST_F(pdo_test, a_dummy_of_another_length_or_sub_index_and_an_index_0_gap_are_refused) {
+  ASSERT_EQ(write(0x1800, 1, 0x80000183, 4), 0u);
+  ASSERT_EQ(write(0x1A00, 0, 0, 1), 0u);
+  EXPECT_EQ(write(0x1A00, 1, 0x00050010, 4), 0x06040041u) << "UNSIGNED8 is 8 bits";
+  EXPECT_EQ(write(0x1A00, 1, 0x00010008, 4), 0x06040041u) << "a BOOLEAN dummy is 1 bit";
+  EXPECT_EQ(write(0x1A00, 1, 0x00070010, 4), 0x06040041u);
+  EXPECT_EQ(write(0x1A00, 1, 0x00050108, 4), 0x06040041u) << "sub-index 1";
+  EXPECT_EQ(write(0x1A00, 1, 0x00000008, 4), 0x06020000u) << "an index-0 gap is EtherCAT's, no object here";
+  EXPECT_EQ(write(0x1A00, 1, 0x00040020, 4), 0u) << "INTEGER32 dummy";
+  EXPECT_EQ(write(0x1A00, 2, 0x606C0020, 4), 0u);
+  EXPECT_EQ(write(0x1A00, 3, boolean_dummy, 4), 0u);
+  EXPECT_EQ(write(0x1A00, 0, 3, 1), 0x06040042u) << "65 bits: a dummy counts in the 64";
+  EXPECT_EQ(write(0x1A00, 0, 2, 1), 0u);
+}
+
 // Objects with sub-indices map as (index, sub): a device that holds an array (as the virtual drive
 // holds 0x607D, 0x6099) is read and written with the sub-index the mapping entry names.
 class array_device final : public dictionary::device {

@@ -35,11 +35,16 @@ void slave::on_sync() {
 }
 
 void slave::apply_rpdo(rpdo_state& r, const std::uint8_t* data) {
-  std::size_t offset = 0;
+  // `data` holds r.cfg.length bytes (the frame was checked against it); entries at any bit offset
+  // after a BOOLEAN dummy.
+  unsigned offset = 0;
   for (std::uint8_t i = 0; i < r.cfg.count; ++i) {
     const mapped_object& m = r.cfg.map[i];
-    const std::int64_t v = dictionary::decode_value(m.type, std::span<const std::uint8_t>(data + offset, m.bytes));
-    offset += m.bytes;
+    const unsigned at = offset;
+    offset += m.bits;
+    if (m.slot == nullptr) continue;  // a dummy entry: its bits are skipped
+    const std::uint64_t raw = pdo_get_bits(data, r.cfg.length, at, m.bits);
+    const std::int64_t v = type_is_signed(m.type) ? pdo_sign_extended(raw, m.bits) : static_cast<std::int64_t>(raw);
     // The slot bound when the mapping was configured, with the rules of an SDO write. A value the
     // object refuses is dropped: a PDO has no answer to carry an abort code.
     (void)write(*m.slot, v);
@@ -47,14 +52,16 @@ void slave::apply_rpdo(rpdo_state& r, const std::uint8_t* data) {
 }
 
 bool slave::sample(const tpdo_state& t, std::array<std::uint8_t, 8>& out) {
-  out.fill(0);
-  std::size_t offset = 0;
+  out.fill(0);  // a dummy entry's bits go out as zeros
+  unsigned offset = 0;
   for (std::uint8_t i = 0; i < t.cfg.count; ++i) {
     const mapped_object& m = t.cfg.map[i];
+    const unsigned at = offset;
+    offset += m.bits;
+    if (m.slot == nullptr) continue;
     std::int64_t v = 0;
     if (read(*m.slot, v) != sdo_abort::none) return false;
-    put_le(out.data() + offset, static_cast<std::uint64_t>(v), m.bytes);
-    offset += m.bytes;
+    pdo_put_bits(out.data(), out.size(), at, m.bits, static_cast<std::uint64_t>(v));
   }
   return true;
 }
@@ -110,19 +117,25 @@ pdo_config slave::resolve(std::uint16_t comm, std::uint16_t mapping) {
   c.inhibit_100us = static_cast<std::uint16_t>(od_.number(comm, 3));
   c.event_timer_ms = static_cast<std::uint16_t>(od_.number(comm, 5));
   c.count = static_cast<std::uint8_t>(od_.number(mapping, 0));
+  unsigned bits = 0;
   for (std::uint8_t i = 0; i < c.count && i < c.map.size(); ++i) {
     const auto entry = static_cast<std::uint32_t>(od_.number(mapping, static_cast<std::uint8_t>(i + 1)));
+    const unsigned dummy = pdo_padding_bits(pdo_mapping_entry::of_word(entry), pdo_padding::dummies);
     sdo_abort ignored = sdo_abort::none;
-    dictionary::object_dictionary::slot* s = od_.find(map_index(entry), map_sub(entry), ignored);
-    if (s == nullptr) {  // cannot happen: entries are checked when written
+    dictionary::object_dictionary::slot* s =
+        dummy != 0 ? nullptr : od_.find(map_index(entry), map_sub(entry), ignored);
+    // Cannot happen (entries are checked when written): an entry that names nothing, or more than
+    // a frame's 64 bits.
+    if ((dummy == 0 && s == nullptr) || bits + map_bits(entry) > 64) {
       c.valid = false;
       c.count = i;
       break;
     }
-    c.map[i] = mapped_object{map_index(entry), map_sub(entry), s->entry->type,
-                             static_cast<std::uint8_t>(map_bits(entry) / 8), s};
-    c.length = static_cast<std::uint8_t>(c.length + c.map[i].bytes);
+    c.map[i] = mapped_object{map_index(entry), map_sub(entry), s != nullptr ? s->entry->type : data_type::unsigned8,
+                             map_bits(entry), s};
+    bits += map_bits(entry);
   }
+  c.length = static_cast<std::uint8_t>((bits + 7) / 8);
   return c;
 }
 
@@ -136,6 +149,11 @@ void slave::resolve_pdos() {
 }
 
 sdo_abort slave::check_mapping_entry(bool receive, std::uint32_t entry) const {
+  // A dummy entry (0x0001..0x0007) maps in either direction, with its type's length only.
+  if (is_pdo_padding(map_index(entry), pdo_padding::dummies)) {
+    const bool sound = pdo_padding_bits(pdo_mapping_entry::of_word(entry), pdo_padding::dummies) != 0;
+    return sound ? sdo_abort::none : sdo_abort::cannot_map_to_pdo;
+  }
   sdo_abort a = sdo_abort::none;
   const dictionary::object_dictionary::slot* s =
       const_cast<dictionary::object_dictionary&>(od_).find(map_index(entry), map_sub(entry), a);
@@ -225,7 +243,8 @@ void slave::object_changed(std::uint16_t index, std::uint8_t sub) noexcept {
   for (tpdo_state& t : tpdo_) {
     if (!t.cfg.valid || !event_type(t.cfg.transmission_type)) continue;
     for (std::uint8_t i = 0; i < t.cfg.count; ++i) {
-      if (t.cfg.map[i].index == index && t.cfg.map[i].sub == sub) t.requested = true;
+      const mapped_object& m = t.cfg.map[i];
+      if (m.slot != nullptr && m.index == index && m.sub == sub) t.requested = true;
     }
   }
 }

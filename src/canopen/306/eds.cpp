@@ -165,11 +165,14 @@ void write_eds(slave& node, const eds_info& info, std::ostream& out) {
       << "RevisionNumber=" << hex(static_cast<std::uint64_t>(revision), 8) << "\n"
       << "OrderCode=\n";
   for (int rate : {10, 20, 50, 125, 250, 500, 800, 1000}) out << "BaudRate_" << rate << "=1\n";
-  out << "SimpleBootUpMaster=0\nSimpleBootUpSlave=1\nGranularity=8\nDynamicChannelsSupported=0\n"
+  // Granularity 1: entries follow each other at any bit offset (after a BOOLEAN dummy's one bit);
+  // an object is still mapped whole.
+  out << "SimpleBootUpMaster=0\nSimpleBootUpSlave=1\nGranularity=1\nDynamicChannelsSupported=0\n"
       << "GroupMessaging=0\nNrOfRXPDO=" << rpdos << "\nNrOfTXPDO=" << tpdos
       << "\nLSS_Supported=0\n\n";
   out << "[DummyUsage]\n";
-  for (int i = 1; i <= 7; ++i) out << "Dummy000" << i << "=0\n";
+  // The node maps every CiA 301 dummy entry (pdo_maps.hpp, pdo_padding).
+  for (int i = 1; i <= 7; ++i) out << "Dummy000" << i << "=1\n";
   out << "\n[Comments]\nLines=1\nLine1=Generated from the node's object dictionary (cia402 eds).\n\n";
   write_commissioning(out, info);
   write_objects(

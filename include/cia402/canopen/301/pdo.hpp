@@ -26,13 +26,15 @@ constexpr bool restricted_can_id(std::uint32_t id) noexcept {
 
 /// One mapped object, resolved when the mapping is configured (the node starts, or a PDO parameter
 /// is written) and bound to its dictionary slot, as CANopenNode binds an OD_IO_t per mapped entry: a
-/// PDO then reads and writes the slot with the dictionary's rules and looks nothing up.
+/// PDO then reads and writes the slot with the dictionary's rules and looks nothing up. A dummy
+/// entry (pdo_maps.hpp, pdo_padding) has no slot: a received PDO skips its bits, a transmitted one
+/// sends them as zeros.
 struct mapped_object {
   std::uint16_t index = 0;
   std::uint8_t sub = 0;
   data_type type = data_type::unsigned8;
-  std::uint8_t bytes = 0;
-  dictionary::object_dictionary::slot* slot = nullptr;
+  std::uint8_t bits = 0;
+  dictionary::object_dictionary::slot* slot = nullptr;  ///< nullptr: a dummy entry
 };
 
 /// One PDO as configured by its two parameter objects.
@@ -43,7 +45,7 @@ struct pdo_config {
   std::uint16_t inhibit_100us = 0;  ///< TPDO only
   std::uint16_t event_timer_ms = 0; ///< TPDO only
   std::uint8_t count = 0;
-  std::uint8_t length = 0;          ///< bytes
+  std::uint8_t length = 0;          ///< bytes (the mapped bits rounded up)
   std::array<mapped_object, 8> map{};
 };
 

@@ -26,7 +26,10 @@
 //   active.
 // - Mapping changes follow CANopenNode: mapping entries need the PDO invalid (COB-ID bit 31) and
 //   sub-index 0 = 0, else 0x06010000; a mapped object must exist (0x06020000 / 0x06090011), be
-//   mappable in that direction with its full length (0x06040041); sub-index 0 above 8 is 0x06090031,
+//   mappable in that direction with its full length (0x06040041), or be a CiA 301 dummy entry
+//   (0x0001..0x0007 sub 0, its type's length, 1 bit for BOOLEAN; pdo_maps.hpp), which maps either
+//   way and whose bits an RPDO skips and a TPDO sends as zeros (a dummy of another length is
+//   0x06040041); entries follow each other at any bit offset; sub-index 0 above 8 is 0x06090031,
 //   more than 64 bits 0x06040042. A COB-ID that enables a PDO without mapping, changes the CAN-ID of
 //   a valid PDO, sets reserved bits or uses a restricted CAN-ID is 0x06090030; so are transmission
 //   types 241..253 (RTR-only 252/253 is not offered) and an inhibit time change while the TPDO is
