@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "drive_bench.hpp"
@@ -237,6 +238,92 @@ TEST(drive_slave, each_sync_manager_change_after_its_check_has_its_own_al_status
     EXPECT_EQ(b.request(0x14), 4);
     EXPECT_EQ(b.request(8), 8);
   }
+}
+
+// Padding between objects (issue 44): an index-0 gap (KickCAT's 0x00000008), a CiA 301 UNSIGNED8
+// dummy (0x00050008), a BOOLEAN dummy (1 bit) and a 3-bit gap, so the last object starts at bit 44.
+// The outputs' padding bits are all set and land nowhere; the inputs' come out as zeros; the
+// objects sit where the mapping puts them.
+std::uint64_t bits_of(const std::vector<std::uint8_t>& b, unsigned offset, unsigned bits) {
+  std::uint64_t v = 0;
+  for (unsigned i = 0; i < bits; ++i) {
+    const unsigned at = offset + i;
+    v |= std::uint64_t{(b[at / 8] >> (at % 8)) & 1u} << i;
+  }
+  return v;
+}
+
+TEST(drive_slave, padding_between_objects_is_skipped_in_the_outputs_and_zeros_in_the_inputs) {
+  bench b;
+  b.to_pre_op();
+  const std::vector<std::uint32_t> rx = {0x60400010, 0x00000008, 0x60600008, 0x00050008,
+                                         0x00010001, 0x00000003, 0x607A0020};
+  const std::vector<std::uint32_t> tx = {0x00000003, 0x00010001, 0x00050008, 0x60410010,
+                                         0x00000008, 0x60610008, 0x60640020};
+  for (const auto& [index, entries] : {std::pair{std::uint16_t{0x1600}, rx}, std::pair{std::uint16_t{0x1A00}, tx}}) {
+    ASSERT_EQ(b.download(index, 0, 0, 1), 0u);
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      ASSERT_EQ(b.download(index, static_cast<std::uint8_t>(k + 1), entries[k], 4), 0u) << std::hex << entries[k];
+    }
+    ASSERT_EQ(b.download(index, 0, static_cast<std::uint32_t>(entries.size()), 1), 0u);
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      EXPECT_EQ(static_cast<std::uint32_t>(b.upload(index, static_cast<std::uint8_t>(k + 1))), entries[k])
+          << "the entry reads as written";
+    }
+  }
+  ASSERT_EQ(b.slave.output_bytes(), 10) << "76 bits";
+  ASSERT_EQ(b.slave.input_bytes(), 10);
+  slave_description d = b.slave.description();
+  d.sync_managers[2].length = 10;
+  d.sync_managers[3].length = 10;
+  b.sync_manager(2, d.sync_managers[2]);
+  b.sync_manager(3, d.sync_managers[3]);
+  b.fmmu(0, 0x10000, 10, d.sync_managers[2].start, 2);
+  b.fmmu(1, 0x10100, 10, d.sync_managers[3].start, 1);
+  ASSERT_EQ(b.request(4), 4);
+  ASSERT_EQ(b.request(8), 8);
+  const auto target = static_cast<std::uint32_t>(-123456);
+  std::vector<std::uint8_t> out(10, 0xFF);  // every padding bit set
+  out[0] = 0x06;                             // Shutdown
+  out[1] = 0x00;
+  out[3] = 0x08;                             // 0x6060 = 8 at bit 24
+  // 0x607A at bits 44..75: the low 4 bits of out[5], out[6..8], the high 4 bits of out[9] stay set.
+  out[5] = static_cast<std::uint8_t>(0x0F | (target << 4));
+  for (unsigned i = 0; i < 3; ++i) out[6 + i] = static_cast<std::uint8_t>(target >> (4 + 8 * i));
+  out[9] = static_cast<std::uint8_t>(0xF0 | (target >> 28));
+  std::vector<std::uint8_t> in;
+  for (int i = 0; i < 40; ++i) {
+    EXPECT_EQ(b.send(command::lwr, 0x10000, out).wkc, 1);
+    b.run(1);
+    const auto a = b.send(command::lrd, 0x10100, std::vector<std::uint8_t>(10, 0xAA));
+    EXPECT_EQ(a.wkc, 1);
+    in = a.data;
+  }
+  EXPECT_EQ(b.upload(0x6040, 0), 0x0006);
+  EXPECT_EQ(b.upload(0x6060, 0), 8);
+  EXPECT_EQ(static_cast<std::uint32_t>(b.upload(0x607A, 0)), target) << "0x607A from bit 44, sign kept";
+  ASSERT_EQ(in.size(), 10u);
+  EXPECT_EQ(bits_of(in, 0, 12), 0u) << "gap and dummies: zeros";
+  EXPECT_EQ(bits_of(in, 12, 16) & 0x6F, 0x21u) << "0x6041 from bit 12: READY TO SWITCH ON";
+  EXPECT_EQ(bits_of(in, 28, 8), 0u) << "the gap: zeros";
+  EXPECT_EQ(bits_of(in, 36, 8), 8u) << "0x6061 from bit 36";
+  EXPECT_EQ(bits_of(in, 44, 32), static_cast<std::uint32_t>(b.upload(0x6064, 0))) << "0x6064 from bit 44";
+  EXPECT_EQ(bits_of(in, 76, 4), 0u) << "the byte's rest";
+}
+
+TEST(drive_slave, padding_of_a_wrong_length_or_sub_index_is_refused) {
+  bench b;
+  b.to_pre_op();
+  ASSERT_EQ(b.download(0x1601, 0, 0, 1), 0u);
+  EXPECT_EQ(b.download(0x1601, 1, 0x00050010, 4), 0x06040041u) << "UNSIGNED8 is 8 bits";
+  EXPECT_EQ(b.download(0x1601, 1, 0x00010008, 4), 0x06040041u) << "a BOOLEAN dummy is 1 bit";
+  EXPECT_EQ(b.download(0x1601, 1, 0x00060008, 4), 0x06040041u) << "UNSIGNED16 is 16 bits";
+  EXPECT_EQ(b.download(0x1601, 1, 0x00050108, 4), 0x06040041u) << "sub-index 1";
+  EXPECT_EQ(b.download(0x1601, 1, 0x00000041, 4), 0x06040041u) << "a gap of 65 bits";
+  EXPECT_EQ(b.download(0x1601, 1, 0x00000108, 4), 0x06040041u) << "a gap with a sub-index";
+  EXPECT_EQ(b.download(0x1A01, 1, 0x00000040, 4), 0u) << "a gap of 64 bits";
+  EXPECT_EQ(b.download(0x1A01, 2, 0x00070020, 4), 0u) << "an UNSIGNED32 dummy in a TxPDO";
+  EXPECT_EQ(b.download(0x1A01, 0, 2, 1), 0u);
 }
 
 }  // namespace

@@ -79,7 +79,10 @@ pdo_description pdo_of(const std::vector<object_entry>& t, std::uint16_t index, 
     e.index = static_cast<std::uint16_t>(m >> 16);
     e.sub = static_cast<std::uint8_t>(m >> 8);
     e.bits = static_cast<std::uint8_t>(m);
-    if (const sub_entry* s = find(t, e.index, e.sub)) {
+    if (is_pdo_padding(e.index, pdo_padding::dummies_and_gaps)) {
+      // Padding: a dummy is of its data type (its index), a gap of none (the ESI gives it no type).
+      if (e.index != 0) e.data_type = e.index;
+    } else if (const sub_entry* s = find(t, e.index, e.sub)) {
       e.name = s->name;
       e.data_type = static_cast<std::uint16_t>(s->type);
     }

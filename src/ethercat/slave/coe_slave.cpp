@@ -47,7 +47,11 @@ sdo_abort coe_slave::read_value(const dictionary::object_dictionary::slot& s, st
 }
 
 bool coe_slave::entry_mappable(std::uint16_t mapping, std::uint32_t m) const {
-  // An entry names an object of the dictionary, mappable in this direction, of its own size.
+  // Padding (an index-0 gap of 1..64 bits or a CiA 301 dummy of its type's length) maps either way.
+  if (is_pdo_padding(static_cast<std::uint16_t>(m >> 16), pdo_padding::dummies_and_gaps)) {
+    return pdo_padding_bits(pdo_mapping_entry::of_word(m), pdo_padding::dummies_and_gaps) != 0;
+  }
+  // Else an entry names an object of the dictionary, mappable in this direction, of its own size.
   const dictionary::object_dictionary::slot* target = od_.find(static_cast<std::uint16_t>(m >> 16),
                                                               static_cast<std::uint8_t>(m >> 8));
   const bool rx = mapping < 0x1A00;

@@ -1,5 +1,6 @@
 // The CoE slave's process data: each assigned PDO entry bound to its dictionary slot on the way to
-// SAFE-OP, then every cycle a copy of bytes between those slots and the sync managers' buffers, with
+// SAFE-OP (padding to nothing), then every cycle a copy of bits between those slots and the sync
+// managers' buffers (pdo_maps.hpp, at any bit offset: a gap or a BOOLEAN dummy may leave one), with
 // no lookup and no allocation (SOES fills its sync manager maps the same way): outputs in before the
 // device's step, inputs out after it (coe_slave::step).
 #include <array>
@@ -12,18 +13,6 @@ namespace {
 
 constexpr int sm_outputs = 2;
 constexpr int sm_inputs = 3;
-
-// An entry's bytes in a little-endian buffer (EtherCAT's byte order). Entries map whole objects
-// (entry_mappable), so each starts and ends on a byte.
-std::uint64_t get_bytes(std::span<const std::uint8_t> b, unsigned bit_offset, unsigned bits) noexcept {
-  std::uint64_t v = 0;
-  for (unsigned i = 0; i < bits / 8; ++i) v |= std::uint64_t{b[bit_offset / 8 + i]} << (8 * i);
-  return v;
-}
-
-void put_bytes(std::span<std::uint8_t> b, unsigned bit_offset, unsigned bits, std::uint64_t v) noexcept {
-  for (unsigned i = 0; i < bits / 8; ++i) b[bit_offset / 8 + i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
 
 }  // namespace
 
@@ -55,11 +44,18 @@ bool coe_slave::bind(std::uint16_t assignment, std::vector<bound_entry>& out, un
     const std::int64_t entries = od_.number(pdo, 0);
     for (std::int64_t k = 1; k <= entries; ++k) {
       const auto m = static_cast<std::uint32_t>(od_.number(pdo, static_cast<std::uint8_t>(k)));
+      // Padding binds nothing: its bits are skipped in the outputs and stay zeros in the inputs.
+      if (is_pdo_padding(static_cast<std::uint16_t>(m >> 16), pdo_padding::dummies_and_gaps)) {
+        const unsigned padding = pdo_padding_bits(pdo_mapping_entry::of_word(m), pdo_padding::dummies_and_gaps);
+        if (padding == 0) return false;
+        bits += padding;
+        continue;
+      }
       sdo_abort ignored = sdo_abort::none;
       dictionary::object_dictionary::slot* s = od_.find(static_cast<std::uint16_t>(m >> 16), static_cast<std::uint8_t>(m >> 8), ignored);
       const auto length = static_cast<std::uint8_t>(m);
       // An entry cleared after its count was written names nothing: the mapping cannot run.
-      if (s == nullptr || length == 0 || length > 64 || length % 8 != 0) return false;
+      if (s == nullptr || length == 0 || length > 64 || length % 8 != 0 || bits > 8u * max_process_data) return false;
       out.push_back({s, static_cast<std::uint16_t>(bits), length, type_is_signed(s->entry->type)});
       bits += length;
     }
@@ -91,11 +87,9 @@ void coe_slave::outputs_in() {
   if (state_ == al_state::operational && take_outputs && out_bytes <= buffer.size() &&
       output_bits_ <= 8 * out_bytes && esc_.read_buffer(sm_outputs, std::span(buffer.data(), out_bytes))) {
     for (const bound_entry& e : outputs_) {
-      const std::uint64_t raw = get_bytes(buffer, e.bit_offset, e.bits);
-      auto value = static_cast<std::int64_t>(raw);
+      const std::uint64_t raw = pdo_get_bits(buffer.data(), out_bytes, e.bit_offset, e.bits);
       // Signed objects come sign-extended, as the dictionary takes them.
-      if (e.is_signed && e.bits < 64 && ((raw >> (e.bits - 1)) & 1u)) value -= std::int64_t{1} << e.bits;
-      (void)write(*e.slot, value);
+      (void)write(*e.slot, e.is_signed ? pdo_sign_extended(raw, e.bits) : static_cast<std::int64_t>(raw));
     }
   }
 }
@@ -109,7 +103,7 @@ void coe_slave::inputs_out() {
   for (const bound_entry& e : inputs_) {
     std::int64_t value = 0;
     (void)read(*e.slot, value);
-    put_bytes(buffer, e.bit_offset, e.bits, static_cast<std::uint64_t>(value));
+    pdo_put_bits(buffer.data(), in_bytes, e.bit_offset, e.bits, static_cast<std::uint64_t>(value));
   }
   (void)esc_.write_buffer(sm_inputs, std::span<const std::uint8_t>(buffer.data(), in_bytes));
 }

@@ -29,7 +29,10 @@
 // (dictionary_access). PDO mappings and assignments are written in PRE-OP only (0x08000022
 // otherwise), and only with objects that are PDO mappable the right way, of their own length and
 // within the process data room; an entry of 0 bits, or a count that takes in an entry left empty, is
-// refused (0x06040041).
+// refused (0x06040041). Padding maps either way (pdo_maps.hpp, pdo_padding): an index-0 gap of 1..64
+// bits (ETG's convention, KickCAT's default) and a CiA 301 dummy (0x0001..0x0007, sub 0, its type's
+// length, 1 bit for BOOLEAN; another length is 0x06040041). It binds nothing: the outputs' padding
+// bits are skipped, the inputs' sent as zeros, and it counts in the process data's length.
 //
 // Sync managers changed under a state that checked them take the slave back (with the error flag):
 // SM0/SM1 in PRE-OP or above to INIT (0x0016), SM2/SM3 in SAFE-OP or OP to PRE-OP (0x001D / 0x001E).
