@@ -211,7 +211,6 @@ std::uint64_t session::write_object(std::uint16_t index, std::uint8_t sub, const
   std::string why;
   if (res->format && !encode_value(v, *res->format, bytes, why)) return refuse(why);
   if (!res->format) bytes = v.what == value_format::kind::text ? std::vector<std::uint8_t>(v.text.begin(), v.text.end()) : v.bytes;
-  const std::int64_t number = v.what == value_format::kind::integer ? v.number : 0;
   queue_download(index, sub, std::move(bytes), [this, res, index, sub, done](const transfer_result& r) {
     if (!r.ok) {
       res->end = outcome::failed;
@@ -230,8 +229,9 @@ std::uint64_t session::write_object(std::uint16_t index, std::uint8_t sub, const
     // lease use it.
     queue_upload(index, 0, [this, res, index, done](const transfer_result& back) {
       if (back.ok && !back.data.empty() && back.data.size() <= 2) {
-        const object_value v = decode_value(back.data, value_format::integer(static_cast<unsigned>(back.data.size()), true));
-        (void)write_option(*profile_, options_, index, static_cast<std::int32_t>(v.number));
+        const object_value read_back =
+            decode_value(back.data, value_format::integer(static_cast<unsigned>(back.data.size()), true));
+        (void)write_option(*profile_, options_, index, static_cast<std::int32_t>(read_back.number));
       }
       fill_result(*res);
       if (done) done(*res);
