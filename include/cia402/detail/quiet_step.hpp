@@ -1,8 +1,8 @@
 // The ordinary cycle of the drive-side machine, inline so a controller's loop over its axes compiles
 // it in place. Most cycles of a running drive are ordinary: no fault, voltage on, no STO, remote
 // control, no stop running, and the control word either asks for the state the drive is in or for
-// a transition that takes effect at once (T2, T3, T4, T6, T7, T9, T10, ...). This path handles
-// exactly those, by one entry of the profile's compiled ordinary cycles (profile::ordinary, which
+// a transition that takes effect at once (T2, T3, T4, T6, T7, T9, T10, ...) or whose stop starts
+// under torque (T5, T8: S7). This path handles exactly those, by one entry of the profile's compiled ordinary cycles (profile::ordinary, which
 // finalize() compiles from the rows: at compile time for the built-in profiles, at load for a
 // profile file), and returns false, touching nothing, whenever anything else might happen;
 // detail::full_step (src/core/drive.cpp) then does the whole work. The model check
@@ -109,8 +109,8 @@ inline bool quiet_cycle(const profile& p, axis& a, const drive_inputs& in, std::
     const std::uint32_t span = static_cast<std::uint32_t>(p.speed_limit_rpm) - 1u;
     if (static_cast<std::uint32_t>(in.actual_speed_rpm) + span > 2u * span) return false;
   }
-  // One test of the keep word for the rare entries: the full step decides, or the control word
-  // halts (bit 8) where the profile has 0x605D.
+  // One test of the keep word for the rare entries: the full step decides or a stop starts, or the
+  // control word halts (bit 8) where the profile has 0x605D.
   if (seldom(keep & ((((cw >> 8) & 1u) | ordinary_action::full) << actions_shift))) {
     if (actions & ordinary_action::full) {
       if (!(actions & ordinary_action::stop_starts)) return false;
