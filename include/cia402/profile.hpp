@@ -407,6 +407,7 @@ struct profile {
       t.row_offset[bits] = static_cast<std::uint16_t>(
           ordinary_tables::offset_of((unsigned{command_of_bits[bits & 0x1Fu]} << 4) | (bits & 0x80u)));
     }
+    detail::compile_stop_entries(*this, t);
   }
 
   /// The entry at byte offset `at` of a key whose row (index `take`, leaving state s) starts its stop
@@ -595,3 +596,5 @@ const profile& standard_profile() noexcept;
 const char* check_profile(const profile& p, int& row) noexcept;
 
 }  // namespace cia402
+
+#include "cia402/detail/stop_entries.hpp"

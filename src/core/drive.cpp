@@ -29,12 +29,6 @@ std::int8_t option_value(const axis& a, option o) noexcept {
   return a.options[static_cast<int>(o)];
 }
 
-// 1/5 slow-down, 2/6 quick-stop, 3/7 current limit, 4/8 voltage limit, 0 coast (0x605A, 0x605E).
-stop_ramp ramp_of_code(int code) noexcept {
-  if (code <= 0) return stop_ramp::coast;
-  return static_cast<stop_ramp>(((code - 1) & 3) + 1);
-}
-
 namespace stop_bits = detail::stop_bits;
 using detail::stop_nibble;
 
@@ -44,7 +38,8 @@ constexpr std::uint32_t stop_table = [] {
   return t;
 }();
 static_assert(row_stop_count <= 8, "a nibble per row_stop in 32 bits");
-static_assert(static_cast<int>(stop_ramp::slow_down) == 1 && static_cast<int>(stop_ramp::quick_stop) == 2);
+static_assert(static_cast<int>(stop_ramp::slow_down) == 1 && static_cast<int>(stop_ramp::quick_stop) == 2 &&
+              static_cast<unsigned>(stop_ramp::coast) == detail::ramp_of_code(0));
 
 unsigned stop_of(row_stop s) noexcept {
   const unsigned i = static_cast<unsigned>(s);
@@ -73,7 +68,7 @@ constexpr unsigned ramp = 0xFFu;
 }  // namespace activity
 
 unsigned activity_of(const profile& p, const axis& a, bool halt) noexcept {
-  // The option code is chosen first so that ramp_of_code() is compiled once, not per case (the
+  // The option code is chosen first so that detail::ramp_of_code() is compiled once, not per case (the
   // Cortex-M4 firmware: bench/cortex_m4). Torque is "wanted" in every state but an idle one, also
   // where the stop coasts: the outputs turn a coast's torque off all the same.
   unsigned ends = 0;
@@ -102,7 +97,7 @@ unsigned activity_of(const profile& p, const axis& a, bool halt) noexcept {
       ends = activity::stop_ends_torque;
     }
   }
-  return static_cast<unsigned>(ramp_of_code(code)) | activity::torque_wanted | ends;
+  return detail::ramp_of_code(code) | activity::torque_wanted | ends;
 }
 
 bool raised_by_drive(std::uint16_t code) noexcept {

@@ -142,7 +142,7 @@ TEST(ordinary_tables, a_stop_with_torque_on_starts_in_the_table_and_a_reset_edge
   ASSERT_FALSE(to_full_step(held));
   EXPECT_EQ((held.set >> detail::byte_shift<4>(0)) & axis_flag::fault_reset_bit, axis_flag::fault_reset_bit)
       << "bit 7 kept for the next cycle's edge";
-  // QUICK STOP ACTIVE stops by 0x605A in every cycle.
+  // QUICK STOP ACTIVE stops by 0x605A in every cycle: its cycles take the rare path (stop words).
   EXPECT_TRUE(to_full_step(compiled(p, state::quick_stop_active, 0x0F, false, true)));
 }
 
@@ -173,6 +173,52 @@ TEST(ordinary_tables, the_stop_of_t5_starts_by_0x605c_as_the_full_step_starts_it
     EXPECT_EQ(stop_running(a), code == 1);
     EXPECT_EQ(x.torque, code == 1) << "the ramp runs with torque on";
   }
+}
+
+// The cycles of a running stop by the tables, each as the full step has it: T11 and QUICK STOP
+// ACTIVE by the default 0x605A (cia402's 2 ends the state at standstill, T12; lexium32's 6 holds it
+// and shows bit 10), and T5's ramp while the shaft turns and once it stands. With another 0x605A
+// than the default the quick stop's start is the full step's.
+TEST(ordinary_tables, a_running_stop_and_quick_stop_active_are_answered_by_the_tables) {
+  struct cycle {
+    std::uint16_t cw;
+    bool standstill;
+    bool answered;  // by detail::quiet_step, without the full step
+  };
+  const auto run = [](const profile& p, std::int8_t quick_stop_code, std::initializer_list<cycle> cycles) {
+    axis a = make_axis(p);
+    drive_inputs in;
+    for (const std::uint16_t cw : {0x00, 0x00, 0x06, 0x07, 0x0F}) {
+      in.control_word = cw;
+      step(p, a, in);
+    }
+    ASSERT_EQ(write_option(p, a, 0x605A, quick_stop_code), sdo_abort::none);
+    for (const cycle& c : cycles) {
+      in.control_word = c.cw;
+      in.standstill = c.standstill;
+      axis by_quiet = a, by_full = a;
+      drive_outputs quiet{};
+      EXPECT_EQ(detail::quiet_step(p, by_quiet, in, quiet), c.answered)
+          << p.name << " 0x" << std::hex << c.cw << " in " << state_name(a.current);
+      const drive_outputs x = step(p, a, in);
+      const drive_outputs y = detail::full_step(p, by_full, in);
+      EXPECT_TRUE(test::same_outputs(x, y)) << p.name << " 0x" << std::hex << c.cw;
+      EXPECT_EQ(std::memcmp(&a, &by_full, sizeof(axis)), 0) << p.name << " 0x" << std::hex << c.cw;
+    }
+    EXPECT_EQ(a.current, state::switched_on) << p.name;
+  };
+  const profile& standard = standard_profile();
+  const profile& lexium = *find_builtin_profile("lexium32");
+  // T11, the ramp, T12 at standstill (0x605A = 2), T2, T3, T4; then T5's ramp and its end.
+  run(standard, 2, {{0x0B, false, true}, {0x0B, false, true}, {0x0B, true, true}, {0x06, true, true},
+                    {0x07, true, true}, {0x0F, true, true}, {0x07, false, true}, {0x07, false, true},
+                    {0x07, true, true}});
+  // T11, the ramp, the state held at standstill (0x605A = 6), T16 by Enable operation, T5.
+  run(lexium, 6, {{0x0B, false, true}, {0x0B, true, true}, {0x0B, true, true}, {0x0F, true, true},
+                  {0x07, false, true}, {0x07, true, true}});
+  // 0x605A = 6 where the default is 2: the quick stop is the full step's from its start.
+  run(standard, 6, {{0x0B, false, false}, {0x0B, true, false}, {0x0F, true, false}, {0x07, true, true},
+                    {0x07, true, true}});
 }
 
 TEST(ordinary_tables, a_profile_finalized_without_tables_steps_by_the_full_step_alone) {

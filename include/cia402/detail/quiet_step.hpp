@@ -14,14 +14,6 @@
 
 namespace cia402::detail {
 
-/// The facts 0x605A's value raises (S5): 1..4 end QUICK STOP ACTIVE by themselves, 5..8 stay.
-constexpr std::uint32_t quick_stop_facts(std::int8_t code) noexcept {
-  const unsigned qs = static_cast<std::uint8_t>(code);
-  return qs - 1u < 4u   ? static_cast<std::uint32_t>(fact::quick_stop_ends)
-         : qs - 5u < 4u ? static_cast<std::uint32_t>(fact::quick_stop_stays)
-                        : 0u;
-}
-
 /// A condition the ordinary cycle does not meet: its code is laid out away from the table's path.
 inline constexpr bool seldom(bool condition) noexcept {
 #if defined(__GNUC__)
@@ -68,6 +60,108 @@ inline bool ordinary_inputs(const drive_inputs& in) noexcept {
            in.local_enable | in.local_disable);
 }
 
+/// The stop word of a cycle's key (ordinary_tables::stop_words).
+inline std::uint32_t stop_word_of(const ordinary_tables& t, unsigned cw, std::size_t axis_offset) noexcept {
+  return t.stop_words[(t.row_offset[cw & 0xFFu] + axis_offset) / 8u];
+}
+
+/// Row r's state change as this cycle's outcome (a pending stop that completes, or the row QUICK
+/// STOP ACTIVE takes once its stop is complete); false, touching nothing, where its entry does not hold.
+inline bool commit_entry(const ordinary_tables& t, unsigned r, axis& a, const drive_inputs& in,
+                         std::uint32_t word, std::uint64_t& head) noexcept {
+  static_assert(row_action::runs == ordinary_action::runs, "reported_bits reads a row's runs bit");
+  const ordinary_tables::row_entry& e = t.row_entries[r];
+  if (!(e.actions & row_action::commits)) return false;
+  const std::uint32_t after = (word & e.keep) | e.set |
+                              ((((in.control_word >> 7) & 1u) << 3) << byte_shift<4>(0));  // fault_reset_bit
+  std::memcpy(static_cast<void*>(&a), &after, 4);
+  a.stop_code = 0;  // S16: outside a stop the code is 0
+  head = e.image | (std::uint64_t{reported_bits(in.status_bits, e.actions)} << status_shift);
+  return true;
+}
+
+/// A cycle whose row enters QUICK STOP ACTIVE (T11) or that runs in it, by the stop word `sw` of its
+/// key, for the profile's default 0x605A: `head` holds the entry's image, the entry's axis words
+/// are keep and set. False, touching nothing, where the full step must decide.
+inline bool quick_stop_cycle(const profile& p, const ordinary_tables& t, axis& a, const drive_inputs& in,
+                             std::uint32_t word, std::uint32_t keep, std::uint32_t set, std::uint32_t sw,
+                             std::uint64_t& head) noexcept {
+  const unsigned kind = sw & 0xFFu, flags = (sw >> 8) & 0xFFu;
+  if (kind < stop_kind::enters_quick_stop ||
+      ((in.control_word & control_bit::halt) && (flags & stop_flag::has_halt))) {
+    return false;
+  }
+  // S16: the quick stop runs by the code it read as it started; the entry holds for the default.
+  const std::int8_t code = p.options[static_cast<int>(option::quick_stop)].default_value;
+  const std::int8_t running = kind == stop_kind::enters_quick_stop
+                                  ? a.options[static_cast<int>(option::quick_stop)]
+                                  : a.stop_code;
+  if ((running != code) | ((a.flags & (axis_flag::entered_by_fault | axis_flag::fault_latched)) != 0)) {
+    return false;
+  }
+  const unsigned completes = sw >> 24;
+  if (completes != 0 && ((flags & stop_flag::quick_stop_coasts) ||
+                         (in.standstill && (in.brake_engaged || !(flags & stop_flag::quick_stop_ends_torque))))) {
+    return commit_entry(t, completes - 1u, a, in, word, head);
+  }
+  const std::uint32_t after = (word & keep) | set;
+  std::memcpy(static_cast<void*>(&a), &after, 4);
+  const bool lands = (flags & stop_flag::lands_in_quick_stop) != 0;
+  a.stop_code = lands ? code : std::int8_t{0};
+  if (lands && in.standstill) {
+    // At standstill a quick stop that ends with torque off closes the brake (S12); one that holds
+    // the state shows bit 10 (target reached).
+    if (flags & stop_flag::quick_stop_ends_torque) head &= ~(std::uint64_t{0xFF} << byte_shift<8>(7));
+    if (flags & stop_flag::quick_stop_stays) head |= std::uint64_t{status_bit::target_reached} << status_shift;
+  }
+  return true;
+}
+
+/// A cycle with a pending row (its stop runs, S7): the key's row takes over where it interrupts
+/// stops, else the stop goes on, or completes at standstill (with the brake engaged where it ends
+/// torque). `head` holds the key's entry's image. False, touching nothing, where the full step must decide.
+inline bool pending_cycle(const profile& p, const ordinary_tables& t, axis& a, const drive_inputs& in,
+                          std::uint32_t word, std::uint32_t keep, std::uint32_t set, std::size_t axis_offset,
+                          std::uint64_t& head) noexcept {
+  const std::uint32_t sw = stop_word_of(t, in.control_word, axis_offset);
+  const unsigned kind = sw & 0xFFu, flags = (sw >> 8) & 0xFFu;
+  if (kind == stop_kind::none || kind == stop_kind::in_quick_stop ||
+      ((in.control_word & control_bit::halt) && (flags & stop_flag::has_halt))) {
+    return false;
+  }
+  const unsigned pending = (word >> byte_shift<4>(2)) & 0xFFu;
+  const unsigned fired = (sw >> 16) & 0xFFu;
+  if (fired != 0 && fired - 1u != pending && (flags & stop_flag::interrupts)) {
+    if (kind == stop_kind::enters_quick_stop) return quick_stop_cycle(p, t, a, in, word, keep, set, sw, head);
+    if (kind != stop_kind::ordinary) return false;  // another row's stop takes over
+    const std::uint32_t after = (word & keep) | set;
+    std::memcpy(static_cast<void*>(&a), &after, 4);
+    a.stop_code = 0;
+    return true;
+  }
+  if (pending >= ordinary_tables::row_capacity) return false;
+  const ordinary_tables::row_entry& e = t.row_entries[pending];
+  if (!(e.actions & row_action::stop_runs) || ((word >> byte_shift<4>(1)) & 0xFFu) != e.stop_state ||
+      ((e.actions & row_action::stop_reads_code) && a.stop_code != 1)) {
+    return false;
+  }
+  std::uint64_t image = e.stop_image;
+  if (e.actions & row_action::halt_ramp) {  // 0x605D, read live (S16): 1..4, else the full step's
+    const auto ramp = static_cast<std::uint8_t>(a.options[static_cast<int>(option::halt)]);
+    if (static_cast<std::uint8_t>(ramp - 1u) >= 4u) return false;
+    image |= std::uint64_t{ramp} << byte_shift<8>(5);
+  }
+  const bool ends = (e.actions & row_action::stop_ends_torque) != 0;
+  if (in.standstill && (in.brake_engaged || !ends)) return commit_entry(t, pending, a, in, word, head);
+  if (ends && in.standstill) image &= ~(std::uint64_t{0xFF} << byte_shift<8>(7));  // S12
+  const unsigned flags_after = axis_flag::torque_on | (((in.control_word >> 7) & 1u) << 3);
+  const std::uint32_t after = (word & ~(std::uint32_t{axis_flag::fault_reset_bit} << byte_shift<4>(0))) |
+                              (flags_after << byte_shift<4>(0));
+  std::memcpy(static_cast<void*>(&a), &after, 4);
+  head = image | (std::uint64_t{reported_bits(in.status_bits, 0)} << status_shift);
+  return true;
+}
+
 /// The ordinary cycle: false, touching nothing, where anything else might happen; else the axis
 /// stepped and `head` the outputs' first 8 bytes (outputs_of adds the error code). The same path
 /// as the compiled step's (compiled.hpp), on the profile's own tables.
@@ -100,8 +194,6 @@ inline bool quiet_cycle(const profile& p, axis& a, const drive_inputs& in, std::
   constexpr unsigned actions_shift = byte_shift<4>(2);
   const unsigned actions = (keep >> actions_shift) & 0xFFu;
   head = image | (std::uint64_t{reported_bits(in.status_bits, actions)} << status_shift);
-  // A stop runs (the pending row is not 0xFF: adding one to its byte leaves it nonzero).
-  if (seldom(((word + (1u << actions_shift)) & (0xFFu << actions_shift)) != 0)) return false;
   // A profile that watches |speed| (seed 001's T2/T7): speed + limit - 1 in [0, 2 limit - 2] is
   // |speed| < limit, one unsigned compare that no speed or limit can overflow (mod 2^32 it is a
   // shift of the interval). Its own test: in the one below, lexium32's every cycle took the rare path.
@@ -109,11 +201,17 @@ inline bool quiet_cycle(const profile& p, axis& a, const drive_inputs& in, std::
     const std::uint32_t span = static_cast<std::uint32_t>(p.speed_limit_rpm) - 1u;
     if (static_cast<std::uint32_t>(in.actual_speed_rpm) + span > 2u * span) return false;
   }
+  // A stop runs (the pending row is not 0xFF: adding one to its byte leaves it nonzero).
+  if (seldom(((word + (1u << actions_shift)) & (0xFFu << actions_shift)) != 0)) {
+    return pending_cycle(p, *tables, a, in, word, keep, set, axis_offset, head);
+  }
   // One test of the keep word for the rare entries: the full step decides or a stop starts, or the
   // control word halts (bit 8) where the profile has 0x605D.
   if (seldom(keep & ((((cw >> 8) & 1u) | ordinary_action::full) << actions_shift))) {
     if (actions & ordinary_action::full) {
-      if (!(actions & ordinary_action::stop_starts)) return false;
+      if (!(actions & ordinary_action::stop_starts)) {
+        return quick_stop_cycle(p, *tables, a, in, word, keep, set, stop_word_of(*tables, cw, axis_offset), head);
+      }
       // S7: the row's stop starts, by the option code it reads as it starts (S16), if any: a code
       // other than 1 makes the change immediate, which the full step commits.
       std::int8_t code = 0;
