@@ -127,7 +127,7 @@ inline constexpr ordinary_tables ordinary_cycles_of = [] {
 
 /// The built-in profile, pointed at its compiled ordinary cycles. A build for size (-Os: a firmware)
 /// leaves them out, so its step is the full step every cycle (as drive.hpp's step() is there) and
-/// the 16.5 KiB a profile stay out of its flash (bench/cortex_m4).
+/// the 21.5 KiB a profile stay out of its flash (bench/cortex_m4).
 template <const profile& Base>
 constexpr profile with_ordinary_cycles() noexcept {
   profile p = Base;
