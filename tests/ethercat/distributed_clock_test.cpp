@@ -194,6 +194,22 @@ TEST(drive_slave_dc, sync0_started_by_the_master_is_dc_mode_and_the_drive_takes_
   EXPECT_GE(b.slave.controller().system_time(), pulse) << "not before the pulse";
 }
 
+// SOEM's slaveinfo -sdo reads every sub-index up to sub 0's count: 0x1C32 and 0x1C33 have no gap
+// (ETG.1020 §5.3 names subs 7 and 8 too), and the one command sub is read-only here.
+TEST(drive_slave_dc, the_sync_manager_parameters_have_every_sub_index_up_to_their_count) {
+  bench b;
+  b.to_pre_op();
+  for (const std::uint16_t index : {sync_parameter::outputs, sync_parameter::inputs}) {
+    const std::int64_t count = b.upload(index, 0);
+    EXPECT_EQ(count, sync_parameter::sync_error_count);
+    for (std::int64_t sub = 1; sub <= count; ++sub) {
+      SCOPED_TRACE("0x" + std::to_string(index) + " sub " + std::to_string(sub));
+      b.upload(index, static_cast<std::uint8_t>(sub));  // fails on an abort
+    }
+    EXPECT_EQ(b.download(index, 8, 1, 2), 0x06010002u) << "the get-cycle-time command is not offered";
+  }
+}
+
 TEST(drive_slave_dc, pulses_that_find_no_new_outputs_are_counted_in_0x1c32_0b) {
   bench b;
   b.to_pre_op();

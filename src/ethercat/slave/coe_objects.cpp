@@ -43,6 +43,11 @@ object_entry sync_manager_parameter(std::uint16_t index, std::string name, std::
        variable(sync_parameter::minimum_cycle_time, "Minimum cycle time", data_type::unsigned32, access::ro,
                 std::int64_t{cycle_us} * 1000),
        variable(6, "Calc and copy time", data_type::unsigned32, access::ro, 0),
+       // Subs 7 and 8 as ETG.1020 §5.3 and SOES have them, so a master that reads every sub up to
+       // sub 0's count (SOEM's slaveinfo -sdo) finds no gap. The command (sub 8: measure the local
+       // cycle, reset the error counters) is not offered: it reads 0 and a write is refused.
+       variable(7, "Minimum delay time", data_type::unsigned32, access::ro, 0),
+       variable(8, "Get cycle time", data_type::unsigned16, access::ro, 0),
        variable(9, "Delay time", data_type::unsigned32, access::ro, 0),
        variable(sync_parameter::sync0_cycle_time, "Sync0 cycle time", data_type::unsigned32, access::ro, 0),
        variable(sync_parameter::sync_error_count, "SM event missed", data_type::unsigned16, access::ro, 0)});
