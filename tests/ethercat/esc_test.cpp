@@ -54,6 +54,21 @@ TEST(esc, broadcast_reads_or_the_slaves_and_writes_all) {
   EXPECT_EQ(b.write16(command::brw, reg::event_mask << 16, 0x0002).wkc, 9);
 }
 
+// DL status (0x0110, ETG.1000.4): the PDI is operational and its watchdog reloaded (bit 1: SOEM and
+// KickCAT read 0 there as an expired PDI watchdog), port 0 has link and communication on every
+// slave, port 1 on all but the last, which closes the loop.
+TEST(esc, dl_status_shows_the_pdi_running_and_the_ports_of_the_line) {
+  bus b(3);
+  for (std::uint16_t i = 0; i < 3; ++i) {
+    const result r = b.send(command::aprd, ap(i, reg::dl_status), {0, 0});
+    ASSERT_EQ(r.wkc, 1);
+    const std::uint16_t dl = b.value16(r);
+    EXPECT_EQ(dl & 0x0003, 0x0003) << "slave " << i << ": PDI operational, its watchdog reloaded";
+    EXPECT_EQ(dl & 0x0210, 0x0210) << "slave " << i << ": port 0 link and communication";
+    EXPECT_EQ((dl & 0x0400) != 0, i == 2) << "slave " << i << ": port 1 closed (loop) at the end only";
+  }
+}
+
 TEST(esc, read_only_registers_keep_their_value) {
   bus b(1);
   const std::uint16_t before = b.escs[0].read16(reg::al_status);

@@ -13,6 +13,10 @@ using detail::al_event_sm_activation;
 using detail::sm_status_mailbox_full;
 
 constexpr std::uint16_t dl_pdi_operational = 1u << 0;
+// ETG.1000.4 DL status bit 1: 1 = the PDI watchdog was reloaded, 0 = it expired. The PDI here is
+// the drive's application in the same process, which serves the ESC every cycle it is given, so
+// the watchdog never expires.
+constexpr std::uint16_t dl_pdi_watchdog_reloaded = 1u << 1;
 constexpr std::uint16_t dl_link_port0 = 1u << 4;
 constexpr std::uint16_t dl_link_port1 = 1u << 5;
 constexpr std::uint16_t dl_loop_port1 = 1u << 10;
@@ -64,7 +68,8 @@ esc::esc(std::vector<std::uint8_t> eeprom) : eeprom_(std::move(eeprom)) {
     memory_[reg::station_alias] = eeprom_[8];
     memory_[reg::station_alias + 1] = eeprom_[9];
   }
-  set_register16(reg::dl_status, dl_pdi_operational | dl_link_port0 | dl_communication_port0 | dl_loop_port1);
+  set_register16(reg::dl_status, dl_pdi_operational | dl_pdi_watchdog_reloaded | dl_link_port0 |
+                                      dl_communication_port0 | dl_loop_port1);
   set_register16(reg::al_status, static_cast<std::uint16_t>(al_state::init));
   set_register16(reg::watchdog_divider, 2498);           // 100 us units: (2498 + 2) x 40 ns
   set_register16(reg::watchdog_time_process_data, 1000); // 100 ms
