@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cia402/dictionary/dictionary_access.hpp"
+#include "cia402/dictionary/object_builders.hpp"
 #include "cia402/ethercat/slave/coe_server.hpp"
 
 namespace cia402::ethercat {
@@ -18,23 +19,15 @@ using cia402::data_type;
 using dictionary::object_code;
 using dictionary::object_entry;
 using dictionary::sub_entry;
+using dictionary::variable;
 
-sub_entry entry(std::uint8_t sub, std::string name, data_type t, access a, std::int64_t def = 0) {
-  sub_entry e;
-  e.sub = sub;
-  e.name = std::move(name);
-  e.type = t;
-  e.acc = a;
-  e.default_value = def;
-  return e;
-}
 
 std::vector<object_entry> table() {
   std::vector<object_entry> t;
   object_entry name;
   name.index = 0x1008;
   name.name = "Manufacturer device name";
-  sub_entry text = entry(0, name.name, data_type::visible_string, access::rw);
+  sub_entry text = variable(0, name.name, data_type::visible_string, access::rw);
   text.default_text = "a virtual drive with a long enough name to need segments";
   text.capacity = 200;
   name.subs.push_back(text);
@@ -43,24 +36,24 @@ std::vector<object_entry> table() {
   assign.index = 0x1C12;
   assign.name = "RxPDO assign";
   assign.code = object_code::array;
-  sub_entry count = entry(0, "Number of assigned PDOs", data_type::unsigned8, access::rw, 1);
+  sub_entry count = variable(0, "Number of assigned PDOs", data_type::unsigned8, access::rw, 1);
   count.has_limits = true;
   count.low = 0;
   count.high = 2;
-  assign.subs = {count, entry(1, "PDO 1", data_type::unsigned16, access::rw, 0x1600),
-                 entry(2, "PDO 2", data_type::unsigned16, access::rw, 0)};
+  assign.subs = {count, variable(1, "PDO 1", data_type::unsigned16, access::rw, 0x1600),
+                 variable(2, "PDO 2", data_type::unsigned16, access::rw, 0)};
   t.push_back(assign);
   object_entry control;
   control.index = 0x6040;
   control.name = "Controlword";
-  sub_entry cw = entry(0, "Controlword", data_type::unsigned16, access::rw);
+  sub_entry cw = variable(0, "Controlword", data_type::unsigned16, access::rw);
   cw.pdo_mappable = true;
   control.subs.push_back(cw);
   t.push_back(control);
   object_entry status;
   status.index = 0x6041;
   status.name = "Statusword";
-  sub_entry sw = entry(0, "Statusword", data_type::unsigned16, access::ro, 0x0250);
+  sub_entry sw = variable(0, "Statusword", data_type::unsigned16, access::ro, 0x0250);
   sw.pdo_mappable = true;
   status.subs.push_back(sw);
   t.push_back(status);
@@ -288,7 +281,7 @@ TEST_F(fixture, a_long_list_comes_in_fragments) {
     object_entry o;
     o.index = static_cast<std::uint16_t>(0x2000 + i);
     o.name = "object";
-    o.subs.push_back(entry(0, "object", data_type::unsigned8, access::rw));
+    o.subs.push_back(variable(0, "object", data_type::unsigned8, access::rw));
     many.push_back(o);
   }
   dictionary::object_dictionary big(many, 1);
