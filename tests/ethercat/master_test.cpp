@@ -186,6 +186,48 @@ TEST(ecat_master, carries_every_drives_words_of_enable_quick_stop_fault_and_rese
   EXPECT_EQ(l.master.last_working_counter(), 16 * 3);
 }
 
+TEST(ecat_master, a_line_whose_image_one_frame_cannot_hold_runs_in_several_frames_a_cycle) {
+  // 64 drives with the default mapping: 2,048 bytes of process data, more than a frame's 1,500.
+  line l(64);
+  l.up();
+  std::size_t image = 0;
+  for (const ecat_slave& s : l.master.slaves()) image += std::size_t{s.output_bytes} + s.input_bytes;
+  ASSERT_GT(image, 1500u);
+  EXPECT_EQ(l.master.expected_working_counter(), 64 * 3);
+  EXPECT_EQ(l.master.last_working_counter(), 64 * 3) << "every part's LRW reached its slaves";
+  ASSERT_GT(enable(l.master, l.link, first(64)), 0) << "every drive's words, in whichever frame, out and back";
+  for (std::size_t i = 0; i < 64; ++i) {
+    EXPECT_EQ(l.link.slaves[i]->device().drive().view().current(), state::operation_enabled) << i;
+  }
+  // One cycle: its frames, each within the Ethernet maximum, the LRWs covering the image once.
+  std::size_t frames = 0, largest = 0;
+  l.master.on_frame = [&](const std::vector<std::uint8_t>& sent, const std::vector<std::uint8_t>&) {
+    ++frames;
+    largest = std::max(largest, sent.size());
+  };
+  ASSERT_TRUE(l.master.cycle()) << l.master.error();
+  l.master.on_frame = nullptr;
+  EXPECT_GE(frames, (image + 1499) / 1500);
+  EXPECT_LE(largest, 1514u);
+  // A drive in the last part that stops taking its outputs (its FMMU 0 deactivated, 0x060C, behind
+  // the master's back): the cycle fails, and the error names that part's LRW, not only the line's sum.
+  frame_builder b({0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF}, {0x02, 0x00, 0x00, 0x00, 0x00, 0x02});
+  const std::uint16_t station = l.master.slaves()[63].station;
+  const std::vector<std::uint8_t> off{0x00};
+  ASSERT_GE(b.add(command::fpwr, 0x55, station | (std::uint32_t{0x060C} << 16), off, 1), 0);
+  std::vector<std::uint8_t> request = b.finish();
+  ASSERT_EQ(l.link.wire.pass(request), frame_error::none);
+  l.link.wait_us(1000);
+  bool failed = false;
+  for (int i = 0; i < 5 && !failed; ++i) {
+    failed = !l.master.cycle();
+    l.link.wait_us(1000);
+  }
+  ASSERT_TRUE(failed);
+  EXPECT_NE(l.master.error().find("of the LRW of image bytes"), std::string::npos) << l.master.error();
+  EXPECT_EQ(l.master.error().find("image bytes 0.."), std::string::npos) << "the first part is whole: " << l.master.error();
+}
+
 TEST(ecat_master, cyclic_synchronous_position_over_the_process_data_at_1_ms) {
   // Mode 8 in 0x6060 and a ramp of 0x607A in the RxPDO, one set-point a cycle; 0x6064 and 0x6061
   // come back in the TxPDO. 100 increments a ms is 600 rpm at 10,000 increments a revolution.

@@ -365,11 +365,21 @@ bool ecat_master::bring_to_operational() {
     expected_wkc_ = static_cast<std::uint16_t>(expected_wkc_ + (s.output_bytes ? 2 : 0) + (s.input_bytes ? 1 : 0));
   }
   image_.assign(logical - logical_base, 0);
-  constexpr std::size_t room = maximum_frame_size - ethernet_header_size - ethercat_header_size -
-                               2 * (datagram_header_size + working_counter_size) - 2;
-  if (image_.size() > room) {
-    return fail("the process image (" + std::to_string(image_.size()) + " bytes) does not fit one frame; "
-                "this master sends one LRW a cycle");
+  // The image in LRWs of whole slaves (SOEM splits its image the same way): the first frame also
+  // carries the AL status BRD (2 bytes), the clock's FRMW (8) and one SM1 status read (1).
+  const std::size_t frame_room = maximum_frame_size - ethernet_header_size - ethercat_header_size -
+                                 datagram_header_size - working_counter_size;
+  const std::size_t first_room = frame_room - 3 * (datagram_header_size + working_counter_size) - 2 - 8 - 1;
+  parts_.clear();
+  for (const ecat_slave& s : slaves_) {
+    const std::size_t bytes = std::size_t{s.output_bytes} + s.input_bytes;
+    const std::uint16_t wkc = static_cast<std::uint16_t>((s.output_bytes ? 2 : 0) + (s.input_bytes ? 1 : 0));
+    if (bytes > first_room) return fail(slave_text(s) + ": its process data does not fit one frame");
+    if (parts_.empty() || parts_.back().length + bytes > (parts_.size() == 1 ? first_room : frame_room)) {
+      parts_.push_back({static_cast<std::size_t>(s.logical_outputs - logical_base), 0, 0});
+    }
+    parts_.back().length += bytes;
+    parts_.back().wkc = static_cast<std::uint16_t>(parts_.back().wkc + wkc);
   }
   // The outputs start as the drive has them, so running the line commands nothing by itself: the
   // control word it last got, the set-points and mode it holds (a zero 0x6060 or 0x60FF would).
@@ -448,6 +458,35 @@ void ecat_master::stop_cycling() {
   line_was_operational_ = false;
 }
 
+// One LRW of a part of the image in a frame of its own: its answer into `back`, its working
+// counter added to `wkc`; the first part whose counter is wrong is named in `wrong`.
+bool ecat_master::exchange_part(const image_part& part, std::vector<std::uint8_t>& back, std::uint16_t& wkc,
+                                std::string& wrong) {
+  frame_builder b(broadcast, master_mac);
+  const long lrw = b.add(command::lrw, ++index_, static_cast<std::uint32_t>(logical_base + part.offset),
+                         std::span<const std::uint8_t>(image_.data() + part.offset, part.length),
+                         static_cast<std::uint16_t>(part.length));
+  std::vector<std::uint8_t> f = b.finish();
+  std::vector<std::uint8_t> sent;
+  if (on_frame) sent = f;
+  if (lrw < 0 || !link_->exchange(f) || f.size() < static_cast<std::size_t>(lrw) + part.length + 2) {
+    ++lost_frames_;
+    error_ = "a cycle's frame did not come back (the LRW of image bytes " + std::to_string(part.offset) + ".." +
+             std::to_string(part.offset + part.length - 1) + ")";
+    return false;
+  }
+  if (on_frame) on_frame(sent, f);
+  std::copy(f.begin() + lrw, f.begin() + lrw + static_cast<std::ptrdiff_t>(part.length),
+            back.begin() + static_cast<std::ptrdiff_t>(part.offset));
+  const std::uint16_t got = le16(f.data() + lrw + part.length);
+  if (got != part.wkc && wrong.empty()) {
+    wrong = "working counter " + std::to_string(got) + " of the LRW of image bytes " + std::to_string(part.offset) +
+             ".." + std::to_string(part.offset + part.length - 1) + ", expected " + std::to_string(part.wkc);
+  }
+  wkc = static_cast<std::uint16_t>(wkc + got);
+  return true;
+}
+
 bool ecat_master::cycle() {
   if (!cycling_) {
     error_ = "no process data to exchange: bring the line to OP first";
@@ -459,8 +498,22 @@ bool ecat_master::cycle() {
     if (!s.control_word) continue;
     put_bits(image_, (s.logical_outputs - logical_base) * 8u + s.control_word->bit_offset, 16, s.last_control);
   }
+  std::vector<std::uint8_t> back(image_.size(), 0);
+  std::uint16_t wkc = 0;
+  std::string wrong;
+  // The image's later parts first, each in a frame of its own (a line whose image one frame cannot
+  // hold); the first travels with the AL status, read once every drive has this cycle's outputs.
+  for (std::size_t k = 1; k < parts_.size(); ++k) {
+    if (!exchange_part(parts_[k], back, wkc, wrong)) {
+      ++cycles_;
+      return false;
+    }
+  }
+  const image_part head = parts_.empty() ? image_part{} : parts_.front();
   frame_builder b(broadcast, master_mac);
-  const long lrw = b.add(command::lrw, ++index_, logical_base, image_, static_cast<std::uint16_t>(image_.size()));
+  const long lrw = b.add(command::lrw, ++index_, static_cast<std::uint32_t>(logical_base + head.offset),
+                         std::span<const std::uint8_t>(image_.data() + head.offset, head.length),
+                         static_cast<std::uint16_t>(head.length));
   const long al = b.add(command::brd, ++index_, static_cast<std::uint32_t>(reg_al_status) << 16, {}, 2);
   // The drift distribution: the reference clock's system time to every other DC slave.
   if (dc_reference_) {
@@ -484,7 +537,13 @@ bool ecat_master::cycle() {
   }
   if (on_frame) on_frame(sent, f);
   const std::uint8_t* data = f.data() + lrw;
-  last_wkc_ = le16(data + image_.size());
+  std::copy(data, data + head.length, back.begin() + static_cast<std::ptrdiff_t>(head.offset));
+  const std::uint16_t head_wkc = le16(data + head.length);
+  if (head_wkc != head.wkc && wrong.empty() && parts_.size() > 1) {
+    wrong = "working counter " + std::to_string(head_wkc) + " of the LRW of image bytes 0.." +
+             std::to_string(head.length - 1) + ", expected " + std::to_string(head.wkc);
+  }
+  last_wkc_ = static_cast<std::uint16_t>(wkc + head_wkc);
   const std::uint8_t line = f[static_cast<std::size_t>(al)];  // every slave's AL status, ORed
   if (sm1 >= 0 && static_cast<std::size_t>(sm1) + 3 <= f.size() && le16(f.data() + sm1 + 1) == 1 &&
       (f[static_cast<std::size_t>(sm1)] & 0x08)) {
@@ -493,10 +552,10 @@ bool ecat_master::cycle() {
     if (m.ok && m.wkc == 1) note_emergency(*asked, m.data);
   }
   if (last_wkc_ != expected_wkc_) {
-    error_ = "working counter " + std::to_string(last_wkc_) + ", expected " + std::to_string(expected_wkc_);
+    error_ = wrong.empty() ? "working counter " + std::to_string(last_wkc_) + ", expected " + std::to_string(expected_wkc_)
+                           : wrong;
     return false;
   }
-  std::vector<std::uint8_t> back(data, data + image_.size());
   for (ecat_slave& s : slaves_) {
     const std::size_t base = (s.logical_inputs - logical_base) * 8u;
     s.last_status = static_cast<std::uint16_t>(get_bits(back, base + s.status_word->bit_offset, 16));

@@ -217,6 +217,16 @@ class ecat_master {
   std::uint32_t cycle_us_;
   std::vector<ecat_slave> slaves_;
   std::vector<std::uint8_t> image_;  // the logical process image, outputs and inputs of every slave
+  // The image as the cycle's LRWs carry it: runs of whole slaves, each within one frame (the first
+  // beside the cycle's other datagrams), each with the working counter its slaves owe.
+  struct image_part {
+    std::size_t offset = 0;
+    std::size_t length = 0;
+    std::uint16_t wkc = 0;
+  };
+  std::vector<image_part> parts_;
+  bool exchange_part(const image_part& part, std::vector<std::uint8_t>& back, std::uint16_t& wkc,
+                     std::string& wrong);
   std::uint16_t expected_wkc_ = 0;
   std::uint16_t last_wkc_ = 0;
   std::uint64_t cycles_ = 0;
