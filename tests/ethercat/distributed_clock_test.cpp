@@ -175,7 +175,7 @@ TEST(drive_slave_dc, sync0_started_by_the_master_is_dc_mode_and_the_drive_takes_
   EXPECT_EQ(b.upload(sync_parameter::outputs, sync_parameter::supported), 0x0007) << "free run, SM, DC SYNC0";
   start_sync0(b, 4'000'000, 10'000'000);  // a pulse 10 ms from now, then every 4 ms
   EXPECT_EQ(to_safe_op(b), 4);
-  EXPECT_EQ(b.request(8), 8);
+  EXPECT_EQ(b.request(8), 4) << "OP waits for the first pulse";
   b.drain_mailbox();
   EXPECT_EQ(b.upload(sync_parameter::outputs, sync_parameter::mode), sync_mode::dc_sync0);
   EXPECT_EQ(b.upload(sync_parameter::inputs, sync_parameter::mode), sync_mode::dc_sync0);
@@ -192,6 +192,44 @@ TEST(drive_slave_dc, sync0_started_by_the_master_is_dc_mode_and_the_drive_takes_
   }
   EXPECT_EQ(sw & 0x6F, 0x21) << "READY TO SWITCH ON";
   EXPECT_GE(b.slave.controller().system_time(), pulse) << "not before the pulse";
+}
+
+// Until its first SYNC0 pulse a drive in DC SYNC0 mode takes no outputs, so it does not say OP before
+// it: the request waits in SAFE-OP without an error, the pulse enters OP and applies that pulse's
+// outputs; a pulse that never comes refuses OP with 0x002D after first_pulse_wait_us.
+TEST(drive_slave_dc, an_op_request_waits_for_the_first_pulse_and_is_refused_when_none_comes) {
+  {
+    bench b;
+    b.to_pre_op();
+    start_sync0(b, 1'000'000, 20'000'000);  // the first pulse 20 ms from now
+    const std::uint64_t pulse = b.slave.controller().read32(reg::dc_start_time) |
+                                (std::uint64_t{b.slave.controller().read32(reg::dc_start_time + 4)} << 32);
+    EXPECT_EQ(to_safe_op(b), 4);
+    EXPECT_EQ(b.request(8), 4) << "SAFE-OP, no error flag";
+    EXPECT_EQ(b.read16(reg::al_status_code), al_code::none);
+    std::uint16_t sw = 0;
+    int cycles = 0;
+    while (b.read16(reg::al_status) != 8 && cycles < 100) {
+      EXPECT_EQ(b.read16(reg::al_status), 4) << "no error while it waits";
+      sw = b.cycle(0x0006);  // Shutdown, waiting in the outputs
+      ++cycles;
+    }
+    ASSERT_EQ(b.read16(reg::al_status), 8) << "OP at the pulse";
+    EXPECT_GE(b.slave.controller().system_time(), pulse);
+    EXPECT_LE(b.slave.controller().system_time(), pulse + 2'000'000) << "not later than the cycle after it";
+    EXPECT_EQ(sw & 0x6F, 0x21) << "READY TO SWITCH ON: the pulse that entered OP applied the outputs";
+  }
+  {
+    bench b;
+    b.to_pre_op();
+    start_sync0(b, 1'000'000, 30'000'000'000);  // a pulse far beyond the wait
+    EXPECT_EQ(to_safe_op(b), 4);
+    EXPECT_EQ(b.request(8), 4);
+    b.run(static_cast<int>(first_pulse_wait_us / 1000));
+    EXPECT_EQ(b.read16(reg::al_status), 0x14) << "SAFE-OP with the error flag";
+    EXPECT_EQ(b.read16(reg::al_status_code), al_code::no_sync);
+    EXPECT_EQ(b.cycle(0x0006) & 0x6F, 0x40) << "the outputs were never applied: SWITCH ON DISABLED";
+  }
 }
 
 // SOEM's slaveinfo -sdo reads every sub-index up to sub 0's count: 0x1C32 and 0x1C33 have no gap

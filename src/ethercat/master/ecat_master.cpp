@@ -110,6 +110,7 @@ const char* al_status_code_text(std::uint16_t code) noexcept {
     case 0x001E: return "invalid input configuration";
     case 0x0024: return "invalid input mapping";
     case 0x0025: return "invalid output mapping";
+    case 0x002D: return "no sync error (no SYNC0 pulse came)";
     case 0x0030: return "invalid DC sync configuration";
     default: return "unknown AL status code";
   }

@@ -223,6 +223,7 @@ bool coe_slave::choose_sync_mode() {
     od_.set_number(index, sync_error_count, 0);
   }
   outputs_waiting_ = false;
+  pulse_seen_ = false;
   return true;
 }
 
@@ -237,6 +238,7 @@ void coe_slave::handle_al_control() {
     code_ = al_code::none;
   }
   const auto current = static_cast<unsigned>(state_);
+  op_waits_for_pulse_ = false;  // a new request replaces one that waited
   switch (wanted) {
     case 1: enter(al_state::init); return;
     case 3: refuse(al_code::bootstrap_not_supported); return;
@@ -251,6 +253,11 @@ void coe_slave::handle_al_control() {
       return;
     case 8:
       if (current < static_cast<unsigned>(al_state::safe_operational)) return refuse(al_code::invalid_state_change);
+      if (state_ == al_state::safe_operational && dc_sync0_ && !pulse_seen_) {
+        op_waits_for_pulse_ = true;  // outputs_in() enters OP on the pulse
+        op_wait_us_ = 0;
+        return;
+      }
       enter(al_state::operational);
       return;
     default: refuse(al_code::unknown_state); return;
@@ -361,6 +368,13 @@ void coe_slave::step(std::uint32_t elapsed_us) {
   // As SOES runs its application: the outputs in, the device's step on them, then the inputs out,
   // so the inputs a master reads next answer the outputs it wrote before this step (no cycle more).
   outputs_in();
+  if (op_waits_for_pulse_) {
+    op_wait_us_ = op_wait_us_ + elapsed_us;
+    if (op_wait_us_ >= first_pulse_wait_us) {
+      op_waits_for_pulse_ = false;
+      refuse(al_code::no_sync);
+    }
+  }
   device_->step(elapsed_us);
   inputs_out();
   esc_.advance(std::uint64_t{elapsed_us} * 1000);

@@ -70,6 +70,11 @@ void coe_slave::outputs_in() {
   std::array<std::uint8_t, max_process_data> buffer{};
   const bool outputs_arrived = esc_.take_sync_manager_event(sm_outputs);
   const bool sync0 = esc_.take_sync0_event();
+  if (dc_sync0_ && sync0) pulse_seen_ = true;
+  if (op_waits_for_pulse_ && pulse_seen_) {
+    op_waits_for_pulse_ = false;
+    enter(al_state::operational);  // and this pulse's outputs are applied below
+  }
   // Free run and SM-synchronous: outputs when they arrive. DC SYNC0: the newest on each pulse.
   bool take_outputs = outputs_arrived;
   if (dc_sync0_) {

@@ -43,7 +43,10 @@
 // DC SYNC0 written without SYNC0 running is refused (0x0030), a SYNC0 cycle below 0x1C32:05 too
 // (0x0035). In DC SYNC0 mode the outputs go to the device on each SYNC0 pulse (the newest whole buffer),
 // not when they arrive; a pulse that finds no new outputs in OP counts in 0x1C32:0B. Free run and
-// SM-synchronous take the outputs when they arrive.
+// SM-synchronous take the outputs when they arrive. In DC SYNC0 mode SAFE-OP to OP waits for the
+// first pulse (the AL status stays SAFE-OP, no error), because until then the drive would be in OP
+// taking no outputs; the pulse enters OP and applies that pulse's outputs. No pulse within
+// first_pulse_wait_us refuses OP with 0x002D (no sync error).
 //
 // Mailbox repeat (ETG.1000.4, as the ETG's slave code answers it): a master that lost a reply
 // toggles SM1's repeat request; the slave puts the reply the master read last back into SM1 (a newer
@@ -78,6 +81,7 @@ inline constexpr std::uint16_t invalid_input_configuration = 0x001E;
 inline constexpr std::uint16_t invalid_input_mapping = 0x0024;
 inline constexpr std::uint16_t invalid_output_mapping = 0x0025;
 inline constexpr std::uint16_t invalid_dc_sync_configuration = 0x0030;
+inline constexpr std::uint16_t no_sync = 0x002D;  ///< ETG.1000.6: no SYNC0 pulse came
 inline constexpr std::uint16_t invalid_dc_sync_cycle_time = 0x0035;
 }  // namespace al_code
 
@@ -112,6 +116,9 @@ inline constexpr std::uint16_t inputs_start = 0x1180;
 inline constexpr std::uint16_t max_process_data = 0x80;
 /// Entries a PDO mapping object holds.
 inline constexpr int max_pdo_entries = 12;
+/// How long an OP request in DC SYNC0 mode waits for the first SYNC0 pulse before it is refused
+/// with 0x002D: ten times the 100 ms SOEM's ec_dcsync0 puts the first pulse ahead of now.
+inline constexpr std::uint32_t first_pulse_wait_us = 1'000'000;
 
 struct coe_slave_config {
   /// The device's objects: its identity (0x1000, 0x1008, 0x1018 ...), its profile's objects, its own.
@@ -217,6 +224,10 @@ class coe_slave final : private dictionary::dictionary_access, private dictionar
   // DC SYNC0 mode, as chosen on the way to SAFE-OP: outputs go to the device on a SYNC0 pulse.
   bool dc_sync0_ = false;
   bool outputs_waiting_ = false;  // outputs arrived since the last pulse
+  bool pulse_seen_ = false;       // a SYNC0 pulse came since DC SYNC0 mode was chosen
+  // An OP request in DC SYNC0 mode that waits for the first pulse, and for how long it has waited.
+  bool op_waits_for_pulse_ = false;
+  std::uint32_t op_wait_us_ = 0;
   std::vector<std::uint8_t> mailbox_;  // the last request SM0 brought (its room kept across cycles)
   // Mailbox repeat (ETG.1000.4): the reply SM1 holds unread, the one the master read last (which a
   // repeat request puts back), and one taken back from SM1 for a repeat, which goes out next.
