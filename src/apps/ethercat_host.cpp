@@ -16,6 +16,7 @@ ethercat_host::ethercat_host(const profile& p, int nodes, std::uint32_t cycle_us
   for (int i = 0; i < nodes; ++i) {
     drives_.push_back(std::make_unique<virtual_drive_slave>(p, static_cast<std::uint32_t>(i + 1), sim::plant_config{}, cycle_us));
     wire_.add(drives_.back()->controller());
+    drives_.back()->slave().keep_clock_outside();
   }
   next_drive_ = drives_.size();  // no cycle under way until one is due
 }
@@ -37,7 +38,12 @@ bool ethercat_host::pass(std::vector<std::uint8_t>& frame) {
 }
 
 void ethercat_host::cycle(std::uint32_t elapsed_us) {
+  advance_clocks(std::uint64_t{elapsed_us} * 1000);
   for (auto& d : drives_) d->step(elapsed_us);
+}
+
+void ethercat_host::advance_clocks(std::uint64_t ns) {
+  for (auto& d : drives_) d->controller().advance(ns);
 }
 
 bool ethercat_host::step_one_drive(std::uint32_t elapsed_us) {
@@ -53,7 +59,7 @@ bool ethercat_host::step_one_drive(std::uint32_t elapsed_us) {
   return next_drive_ < drives_.size() || owed_us_ >= cycle_us_;
 }
 
-void ethercat_host::answer_waiting_frames(std::vector<std::uint8_t>& frame) {
+void ethercat_host::answer_waiting_frames(std::vector<std::uint8_t>& frame, elapsed_clock& controllers_clock) {
   // Every frame waiting, answered at once: a master's cycle is a frame and its answer.
   for (int burst = 0; burst < 64 && socket_.fd >= 0; ++burst) {
     sockaddr_ll from{};
@@ -64,6 +70,7 @@ void ethercat_host::answer_waiting_frames(std::vector<std::uint8_t>& frame) {
     if (n <= 0) break;
     if (from.sll_pkttype == PACKET_OUTGOING) continue;  // our own answer, seen going out
     frame.resize(static_cast<std::size_t>(n));
+    advance_clocks(controllers_clock.take_ns());  // the frame finds the time it arrives at
     if (!pass(frame)) continue;
     (void)detail::send_raw_frame(socket_, frame);
   }
@@ -71,6 +78,7 @@ void ethercat_host::answer_waiting_frames(std::vector<std::uint8_t>& frame) {
 
 void ethercat_host::run(const volatile std::sig_atomic_t& stop) {
   elapsed_clock clock;
+  elapsed_clock controllers_clock;  // to the nanosecond, not capped
   std::vector<std::uint8_t> frame(ethercat::maximum_frame_size + 4);
   bool steps_owed = false;
   while (stop == 0) {
@@ -81,7 +89,8 @@ void ethercat_host::run(const volatile std::sig_atomic_t& stop) {
       const timespec wait{0, static_cast<long>(wait_us) * 1000};
       (void)::ppoll(&p, 1, &wait, nullptr);
     }
-    answer_waiting_frames(frame);
+    advance_clocks(controllers_clock.take_ns());  // a SYNC0 pulse or a watchdog the step takes
+    answer_waiting_frames(frame, controllers_clock);
     steps_owed = step_one_drive(clock.take());
   }
 }

@@ -116,6 +116,59 @@ TEST(distributed_clocks, offsets_and_delays_from_the_receive_times_leave_no_diff
   EXPECT_EQ(l.read(2, reg::dc_system_time_difference, 4), 2u * l.wire.hop_delay_ns);
 }
 
+// A master whose offsets leave out the hop delay (0x092C then shows the delay on every slave, as
+// SOEM's ec_configdc leaves it here): the drift distribution's writes steer each clock until the
+// difference is 0 and every controller has the reference's system time (the time control loop).
+TEST(distributed_clocks, the_time_control_loop_steers_the_difference_the_offsets_left_to_zero) {
+  constexpr int n = 16;
+  line l(n);
+  for (int i = 1; i < n; ++i) l.escs[static_cast<std::size_t>(i)].advance(static_cast<std::uint64_t>(i) * 1'000'003);
+  std::vector<std::uint8_t> any(4, 0);
+  l.send(command::bwr, 0, reg::dc_receive_time, any);
+  const std::uint64_t unit0 = l.read(0, reg::dc_receive_time_unit, 8);
+  for (int i = 1; i < n; ++i) {
+    l.write(i, reg::dc_system_time_delay, static_cast<std::uint64_t>(i) * l.wire.hop_delay_ns, 4);
+    l.write(i, reg::dc_system_time_offset, unit0 - l.read(i, reg::dc_receive_time_unit, 8), 8);
+  }
+  const auto difference_ns = [&](int i) {
+    const auto d = static_cast<std::uint32_t>(l.read(i, reg::dc_system_time_difference, 4));
+    return (d & 0x80000000u) ? -static_cast<std::int64_t>(d & 0x7FFFFFFFu) : static_cast<std::int64_t>(d);
+  };
+  std::vector<std::uint8_t> time(8, 0);
+  l.send(command::frmw, line::station(0), reg::dc_system_time, time);
+  for (int i = 1; i < n; ++i) {
+    EXPECT_EQ(difference_ns(i), -static_cast<std::int64_t>(i) * l.wire.hop_delay_ns) << "the first write finds the delay, " << i;
+  }
+  int writes = 1;
+  const auto all_zero = [&] {
+    for (int i = 1; i < n; ++i) {
+      if (difference_ns(i) != 0) return false;
+    }
+    return true;
+  };
+  std::int64_t last_of_15 = difference_ns(15);
+  while (!all_zero() && writes < 1000) {
+    l.advance(1'000'000);
+    time.assign(8, 0);
+    l.send(command::frmw, line::station(0), reg::dc_system_time, time);
+    ++writes;
+    const std::int64_t d = difference_ns(15);
+    ASSERT_LE(d, 0) << "no overshoot, write " << writes;
+    ASSERT_GE(d, last_of_15) << "it only shrinks, write " << writes;
+    ASSERT_LE(d - last_of_15, 1000) << "at most 1 us a write";
+    last_of_15 = d;
+  }
+  EXPECT_TRUE(all_zero());
+  EXPECT_LT(writes, 200) << "a few hundred cycles of drift distribution at most";
+  for (int i = 1; i < n; ++i) EXPECT_EQ(l.escs[static_cast<std::size_t>(i)].system_time(), l.escs[0].system_time()) << i;
+  for (int k = 0; k < 10; ++k) {  // and it stays there
+    l.advance(1'000'000);
+    time.assign(8, 0);
+    l.send(command::frmw, line::station(0), reg::dc_system_time, time);
+  }
+  EXPECT_TRUE(all_zero());
+}
+
 TEST(distributed_clocks, sync0_pulses_at_the_start_time_and_every_cycle_after) {
   line l(1);
   esc& e = l.escs[0];

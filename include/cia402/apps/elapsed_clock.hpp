@@ -29,6 +29,16 @@ class elapsed_clock {
     last_ = us > cap_us ? now : last_ + std::chrono::microseconds(step);
     return step;
   }
+  /// Nanoseconds since the last take_ns() (or construction), not capped: for a clock that keeps the
+  /// host's time across a stall (an emulated controller's system time). One instance takes one or
+  /// the other, never both.
+  std::uint64_t take_ns() {
+    const auto now = clock::now();
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now - last_).count();
+    if (ns <= 0) return 0;
+    last_ += std::chrono::nanoseconds(ns);
+    return static_cast<std::uint64_t>(ns);
+  }
 
  private:
   using clock = std::chrono::steady_clock;

@@ -4,8 +4,11 @@
 // of a real line does. Between frames each drive's application runs once per cycle of wall time
 // (AL state machine, mailboxes, process data, the simulator), one drive at a time with the socket
 // looked at between any two: a frame waits at most one drive's step, never a whole cycle of every
-// drive or a catch-up after a stall, so its answer time depends on the frame alone. Linux; needs
-// CAP_NET_RAW (root).
+// drive or a catch-up after a stall, so its answer time depends on the frame alone. The
+// controllers' clocks (DC system time, SYNC0, watchdogs) run on the host's clock to the nanosecond,
+// brought up to it before every frame, not in the drives' 1 ms steps: a master reading 0x0910 sees
+// it move between cycles, every controller of the line reads the same time, and a stalled host's
+// time is not lost. Linux; needs CAP_NET_RAW (root).
 #pragma once
 
 #include <csignal>
@@ -15,6 +18,7 @@
 #include <system_error>
 #include <vector>
 
+#include "cia402/apps/elapsed_clock.hpp"
 #include "cia402/apps/raw_socket.hpp"
 #include "cia402/apps/virtual_drive_slave.hpp"
 #include "cia402/ethercat/esc/esc.hpp"
@@ -39,11 +43,13 @@ class ethercat_host {
   /// One frame from the wire: through every controller; false when it is not a sound EtherCAT
   /// frame (it is then not answered, as a line does not answer garbage).
   bool pass(std::vector<std::uint8_t>& frame);
-  /// One application cycle of every drive.
+  /// One application cycle of every drive, with `elapsed_us` of their clocks.
   void cycle(std::uint32_t elapsed_us);
+  /// `ns` more of every controller's clock (DC system time, SYNC0, watchdogs), no application step.
+  void advance_clocks(std::uint64_t ns);
   /// `elapsed_us` more wall time, then at most one drive's application cycle of those it made due
   /// (at most 10 cycles are owed after a stall): true while drives' steps are still owed, so the
-  /// caller answers frames between any two steps.
+  /// caller answers frames between any two steps. The clocks are advance_clocks()'.
   bool step_one_drive(std::uint32_t elapsed_us);
 
   std::vector<std::unique_ptr<virtual_drive_slave>>& drives() noexcept { return drives_; }
@@ -51,7 +57,7 @@ class ethercat_host {
   std::uint64_t frames_refused() const noexcept { return wire_.refused_frames(); }
 
  private:
-  void answer_waiting_frames(std::vector<std::uint8_t>& frame);
+  void answer_waiting_frames(std::vector<std::uint8_t>& frame, elapsed_clock& controllers_clock);
 
   std::vector<std::unique_ptr<virtual_drive_slave>> drives_;
   ethercat::chain wire_;

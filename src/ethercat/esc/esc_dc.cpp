@@ -2,6 +2,7 @@
 // ETG.1000.4 §9.1): receive time latches, the system time with its offset and delay, the difference
 // a drift distribution write leaves, and the SYNC0 unit. No allocation, no loop that time does not
 // bound (a SYNC0 catch-up is one division).
+#include <algorithm>
 #include <cstring>
 
 #include "cia402/ethercat/esc/esc.hpp"
@@ -12,6 +13,7 @@ namespace {
 constexpr std::uint8_t activation_cyclic_unit = 1u << 0;
 constexpr std::uint8_t activation_sync0 = 1u << 1;
 constexpr std::uint32_t difference_local_smaller = 1u << 31;
+constexpr std::uint64_t max_slew_step_ns = 1000;
 
 bool overlaps(std::uint32_t a, std::uint32_t a_len, std::uint32_t b, std::uint32_t b_len) noexcept {
   return a < b + b_len && b < a + a_len;
@@ -78,6 +80,12 @@ void esc::dc_written(std::uint16_t address, std::uint16_t length) noexcept {
                                      (smaller ? difference_local_smaller : 0u);
     set_register16(reg::dc_system_time_difference, static_cast<std::uint16_t>(difference));
     set_register16(reg::dc_system_time_difference + 2, static_cast<std::uint16_t>(difference >> 16));
+    // The time control loop (ETG.1000.4 §9.1): the local clock steered towards the time received,
+    // an eighth of the difference a write finds, at least 1 ns and at most 1 us, so a difference the
+    // offsets left (a master's offset without the hop delay leaves that delay) goes to 0 within a few
+    // hundred writes, in steps no SYNC0 cycle notices. The clocks share one time base and do not drift.
+    const std::uint64_t step = std::min<std::uint64_t>(std::max<std::uint64_t>(magnitude / 8, 1), max_slew_step_ns);
+    if (magnitude != 0) local_time_ns_ = smaller ? local_time_ns_ + step : local_time_ns_ - std::min(step, local_time_ns_);
   }
   if (touched(reg::dc_activation, 1)) {
     if (sync0_active()) {

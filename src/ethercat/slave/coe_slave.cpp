@@ -377,7 +377,7 @@ void coe_slave::step(std::uint32_t elapsed_us) {
   }
   device_->step(elapsed_us);
   inputs_out();
-  esc_.advance(std::uint64_t{elapsed_us} * 1000);
+  if (!clock_outside_) esc_.advance(std::uint64_t{elapsed_us} * 1000);
   if (esc_.take_watchdog_event() && state_ == al_state::operational) {
     // The master stopped sending outputs: SAFE-OP with the watchdog's code, and the device's
     // fieldbus connection is lost.

@@ -162,11 +162,29 @@ def main():
         assert wkc == 1, "no reply in the send mailbox"
         assert reply[5] & 0x0F == 3 and reply[7] >> 4 == 3 and reply[8] == 0x43, reply[:16]
         assert struct.unpack("<I", reply[12:16])[0] == 0x402, reply[:16]
+        # The DC system time (0x0910) as a master reads it between cycles: the host's clock to the
+        # nanosecond, so successive reads a round trip apart differ (the drives' 1 ms steps would
+        # give equal reads and jumps of 1 ms), and across the reads it kept the host's time.
+        times, stamps = [], []
+        for _ in range(400):
+            data, wkc = bus.one(4, 0x1001, 0x0910, [0] * 8)
+            assert wkc == 1, wkc
+            times.append(struct.unpack("<Q", data)[0])
+            stamps.append(time.monotonic_ns())
+        steps = [b - a for a, b in zip(times, times[1:])]
+        assert all(d >= 0 for d in steps), "the system time went back"
+        moved = sum(1 for d in steps if d > 0)
+        assert moved >= 0.9 * len(steps), "only %d of %d reads saw the time move" % (moved, len(steps))
+        fine = sorted(steps)[len(steps) // 2]
+        assert fine < 1_000_000 and fine % 1_000_000 != 0, "the median step is %d ns" % fine
+        host = stamps[-1] - stamps[0]
+        assert abs((times[-1] - times[0]) - host) < 0.05 * host + 200_000, (times[-1] - times[0], host)
         slave.send_signal(signal.SIGTERM)
         out, err = slave.communicate(timeout=10)
         assert slave.returncode == 0, err
         assert "stopped after" in out, out
-        print("ecat-slave over veth: 2 slaves found, addressed, SII read, PRE-OP, CoE SDO upload answered")
+        print("ecat-slave over veth: 2 slaves found, addressed, SII read, PRE-OP, CoE SDO upload answered, "
+              "0x0910 read at a median step of %d ns" % fine)
         return 0
     finally:
         if slave is not None and slave.poll() is None:

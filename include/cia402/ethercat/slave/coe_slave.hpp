@@ -161,6 +161,9 @@ class coe_slave final : private dictionary::dictionary_access, private dictionar
   /// device, the inputs from it (so they answer this cycle's outputs, as SOES runs its application
   /// between the two), then `elapsed_us` of the controller and the watchdog.
   void step(std::uint32_t elapsed_us);
+  /// The controller's clock kept by whoever hosts the slave (the host's clock to the nanosecond,
+  /// esc::advance before every frame), not by step(), which then runs the application only.
+  void keep_clock_outside() noexcept { clock_outside_ = true; }
   al_state state() const noexcept { return state_; }
   const slave_description& description() const noexcept { return description_; }
   const dictionary::object_dictionary& dictionary() const noexcept { return od_; }
@@ -225,6 +228,7 @@ class coe_slave final : private dictionary::dictionary_access, private dictionar
   bool dc_sync0_ = false;
   bool outputs_waiting_ = false;  // outputs arrived since the last pulse
   bool pulse_seen_ = false;       // a SYNC0 pulse came since DC SYNC0 mode was chosen
+  bool clock_outside_ = false;    // step() leaves the controller's clock alone
   // An OP request in DC SYNC0 mode that waits for the first pulse, and for how long it has waited.
   bool op_waits_for_pulse_ = false;
   std::uint32_t op_wait_us_ = 0;
