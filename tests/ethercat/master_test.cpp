@@ -360,6 +360,42 @@ TEST(ecat_master, sdo_reads_writes_and_reports_aborts_in_words) {
   EXPECT_EQ(range.abort, sdo_abort::invalid_value) << "0x605A takes only the codes the profile defines";
 }
 
+// The parameter list a tool shows over EtherCAT: every object the slave has, read through CoE SDO
+// information while the line runs in OP, as the slave's own dictionary has it.
+TEST(ecat_master, reads_the_slaves_whole_dictionary_through_sdo_information) {
+  line l(2);
+  l.up();
+  const ecat_dictionary_result r = l.master.read_dictionary(1);
+  ASSERT_TRUE(r.ok) << r.error;
+  const std::vector<dictionary::object_entry>& own = l.link.slaves[1]->slave().dictionary().table();
+  ASSERT_EQ(r.objects.size(), own.size());
+  EXPECT_GT(own.size(), 40u) << "the communication objects and the drive's";
+  for (std::size_t k = 0; k < own.size(); ++k) {
+    const ecat_object_description& o = r.objects[k];
+    const dictionary::object_entry& t = own[k];
+    SCOPED_TRACE("object 0x" + std::to_string(t.index));
+    EXPECT_EQ(o.index, t.index);
+    EXPECT_EQ(o.name, t.name);
+    EXPECT_EQ(o.object_code, static_cast<std::uint8_t>(t.code));
+    ASSERT_EQ(o.entries.size(), t.subs.size()) << "every sub-index, and no other";
+    for (std::size_t e = 0; e < t.subs.size(); ++e) {
+      const dictionary::sub_entry& want = t.subs[e];
+      EXPECT_EQ(o.entries[e].sub, want.sub);
+      EXPECT_EQ(o.entries[e].name, want.name);
+      EXPECT_EQ(o.entries[e].data_type, static_cast<std::uint16_t>(want.type));
+      if (type_size(want.type) != 0) EXPECT_EQ(o.entries[e].bit_length, 8 * type_size(want.type));
+      EXPECT_EQ((o.entries[e].access & 0x0007) != 0, dictionary::readable(want.acc)) << int(want.sub);
+      EXPECT_EQ((o.entries[e].access & 0x0038) != 0, dictionary::writable(want.acc)) << int(want.sub);
+      EXPECT_EQ((o.entries[e].access & 0x00C0) != 0, want.pdo_mappable) << int(want.sub);
+    }
+  }
+  EXPECT_TRUE(l.all(state::switch_on_disabled));
+  EXPECT_TRUE(l.master.cycle()) << "the process data ran on meanwhile: " << l.master.error();
+  const ecat_dictionary_result none = l.master.read_dictionary(7);
+  EXPECT_FALSE(none.ok);
+  EXPECT_NE(none.error.find("no slave 7"), std::string::npos) << none.error;
+}
+
 TEST(ecat_master, a_master_that_stops_leaves_the_drives_to_their_watchdog) {
   line l(2);
   l.up();

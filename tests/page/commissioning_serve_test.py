@@ -10,8 +10,8 @@ Through the page's HTTP API (POST /api/enable, /api/jog, /api/stop): Enable walk
 OPERATION ENABLED; a jog at 300 rpm renewed every 100 ms turns the drive at 300 rpm in profile
 velocity (0x6060 = 3); a release (velocity 0) brings 0x60FF to 0 and the shaft to rest, the drive
 still enabled; a jog whose keep-alives stop has 0x60FF = 0 within its time-to-live (300 ms) plus a
-margin for the bus and a loaded machine; Stop ends in SWITCH ON DISABLED. Processes are stopped by
-their PIDs.
+margin for the bus and a loaded machine; Stop ends in SWITCH ON DISABLED. Over EtherCAT the parameter list comes from the drive's CoE SDO
+information (0x1C32, 0x1C12, 0x1A00 listed and read). Processes are stopped by their PIDs.
 """
 import os
 import subprocess
@@ -73,6 +73,21 @@ def check(base, label):
     print(f'ok - {label}: Stop: {result["text"]}')
 
 
+def check_ecat_parameters(base, label):
+    """The parameter list from the drive's CoE SDO information: the EtherCAT objects beyond the CiA
+    402 table (sync manager parameters, PDO assignment) are listed with their names and read."""
+    status, reply = request(base + 'api/parameters')
+    assert status == 200, (label, status, reply)
+    entries = {(e['index'].upper(), e['sub']): e for e in reply['entries']}
+    for key, name in ((('0X1C32', 1), 'Sync mode'), (('0X1C12', 1), None), (('0X1A00', 1), None)):
+        assert key in entries, (label, key, 'not listed')
+        if name is not None:
+            assert entries[key]['name'] == name, (label, key, entries[key]['name'])
+        assert 'value' in entries[key], (label, key, entries[key])
+    print(f'ok - {label}: parameter list from SDO information: {len(entries)} entries, 0x1C32, 0x1C12, 0x1A00 among them')
+    check(base, label)
+
+
 def over_can(cia402):
     with bus_and_serve(cia402, '1', ('--node', '1')) as (_, serve, base):
         wait_state(base, lambda s: s['remote']['status'] == 'running', 'set-up of node 1')
@@ -124,7 +139,7 @@ def main():
     if len(sys.argv) != 3 or sys.argv[2] not in ('can', 'ecat'):
         print('usage: commissioning_serve_test.py CIA402_BINARY can|ecat', file=sys.stderr)
         return 2
-    return over_can(sys.argv[1]) if sys.argv[2] == 'can' else over_ecat(sys.argv[1])
+    return over_can(sys.argv[1]) if sys.argv[2] == 'can' else over_ecat(sys.argv[1], check_ecat_parameters)
 
 
 if __name__ == '__main__':

@@ -172,4 +172,41 @@ std::vector<page::parameter_entry> parameter_entries(const std::vector<dictionar
   return out;
 }
 
+std::vector<page::parameter_entry> parameter_entries(const std::vector<ethercat::ecat_object_description>& objects) {
+  const auto shown = [](std::uint16_t t) {
+    switch (static_cast<data_type>(t)) {
+      case data_type::boolean:
+      case data_type::integer8:
+      case data_type::integer16:
+      case data_type::integer32:
+      case data_type::unsigned8:
+      case data_type::unsigned16:
+      case data_type::unsigned32:
+      case data_type::visible_string:
+      case data_type::integer64:
+      case data_type::unsigned64: return true;
+    }
+    return false;
+  };
+  constexpr std::uint8_t var = 7;
+  std::vector<page::parameter_entry> out;
+  for (const ethercat::ecat_object_description& o : objects) {
+    for (const ethercat::ecat_entry_description& s : o.entries) {
+      if (!shown(s.data_type)) continue;
+      page::parameter_entry e;
+      e.index = o.index;
+      e.sub = s.sub;
+      e.name = o.object_code == var || s.sub == 0 ? o.name : s.name;
+      e.data_type = s.data_type;
+      // ETG.1000.6 object access: bits 0..2 read, 3..5 write (PRE-OP, SAFE-OP, OP), 6..7 PDO mapping.
+      const bool read = (s.access & 0x0007) != 0;
+      const bool write = (s.access & 0x0038) != 0;
+      e.access = read && write ? "rw" : write ? "wo" : "ro";
+      e.pdo_mappable = (s.access & 0x00C0) != 0;
+      out.push_back(std::move(e));
+    }
+  }
+  return out;
+}
+
 }  // namespace cia402::cli

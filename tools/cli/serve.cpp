@@ -69,6 +69,15 @@ int open_ecat(const serve_args& args, const profile& p, page::axis_page_config p
         << " slave(s)\n";
     return refused;
   }
+  // The parameter list from the drive itself, as over CANopen: every object its SDO information
+  // describes. A slave without it still shows the CiA 402 table.
+  const ethercat::ecat_dictionary_result objects = d.ecat->master().read_dictionary(static_cast<std::size_t>(args.position));
+  if (objects.ok) {
+    pc.parameters = parameter_entries(objects.objects);
+  } else {
+    err << "cia402 serve: slave " << args.position << ": no SDO information (" << objects.error
+        << "): the parameter list shows the CiA 402 objects only\n";
+  }
   pc.reset_pulse_us = 20000;
   pc.settle_quiet_us = 150000;
   pc.node = args.position;

@@ -1,7 +1,7 @@
 // Our master's mailbox and SDO transfers: every mailbox it writes is built, and every one it reads is
 // parsed, by the CoE codec (ethercat/coe), which checks each length the slave gives before it reads
 // what the length covers. Expedited, normal and segmented upload and download; aborts both ways;
-// emergencies met on the way are kept with the slave.
+// emergencies met on the way are kept with the slave. SDO information: the slave's dictionary.
 #include <algorithm>
 #include <utility>
 
@@ -276,6 +276,119 @@ ecat_sdo_result ecat_master::sdo_write_bytes(std::size_t i, std::uint16_t index,
       return result;
     }
     at += n;
+  }
+  result.ok = true;
+  return result;
+}
+
+// ---- SDO information ----------------------------------------------------------------------------
+
+std::optional<std::vector<std::uint8_t>> ecat_master::sdo_info_exchange(ecat_slave& s, sdo_info_opcode request,
+                                                                        std::span<const std::uint8_t> data,
+                                                                        sdo_info_opcode expected, std::string& error,
+                                                                        std::uint32_t& code) {
+  code = 0;
+  bool answered = false;
+  if (!mailbox_send(s, sdo_info_fragment(request, 0, data), &answered)) {
+    error = slave_text(s) + (answered ? ": its receive mailbox stays full" : ": the line does not answer");
+    return std::nullopt;
+  }
+  std::vector<std::uint8_t> whole;
+  std::optional<std::uint16_t> left;  // fragments the last one said were to come
+  for (int looked = 0; looked < max_unrelated_replies;) {
+    pause(0);
+    const std::optional<std::vector<std::uint8_t>> got = mailbox_receive(s);
+    if (!got) {
+      error = slave_text(s) + ": no SDO information answer";
+      return std::nullopt;
+    }
+    const std::optional<mailbox_view> m = parse_mailbox(*got);
+    const std::optional<coe_view> c = m && m->header.type == mailbox_type::coe ? parse_coe(m->data) : std::nullopt;
+    if (c && c->service == coe_service::emergency) note_emergency(s, *got);
+    const std::optional<sdo_info_view> v =
+        c && c->service == coe_service::sdo_information ? parse_sdo_information(c->body) : std::nullopt;
+    if (!v || (v->opcode != expected && v->opcode != sdo_info_opcode::error)) {
+      ++looked;  // not an answer to this request
+      continue;
+    }
+    if (v->opcode == sdo_info_opcode::error) {
+      code = v->data.size() >= 4 ? static_cast<std::uint32_t>(v->data[0] | (v->data[1] << 8) |
+                                                                                   (v->data[2] << 16)) |
+                                                           (static_cast<std::uint32_t>(v->data[3]) << 24)
+                                                     : 0;
+      error = slave_text(s) + " answered with SDO information error " + hex(code, 8) + " (" +
+              sdo_abort_text(static_cast<sdo_abort>(code)) + ")";
+      return std::nullopt;
+    }
+    // Each fragment says one fewer is left than the one before; the data as a whole is bounded.
+    if (left && v->fragments_left + 1u != *left) {
+      error = slave_text(s) + ": SDO information fragments out of order (" + std::to_string(v->fragments_left) +
+              " left after " + std::to_string(*left) + ")";
+      return std::nullopt;
+    }
+    if (whole.size() + v->data.size() > max_sdo_upload) {
+      error = slave_text(s) + ": SDO information answer longer than " + std::to_string(max_sdo_upload) + " bytes";
+      return std::nullopt;
+    }
+    whole.insert(whole.end(), v->data.begin(), v->data.end());
+    if (!v->incomplete || v->fragments_left == 0) return whole;
+    left = v->fragments_left;
+  }
+  error = slave_text(s) + ": no SDO information answer among " + std::to_string(max_unrelated_replies) +
+          " mailboxes it sent";
+  return std::nullopt;
+}
+
+ecat_dictionary_result ecat_master::read_dictionary(std::size_t i) {
+  ecat_dictionary_result result;
+  ecat_sdo_result slave_check;
+  ecat_slave* s = sdo_slave(i, slave_check);
+  if (s == nullptr) {
+    result.error = slave_check.error;
+    return result;
+  }
+  const mailbox_owner owner(in_mailbox_);
+  const auto le16_at = [](const std::vector<std::uint8_t>& d, std::size_t at) {
+    return static_cast<std::uint16_t>(d[at] | (d[at + 1] << 8));
+  };
+  const std::uint8_t all_objects[2] = {1, 0};
+  std::string why;
+  std::uint32_t code = 0;
+  const std::optional<std::vector<std::uint8_t>> list =
+      sdo_info_exchange(*s, sdo_info_opcode::od_list_request, all_objects, sdo_info_opcode::od_list_response, why, code);
+  if (!list || list->size() < 2 || list->size() % 2 != 0 || le16_at(*list, 0) != 1) {
+    result.error = list ? slave_text(*s) + ": its object list is not a list of all objects" : "the object list: " + why;
+    return result;
+  }
+  for (std::size_t at = 2; at < list->size(); at += 2) {
+    const std::uint16_t index = le16_at(*list, at);
+    const std::uint8_t ask[2] = {static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8)};
+    const std::optional<std::vector<std::uint8_t>> d = sdo_info_exchange(
+        *s, sdo_info_opcode::object_description_request, ask, sdo_info_opcode::object_description_response, why, code);
+    if (!d || d->size() < 6 || le16_at(*d, 0) != index) {
+      result.error = "object " + hex(index, 4) + ": " + (d ? slave_text(*s) + " described another object" : why);
+      return result;
+    }
+    ecat_object_description o;
+    o.index = index;
+    o.data_type = le16_at(*d, 2);
+    o.max_sub = (*d)[4];
+    o.object_code = (*d)[5];
+    o.name.assign(d->begin() + 6, d->end());
+    for (unsigned sub = 0; sub <= o.max_sub; ++sub) {
+      const std::uint8_t entry[4] = {ask[0], ask[1], static_cast<std::uint8_t>(sub), 0};  // value info: none
+      const std::optional<std::vector<std::uint8_t>> e = sdo_info_exchange(
+          *s, sdo_info_opcode::entry_description_request, entry, sdo_info_opcode::entry_description_response, why, code);
+      if (!e && code == static_cast<std::uint32_t>(sdo_abort::sub_index_does_not_exist)) continue;  // a gap in the record
+      if (!e || e->size() < 10 || le16_at(*e, 0) != index || (*e)[2] != sub) {
+        result.error = "entry " + hex(index, 4) + ":" + std::to_string(sub) + ": " +
+                       (e ? slave_text(*s) + " described another entry" : why);
+        return result;
+      }
+      o.entries.push_back({static_cast<std::uint8_t>(sub), le16_at(*e, 4), le16_at(*e, 6), le16_at(*e, 8),
+                           std::string(e->begin() + 10, e->end())});
+    }
+    result.objects.push_back(std::move(o));
   }
   result.ok = true;
   return result;

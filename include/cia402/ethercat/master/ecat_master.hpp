@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "cia402/ethercat/coe/sdo.hpp"
+#include "cia402/ethercat/coe/sdo_information.hpp"
 #include "cia402/ethercat/esc/frame.hpp"
 #include "cia402/ethercat/sii/slave_information.hpp"
 #include "cia402/master.hpp"
@@ -106,6 +107,31 @@ struct ecat_sdo_result {
   std::int64_t value(bool is_signed) const noexcept;
 };
 
+/// An entry as a slave's SDO information describes it (ETG.1000.6 §5.6.3.6): its CiA 301 data type,
+/// bit length, object access word (bits 0..2 read, 3..5 write in PRE-OP / SAFE-OP / OP, 6 RxPDO, 7
+/// TxPDO mappable) and name.
+struct ecat_entry_description {
+  std::uint8_t sub = 0;
+  std::uint16_t data_type = 0;
+  std::uint16_t bit_length = 0;
+  std::uint16_t access = 0;
+  std::string name;
+};
+/// An object as the slave's SDO information describes it (§5.6.3.5), with the entries it has.
+struct ecat_object_description {
+  std::uint16_t index = 0;
+  std::uint16_t data_type = 0;
+  std::uint8_t max_sub = 0;
+  std::uint8_t object_code = 0;  ///< 7 VAR, 8 ARRAY, 9 RECORD
+  std::string name;
+  std::vector<ecat_entry_description> entries;  ///< sub-indices 0..max_sub the slave has
+};
+struct ecat_dictionary_result {
+  bool ok = false;
+  std::string error;  ///< why not (the request, the slave and its SDO information error)
+  std::vector<ecat_object_description> objects;
+};
+
 class ecat_master {
  public:
   /// `p` (outliving the master) is the drives' profile; the master itself reads no state from a
@@ -154,6 +180,10 @@ class ecat_master {
   /// Any number of bytes: expedited up to 4, else a normal download with segments for what the first
   /// mailbox does not hold.
   ecat_sdo_result sdo_write_bytes(std::size_t i, std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data);
+  /// Slave `i`'s object dictionary through CoE SDO information (ETG.1000.6 §5.6.3): the list of all
+  /// objects, each object's description and each of its entries' (a sub-index the slave says it
+  /// lacks is left out). Each reply's fragments are taken in order, at most max_sdo_upload bytes.
+  ecat_dictionary_result read_dictionary(std::size_t i);
 
   std::vector<ecat_slave>& slaves() noexcept { return slaves_; }
   const std::vector<ecat_slave>& slaves() const noexcept { return slaves_; }
@@ -200,6 +230,13 @@ class ecat_master {
   // The upload segments after a normal upload response, until the value is whole.
   bool upload_segments(ecat_slave& s, std::uint16_t index, std::uint8_t sub, const sdo_frame& first,
                        ecat_sdo_result& result);
+  // One SDO information request and its whole answer (every fragment, in order) of kind
+  // `expected`; nothing, with `error` saying why (and `code` the slave's, on an error reply), on an
+  // error reply or a broken answer.
+  std::optional<std::vector<std::uint8_t>> sdo_info_exchange(ecat_slave& s, sdo_info_opcode request,
+                                                             std::span<const std::uint8_t> data,
+                                                             sdo_info_opcode expected, std::string& error,
+                                                             std::uint32_t& code);
   // Ends a transfer the slave got wrong: the abort to the slave, the reason in `result`.
   void give_up(ecat_slave& s, std::uint16_t index, std::uint8_t sub, sdo_abort code, std::string why,
                ecat_sdo_result& result);
