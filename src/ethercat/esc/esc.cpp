@@ -166,6 +166,8 @@ void esc::configure_sync_manager(int n, bool reset) noexcept {
   if (!reset && !changed) return;
   s = sm_state{};
   s.config = c;
+  watchdog_armed_ = false;  // kept here, where a sync manager changes, not looked up every advance
+  for (const sm_state& any : sms_) watchdog_armed_ = watchdog_armed_ || (any.config.enabled && any.config.watchdog_trigger());
   s.triple = c.enabled && c.buffered();
   memory_[base + reg::sm_status] = 0;
   memory_[reg::al_event_request + 1] = static_cast<std::uint8_t>(memory_[reg::al_event_request + 1] & ~(1u << n));
@@ -507,11 +509,13 @@ void esc::process(datagram& d) noexcept {
 void esc::advance(std::uint64_t ns) noexcept {
   local_time_ns_ += ns;
   dc_advance();
+  if (!watchdog_armed_) {
+    since_trigger_ns_ = 0;
+    return;
+  }
   const std::uint64_t unit_ns = (std::uint64_t{read16(reg::watchdog_divider)} + 2) * 40;
   const std::uint64_t limit = std::uint64_t{read16(reg::watchdog_time_process_data)} * unit_ns;
-  bool armed = false;
-  for (const sm_state& s : sms_) armed = armed || (s.config.enabled && s.config.watchdog_trigger());
-  if (!armed || limit == 0) {
+  if (limit == 0) {
     since_trigger_ns_ = 0;
     return;
   }

@@ -269,6 +269,7 @@ class esc {
   bool al_control_event_ = false;
   bool watchdog_event_ = false;
   std::uint64_t since_trigger_ns_ = 0;
+  bool watchdog_armed_ = false;        // a sync manager enabled with its watchdog trigger bit
   std::uint64_t local_time_ns_ = 0;
   std::uint32_t arrival_ns_ = 0;       // of the frame being processed
   bool latched_ = false;               // the frame being processed latched the receive times
