@@ -173,6 +173,72 @@ TEST(ecat_master_hostile, a_cycle_before_any_bring_up_is_refused_and_sends_nothi
   EXPECT_EQ(m.cycles(), 0u);
 }
 
+// The data of the first SDO information fragment of kind `op` a frame on its way back brings from
+// a slave's send mailbox (at `send_mailbox`): the information header's first byte, in the frame.
+std::uint8_t* info_fragment(std::vector<std::uint8_t>& frame, std::uint16_t send_mailbox, sdo_info_opcode op) {
+  parsed_frame parsed;
+  if (parse_frame(frame, parsed) != frame_error::none) return nullptr;
+  for (std::size_t k = 0; k < parsed.count; ++k) {
+    const datagram& d = parsed.datagrams[k];
+    if (d.cmd != command::fprd || d.offset() != send_mailbox || d.working_counter() != 1 || d.length < 16) continue;
+    // Mailbox header (6 bytes: type CoE = 3 in byte 5), CoE header (service 8 in byte 7's top), then
+    // the information header: opcode | incomplete, reserved, fragments left.
+    if ((d.data[5] & 0x0F) != 3 || (d.data[7] >> 4) != 8 || (d.data[8] & 0x7F) != static_cast<std::uint8_t>(op)) continue;
+    return d.data + 8;
+  }
+  return nullptr;
+}
+
+// A slave's SDO information is its word as much as any length: fragments that do not count down,
+// a description of another object, a mailbox that never answers each end the read with the reason.
+TEST(ecat_master_hostile, sdo_information_that_does_not_add_up_ends_the_dictionary_read_with_the_reason) {
+  {
+    hostile_line line(1);
+    ecat_master m(line, standard_profile());
+    ASSERT_TRUE(m.scan() && m.bring_to_pre_operational()) << m.error();
+    const std::uint16_t mailbox = m.slaves()[0].sii.mailbox_in_start;
+    bool tampered = false;
+    line.tamper = [&](std::vector<std::uint8_t>& frame) {
+      std::uint8_t* h = info_fragment(frame, mailbox, sdo_info_opcode::od_list_response);
+      if (h == nullptr || tampered || (h[0] & 0x80) == 0) return;
+      h[2] = static_cast<std::uint8_t>(h[2] + 2);  // the first of the list's fragments says two more are left
+      tampered = true;
+    };
+    const ecat_dictionary_result r = m.read_dictionary(0);
+    ASSERT_TRUE(tampered) << "the object list takes more than one fragment";
+    EXPECT_FALSE(r.ok);
+    EXPECT_NE(r.error.find("fragments out of order"), std::string::npos) << r.error;
+  }
+  {
+    hostile_line line(1);
+    ecat_master m(line, standard_profile());
+    ASSERT_TRUE(m.scan() && m.bring_to_pre_operational()) << m.error();
+    const std::uint16_t mailbox = m.slaves()[0].sii.mailbox_in_start;
+    line.tamper = [&](std::vector<std::uint8_t>& frame) {
+      std::uint8_t* h = info_fragment(frame, mailbox, sdo_info_opcode::object_description_response);
+      if (h != nullptr) h[4] = static_cast<std::uint8_t>(h[4] ^ 0x01);  // another index
+    };
+    const ecat_dictionary_result r = m.read_dictionary(0);
+    EXPECT_FALSE(r.ok);
+    EXPECT_NE(r.error.find("described another object"), std::string::npos) << r.error;
+  }
+  {
+    hostile_line line(1);
+    ecat_master m(line, standard_profile());
+    ASSERT_TRUE(m.scan() && m.bring_to_pre_operational()) << m.error();
+    const std::uint16_t mailbox = m.slaves()[0].sii.mailbox_in_start;
+    line.lose_answer = [&](const std::vector<std::uint8_t>& frame) {
+      std::vector<std::uint8_t> copy = frame;
+      return info_fragment(copy, mailbox, sdo_info_opcode::od_list_response) != nullptr;
+    };
+    line.time_limit_us = line.now + 60'000'000;
+    ecat_dictionary_result r;
+    EXPECT_TRUE(hostile_line::ends([&] { r = m.read_dictionary(0); })) << "every wait for the slave ends";
+    EXPECT_FALSE(r.ok);
+    EXPECT_NE(r.error.find("slave 0"), std::string::npos) << r.error;
+  }
+}
+
 }  // namespace
 }  // namespace cia402::ethercat
 
