@@ -1,7 +1,8 @@
 // Our EtherCAT master against slaves that are faulty or hostile (hostile_line.hpp): an SII that
 // gives mailboxes too small for an SDO, AL status reads that get lost slave by slave, a mapping
-// changed in PRE-OP after the line ran, a cycle asked for before any bring-up. Each of these read or
-// wrote outside a buffer, or never returned, before the master checked what a slave says.
+// changed in PRE-OP after the line ran, a cycle asked for before any bring-up, SDO information that
+// does not add up. Each of these read or wrote outside a buffer, or never returned, before the
+// master checked what a slave says.
 #include <gtest/gtest.h>
 
 #include <array>
