@@ -14,6 +14,9 @@ enum class sdo_abort : std::uint32_t {
   toggle_bit_not_alternated = 0x05030000,
   sdo_protocol_timed_out = 0x05040000,
   command_specifier_invalid = 0x05040001,
+  invalid_block_size = 0x05040002,       ///< block mode only
+  invalid_sequence_number = 0x05040003,  ///< block mode only
+  crc_error = 0x05040004,                ///< block mode only
   out_of_memory = 0x05040005,
   unsupported_access = 0x06010000,
   write_only_object = 0x06010001,

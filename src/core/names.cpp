@@ -108,6 +108,9 @@ const char* sdo_abort_text(sdo_abort code) noexcept {
     case sdo_abort::toggle_bit_not_alternated: return "toggle bit not alternated";
     case sdo_abort::sdo_protocol_timed_out: return "SDO protocol timed out";
     case sdo_abort::command_specifier_invalid: return "client/server command specifier not valid";
+    case sdo_abort::invalid_block_size: return "invalid block size";
+    case sdo_abort::invalid_sequence_number: return "invalid sequence number";
+    case sdo_abort::crc_error: return "CRC error";
     case sdo_abort::out_of_memory: return "out of memory";
     case sdo_abort::unsupported_access: return "unsupported access to an object";
     case sdo_abort::write_only_object: return "attempt to read a write only object";

@@ -55,6 +55,12 @@ bool sdo_server::segment_continues(mode open, std::uint8_t command) {
 void sdo_server::on_request(const frame& request) {
   if (request.len != 8 || request.rtr) return;
   const std::uint8_t* d = request.data.data();
+  // Inside a block download the first byte is a sequence number, not a command: only an abort
+  // (0x80, sequence number 0, which no segment has) ends it.
+  if (mode_ == mode::block_downloading && d[0] != 0x80) {
+    idle_us_ = 0;
+    return block_download_segment(d);
+  }
   const unsigned ccs = d[0] >> 5;
   const auto req_index = static_cast<std::uint16_t>(get_le(d + 1, 2));
   const std::uint8_t req_sub = d[3];
@@ -145,7 +151,9 @@ void sdo_server::on_request(const frame& request) {
     case cs_abort:
       mode_ = mode::idle;
       return;
-    default:  // block upload (5), block download (6), and 7
+    case ccs_block_download: return block_download(d);
+    case ccs_block_upload: return block_upload(d);
+    default:  // 7
       mode_ = mode::idle;
       return abort(req_index, req_sub, sdo_abort::command_specifier_invalid);
   }

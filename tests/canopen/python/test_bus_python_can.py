@@ -84,6 +84,61 @@ def test_sdo_segmented_upload_reads_the_device_name(client):
     assert text == b"cia402 virtual drive"
 
 
+def crc16_ccitt(data):
+    """CiA 301 §7.2.4.3.16's block CRC (CRC-16/XMODEM), written out here."""
+    crc = 0
+    for byte in data:
+        crc ^= byte << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1021 if crc & 0x8000 else crc << 1) & 0xFFFF
+    return crc
+
+
+def test_sdo_block_upload_and_download_with_crc(client):
+    # Block upload of 0x1008 in blocks of 2 segments, CRC asked for.
+    send(client, 0x601, [0xA4, 0x08, 0x10, 0, 2, 0, 0, 0])
+    first = wait_for(client, lambda m: m.arbitration_id == 0x581)
+    assert first.data[0] == 0xC6, "block upload initiate response: %02X" % first.data[0]
+    size = int.from_bytes(first.data[4:8], "little")
+    send(client, 0x601, [0xA3, 0, 0, 0, 0, 0, 0, 0])
+    data, done = b"", False
+    while not done:
+        got = 0
+        while True:
+            seg = wait_for(client, lambda m: m.arbitration_id == 0x581)
+            assert seg is not None, "a block segment did not come"
+            assert seg.data[0] & 0x7F == got + 1
+            got += 1
+            data += bytes(seg.data[1:8])
+            if seg.data[0] & 0x80:
+                done = True
+                break
+            if got == 2:
+                break
+        send(client, 0x601, [0xA2, got, 2, 0, 0, 0, 0, 0])
+    end = wait_for(client, lambda m: m.arbitration_id == 0x581)
+    assert end.data[0] & 0xE3 == 0xC1, "block upload end: %02X" % end.data[0]
+    data = data[:len(data) - ((end.data[0] >> 2) & 7)]
+    send(client, 0x601, [0xA1, 0, 0, 0, 0, 0, 0, 0])
+    assert data == b"cia402 virtual drive" and size == len(data)
+    assert int.from_bytes(end.data[1:3], "little") == crc16_ccitt(data)
+    # Block download of 12 bytes to 0x2000 with the CRC, then read back by a segmented upload.
+    text = b"block write!"
+    send(client, 0x601, [0xC6, 0x00, 0x20, 0] + list(len(text).to_bytes(4, "little")))
+    answer = wait_for(client, lambda m: m.arbitration_id == 0x581)
+    assert answer.data[0] == 0xA4, "block download initiate response: %02X" % answer.data[0]
+    send(client, 0x601, [0x01] + list(text[0:7]))
+    send(client, 0x601, [0x82] + list(text[7:12]) + [0, 0])
+    ack = wait_for(client, lambda m: m.arbitration_id == 0x581)
+    assert ack.data[0] == 0xA2 and ack.data[1] == 2, list(ack.data)
+    crc = crc16_ccitt(text)
+    send(client, 0x601, [0xC1 | (2 << 2), crc & 0xFF, crc >> 8, 0, 0, 0, 0, 0])
+    assert wait_for(client, lambda m: m.arbitration_id == 0x581).data[0] == 0xA1
+    send(client, 0x601, [0x40, 0x00, 0x20, 0, 0, 0, 0, 0])
+    first = wait_for(client, lambda m: m.arbitration_id == 0x581)
+    assert first.data[0] == 0x41 and int.from_bytes(first.data[4:8], "little") == len(text)
+
+
 def test_sdo_abort_for_an_unknown_object(client):
     msg = sdo_download(client, NODE, 0x2FFF, 0, 1, 1)
     assert msg.data[0] == 0x80

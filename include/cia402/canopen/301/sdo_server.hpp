@@ -1,8 +1,11 @@
-// SDO server (CiA 301 §7.2.4): expedited and segmented upload and download over one default SDO
-// channel (requests on 0x600 + node-ID, responses on 0x580 + node-ID). Block transfer is not offered:
-// its command specifiers are refused with 0x05040001. Every refused request gets an abort frame with
-// the object dictionary's reason, and a transfer left idle for `timeout_us` is aborted with
-// 0x05040000. Frames whose length is not 8 are ignored, as CiA 301 defines SDO frames as 8 bytes.
+// SDO server (CiA 301 §7.2.4): expedited, segmented and block upload and download over one default
+// SDO channel (requests on 0x600 + node-ID, responses on 0x580 + node-ID). Block transfer
+// (§7.2.4.3.9..17) with the CRC both sides offer, blocks of up to 127 segments, a segment out of
+// sequence acknowledged at the last one in order (the client sends again from there), and the
+// protocol switch threshold of an upload honoured (a value that short goes expedited or
+// segmented). Every refused request gets an abort frame with the object dictionary's reason, and a
+// transfer left idle for `timeout_us` is aborted with 0x05040000. Frames whose length is not 8 are
+// ignored, as CiA 301 defines SDO frames as 8 bytes.
 #pragma once
 
 #include <cstdint>
@@ -33,12 +36,26 @@ class sdo_server {
   bool busy() const noexcept { return mode_ != mode::idle; }
 
  private:
-  enum class mode : std::uint8_t { idle, downloading, uploading };
+  enum class mode : std::uint8_t {
+    idle,
+    downloading,
+    uploading,
+    block_downloading,    // segments of a block come
+    block_download_end,   // the last block acknowledged: the end frame comes
+    block_upload_start,   // the initiate answered: the client's start comes
+    block_uploading,      // a block sent: its acknowledge comes
+    block_upload_end,     // the end frame sent: its response comes
+  };
   void respond(std::uint8_t command, std::span<const std::uint8_t> data = {});
   void abort(std::uint16_t index, std::uint8_t sub, sdo_abort code);
   // A segment continues the transfer open in direction `open` and alternates the toggle (CiA 301
   // §7.2.4.3.4); otherwise the transfer ends with the abort, and false.
   bool segment_continues(mode open, std::uint8_t command);
+  // Block transfer (sdo_block.cpp).
+  void block_download(const std::uint8_t* d);
+  void block_download_segment(const std::uint8_t* d);
+  void block_upload(const std::uint8_t* d);
+  void send_upload_block();
 
   dictionary::object_access* od_;
   channel* out_;
@@ -53,7 +70,18 @@ class sdo_server {
   std::size_t offset_ = 0;
   std::uint32_t idle_us_ = 0;
   std::vector<std::uint8_t> buffer_;
+  // Block transfer: the block size agreed, the last segment taken in order (download) or sent
+  // (upload), where the block sent began, whether the CRC is used, whether the last segment came.
+  std::uint8_t block_size_ = 0;
+  std::uint8_t sequence_ = 0;
+  std::size_t block_start_ = 0;
+  bool crc_ = false;
+  bool last_segment_ = false;
 };
+
+/// The CRC of a block transfer (CiA 301 §7.2.4.3.16): CRC-16-CCITT, polynomial x^16 + x^12 + x^5 +
+/// 1, initial value 0, no reflection.
+std::uint16_t sdo_block_crc(std::span<const std::uint8_t> data) noexcept;
 
 /// An SDO abort frame: 0x80, index, sub-index, code.
 frame sdo_abort_frame(std::uint32_t cob_id, std::uint16_t index, std::uint8_t sub, sdo_abort code) noexcept;
