@@ -218,5 +218,67 @@ TEST_F(sdo_block_test, a_client_abort_ends_a_block_download_and_the_next_request
   EXPECT_EQ(a[0].data[0], 0x43);
 }
 
+// Our own client's block transfers against the server: the whole value both ways, the CRC checked.
+TEST_F(sdo_block_test, our_client_reads_and_writes_by_block_transfer) {
+  const auto run = [&] {
+    for (int i = 0; i < 400 && !client.finished(); ++i) {
+      net.settle();
+      frame f;
+      while (client_channel->receive(f)) client.on_frame(f);
+    }
+  };
+  std::string text(64, ' ');
+  for (std::size_t i = 0; i < text.size(); ++i) text[i] = static_cast<char>('A' + i % 26);
+  ASSERT_TRUE(client.start_block_download(0x2000, 0, std::vector<std::uint8_t>(text.begin(), text.end())));
+  run();
+  ASSERT_EQ(client.state(), sdo_client::status::done) << std::hex << static_cast<std::uint32_t>(client.abort_code());
+  client.clear();
+  ASSERT_TRUE(client.start_block_upload(0x2000, 0));
+  run();
+  ASSERT_EQ(client.state(), sdo_client::status::done) << std::hex << static_cast<std::uint32_t>(client.abort_code());
+  EXPECT_EQ(std::string(client.data().begin(), client.data().end()), text);
+  EXPECT_FALSE(client.server_refuses_blocks());
+  // Within the switch threshold the server answers the ordinary way, and the client follows it.
+  client.clear();
+  ASSERT_TRUE(client.start_block_upload(0x1008, 0, 21));
+  run();
+  ASSERT_EQ(client.state(), sdo_client::status::done);
+  EXPECT_EQ(std::string(client.data().begin(), client.data().end()), "cia402 virtual drive");
+  client.clear();
+  ASSERT_TRUE(client.start_block_upload(0x1000, 0, 4));
+  run();
+  ASSERT_EQ(client.state(), sdo_client::status::done);
+  EXPECT_EQ(client.value(), 0x00020192);
+}
+
+// A server without block transfer refuses it with 0x05040001: the client asks again the ordinary
+// way at once, and from then on does not ask for blocks.
+TEST(sdo_client_block, a_server_that_refuses_blocks_is_asked_the_ordinary_way) {
+  virtual_bus bus;
+  auto client_side = bus.attach();
+  auto server_side = bus.attach();
+  sdo_client c(*client_side, node_id);
+  ASSERT_TRUE(c.start_block_upload(0x1008, 0));
+  frame f;
+  ASSERT_TRUE(server_side->receive(f));
+  EXPECT_EQ(f.data[0], 0xA4);
+  frame refusal;
+  refusal.id = cob::sdo_tx + node_id;
+  refusal.len = 8;
+  refusal.data = {0x80, 0x08, 0x10, 0x00, 0x01, 0x00, 0x04, 0x05};  // 0x05040001
+  EXPECT_TRUE(c.on_frame(refusal));
+  EXPECT_EQ(c.state(), sdo_client::status::busy) << "not aborted: asked again";
+  ASSERT_TRUE(server_side->receive(f));
+  EXPECT_EQ(f.data[0], 0x40) << "an ordinary initiate upload";
+  EXPECT_TRUE(c.server_refuses_blocks());
+  c.cancel();
+  while (server_side->receive(f)) {
+  }
+  c.clear();
+  ASSERT_TRUE(c.start_block_download(0x2000, 0, std::vector<std::uint8_t>(40, 'x')));
+  ASSERT_TRUE(server_side->receive(f));
+  EXPECT_EQ(f.data[0], 0x21) << "segmented download, size indicated, not a block initiate";
+}
+
 }  // namespace
 }  // namespace cia402::canopen::test

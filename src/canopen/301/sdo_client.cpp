@@ -92,9 +92,14 @@ bool sdo_client::on_frame(const frame& f) {
   if (status_ != status::busy) return true;
   const std::uint8_t* d = f.data.data();
   if (d[0] == cs_abort << 5) {
+    if (static_cast<sdo_abort>(get_le(d + 4, 4)) == sdo_abort::command_specifier_invalid && fall_back()) return true;
     abort_ = static_cast<sdo_abort>(get_le(d + 4, 4));
     status_ = status::aborted;
     step_ = step::none;
+    return true;
+  }
+  if (step_ >= step::block_upload_initiate) {
+    on_block_frame(d);
     return true;
   }
   const unsigned scs = d[0] >> 5;
@@ -169,7 +174,7 @@ bool sdo_client::on_frame(const frame& f) {
         send_next_segment();
       }
       break;
-    case step::none: break;
+    default: break;
   }
   return true;
 }

@@ -1,6 +1,9 @@
-// SDO client (CiA 301 §7.2.4): one transfer at a time to one server, expedited or segmented, upload
-// or download. Non-blocking: start a transfer, feed it the server's frames, give it time; it ends
-// done or aborted (by the server's abort code, or 0x05040000 when the server stays silent).
+// SDO client (CiA 301 §7.2.4): one transfer at a time to one server, expedited, segmented or block,
+// upload or download. Non-blocking: start a transfer, feed it the server's frames, give it time; it
+// ends done or aborted (by the server's abort code, or 0x05040000 when the server stays silent). A
+// block transfer (§7.2.4.3.9..17) asks for the CRC and checks it, acknowledges a block at the last
+// segment it got in order (the server sends again from there), and falls back to the ordinary
+// protocol when the server refuses block transfer (0x05040001), which it then does not ask again.
 #pragma once
 
 #include <cstdint>
@@ -26,6 +29,13 @@ class sdo_client {
                       bool segmented = false);
   /// Writes a number of `bytes` bytes, little-endian.
   bool start_download(std::uint16_t index, std::uint8_t sub, std::int64_t value, unsigned bytes);
+  /// Reads an object by block upload in blocks of up to 127 segments; a value no longer than
+  /// `switch_threshold` bytes the server may send as an ordinary upload.
+  bool start_block_upload(std::uint16_t index, std::uint8_t sub, std::uint8_t switch_threshold = 0);
+  /// Writes bytes by block download.
+  bool start_block_download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> data);
+  /// The server refused a block transfer (0x05040001) once: block transfers go the ordinary way.
+  bool server_refuses_blocks() const noexcept { return no_blocks_; }
 
   /// A frame from the bus; true if it was this server's response.
   bool on_frame(const frame& f);
@@ -48,10 +58,17 @@ class sdo_client {
 
  private:
   enum class step : std::uint8_t { none, upload_initiate, upload_segment, download_initiate,
-                                   download_segment };
+                                   download_segment, block_upload_initiate, block_upload_segments,
+                                   block_upload_end, block_download_initiate, block_download_acknowledge,
+                                   block_download_end };
   void send(const std::uint8_t (&bytes)[8]);
   void fail(sdo_abort code, bool tell_server);
   void send_next_segment();
+  // Block transfer (sdo_client_block.cpp): the server's frame in a block step.
+  void on_block_frame(const std::uint8_t* d);
+  void send_download_block();
+  // A block transfer the server refused, done again the ordinary way; false when it was none.
+  bool fall_back();
 
   channel* out_;
   std::uint8_t node_id_;
@@ -68,6 +85,14 @@ class sdo_client {
   bool expedited_ = false;
   std::uint32_t waited_us_ = 0;
   std::vector<std::uint8_t> data_;
+  // Block transfer: the block size, the last segment taken in order (upload) or sent (download),
+  // where the block sent began, whether the CRC is used, whether the last segment came or went.
+  std::uint8_t block_size_ = 0;
+  std::uint8_t sequence_ = 0;
+  std::size_t block_start_ = 0;
+  bool crc_ = false;
+  bool last_segment_ = false;
+  bool no_blocks_ = false;
 };
 
 }  // namespace cia402::canopen
