@@ -7,8 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "cia402/apps/virtual_drive_node.hpp"
 #include "cia402/canopen/301/sdo_client.hpp"
 #include "cia402/canopen/301/sdo_server.hpp"
+#include "cia402/canopen/301/slave.hpp"
+#include "cia402/canopen/axis/can_link.hpp"
 #include "network.hpp"
 
 namespace cia402::canopen::test {
@@ -278,6 +281,52 @@ TEST(sdo_client_block, a_server_that_refuses_blocks_is_asked_the_ordinary_way) {
   ASSERT_TRUE(c.start_block_download(0x2000, 0, std::vector<std::uint8_t>(40, 'x')));
   ASSERT_TRUE(server_side->receive(f));
   EXPECT_EQ(f.data[0], 0x21) << "segmented download, size indicated, not a block initiate";
+}
+
+// The link a session talks through uses block transfer for a long value: a download by its length,
+// an upload by what the entry holds (0x2000, up to 64 characters), and not for a short one.
+TEST(can_link_block, a_long_value_goes_by_block_transfer_and_a_short_one_does_not) {
+  virtual_bus bus;
+  apps::virtual_drive_node drive{standard_profile(), bus.attach(), apps::drive_node_config(2)};
+  auto master_side = bus.attach();
+  auto tap = bus.attach();
+  for (int i = 0; i < 10; ++i) drive.poll(1000);
+  can_link_config c;
+  c.node_id = 2;
+  c.drive_profile = &standard_profile();
+  c.known_objects = node_objects(apps::drive_node_config(2));
+  can_link link(*master_side, c);
+  const auto first_request = [&](auto start) {
+    frame f;
+    while (tap->receive(f)) {
+    }
+    std::optional<axes::transfer_result> result;
+    EXPECT_TRUE(start([&](const axes::transfer_result& r) { result = r; }));
+    std::optional<std::uint8_t> first;
+    for (int i = 0; i < 2000 && !result; ++i) {
+      (void)link.poll(100);
+      drive.poll(100);
+      while (tap->receive(f)) {
+        if (!first && f.id == cob::sdo_rx + 2) first = f.data[0];
+      }
+    }
+    EXPECT_TRUE(result && result->ok) << (result ? result->error : "no result");
+    return std::make_pair(first.value_or(0), result ? result->data : std::vector<std::uint8_t>{});
+  };
+  // The device name first, as every link reads it: 20 bytes, the ordinary upload.
+  auto [name_command, name] = first_request([&](axes::transfer_done d) { return link.upload(0x1008, 0, std::move(d)); });
+  EXPECT_EQ(name_command, 0x40);
+  EXPECT_EQ(std::string(name.begin(), name.end()), "cia402 virtual drive");
+  const std::string label = "a device label longer than twenty-nine bytes";
+  auto [down_command, unused] = first_request([&](axes::transfer_done d) {
+    return link.download(0x2000, 0, std::vector<std::uint8_t>(label.begin(), label.end()), std::move(d));
+  });
+  EXPECT_EQ(down_command, 0xC6) << "block download initiate";
+  auto [up_command, back] = first_request([&](axes::transfer_done d) { return link.upload(0x2000, 0, std::move(d)); });
+  EXPECT_EQ(up_command, 0xA4) << "block upload initiate";
+  EXPECT_EQ(std::string(back.begin(), back.end()), label);
+  auto [short_command, small] = first_request([&](axes::transfer_done d) { return link.download(0x2000, 0, {'s', 'h', 'o', 'r', 't'}, std::move(d)); });
+  EXPECT_EQ(short_command, 0x21) << "5 bytes: segmented";
 }
 
 }  // namespace

@@ -182,7 +182,15 @@ void can_link::run_own_transfers(std::uint32_t elapsed_us) {
   if (sdo_held_ || booting_) return;
   const transfer& t = own_.front();
   talked_ = true;
-  own_busy_ = t.download ? sdo_.start_download(t.index, t.sub, t.bytes) : sdo_.start_upload(t.index, t.sub);
+  // A long value by block transfer: a download by its length, an upload by what the entry holds.
+  if (t.download) {
+    own_busy_ = t.bytes.size() >= sdo_client::block_from_bytes ? sdo_.start_block_download(t.index, t.sub, t.bytes)
+                                                               : sdo_.start_download(t.index, t.sub, t.bytes);
+  } else {
+    own_busy_ = most_bytes(t.index, t.sub) >= sdo_client::block_from_bytes
+                    ? sdo_.start_block_upload(t.index, t.sub, static_cast<std::uint8_t>(sdo_client::block_from_bytes - 1))
+                    : sdo_.start_upload(t.index, t.sub);
+  }
 }
 
 // --- NMT ----------------------------------------------------------------------------------------
@@ -302,6 +310,25 @@ bool can_link::forward(transfer t) {
   };
   return t.download ? master_->download(index, sub, std::move(t.bytes), std::move(done))
                     : master_->upload(index, sub, std::move(done));
+}
+
+std::size_t can_link::most_bytes(std::uint16_t index, std::uint8_t sub) const {
+  // The same sources as describe(), in the same order.
+  const auto in = [&](const std::vector<dictionary::object_entry>& table) -> std::optional<std::size_t> {
+    for (const dictionary::object_entry& o : table) {
+      if (o.index != index) continue;
+      for (const dictionary::sub_entry& e : o.subs) {
+        if (e.sub == sub) return type_size(e.type) != 0 ? type_size(e.type) : std::max(e.capacity, e.default_text.size());
+      }
+    }
+    return std::nullopt;
+  };
+  if (const auto n = in(config_.eds)) return *n;
+  const bool ours = device_name_ == virtual_drive_device_name;
+  if ((index >= 0x1000 && index <= 0x1FFF) || (ours && index >= 0x2000 && index <= 0x5FFF)) {
+    return in(config_.known_objects).value_or(0);
+  }
+  return 0;  // not known: the ordinary upload
 }
 
 std::optional<axes::value_format> can_link::describe(std::uint16_t index, std::uint8_t sub) const {

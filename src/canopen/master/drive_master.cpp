@@ -179,7 +179,9 @@ bool drive_master::request_pending() const noexcept {
 
 void drive_master::start_transfer(const sdo_job& j) {
   sdo_.clear();
-  if (j.write && j.raw) {
+  if (j.write && j.raw && j.raw->size() >= sdo_client::block_from_bytes) {
+    (void)sdo_.start_block_download(j.index, j.sub, *j.raw);
+  } else if (j.write && j.raw) {
     (void)sdo_.start_download(j.index, j.sub, *j.raw);
   } else if (j.write) {
     (void)sdo_.start_download(j.index, j.sub, j.value(), j.bytes);

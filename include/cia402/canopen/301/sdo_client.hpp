@@ -34,6 +34,10 @@ class sdo_client {
   bool start_block_upload(std::uint16_t index, std::uint8_t sub, std::uint8_t switch_threshold = 0);
   /// Writes bytes by block download.
   bool start_block_download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> data);
+  /// Bytes from which a value goes by block transfer where the caller knows its length: shorter
+  /// ones take fewer frames segmented (a block costs 5 frames besides its segments, a segmented
+  /// transfer one more for each of its 7-byte segments).
+  static constexpr std::size_t block_from_bytes = 29;
   /// The server refused a block transfer (0x05040001) once: block transfers go the ordinary way.
   bool server_refuses_blocks() const noexcept { return no_blocks_; }
 

@@ -93,6 +93,8 @@ class can_link final : public axes::link_base {
   bool set_cyclic_output(std::uint16_t index, std::uint8_t sub, std::int64_t value) override;
 
   std::optional<axes::value_format> describe(std::uint16_t index, std::uint8_t sub) const override;
+  /// The most bytes the entry holds as the EDS or the known objects say (0: not known).
+  std::size_t most_bytes(std::uint16_t index, std::uint8_t sub) const;
 
   void close() override;
 
