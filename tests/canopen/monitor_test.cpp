@@ -1,5 +1,5 @@
 // The CANopen frame decoder (canopen/monitor/decoder.hpp): each kind of frame, SDO transfers followed
-// across segments (against a real node where it can answer), aborts, PDO maps from a description and
+// across segments and blocks (against a real node where it can answer), aborts, PDO maps from a description and
 // learnt from the SDO traffic, and a bus that sends nonsense. Expected texts are CiA 301's and
 // CiA 402's terms, written out here.
 #include <gtest/gtest.h>
@@ -198,6 +198,54 @@ TEST_F(monitor_on_a_node, a_segmented_download_is_followed_to_the_nodes_confirma
   EXPECT_EQ(all[6].text, "SDO download 0x2000:0 = \"hello, segments\" (Device label), 15 bytes, the last segment");
   EXPECT_EQ(all[7].event, "download-done");
   EXPECT_EQ(all[7].text, "SDO download 0x2000:0 done, 15 bytes");
+}
+
+// A block transfer is followed like a segmented one: each block's segments in order, a segment
+// sent again after a short acknowledge counted once, the value once the end says what was data. A
+// last segment's first byte (0x81..0x9F) is no abort.
+TEST_F(monitor_on_a_node, block_transfers_are_followed_to_the_whole_value) {
+  (void)decoded();
+  // Block upload of 0x1008 (20 bytes) in blocks of 2, CRC offered: 2 segments, acknowledge, 1, end.
+  for (const frame& f : {bytes8(0x600 + id, {0xA4, 0x08, 0x10, 0x00, 2, 0}), bytes8(0x600 + id, {0xA3}),
+                         bytes8(0x600 + id, {0xA2, 2, 2}), bytes8(0x600 + id, {0xA2, 1, 2}),
+                         bytes8(0x600 + id, {0xA1})}) {
+    net.send(f);
+    net.settle();
+  }
+  std::vector<decoded_frame> all = decoded();
+  std::vector<std::string> texts;
+  for (const auto& d : all) texts.push_back(d.text);
+  ASSERT_EQ(all.size(), 10u) << testing::PrintToString(texts);
+  EXPECT_EQ(all[0].text, "SDO block upload request 0x1008:0 (Manufacturer device name), blocks of 2 segments, CRC offered");
+  EXPECT_EQ(all[1].text, "SDO block upload 0x1008:0 (Manufacturer device name), 20 bytes in blocks, CRC offered");
+  EXPECT_EQ(all[3].text, "SDO block upload 0x1008:0 segment 1");
+  EXPECT_EQ(all[6].text, "SDO block upload 0x1008:0 segment 1, the last") << "0x81 is a segment here, not an abort";
+  EXPECT_EQ(all[8].event, "upload");
+  EXPECT_EQ(all[8].text.rfind("SDO block upload 0x1008:0 = \"cia402 virtual drive\" (Manufacturer device name), 20 bytes, CRC 0x", 0), 0u)
+      << all[8].text;
+  EXPECT_EQ(all[9].text, "SDO block upload 0x1008:0 done");
+  // Block download of 15 bytes to 0x2000, its second segment lost once: 1 and 3 go, the
+  // acknowledge says 1, then 2 and 3 again as segments 1 and 2 of the next block.
+  const std::string text = "hello, blocks!!";
+  const auto seg = [&](std::uint8_t sequence, std::size_t at, bool last) {
+    frame f = bytes8(0x600 + id, {static_cast<std::uint8_t>(sequence | (last ? 0x80 : 0))});
+    for (std::size_t k = 0; k < 7 && at + k < text.size(); ++k) f.data[1 + k] = static_cast<std::uint8_t>(text[at + k]);
+    return f;
+  };
+  for (const frame& f : {bytes8(0x600 + id, {0xC2, 0x00, 0x20, 0x00, 15}), seg(1, 0, false), seg(3, 14, true),
+                         seg(1, 7, false), seg(2, 14, true), bytes8(0x600 + id, {0xC1 | (6 << 2)})}) {
+    net.send(f);
+    net.settle();
+  }
+  all = decoded();
+  texts.clear();
+  for (const auto& d : all) texts.push_back(d.text);
+  ASSERT_EQ(all.size(), 10u) << testing::PrintToString(texts);
+  EXPECT_EQ(all[0].text, "SDO block download 0x2000:0 (Device label), 15 bytes");
+  EXPECT_EQ(all[3].text, "SDO block download 0x2000:0 segment 3, the last (out of sequence: sent again)");
+  EXPECT_EQ(all[4].text, "SDO block download 0x2000:0 block acknowledged at segment 1, next block 127 segments");
+  EXPECT_EQ(all[9].event, "download-done");
+  EXPECT_EQ(all[9].text, "SDO block download 0x2000:0 = \"hello, blocks!!\" (Device label), 15 bytes, done");
 }
 
 TEST_F(monitor_on_a_node, a_refused_write_is_an_abort_with_the_nodes_code) {

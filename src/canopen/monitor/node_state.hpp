@@ -37,6 +37,15 @@ struct sdo_follow {
     download_last_sent,   ///< last segment sent, the server's answer pending
     upload_requested,
     upload_segments,
+    block_download_requested,  ///< block download announced, the server's answer pending
+    block_download_segments,   ///< the client's segments going, block by block
+    block_download_acknowledged,  ///< the last segment acknowledged, the client's end pending
+    block_download_ending,      ///< the client's end sent, the server's answer pending
+    block_upload_requested,    ///< block upload asked for, the server's answer pending
+    block_upload_answered,     ///< the size announced, the client's start pending
+    block_upload_segments,     ///< the server's segments going, block by block
+    block_upload_acknowledged,  ///< the last segment acknowledged, the server's end pending
+    block_upload_ending,       ///< the server's end sent, the client's answer pending
   };
   phase at = phase::idle;
   std::uint16_t index = 0;
@@ -46,7 +55,13 @@ struct sdo_follow {
   bool size_indicated = false;
   std::size_t size = 0;
   std::uint8_t toggle = 0;         ///< the toggle bit the next segment should carry
+  std::uint8_t sequence = 0;       ///< block transfer: the last segment of this block in order
+  std::size_t block_start = 0;     ///< block transfer: bytes moved before this block
+  bool last_in_order = false;      ///< block transfer: the last segment came, all before it too
   void restart(phase p, std::uint16_t i, std::uint8_t s) {
+    sequence = 0;
+    block_start = 0;
+    last_in_order = false;
     at = p;
     index = i;
     sub = s;
@@ -61,6 +76,20 @@ struct sdo_follow {
       if (data.size() < max_kept_bytes) data.push_back(b);
     }
     total += bytes.size();
+  }
+  /// Block transfer: what the acknowledge of segment `acknowledged` says was moved; the rest of the
+  /// block is sent again.
+  void keep_acknowledged(std::uint8_t acknowledged) {
+    if (acknowledged < sequence) last_in_order = false;  // the last is sent again too
+    total = std::min(total, block_start + std::size_t{acknowledged} * 7);
+    if (data.size() > total) data.resize(total);
+    block_start = total;
+    sequence = 0;
+  }
+  /// Block transfer: the end says the last segment carried `unused` bytes that are no data.
+  void drop_unused(std::size_t unused) {
+    total -= std::min(total, unused);
+    if (data.size() > total) data.resize(total);
   }
 };
 

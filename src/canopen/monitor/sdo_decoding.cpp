@@ -1,6 +1,6 @@
 // SDO (CiA 301 §7.2.4.3): each frame of the default server channel, and the node's transfer
-// followed across them, so a segment is named by its object and the value of a segmented
-// transfer shows once its last segment went. What a server confirmed (a download) or reported (an
+// followed across them, so a segment is named by its object and the value of a segmented or block
+// transfer shows once its last segment (a block transfer: its end) went. What a server confirmed (a download) or reported (an
 // upload) is handed to the PDO maps.
 #include "cia402/sdo_abort.hpp"
 #include "cia402/sdo_command.hpp"
@@ -95,11 +95,37 @@ class sdo_step {
     d_.event.clear();
     d_.text = std::string("SDO ") + side + " with command specifier 7, none of CiA 301's";
   }
-  void block(const char* side) {
-    t_.restart(phase::idle, 0, 0);
-    d_.event = "block";
-    d_.text = std::string("SDO block ") + side + " (block transfers are not decoded)";
+  // Block transfer (§7.2.4.3.9..17), followed like a segmented one: the segments of each block in
+  // order, what each acknowledge says arrived, the value once the end says how much was data.
+  void block_segment(const char* direction) {
+    const std::uint8_t sequence = s_.d[0] & 0x7F;
+    const bool last = (s_.d[0] & 0x80) != 0;
+    object(t_.index, t_.sub);
+    d_.event = std::string("block-") + direction + "-segment";
+    const bool in_order = sequence == t_.sequence + 1;
+    if (in_order) {
+      t_.sequence = sequence;
+      t_.append({s_.d + 1, 7});
+      t_.last_in_order = last;
+    }
+    d_.text = std::string("SDO block ") + direction + " " + object_ref(t_.index, t_.sub) + " segment " +
+              std::to_string(sequence) + (last ? ", the last" : "") + (in_order ? "" : " (out of sequence: sent again)");
   }
+  void block_acknowledge(const char* direction) {
+    object(t_.index, t_.sub);
+    d_.event = std::string("block-") + direction + "-acknowledge";
+    const std::uint8_t acknowledged = s_.d[1];
+    const bool short_block = acknowledged < t_.sequence;
+    t_.keep_acknowledged(acknowledged);
+    if (t_.last_in_order) {
+      t_.at = std::string(direction) == "upload" ? phase::block_upload_acknowledged : phase::block_download_acknowledged;
+    }
+    d_.text = std::string("SDO block ") + direction + " " + object_ref(t_.index, t_.sub) + " block acknowledged at segment " +
+              std::to_string(acknowledged) + (short_block ? " (the rest sent again)" : "") + ", next block " +
+              std::to_string(s_.d[2]) + " segments";
+  }
+  void block_request();
+  void block_response();
 
   decoded_frame& d_;
   decoder::node_state& n_;
@@ -109,7 +135,131 @@ class sdo_step {
   sdo_frame s_;
 };
 
+void sdo_step::block_request() {
+  object(s_.index(), s_.sub());
+  if (s_.cs() == ccs_block_download && (s_.d[0] & 0x01) == 0) {  // 110 00 cc s 0: initiate
+    t_.restart(phase::block_download_requested, s_.index(), s_.sub());
+    t_.size_indicated = (s_.d[0] & 0x02) != 0;
+    t_.size = t_.size_indicated ? static_cast<std::size_t>(get_le(s_.d + 4, 4)) : 0;
+    d_.event = "block-download-start";
+    d_.text = "SDO block download " + named(s_.index(), s_.sub()) + ", " + announced_size() +
+              ((s_.d[0] & 0x04) ? ", CRC offered" : "");
+    return;
+  }
+  if (s_.cs() == ccs_block_download) {  // 110 n 0 1: end
+    d_.event = "block-download-end";
+    if (t_.at != phase::block_download_acknowledged) {
+      d_.text = "SDO block download end, with no block download acknowledged to its last segment";
+      return;
+    }
+    object(t_.index, t_.sub);
+    t_.drop_unused((s_.d[0] >> 2) & 0x07);
+    t_.at = phase::block_download_ending;
+    d_.text = "SDO block download " + object_ref(t_.index, t_.sub) + " end, CRC " + hex(get_le(s_.d + 1, 2), 4);
+    return;
+  }
+  switch (s_.d[0] & 0x03) {  // block upload: 101 00 cc cs
+    case 0:
+      t_.restart(phase::block_upload_requested, s_.index(), s_.sub());
+      d_.event = "block-upload-request";
+      d_.text = "SDO block upload request " + named(s_.index(), s_.sub()) + ", blocks of " + std::to_string(s_.d[4]) +
+                " segments" + (s_.d[5] ? ", ordinary up to " + size_text(s_.d[5]) : "") + ((s_.d[0] & 0x04) ? ", CRC offered" : "");
+      return;
+    case 3:
+      d_.event = "block-upload-start";
+      if (t_.at != phase::block_upload_answered) {
+        d_.text = "SDO block upload start, with no block upload open";
+        return;
+      }
+      object(t_.index, t_.sub);
+      t_.at = phase::block_upload_segments;
+      d_.text = "SDO block upload " + object_ref(t_.index, t_.sub) + " start";
+      return;
+    case 2:
+      if (t_.at != phase::block_upload_segments) {
+        d_.event = "block-upload-acknowledge";
+        d_.text = "SDO block upload acknowledge, with no block upload open";
+        return;
+      }
+      return block_acknowledge("upload");
+    default:  // 1: the client's end response
+      d_.event = "block-upload-done";
+      if (t_.at != phase::block_upload_ending) {
+        d_.text = "SDO block upload end response, with no block upload ending";
+        return;
+      }
+      object(t_.index, t_.sub);
+      d_.text = "SDO block upload " + object_ref(t_.index, t_.sub) + " done";
+      t_.restart(phase::idle, 0, 0);
+      return;
+  }
+}
+
+void sdo_step::block_response() {
+  if (s_.cs() == scs_block_download) {  // 101 00 sc ss
+    switch (s_.d[0] & 0x03) {
+      case 0:
+        d_.event = "block-download-start";
+        if (t_.at != phase::block_download_requested) {
+          d_.text = "SDO block download accepted, with no block download seen";
+          return;
+        }
+        object(t_.index, t_.sub);
+        t_.at = phase::block_download_segments;
+        d_.text = "SDO block download " + object_ref(t_.index, t_.sub) + " accepted, blocks of " +
+                  std::to_string(s_.d[4]) + " segments" + ((s_.d[0] & 0x04) ? ", CRC offered" : "");
+        return;
+      case 2:
+        if (t_.at != phase::block_download_segments) {
+          d_.event = "block-download-acknowledge";
+          d_.text = "SDO block download acknowledge, with no block download open";
+          return;
+        }
+        return block_acknowledge("download");
+      default:
+        d_.event = "download-done";
+        if (t_.at != phase::block_download_ending) {
+          d_.text = "SDO block download done, with no block download seen";
+          return;
+        }
+        object(t_.index, t_.sub);
+        learn_transfer();
+        d_.text = "SDO block download " + whole("download").substr(std::string("SDO download ").size()) + ", done";
+        t_.restart(phase::idle, 0, 0);
+        return;
+    }
+  }
+  // Block upload: 110 00 sc s 0 (the size) or 110 n 0 1 (the end).
+  object(s_.index(), s_.sub());
+  if ((s_.d[0] & 0x01) == 0) {
+    d_.event = "block-upload-answer";
+    if (t_.at != phase::block_upload_requested) {
+      d_.text = "SDO block upload answer, with no block upload asked for";
+      return;
+    }
+    t_.size_indicated = (s_.d[0] & 0x02) != 0;
+    t_.size = t_.size_indicated ? static_cast<std::size_t>(get_le(s_.d + 4, 4)) : 0;
+    t_.at = phase::block_upload_answered;
+    d_.text = "SDO block upload " + named(t_.index, t_.sub) + ", " + announced_size() + " in blocks" +
+              ((s_.d[0] & 0x04) ? ", CRC offered" : "");
+    return;
+  }
+  d_.event = "upload";
+  if (t_.at != phase::block_upload_acknowledged) {
+    d_.text = "SDO block upload end, with no block upload acknowledged to its last segment";
+    return;
+  }
+  object(t_.index, t_.sub);
+  t_.drop_unused((s_.d[0] >> 2) & 0x07);
+  learn_transfer();
+  d_.text = "SDO block " + whole("upload").substr(std::string("SDO ").size()) + ", CRC " + hex(get_le(s_.d + 1, 2), 4);
+  t_.at = phase::block_upload_ending;
+}
+
 void sdo_step::request() {
+  // Inside a block download the client's first byte is a sequence number (a last segment's looks
+  // like an abort's command specifier); only 0x80 is the abort.
+  if (t_.at == phase::block_download_segments && s_.d[0] != 0x80) return block_segment("download");
   switch (s_.cs()) {
     case ccs_initiate_download:
       object(s_.index(), s_.sub());
@@ -150,14 +300,13 @@ void sdo_step::request() {
       return;
     case cs_abort: return abort(" (by the client)");
     case ccs_block_upload:
-    case ccs_block_download:
-      object(s_.index(), s_.sub());
-      return block(s_.cs() == ccs_block_upload ? "upload request" : "download request");
+    case ccs_block_download: return block_request();
     default: return unknown_specifier("request");
   }
 }
 
 void sdo_step::response() {
+  if (t_.at == phase::block_upload_segments && s_.d[0] != 0x80) return block_segment("upload");
   switch (s_.cs()) {
     case scs_initiate_download: {
       object(s_.index(), s_.sub());
@@ -219,8 +368,7 @@ void sdo_step::response() {
       return;
     case cs_abort: return abort("");
     case scs_block_download:
-    case scs_block_upload:
-      return block(s_.cs() == scs_block_upload ? "upload response" : "download response");
+    case scs_block_upload: return block_response();
     default: return unknown_specifier("response");
   }
 }
