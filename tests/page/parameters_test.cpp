@@ -217,6 +217,8 @@ TEST(parameter_entries, a_nodes_dictionary_gives_its_communication_objects_with_
   const parameter_entry* tpdo1 = find(0x1800, 1);
   ASSERT_NE(tpdo1, nullptr);
   EXPECT_EQ(tpdo1->default_number.value_or(0) & 0x7FF, 0x180 + 5);
+  EXPECT_NE(find(0x1022, 0), nullptr);
+  EXPECT_EQ(find(0x1021, 0), nullptr) << "the stored EDS is a file of its own, not a parameter to read into the list";
 }
 
 // A drive's text is a peer's: a line break in it stays inside its value in the file and cannot add

@@ -148,6 +148,7 @@ std::vector<page::parameter_entry> parameter_entries(const std::vector<dictionar
                                                      int node_id) {
   std::vector<page::parameter_entry> out;
   for (const dictionary::object_entry& o : objects) {
+    if (o.index == 0x1021) continue;  // the EDS itself (store EDS): a file of 30 KiB, not a parameter
     for (const dictionary::sub_entry& s : o.subs) {
       page::parameter_entry e;
       e.index = o.index;

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "cia402/canopen/301/slave.hpp"
 #include "cia402/canopen/can/channel.hpp"
@@ -21,19 +22,22 @@
 namespace cia402::apps {
 
 /// A node configuration serving the virtual drive's objects (drive402::drive_objects(), serial number
-/// = node-ID) with CiA 402's predefined PDO set (cia402::pdo_maps::can_rpdo / can_tpdo).
+/// = node-ID) with CiA 402's predefined PDO set (cia402::pdo_maps::can_rpdo / can_tpdo), and 0x1021 /
+/// 0x1022 (its EDS stored in the node; virtual_drive_node fills 0x1021).
 canopen::slave_config drive_node_config(std::uint8_t node_id, std::uint32_t sdo_timeout_us = 1000000,
                                         std::uint16_t heartbeat_ms = 0);
 
 class virtual_drive_node {
  public:
-  /// The profile must outlive the node. `config` defaults to drive_node_config(node ID 1).
+  /// The profile must outlive the node. `config` defaults to drive_node_config(node ID 1). With
+  /// config.store_eds and no eds_text of its own, 0x1021 gives the EDS `cia402 eds --node N` writes
+  /// for it (of a node of this profile and configuration as it powers up), made when first read.
   virtual_drive_node(const profile& p, std::unique_ptr<canopen::channel> ch,
                      const canopen::slave_config& config = drive_node_config(1),
                      const sim::plant_config& plant = {})
       : device_(std::make_unique<drive402::sim_device>(p, plant)),
         channel_(std::move(ch)),
-        node_(std::make_unique<canopen::slave>(*device_, *channel_, config)) {}
+        node_(std::make_unique<canopen::slave>(*device_, *channel_, with_stored_eds(p, config, plant))) {}
 
   /// Every frame waiting on the node's channel, then `elapsed_us` of the node's and drive's time.
   std::uint32_t poll(std::uint32_t elapsed_us) { return node_->poll(*channel_, elapsed_us); }
@@ -43,7 +47,13 @@ class virtual_drive_node {
   sim::virtual_drive& drive() noexcept { return device_->drive(); }
   canopen::channel& bus_channel() noexcept { return *channel_; }
 
+  /// The EDS of a freshly powered-up node of profile `p` and configuration `config` (as `cia402 eds`
+  /// writes it, for config.node_id).
+  static std::string powered_up_eds(const profile& p, const canopen::slave_config& config, const sim::plant_config& plant);
+
  private:
+  static canopen::slave_config with_stored_eds(const profile& p, canopen::slave_config config, const sim::plant_config& plant);
+
   // Declared in this order so the node, which refers to both, goes first.
   std::unique_ptr<drive402::sim_device> device_;
   std::unique_ptr<canopen::channel> channel_;

@@ -62,6 +62,10 @@ std::vector<dictionary::object_entry> communication_objects(const slave_config& 
                     {variable(0, "Highest sub-index supported", data_type::unsigned8, dictionary::access::ro, 2),
                      plus_node_id(variable(1, "COB-ID client to server", data_type::unsigned32, dictionary::access::ro, cob::sdo_rx)),
                      plus_node_id(variable(2, "COB-ID server to client", data_type::unsigned32, dictionary::access::ro, cob::sdo_tx))}));
+  if (c.store_eds) {
+    t.push_back(single(0x1021, optional, text(0, "Store EDS", dictionary::access::ro, "", 0)));
+    t.push_back(single(0x1022, optional, variable(0, "Store format", data_type::unsigned8, dictionary::access::ro, 0)));
+  }
   add_pdos(t, c);
   return t;
 }

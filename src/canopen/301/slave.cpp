@@ -146,6 +146,15 @@ void slave::configure_consumer() {
   consumer_.configure(entries);
 }
 
+sdo_abort slave::upload(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t>& data) noexcept {
+  if (index == 0x1021 && sub == 0 && config_.store_eds && config_.eds_text) {
+    if (eds_.empty()) eds_ = config_.eds_text();
+    data.assign(eds_.begin(), eds_.end());
+    return sdo_abort::none;
+  }
+  return dictionary::dictionary_access::upload(index, sub, data);
+}
+
 sdo_abort slave::read_value(const dictionary::object_dictionary::slot& s, std::int64_t& v) {
   if (s.entry->where == dictionary::backing::device) {
     const sdo_abort a = device_->read(s.object->index, s.entry->sub, v);

@@ -44,6 +44,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -79,6 +80,12 @@ struct slave_config {
   /// event timer (a CiA 402 drive's: cia402::pdo_maps). A PDO with no entries starts invalid.
   std::array<pdo_map, pdo_count> rpdo{};
   std::array<pdo_map, pdo_count> tpdo{};
+  /// 0x1021 store EDS and 0x1022 storage format (CiA 301 §7.5.2.36-37), which a master reads to build
+  /// the node's dictionary from the node itself (python-canopen's import_from_node): `store_eds`
+  /// puts both in the table; `eds_text` is what 0x1021 gives, made once, when it is first read (the
+  /// layer above writes EDS files; this CiA 301 node does not). 0x1022 reads 0: ASCII.
+  bool store_eds = false;
+  std::function<std::string()> eds_text;
 };
 
 /// The communication objects the node serves itself, beside the services that use them (CiA 301
@@ -160,6 +167,8 @@ class slave final : private dictionary::dictionary_access, private dictionary::d
   bool cob_id_taken(std::uint32_t id, std::uint16_t writing) const;
   sdo_abort write_pdo_parameter(dictionary::object_dictionary::slot& s, std::int64_t v);
   sdo_abort read_value(const dictionary::object_dictionary::slot& s, std::int64_t& v) override;
+  // 0x1021 from eds_text, made once; every other object as the dictionary has it.
+  sdo_abort upload(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t>& data) noexcept override;
   sdo_abort check_mapping_entry(bool receive, std::uint32_t entry) const;
   void resolve_pdos();
   pdo_config resolve(std::uint16_t comm, std::uint16_t mapping);
@@ -194,6 +203,7 @@ class slave final : private dictionary::dictionary_access, private dictionary::d
   bool heartbeat_error_ = false;
   bool pdo_length_error_ = false;
   bool any_error_reported_ = false;    // an EMCY other than 0x0000 went out since the last reset one
+  std::string eds_;                    // 0x1021 once read
 };
 
 }  // namespace cia402::canopen
