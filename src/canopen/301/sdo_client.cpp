@@ -26,14 +26,18 @@ void sdo_client::fail(sdo_abort code, bool tell_server) {
   step_ = step::none;
 }
 
-bool sdo_client::start_upload(std::uint16_t index, std::uint8_t sub) {
-  if (status_ == status::busy) return false;
+void sdo_client::begin(std::uint16_t index, std::uint8_t sub, step first) noexcept {
   index_ = index;
   sub_ = sub;
   abort_ = sdo_abort::none;
-  data_.clear();
   status_ = status::busy;
-  step_ = step::upload_initiate;
+  step_ = first;
+}
+
+bool sdo_client::start_upload(std::uint16_t index, std::uint8_t sub) {
+  if (status_ == status::busy) return false;
+  begin(index, sub, step::upload_initiate);
+  data_.clear();
   const std::uint8_t b[8] = {ccs_initiate_upload << 5, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8),
                              sub, 0, 0, 0, 0};
   send(b);
@@ -43,12 +47,8 @@ bool sdo_client::start_upload(std::uint16_t index, std::uint8_t sub) {
 bool sdo_client::start_download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> data,
                                 bool segmented) {
   if (status_ == status::busy) return false;
-  index_ = index;
-  sub_ = sub;
-  abort_ = sdo_abort::none;
+  begin(index, sub, step::download_initiate);
   data_ = std::move(data);
-  status_ = status::busy;
-  step_ = step::download_initiate;
   std::uint8_t b[8] = {0, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8), sub,
                        0, 0, 0, 0};
   if (!segmented && !data_.empty() && data_.size() <= 4) {

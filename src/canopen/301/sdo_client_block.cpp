@@ -19,12 +19,8 @@ constexpr std::size_t segment_bytes = 7;
 bool sdo_client::start_block_upload(std::uint16_t index, std::uint8_t sub, std::uint8_t switch_threshold) {
   if (no_blocks_) return start_upload(index, sub);
   if (status_ == status::busy) return false;
-  index_ = index;
-  sub_ = sub;
-  abort_ = sdo_abort::none;
+  begin(index, sub, step::block_upload_initiate);
   data_.clear();
-  status_ = status::busy;
-  step_ = step::block_upload_initiate;
   // 101 00 cc=1 00: the CRC asked for; the block size; the protocol switch threshold.
   const std::uint8_t b[8] = {0xA4, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8), sub,
                              max_block_size, switch_threshold, 0, 0};
@@ -35,12 +31,8 @@ bool sdo_client::start_block_upload(std::uint16_t index, std::uint8_t sub, std::
 bool sdo_client::start_block_download(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t> data) {
   if (no_blocks_) return start_download(index, sub, std::move(data), true);
   if (status_ == status::busy) return false;
-  index_ = index;
-  sub_ = sub;
-  abort_ = sdo_abort::none;
+  begin(index, sub, step::block_download_initiate);
   data_ = std::move(data);
-  status_ = status::busy;
-  step_ = step::block_download_initiate;
   // 110 00 cc=1 s=1 0, the size.
   std::uint8_t b[8] = {0xC6, static_cast<std::uint8_t>(index), static_cast<std::uint8_t>(index >> 8), sub, 0, 0, 0, 0};
   put_le(b + 4, data_.size(), 4);

@@ -65,6 +65,8 @@ class sdo_client {
                                    download_segment, block_upload_initiate, block_upload_segments,
                                    block_upload_end, block_download_initiate, block_download_acknowledge,
                                    block_download_end };
+  // A transfer of index:sub under way from `first` on.
+  void begin(std::uint16_t index, std::uint8_t sub, step first) noexcept;
   void send(const std::uint8_t (&bytes)[8]);
   void fail(sdo_abort code, bool tell_server);
   void send_next_segment();
