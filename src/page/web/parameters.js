@@ -60,9 +60,12 @@ function writeCell(row, e) {
   row.append(td);
 }
 
+// The abort once: the server's reason already names it ("WRITE ...: SDO abort 0x06090030 (...)"),
+// and is given it alone where it does not.
 function refusalText(key, reply) {
-  const abort = reply.abort ? ` (${reply.abort}: ${reply.abort_text})` : '';
-  return `${key}: refused: ${reply.error || 'no reason given'}${abort}`;
+  const reason = reply.error || 'no reason given';
+  const abort = reply.abort && !reason.includes(reply.abort) ? ` (SDO abort ${reply.abort}: ${reply.abort_text})` : '';
+  return `${key}: refused: ${reason}${abort}`;
 }
 
 function showOutcome(text, outcome) {

@@ -85,6 +85,8 @@ async function checks(context, name, server) {
       null, { timeout: patience });
     const text = await page.textContent('#param-outcome');
     expect(text.includes('invalid value for parameter'), `outcome: ${text}`);
+    expect(text.split('0x06090030').length === 2 && text.split('invalid value for parameter').length === 2,
+      `the abort printed once: ${text}`);
   });
   await check(`${name}: a parameter set saved, changed and loaded back gives the same values and lists the refused`, async () => {
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#param-save')]);
