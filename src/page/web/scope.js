@@ -3,7 +3,7 @@
 // fraction; two cursors and their difference; export of the view as CSV and PNG; and the spans the
 // page missed, shown rather than hidden.
 import { el, page, serverNow, stateLabel } from './page.js';
-import { DRAWN_CYCLES, catalogue, edges, series, store, valueAt } from './scope_data.js';
+import { DRAWN_CYCLES, catalogue, edges, levelSignals, series, store, valueAt } from './scope_data.js';
 import { COLOURS, DASHES, drawScope, formatSpan } from './scope_draw.js';
 import { acquisition } from './scope_trigger.js';
 
@@ -110,9 +110,7 @@ function buildTrigger() {
   for (const n of numbers) option(el('trig-transition'), n, `transition ${n}`);
   for (const s of info.states.filter((x) => x !== 'START')) option(el('trig-state'), s, stateLabel(s));
   for (const sig of scope.signals.filter((s) => s.kind === 'bit')) option(el('trig-bit'), sig.key, sig.label);
-  for (const sig of scope.signals.filter((s) => s.kind === 'analog' || s.kind === 'step')) {
-    option(el('trig-signal'), sig.key, sig.label);
-  }
+  for (const sig of levelSignals(scope.signals)) option(el('trig-signal'), sig.key, sig.label);
   const showFields = () => {
     const type = el('trig-type').value;
     el('trig-transition').hidden = type !== 'transition';

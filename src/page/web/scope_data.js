@@ -165,6 +165,26 @@ export function catalogue() {
   return list;
 }
 
+/**
+ * The signals a level trigger offers: one entry per object. Where two signals show one object
+ * (0x60FF as "target velocity" and as the set-point of the velocity modes), the object itself is
+ * kept, not the view of it a mode gates.
+ */
+export function levelSignals(signals) {
+  const objectOf = (s) => (s.label.match(/0x[0-9A-F]{4}/) || [null])[0];
+  const analog = signals.filter((s) => s.kind === 'analog' || s.kind === 'step');
+  const taken = new Set(analog.filter((s) => !s.part).map(objectOf).filter((o) => o !== null));
+  const seen = new Set();
+  return analog.filter((s) => {
+    const o = objectOf(s);
+    if (o === null) return true;
+    if (s.part && taken.has(o)) return false;
+    if (seen.has(o)) return false;
+    seen.add(o);
+    return true;
+  });
+}
+
 const usable = (v) => v !== undefined && v !== null;
 
 /**

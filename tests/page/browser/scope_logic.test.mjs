@@ -208,6 +208,21 @@ try {
     expect(drawnPulse.every((p, i) => i === 0 || p.t > drawnPulse[i - 1].t), 'in time order');
     expect(data.series(signal('v'), t0, t1).length === n, 'the export has every cycle');
   });
+  check('the level trigger lists each object once', () => {
+    const saved = page.info.objects;
+    page.info.objects = [{ index: '0x607A', name: 'target position' }, { index: '0x6081', name: 'profile velocity' },
+      { index: '0x6064', name: 'position actual value' }];
+    const levels = data.levelSignals(data.catalogue());
+    page.info.objects = saved;
+    const objects = levels.map((s) => (s.label.match(/0x[0-9A-F]{4}/) || [null])[0]).filter((o) => o !== null);
+    expect(objects.length === new Set(objects).size, `an object twice: ${objects.join(' ')}`);
+    expect(levels.some((s) => s.key === 'tv') && !levels.some((s) => s.key === 'sp_vel'),
+      '0x60FF as the object, not its set-point view');
+    expect(levels.some((s) => s.key === 'pos') && !levels.some((s) => s.key === 'obj0x6064'), '0x6064 once');
+    expect(levels.some((s) => s.key === 'obj0x6081') && levels.some((s) => s.key === 'sp_pos'),
+      'the others kept');
+    expect(!levels.some((s) => s.kind === 'bit' || s.kind === 'state'), 'levels only');
+  });
   console.log(`# ${passed} scope logic checks passed`);
 } catch (e) {
   console.error(`not ok ${passed + 1} - scope logic: ${e.message}`);
