@@ -45,8 +45,12 @@ void axis_page::impl::keep_views_read() {
         if (const auto v = integer_of(r); r.ok() && v) (sub == 1 ? switch_speed_read : zero_speed_read) = *v;
       });
     }
+    // And the mode panel's profile parameters, which no PDO carries and the page shows beside the
+    // set-points (0x6081, 0x6083..0x6085): read once, then the page's own writes keep them.
     for (const std::uint16_t index : {object_index::homing_method, object_index::homing_acceleration,
-                                      object_index::home_offset}) {
+                                      object_index::home_offset, object_index::profile_velocity,
+                                      object_index::profile_acceleration, object_index::profile_deceleration,
+                                      object_index::quick_stop_deceleration}) {
       session->read_object(index, 0, [this, index](const axes::result& r) {
         // A value the page wrote meanwhile stays: it is newer than this read.
         if (const auto v = integer_of(r); r.ok() && v) objects.emplace(index, *v);

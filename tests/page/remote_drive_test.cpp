@@ -24,6 +24,10 @@ TEST(remote_drive, set_up_reads_the_drive_and_shows_switch_on_disabled) {
   EXPECT_EQ(s["objects"]["0x605A"], 2);
   EXPECT_EQ(s["objects"]["0x605E"], 2);
   EXPECT_EQ(s["objects"]["0x6007"], 1);
+  // The mode panel's profile parameters, which no PDO carries, read from the node too.
+  for (const char* index : {"0x6081", "0x6083", "0x6084", "0x6085"}) {
+    EXPECT_TRUE(s["objects"].contains(index) && s["objects"][index].is_number()) << index << " " << s["objects"].dump();
+  }
   EXPECT_TRUE(s["last_transition"].is_null());
   EXPECT_TRUE(b.remote().fault_injection_available());
 }
