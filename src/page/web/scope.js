@@ -246,7 +246,7 @@ export function drawScopeFrame() {
   el('scope-status').dataset.state = scope.acq.stopped ? 'stopped' : (c ? 'triggered' : scope.acq.mode);
   showHealth();
   showLegend(shown, map);
-  showCursors(shown);
+  showCursors(shown, reference, c);
 }
 
 // What the page could not keep up with, said plainly.
@@ -353,14 +353,18 @@ function buildPointer(canvas) {
 
 const fmt = (v) => (v === null || v === undefined ? '–' : typeof v === 'number' ? String(+v.toFixed(3)) : stateLabel(v));
 
-function showCursors(shown) {
+// The cursors' times read as the time axis does, from its time 0 (`reference`: the trigger of the
+// capture shown, else now); their values are read again for each new capture.
+function showCursors(shown, reference, capture) {
   const { a, b } = scope.cursors;
   const cyc = cycleMs();
   const ta = el('cursor-a-time'), tb = el('cursor-b-time'), dt = el('cursor-dt');
-  ta.textContent = a === null ? '–' : `${(a / 1000).toFixed(3)} s`;
-  tb.textContent = b === null ? '–' : `${(b / 1000).toFixed(3)} s`;
+  const relative = (t) => { const s = (t - reference) / 1000; return `${s > 0 ? '+' : ''}${s.toFixed(3)} s`; };
+  ta.textContent = a === null ? '–' : relative(a);
+  tb.textContent = b === null ? '–' : relative(b);
   ta.dataset.ms = a === null ? '' : String(a);
   tb.dataset.ms = b === null ? '' : String(b);
+  ta.dataset.relative = a === null ? '' : String(a - reference);
   if (a !== null && b !== null) {
     const d = b - a;
     dt.textContent = `${formatSpan(d)} = ${+(d / cyc).toFixed(3)} cycles` +
@@ -372,7 +376,8 @@ function showCursors(shown) {
   }
   const body = el('cursor-values');
   const newestCycle = store.cyc.length ? store.cyc[store.cyc.length - 1].n : '';
-  const key = `${a}|${b}|${shown.map((s) => s.key).join(',')}|${store.snaps.length}|${store.rec.length}|${newestCycle}`;
+  const key = `${a}|${b}|${shown.map((s) => s.key).join(',')}|${store.snaps.length}|${store.rec.length}|${newestCycle}|` +
+    `${capture ? capture.t : ''}`;
   if (body.dataset.key === key) return;
   body.dataset.key = key;
   body.textContent = '';

@@ -126,6 +126,11 @@ async function main() {
     const at = await cursorsFromTrigger(page, t4, t3);
     expect(at.a === t4, `cursor A at ${at.a}, T4 at ${t4}`);
     expect(await cursorMs('cursor-b-time') === t3, `cursor B at ${await cursorMs('cursor-b-time')}, T3 at ${t3}`);
+    // Read from the trigger, as the time axis: A on the trigger is 0, B on T3 before it negative.
+    const aText = await page.textContent('#cursor-a-time');
+    const bText = await page.textContent('#cursor-b-time');
+    expect(aText === '0.000 s', `cursor A reads "${aText}" on the trigger`);
+    expect(bText === `${((t3 - t4) / 1000).toFixed(3)} s`, `cursor B reads "${bText}", ${t3 - t4} ms from the trigger`);
     expect(await cursorMs('cursor-dt') === t3 - t4, `Δt ${await cursorMs('cursor-dt')}, the recording says ${t3 - t4}`);
     const cycleMs = await cycleOf(page);
     const text = await page.textContent('#cursor-dt');
