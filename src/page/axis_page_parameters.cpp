@@ -10,6 +10,7 @@
 
 #include "cia402/objects.hpp"
 #include "page_json.hpp"
+#include "page_names.hpp"
 #include "json_text.hpp"
 
 namespace cia402::page {
@@ -161,6 +162,11 @@ document axis_page::parameters() {
            {"pdo_mapping", e.pdo_mappable}, {"writable", writable(e)}};
     j["low"] = e.low ? json(*e.low) : json(nullptr);
     j["high"] = e.high ? json(*e.high) : json(nullptr);
+    // Where a write is a choice (an option code, the mode, the homing method) the values the drive
+    // takes, not the range of its type.
+    if (e.sub == 0) {
+      if (const std::vector<std::int64_t> v = accepted_values(*m.table, e.index); !v.empty()) j["values"] = v;
+    }
     j["default"] = e.default_number ? json(*e.default_number) : f && f->what == axes::value_format::kind::text ? json(e.default_text) : json(nullptr);
     const auto& r = read.results[i];
     if (const auto v = value_of(r, e)) {

@@ -106,25 +106,7 @@ json profile_info(const profile& p) {
 
   json objects = json::array();
   for (const object_name& o : object_names(p)) {
-    json values = json::array();
-    option opt{};
-    if (option_of_index(o.index, opt)) {
-      for (int v = 0; v < 16; ++v) {
-        if (p.spec(opt).allows(v)) values.push_back(v);
-      }
-    }
-    // The modes 0x6502 announces, the homing methods the drive runs: a choice, not a number.
-    if (o.index == object_index::modes_of_operation) {
-      const object_description* supported = find_drive_object(object_index::supported_drive_modes);
-      for (int m = 1; m <= 10 && supported != nullptr; ++m) {
-        if (mode::supported_bit(m) & static_cast<std::uint32_t>(supported->default_value)) values.push_back(m);
-      }
-    }
-    if (o.index == object_index::homing_method) {
-      for (int m = 0; m <= 37; ++m) {
-        if (motion::homing::supports(m)) values.push_back(m);
-      }
-    }
+    const json values = accepted_values(p, o.index);
     json entry = {{"index", hex(o.index, 4)}, {"name", o.name}, {"values", values}};
     // The range the object table allows, so the page refuses an impossible value without a request.
     if (const object_description* d = find_drive_object(o.index)) {

@@ -4,6 +4,7 @@
 #include <string>
 #include <string_view>
 
+#include "cia402/motion/homing.hpp"
 #include "cia402/objects.hpp"
 #include "cia402/sim/virtual_drive.hpp"
 
@@ -43,6 +44,29 @@ std::vector<object_name> object_names(const profile& p) {
     out.push_back({index, std::move(name)});
   }
   return out;
+}
+
+std::vector<std::int64_t> accepted_values(const profile& p, std::uint16_t index) {
+  std::vector<std::int64_t> values;
+  option opt{};
+  if (option_of_index(index, opt)) {
+    for (int v = 0; v < 16; ++v) {
+      if (p.spec(opt).allows(v)) values.push_back(v);
+    }
+  }
+  // The modes 0x6502 announces, the homing methods the drive runs: a choice, not a number.
+  if (index == object_index::modes_of_operation) {
+    const object_description* supported = find_drive_object(object_index::supported_drive_modes);
+    for (int m = 1; m <= 10 && supported != nullptr; ++m) {
+      if (mode::supported_bit(m) & static_cast<std::uint32_t>(supported->default_value)) values.push_back(m);
+    }
+  }
+  if (index == object_index::homing_method) {
+    for (int m = 0; m <= 37; ++m) {
+      if (motion::homing::supports(m)) values.push_back(m);
+    }
+  }
+  return values;
 }
 
 namespace {

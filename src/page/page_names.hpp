@@ -31,6 +31,11 @@ struct object_name {
 /// then the ramps.
 std::vector<object_name> object_names(const profile& p);
 
+/// The values a write of `index` may take where they are a choice, not a range: an option code's
+/// values the profile allows, the modes 0x6502 announces (0x6060), the homing methods the drive
+/// runs (0x6098); empty for any other object.
+std::vector<std::int64_t> accepted_values(const profile& p, std::uint16_t index);
+
 /// The name CiA 402-2 gives an operation mode ("Profile position", ...), "" for any other value.
 const char* mode_title(std::int64_t m) noexcept;
 

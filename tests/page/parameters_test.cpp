@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdio>
 #include <memory>
 #include <regex>
 #include <string>
@@ -56,6 +57,11 @@ class parameters : public ::testing::Test {
     }
     ADD_FAILURE() << key << " is not listed";
     return {};
+  }
+  static std::string hex_key(std::uint16_t index) {
+    char b[16];
+    std::snprintf(b, sizeof b, "0x%04X:0", index);
+    return b;
   }
   httplib::Result write(const std::string& key, const json& value) {
     return client->Post("/api/object", json{{"index", key}, {"value", value}}.dump(), "application/json");
@@ -107,6 +113,30 @@ TEST_F(parameters, every_entry_of_the_object_table_the_drive_has_is_listed_with_
   EXPECT_EQ(speed["unit"], "rpm");
   EXPECT_EQ(speed["value"], speed["default"]);
   EXPECT_EQ(speed["differs"], false);
+}
+
+// Where a write is a choice, the list gives the values the drive takes, not its type's range: each
+// option code's as the profile allows them, the modes 0x6502 announces, the homing methods.
+TEST_F(parameters, a_choice_lists_the_values_the_drive_takes) {
+  const profile& p = cia402::standard_profile();
+  for (int k = 0; k < option_count; ++k) {
+    const auto o = static_cast<option>(k);
+    if (!p.spec(o).exists()) continue;
+    std::vector<std::int64_t> allowed;
+    for (int v = -32768; v <= 32767; ++v) {
+      if (p.spec(o).allows(v)) allowed.push_back(v);
+    }
+    const json e = entry(hex_key(option_index(o)));
+    ASSERT_TRUE(e.contains("values")) << e.dump();
+    EXPECT_EQ(e["values"].get<std::vector<std::int64_t>>(), allowed) << e.dump();
+  }
+  const json modes = entry("0x6060:0");
+  ASSERT_TRUE(modes.contains("values"));
+  const auto supported = static_cast<std::uint32_t>(find_drive_object(object_index::supported_drive_modes)->default_value);
+  for (const std::int64_t m : modes["values"].get<std::vector<std::int64_t>>()) {
+    EXPECT_NE(supported & (1u << (m - 1)), 0u) << "mode " << m << " is announced in 0x6502";
+  }
+  EXPECT_FALSE(entry("0x6099:1").contains("values")) << "a speed is a range";
 }
 
 TEST_F(parameters, a_write_by_index_and_sub_index_changes_the_value_and_marks_it_as_differing) {

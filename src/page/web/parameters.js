@@ -16,7 +16,18 @@ function cell(row, text, cls) {
   return td;
 }
 
+// The values a write may take: the choice where there is one (runs of consecutive values as
+// "0 … 8"), else the range.
 function limits(e) {
+  if (Array.isArray(e.values) && e.values.length) {
+    const runs = [];
+    for (const v of e.values) {
+      const last = runs[runs.length - 1];
+      if (last && v === last[1] + 1) last[1] = v;
+      else runs.push([v, v]);
+    }
+    return runs.map(([a, b]) => (a === b ? `${a}` : b === a + 1 ? `${a}, ${b}` : `${a} … ${b}`)).join(', ');
+  }
   if (e.low === null && e.high === null) return '';
   return `${e.low ?? ''} … ${e.high ?? ''}`;
 }

@@ -55,6 +55,9 @@ async function checks(context, name, server) {
     const cells = await page.$$eval('#param-rows tr[data-key="0x6099:1"] td', (tds) => tds.map((t) => t.textContent));
     expect(cells[1] === 'Speed during search for switch' && cells[2] === 'unsigned32' && cells[3] === 'rpm' &&
       cells[6] === '1000', `0x6099:1 row ${JSON.stringify(cells)}`);
+    // An option code's limits are the values it takes (semantics: 0x605A 0..8), not INT16's range.
+    const quickStop = await page.$$eval('#param-rows tr[data-key="0x605A:0"] td', (tds) => tds.map((t) => t.textContent));
+    expect(quickStop[5] === '0 … 8', `0x605A limits "${quickStop[5]}"`);
   });
   await check(`${name}: search by index or name and the filters narrow the list`, async () => {
     await page.fill('#param-search', '6099');
