@@ -4,7 +4,7 @@
 // drive's refusal shown (the SDO abort code and its text), and the whole set saved to a file and
 // loaded back with what was written, refused and skipped. Every value is the server's: the list is
 // read again after each write.
-import { api, el, send } from './page.js';
+import { api, el, page, send } from './page.js';
 
 const state = { entries: [], loading: false };
 
@@ -30,6 +30,19 @@ function limits(e) {
   }
   if (e.low === null && e.high === null) return '';
   return `${e.low ?? ''} … ${e.high ?? ''}`;
+}
+
+// Words as a commissioning engineer reads them: in hex, and the control and status word with the
+// names of the bits set (the profile's names, from /api/info).
+const HEX_WORDS = ['0x1001', '0x603F', '0x6040', '0x6041', '0x6502', '0x60FD'];
+function valueText(e) {
+  if (typeof e.value !== 'number' || e.sub !== 0 || !HEX_WORDS.includes(e.index)) return e.value;
+  const digits = e.index === '0x6502' || e.index === '0x60FD' ? 8 : e.index === '0x1001' ? 2 : 4;
+  const hex = `0x${(e.value >>> 0).toString(16).toUpperCase().padStart(digits, '0')}`;
+  const names = { '0x6040': page.info && page.info.control_bits, '0x6041': page.info && page.info.status_bits }[e.index];
+  if (!names) return hex;
+  const set = names.filter((b) => (e.value >> b.bit) & 1).map((b) => b.name);
+  return set.length ? `${hex}: ${set.join(', ')}` : hex;
 }
 
 function matches(e) {
@@ -102,7 +115,7 @@ function draw() {
     cell(row, e.access);
     cell(row, limits(e), 'mono');
     cell(row, e.default, 'mono');
-    const v = cell(row, e.error ? e.error : e.value, 'mono param-value');
+    const v = cell(row, e.error ? e.error : valueText(e), 'mono param-value');
     if (e.error) v.classList.add('param-error');
     if (e.differs) v.title = `differs from the default ${e.default}`;
     writeCell(row, e);

@@ -55,6 +55,9 @@ async function checks(context, name, server) {
     const cells = await page.$$eval('#param-rows tr[data-key="0x6099:1"] td', (tds) => tds.map((t) => t.textContent));
     expect(cells[1] === 'Speed during search for switch' && cells[2] === 'unsigned32' && cells[3] === 'rpm' &&
       cells[6] === '1000', `0x6099:1 row ${JSON.stringify(cells)}`);
+    // The status word in hex with its bits named: SWITCH ON DISABLED shows bit 6 by its name.
+    const status = await page.textContent('#param-rows tr[data-key="0x6041:0"] td.param-value');
+    expect(/^0x[0-9A-F]{4}: .*Switch on disabled/.test(status), `0x6041 reads "${status}"`);
     // An option code's limits are the values it takes (semantics: 0x605A 0..8), not INT16's range.
     const quickStop = await page.$$eval('#param-rows tr[data-key="0x605A:0"] td', (tds) => tds.map((t) => t.textContent));
     expect(quickStop[5] === '0 … 8', `0x605A limits "${quickStop[5]}"`);
