@@ -163,7 +163,7 @@ void axis_page::impl::note_error_code(std::uint16_t code) {
   error_shown = code;
   error_field.stale = true;  // the drive's own list 0x1003 changed with it
   if (code == 0) return;
-  errors_seen.push_front({now_us, code});
+  errors_seen.push_front({now_us, code, config.wall_clock_us ? std::optional(config.wall_clock_us()) : std::nullopt});
   if (errors_seen.size() > errors_kept) errors_seen.pop_back();
 }
 
@@ -335,7 +335,8 @@ json axis_page::impl::snapshot(bool with_time) const {
   j["results"] = log.results_json();
   json history = json::array();
   for (const error_seen& e : errors_seen) {
-    history.push_back({{"time_ms", e.time_us / 1000}, {"code", hex(e.code, 4)}, {"text", error_code_text(e.code)}});
+    history.push_back({{"time_ms", e.time_us / 1000}, {"code", hex(e.code, 4)}, {"text", error_code_text(e.code)},
+                       {"unix_ms", e.wall_us ? json(*e.wall_us / 1000) : json(nullptr)}});
   }
   j["error_history"] = std::move(history);
   j["drive_errors"] = drive_errors_json();

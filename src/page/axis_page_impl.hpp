@@ -65,6 +65,7 @@ struct axis_page::impl {
   struct error_seen {
     std::uint64_t time_us = 0;
     std::uint16_t code = 0;
+    std::optional<std::uint64_t> wall_us;  // the time of day, where the page has a clock for it
   };
   std::deque<error_seen> errors_seen;
   std::uint16_t error_shown = 0;

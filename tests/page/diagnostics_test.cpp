@@ -102,6 +102,22 @@ TEST(diagnostics, the_snapshot_lists_each_error_the_drive_showed_newest_first_wi
   EXPECT_GT(h[0]["time_ms"].get<int>(), h[1]["time_ms"].get<int>());
   EXPECT_GT(h[1]["time_ms"].get<int>(), h[2]["time_ms"].get<int>());
   EXPECT_EQ(snapshot(inst)["state"], "SWITCH_ON_DISABLED") << "each fault was reset";
+  EXPECT_TRUE(h[0]["unix_ms"].is_null()) << "no clock of day given: the drive's time alone";
+}
+
+// Given the time of day, each error seen carries it too: when it happened, not only the drive's time.
+TEST(diagnostics, an_error_seen_is_stamped_with_the_time_of_day_the_page_is_given) {
+  std::uint64_t wall_us = 1'764'000'000'000'000;  // a time of day the test sets
+  cia402::page::axis_page_config c;
+  c.wall_clock_us = [&wall_us] { return wall_us; };
+  virtual_axis_page inst(cia402::standard_profile(), c);
+  run(inst, 10);
+  wall_us += 5'000'000;
+  inst.change_plant(fault_of(0x2310));
+  run(inst, 100);
+  const json h = snapshot(inst)["error_history"];
+  ASSERT_EQ(h.size(), 1u) << h;
+  EXPECT_EQ(h[0]["unix_ms"].get<std::uint64_t>(), wall_us / 1000);
 }
 
 }  // namespace

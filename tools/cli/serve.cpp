@@ -10,6 +10,7 @@
 #include <ostream>
 #include <pthread.h>
 
+#include "cia402/apps/elapsed_clock.hpp"
 #include "cia402/apps/ethercat_link.hpp"
 #include "cia402/apps/local_link.hpp"
 #include "cia402/apps/virtual_drive_node.hpp"
@@ -247,6 +248,7 @@ int run_serve(const serve_args& args, std::ostream& out, std::ostream& err) {
   served_drives served;
   page::axis_page_config pc;
   pc.lease_us = static_cast<std::uint64_t>(args.lease_ms) * 1000;
+  pc.wall_clock_us = apps::unix_time_us;
   pc.parameter_file = dcf_parameter_file();
   if (!args.ecat.empty()) {
     if (const int status = open_ecat(args, choice.get(), pc, served, err)) return status;

@@ -153,6 +153,7 @@ function fillObjectValue() {
 
 export function buildPlant() {
   el('fault-class-wrap').hidden = !page.info.error_classes;
+  el('error-history-export').addEventListener('click', exportErrorHistory);
   el('target-form').addEventListener('submit', (e) => {
     e.preventDefault();
     const v = el('target-input').value.trim();
@@ -243,13 +244,33 @@ function setLamp(id, on, text) {
 }
 
 
-// Each error code the drive showed in 0x603F, newest first, with the drive's time it came (the
-// snapshot's error_history); redrawn only when it changed.
+// Each error code the drive showed in 0x603F, newest first, with the drive's time it came and the
+// time of day (the snapshot's error_history); redrawn only when it changed. Export: the list as CSV.
+const wallText = (e) => (e.unix_ms === null || e.unix_ms === undefined ? '' : new Date(e.unix_ms).toISOString());
+let historyShown = [];
 function showErrorHistory(history) {
+  historyShown = history;
   showList('error-history', history, (li, e) => {
-    li.textContent = `${(e.time_ms / 1000).toFixed(3)} s  ${errorText(e)}`;
+    const wall = wallText(e);
+    li.textContent = `${wall ? `${wall}  ` : ''}${(e.time_ms / 1000).toFixed(3)} s  ${errorText(e)}`;
   });
   el('error-history-none').hidden = history.length > 0;
+  el('error-history-export').disabled = history.length === 0;
+}
+
+export function errorHistoryCsv(history) {
+  const quote = (s) => `"${String(s).replace(/"/g, '""')}"`;
+  const lines = ['time of day (UTC),drive time (s),code,text'];
+  for (const e of history) lines.push([wallText(e), (e.time_ms / 1000).toFixed(3), e.code, quote(e.text || '')].join(','));
+  return `${lines.join('\n')}\n`;
+}
+
+function exportErrorHistory() {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(new Blob([errorHistoryCsv(historyShown)], { type: 'text/csv' }));
+  a.download = 'cia402-errors.csv';
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
 }
 
 // The readouts, lamps, switches, set-points and objects of the newest snapshot.

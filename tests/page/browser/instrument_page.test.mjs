@@ -181,7 +181,13 @@ async function main(context) {
     const seen = await page.$$eval('#error-history li', (items) => items.map((li) => li.textContent));
     expect(seen.length === 1 && seen[0].includes('0x2310 continuous over-current'),
       `the errors seen: ${JSON.stringify(seen)}`);
+    const year = new Date().getUTCFullYear();
+    expect(seen[0].startsWith(`${year}-`), `the time of day first: ${seen[0]}`);
     expect(await page.isHidden('#error-history-none'), '"none" shown beside an error');
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#error-history-export')]);
+    const csv = fs.readFileSync(await download.path(), 'utf8').trim().split('\n');
+    expect(csv.length === 2 && csv[0] === 'time of day (UTC),drive time (s),code,text' &&
+      csv[1].startsWith(`${year}-`) && csv[1].includes(',0x2310,"continuous over-current"'), `the export: ${csv}`);
   });
   await page.screenshot({ path: path.join(outDir, 'fault-1280x800.png') });
 

@@ -70,6 +70,9 @@ struct axis_page_config {
   std::vector<parameter_entry> parameters;
   /// The parameter files (CiA 306 DCF from `cia402 serve`); empty: none offered.
   parameter_file_format parameter_file;
+  /// The time of day (microseconds since the Unix epoch) an error seen is stamped with beside the
+  /// drive's time, so the history says when it happened; none: the drive's time alone.
+  std::function<std::uint64_t()> wall_clock_us;
 };
 
 class axis_page : public backend {
