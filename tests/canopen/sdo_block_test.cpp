@@ -1,4 +1,4 @@
-// The SDO server's block transfer (CiA 301 §7.2.4.3.9..17) frame by frame over the in-process bus:
+// The SDO server's block transfer (CiA 301 §7.2.4.3) frame by frame over the in-process bus:
 // block download and upload with the CRC, a segment lost in a block and sent again, blocks of the
 // client's size, the upload's protocol switch threshold, and the abort codes of the block protocol.
 // Commands and abort codes are written out as the standard's numbers, not taken from the code.

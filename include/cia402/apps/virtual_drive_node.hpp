@@ -31,7 +31,8 @@ class virtual_drive_node {
  public:
   /// The profile must outlive the node. `config` defaults to drive_node_config(node ID 1). With
   /// config.store_eds and no eds_text of its own, 0x1021 gives the EDS `cia402 eds --node N` writes
-  /// for it (of a node of this profile and configuration as it powers up), made when first read.
+  /// for it (of a node of this profile and configuration as it powers up; the date aside), made when
+  /// first read.
   virtual_drive_node(const profile& p, std::unique_ptr<canopen::channel> ch,
                      const canopen::slave_config& config = drive_node_config(1),
                      const sim::plant_config& plant = {})

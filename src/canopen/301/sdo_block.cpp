@@ -1,4 +1,4 @@
-// The SDO server's block transfer (CiA 301 §7.2.4.3.9..17): block download and block upload with
+// The SDO server's block transfer (CiA 301 §7.2.4.3): block download and block upload with
 // the CRC, blocks of up to 127 segments of 7 bytes, and the upload's protocol switch threshold.
 // Every command and sequence number the client sends is checked against the state of the transfer;
 // anything else ends it with an abort.
@@ -28,6 +28,22 @@ std::uint16_t sdo_block_crc(std::span<const std::uint8_t> data) noexcept {
     }
   }
   return crc;
+}
+
+bool sdo_block_segment(std::span<const std::uint8_t> data, std::size_t at, std::uint8_t sequence,
+                       std::uint8_t (&out)[8]) noexcept {
+  const std::size_t n = at < data.size() ? std::min(segment_bytes, data.size() - at) : 0;
+  const bool last = at + n >= data.size();
+  std::fill(std::begin(out), std::end(out), std::uint8_t{0});
+  out[0] = static_cast<std::uint8_t>(sequence | (last ? last_segment_flag : 0));
+  std::copy(data.begin() + static_cast<std::ptrdiff_t>(std::min(at, data.size())),
+            data.begin() + static_cast<std::ptrdiff_t>(std::min(at, data.size()) + n), out + 1);
+  return last;
+}
+
+std::uint8_t sdo_block_unused(std::size_t size) noexcept {
+  const std::size_t rest = size % segment_bytes;
+  return static_cast<std::uint8_t>(size == 0 ? segment_bytes : (rest == 0 ? 0 : segment_bytes - rest));
 }
 
 void sdo_server::block_download(const std::uint8_t* d) {
@@ -148,8 +164,7 @@ void sdo_server::block_upload(const std::uint8_t* d) {
       offset_ = std::min(buffer_.size(), block_start_ + std::size_t{acknowledged} * segment_bytes);
       if (acknowledged == sequence_ && last_segment_) {
         // Everything acknowledged: the end, with the bytes of the last segment that carry no data.
-        const std::size_t rest = buffer_.size() % segment_bytes;
-        const std::size_t unused = buffer_.empty() ? segment_bytes : (rest == 0 ? 0 : segment_bytes - rest);
+        const std::size_t unused = sdo_block_unused(buffer_.size());
         std::uint8_t payload[7] = {0, 0, 0, 0, 0, 0, 0};
         put_le(payload, crc_ ? sdo_block_crc(buffer_) : 0u, 2);
         mode_ = mode::block_upload_end;
@@ -172,19 +187,15 @@ void sdo_server::send_upload_block() {
   block_start_ = offset_;
   sequence_ = 0;
   last_segment_ = false;
-  std::size_t at = offset_;
   while (sequence_ < block_size_ && !last_segment_) {
-    const std::size_t n = std::min(segment_bytes, buffer_.size() - at);
-    last_segment_ = at + n == buffer_.size();
-    ++sequence_;
+    std::uint8_t segment[8];
+    const std::size_t at = offset_ + std::size_t{sequence_} * segment_bytes;
+    last_segment_ = sdo_block_segment(buffer_, at, ++sequence_, segment);
     frame f;
     f.id = cob::sdo_tx + node_id_;
     f.len = 8;
-    f.data[0] = static_cast<std::uint8_t>(sequence_ | (last_segment_ ? last_segment_flag : 0));
-    std::copy(buffer_.begin() + static_cast<std::ptrdiff_t>(at), buffer_.begin() + static_cast<std::ptrdiff_t>(at + n),
-              f.data.begin() + 1);
+    std::copy(std::begin(segment), std::end(segment), f.data.begin());
     (void)out_->send(f);
-    at += n;
   }
 }
 

@@ -1,4 +1,4 @@
-// The SDO client's block transfer (CiA 301 §7.2.4.3.9..17): block upload and block download with
+// The SDO client's block transfer (CiA 301 §7.2.4.3): block upload and block download with
 // the CRC. Every frame the server sends is checked against the step of the transfer; a block the
 // client did not get whole is acknowledged at its last segment in order.
 #include <algorithm>
@@ -127,8 +127,7 @@ void sdo_client::on_block_frame(const std::uint8_t* d) {
       offset_ = std::min(data_.size(), block_start_ + std::size_t{d[1]} * segment_bytes);
       block_size_ = d[2];
       if (d[1] == sequence_ && last_segment_) {
-        const std::size_t rest = data_.size() % segment_bytes;
-        const std::size_t unused = data_.empty() ? segment_bytes : (rest == 0 ? 0 : segment_bytes - rest);
+        const std::size_t unused = sdo_block_unused(data_.size());
         std::uint8_t b[8] = {static_cast<std::uint8_t>(0xC1 | (unused << 2)), 0, 0, 0, 0, 0, 0, 0};
         put_le(b + 1, crc_ ? sdo_block_crc(data_) : 0u, 2);
         step_ = step::block_download_end;
@@ -149,15 +148,11 @@ void sdo_client::send_download_block() {
   block_start_ = offset_;
   sequence_ = 0;
   last_segment_ = false;
-  std::size_t at = offset_;
   while (sequence_ < block_size_ && !last_segment_) {
-    const std::size_t n = std::min(segment_bytes, data_.size() - at);
-    last_segment_ = at + n == data_.size();
-    ++sequence_;
-    std::uint8_t b[8] = {static_cast<std::uint8_t>(sequence_ | (last_segment_ ? last_segment_flag : 0)), 0, 0, 0, 0, 0, 0, 0};
-    std::copy(data_.begin() + static_cast<std::ptrdiff_t>(at), data_.begin() + static_cast<std::ptrdiff_t>(at + n), b + 1);
-    send(b);
-    at += n;
+    std::uint8_t segment[8];
+    const std::size_t at = offset_ + std::size_t{sequence_} * segment_bytes;
+    last_segment_ = sdo_block_segment(data_, at, ++sequence_, segment);
+    send(segment);
   }
   step_ = step::block_download_acknowledge;
 }

@@ -95,7 +95,7 @@ class sdo_step {
     d_.event.clear();
     d_.text = std::string("SDO ") + side + " with command specifier 7, none of CiA 301's";
   }
-  // Block transfer (§7.2.4.3.9..17), followed like a segmented one: the segments of each block in
+  // Block transfer, followed like a segmented one: the segments of each block in
   // order, what each acknowledge says arrived, the value once the end says how much was data.
   void block_segment(const char* direction) {
     const std::uint8_t sequence = s_.d[0] & 0x7F;
@@ -111,14 +111,15 @@ class sdo_step {
     d_.text = std::string("SDO block ") + direction + " " + object_ref(t_.index, t_.sub) + " segment " +
               std::to_string(sequence) + (last ? ", the last" : "") + (in_order ? "" : " (out of sequence: sent again)");
   }
-  void block_acknowledge(const char* direction) {
+  // `last_acknowledged`: the phase once the block with the last segment is acknowledged whole.
+  void block_acknowledge(const char* direction, phase last_acknowledged) {
     object(t_.index, t_.sub);
     d_.event = std::string("block-") + direction + "-acknowledge";
     const std::uint8_t acknowledged = s_.d[1];
     const bool short_block = acknowledged < t_.sequence;
     t_.keep_acknowledged(acknowledged);
     if (t_.last_in_order) {
-      t_.at = std::string(direction) == "upload" ? phase::block_upload_acknowledged : phase::block_download_acknowledged;
+      t_.at = last_acknowledged;
     }
     d_.text = std::string("SDO block ") + direction + " " + object_ref(t_.index, t_.sub) + " block acknowledged at segment " +
               std::to_string(acknowledged) + (short_block ? " (the rest sent again)" : "") + ", next block " +
@@ -181,7 +182,7 @@ void sdo_step::block_request() {
         d_.text = "SDO block upload acknowledge, with no block upload open";
         return;
       }
-      return block_acknowledge("upload");
+      return block_acknowledge("upload", phase::block_upload_acknowledged);
     default:  // 1: the client's end response
       d_.event = "block-upload-done";
       if (t_.at != phase::block_upload_ending) {
@@ -215,7 +216,7 @@ void sdo_step::block_response() {
           d_.text = "SDO block download acknowledge, with no block download open";
           return;
         }
-        return block_acknowledge("download");
+        return block_acknowledge("download", phase::block_download_acknowledged);
       default:
         d_.event = "download-done";
         if (t_.at != phase::block_download_ending) {

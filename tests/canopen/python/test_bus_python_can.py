@@ -85,7 +85,7 @@ def test_sdo_segmented_upload_reads_the_device_name(client):
 
 
 def crc16_ccitt(data):
-    """CiA 301 §7.2.4.3.16's block CRC (CRC-16/XMODEM), written out here."""
+    """CiA 301's block CRC (CRC-16/XMODEM), written out here."""
     crc = 0
     for byte in data:
         crc ^= byte << 8

@@ -1,7 +1,7 @@
 // SDO client (CiA 301 §7.2.4): one transfer at a time to one server, expedited, segmented or block,
 // upload or download. Non-blocking: start a transfer, feed it the server's frames, give it time; it
 // ends done or aborted (by the server's abort code, or 0x05040000 when the server stays silent). A
-// block transfer (§7.2.4.3.9..17) asks for the CRC and checks it, acknowledges a block at the last
+// block transfer asks for the CRC and checks it, acknowledges a block at the last
 // segment it got in order (the server sends again from there), and falls back to the ordinary
 // protocol when the server refuses block transfer (0x05040001), which it then does not ask again.
 #pragma once

@@ -1,6 +1,6 @@
 // SDO server (CiA 301 §7.2.4): expedited, segmented and block upload and download over one default
 // SDO channel (requests on 0x600 + node-ID, responses on 0x580 + node-ID). Block transfer
-// (§7.2.4.3.9..17) with the CRC both sides offer, blocks of up to 127 segments, a segment out of
+// with the CRC both sides offer, blocks of up to 127 segments, a segment out of
 // sequence acknowledged at the last one in order (the client sends again from there), and the
 // protocol switch threshold of an upload honoured (a value that short goes expedited or
 // segmented). Every refused request gets an abort frame with the object dictionary's reason, and a
@@ -79,9 +79,16 @@ class sdo_server {
   bool last_segment_ = false;
 };
 
-/// The CRC of a block transfer (CiA 301 §7.2.4.3.16): CRC-16-CCITT, polynomial x^16 + x^12 + x^5 +
+/// The CRC of a block transfer: CRC-16-CCITT, polynomial x^16 + x^12 + x^5 +
 /// 1, initial value 0, no reflection.
 std::uint16_t sdo_block_crc(std::span<const std::uint8_t> data) noexcept;
+/// Segment `sequence` (1..127) of a block that starts its data at byte `at`: the sequence number,
+/// flagged last when the segment holds the value's last byte (a value of no bytes is one empty last
+/// segment), then up to 7 bytes. Both ends send segments this way; true when it is the last.
+bool sdo_block_segment(std::span<const std::uint8_t> data, std::size_t at, std::uint8_t sequence,
+                       std::uint8_t (&out)[8]) noexcept;
+/// The bytes of the last segment that carry no data (n of a block transfer's end).
+std::uint8_t sdo_block_unused(std::size_t size) noexcept;
 
 /// An SDO abort frame: 0x80, index, sub-index, code.
 frame sdo_abort_frame(std::uint32_t cob_id, std::uint16_t index, std::uint8_t sub, sdo_abort code) noexcept;

@@ -80,7 +80,7 @@ struct slave_config {
   /// event timer (a CiA 402 drive's: cia402::pdo_maps). A PDO with no entries starts invalid.
   std::array<pdo_map, pdo_count> rpdo{};
   std::array<pdo_map, pdo_count> tpdo{};
-  /// 0x1021 store EDS and 0x1022 storage format (CiA 301 §7.5.2.36-37), which a master reads to build
+  /// 0x1021 store EDS and 0x1022 storage format, which a master reads to build
   /// the node's dictionary from the node itself (python-canopen's import_from_node): `store_eds`
   /// puts both in the table; `eds_text` is what 0x1021 gives, made once, when it is first read (the
   /// layer above writes EDS files; this CiA 301 node does not). 0x1022 reads 0: ASCII.

@@ -107,7 +107,7 @@ struct ecat_sdo_result {
   std::int64_t value(bool is_signed) const noexcept;
 };
 
-/// An entry as a slave's SDO information describes it (ETG.1000.6 §5.6.3.6): its CiA 301 data type,
+/// An entry as a slave's SDO information describes it (ETG.1000.6 §5.6.3): its CiA 301 data type,
 /// bit length, object access word (bits 0..2 read, 3..5 write in PRE-OP / SAFE-OP / OP, 6 RxPDO, 7
 /// TxPDO mappable) and name.
 struct ecat_entry_description {
@@ -117,7 +117,7 @@ struct ecat_entry_description {
   std::uint16_t access = 0;
   std::string name;
 };
-/// An object as the slave's SDO information describes it (§5.6.3.5), with the entries it has.
+/// An object as the slave's SDO information describes it, with the entries it has.
 struct ecat_object_description {
   std::uint16_t index = 0;
   std::uint16_t data_type = 0;
